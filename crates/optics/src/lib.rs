@@ -1,0 +1,28 @@
+//! # nacre-optics
+//!
+//! Pure physics and colorimetry for nacre, in f64: complex refractive indices and
+//! dispersive materials ([`material`]), Snell's law and Fresnel coefficients for absorbing
+//! media ([`fresnel`]), and multilayer thin-film stacks ([`stack`]).
+//!
+//! This crate does no file or GPU I/O: parsers take the text they are handed.
+//!
+//! ```
+//! use nacre_optics::{Layer, Material, Stack};
+//! // A 400 nm soap film (n = 1.33) in air, at normal incidence and 550 nm.
+//! let air = Material::parse_index("1.0")?;
+//! let water = Material::parse_index("1.33")?;
+//! let stack = Stack::new(air.clone(), vec![Layer { material: water, thickness_nm: 400.0 }], air)?;
+//! let r = stack.evaluate(0.0, 550.0)?.power;
+//! assert!((r.R() + r.T() - 1.0).abs() < 1e-12); // lossless
+//! # Ok::<(), nacre_optics::Error>(())
+//! ```
+
+pub mod error;
+pub mod fresnel;
+pub mod material;
+pub mod stack;
+
+pub use error::{Error, Result};
+pub use material::Material;
+pub use num_complex::Complex64 as C64;
+pub use stack::{Amplitudes, Layer, Power, Prepared, Response, Stack};

@@ -1,0 +1,487 @@
+//! Multilayer thin-film stacks: reflectance, transmittance and absorptance of an ambient
+//! medium, 0..N films and a substrate, by the substrate-up recurrence of composite
+//! amplitudes.
+//!
+//! # Symbols
+//!
+//! | symbol | code | meaning |
+//! |---|---|---|
+//! | j = 0 … N+1 | index into `indices` | medium: 0 ambient, 1 … N films (top first), N+1 substrate |
+//! | d_j | `thickness_nm[j-1]` | physical thickness of film j, nm |
+//! | δ_j = k₀ q_j d_j | `delta` | complex phase thickness of film j |
+//! | r_{j,j+1}, t_{j,j+1} | `Prepared::interfaces[j]` | Fresnel amplitudes of interface j ([`crate::fresnel`]) |
+//! | Γ_j, τ_j | `gamma`, `tau` | composite reflection / transmission amplitude of everything below interface j, seen from medium j |
+//!
+//! # Method
+//!
+//! Starting at the substrate, `Γ_N = r_{N,N+1}`, `τ_N = t_{N,N+1}`, and for j = N−1 … 0
+//!
+//! ```text
+//!          r_{j,j+1} + Γ_{j+1} e^{2iδ_{j+1}}                 t_{j,j+1} τ_{j+1} e^{iδ_{j+1}}
+//! Γ_j = ─────────────────────────────────────     τ_j = ─────────────────────────────────────
+//!        1 + r_{j,j+1} Γ_{j+1} e^{2iδ_{j+1}}               1 + r_{j,j+1} Γ_{j+1} e^{2iδ_{j+1}}
+//! ```
+//!
+//! (Heavens, *Optical Properties of Thin Solid Films*, 1955, §4; Born & Wolf §1.6.5 — the
+//! Airy summation of the real-time thesis in `shared/seeds`, Sussenbach 2013 §3.1, applied
+//! recursively; for one film it *is* the Airy formula of Belcour & Barla 2017, Eq. 2.)
+//! The stack's amplitudes are r = Γ₀ and t = τ₀, identical to the transfer-matrix result of
+//! Byrnes' `tmm` (phase reference at the top interface for r, at the substrate's interface
+//! for t). Only `e^{+iδ}` with Im δ ≥ 0 appears, so thick, absorbing or evanescent layers
+//! never overflow, unlike a transfer-matrix product.
+//!
+//! Powers: `R = |r|²`; `T` is the power that crosses into the substrate, with the
+//! `Re(ñ cos θ)` factors of [`crate::fresnel`] (the `tmm` convention); unpolarised
+//! `R = (R_s + R_p)/2`, `T = (T_s + T_p)/2`, and the absorptance `A = 1 − R − T` is the
+//! power absorbed in the films (and, for an evanescent substrate, zero).
+//!
+//! # Sweeps
+//!
+//! [`Stack::sweep`] and [`Stack::sweep_thickness`] resolve the material indices once per
+//! wavelength, compute interface coefficients once per (angle, distinct set of indices) —
+//! so for non-dispersive stacks once per angle, shared by every wavelength and thickness —
+//! and run angles in parallel with rayon. Every value is computed by the same code whatever
+//! the thread count, so results are bit-identical across thread counts.
+
+use crate::error::{Error, Result};
+use crate::fresnel::{Interface, normal_component, power_factor_p, power_factor_s};
+use crate::material::Material;
+use num_complex::Complex64 as C64;
+use rayon::prelude::*;
+use std::f64::consts::PI;
+
+/// One film of a stack.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Layer {
+    /// The film's material.
+    pub material: Material,
+    /// Physical thickness d, in nanometres (≥ 0).
+    pub thickness_nm: f64,
+}
+
+/// Complex amplitude coefficients of a whole stack.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Amplitudes {
+    /// Reflection amplitude, s polarisation.
+    pub r_s: C64,
+    /// Reflection amplitude, p polarisation.
+    pub r_p: C64,
+    /// Transmission amplitude into the substrate, s polarisation.
+    pub t_s: C64,
+    /// Transmission amplitude into the substrate, p polarisation.
+    pub t_p: C64,
+}
+
+/// Power reflectance and transmittance of a stack, per polarisation.
+#[allow(non_snake_case)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Power {
+    /// Reflectance, s polarisation.
+    pub R_s: f64,
+    /// Reflectance, p polarisation.
+    pub R_p: f64,
+    /// Transmittance into the substrate, s polarisation.
+    pub T_s: f64,
+    /// Transmittance into the substrate, p polarisation.
+    pub T_p: f64,
+}
+
+#[allow(non_snake_case)]
+impl Power {
+    /// Unpolarised reflectance (R_s + R_p) / 2.
+    pub fn R(&self) -> f64 {
+        0.5 * (self.R_s + self.R_p)
+    }
+    /// Unpolarised transmittance (T_s + T_p) / 2.
+    pub fn T(&self) -> f64 {
+        0.5 * (self.T_s + self.T_p)
+    }
+    /// Unpolarised absorptance A = 1 − R − T.
+    pub fn A(&self) -> f64 {
+        1.0 - self.R() - self.T()
+    }
+}
+
+/// Amplitudes and powers at one angle and wavelength.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Response {
+    /// Complex amplitude coefficients.
+    pub amplitudes: Amplitudes,
+    /// Power coefficients.
+    pub power: Power,
+}
+
+/// Vacuum wavenumber k₀ = 2π/λ, in rad/nm.
+#[inline]
+pub fn wavenumber(wavelength_nm: f64) -> f64 {
+    2.0 * PI / wavelength_nm
+}
+
+/// `exp(i z)` for complex z, without the general complex `exp` when z is real.
+#[inline]
+fn exp_i(z: C64) -> C64 {
+    let (s, c) = z.re.sin_cos();
+    if z.im == 0.0 {
+        C64::new(c, s)
+    } else {
+        let m = (-z.im).exp();
+        C64::new(m * c, m * s)
+    }
+}
+
+/// Everything at one angle and one set of media indices that does not depend on
+/// wavelength or thickness: normal components and interface coefficients.
+#[derive(Clone, Debug)]
+pub struct Prepared {
+    indices: Vec<C64>,
+    /// q_j = ñ_j cos θ_j for every medium.
+    q: Vec<C64>,
+    /// Interface j: from medium j into medium j + 1.
+    interfaces: Vec<Interface>,
+    factor_s: f64,
+    factor_p: f64,
+}
+
+impl Prepared {
+    /// Prepares media `indices` (ambient first, substrate last; at least two) for a
+    /// tangential component `beta = n₀ sin θ₀`.
+    pub fn new(indices: &[C64], beta: f64) -> Self {
+        assert!(indices.len() >= 2, "a stack has an ambient and a substrate");
+        let q: Vec<C64> = indices.iter().map(|&n| normal_component(n, beta)).collect();
+        let interfaces = (0..indices.len() - 1)
+            .map(|j| Interface::new(indices[j], q[j], indices[j + 1], q[j + 1]))
+            .collect();
+        let last = indices.len() - 1;
+        Prepared {
+            factor_s: power_factor_s(q[0], q[last]),
+            factor_p: power_factor_p(indices[0], q[0], indices[last], q[last]),
+            indices: indices.to_vec(),
+            q,
+            interfaces,
+        }
+    }
+
+    /// The media indices this was prepared for.
+    pub fn indices(&self) -> &[C64] {
+        &self.indices
+    }
+
+    /// Number of films.
+    fn films(&self) -> usize {
+        self.indices.len() - 2
+    }
+
+    /// `e^{iδ_j}` for film j (1-based medium index) of thickness `thickness_nm`.
+    #[inline]
+    fn phase(&self, j: usize, k0: f64, thickness_nm: f64) -> C64 {
+        exp_i(self.q[j] * (k0 * thickness_nm))
+    }
+
+    /// Composite amplitudes seen from medium `j` looking down, given those seen from
+    /// medium `j + 1` (Γ_{j+1}, τ_{j+1}) and film j+1's phase `e = e^{iδ_{j+1}}`.
+    #[inline]
+    fn step(&self, j: usize, e: C64, gamma: [C64; 2], tau: [C64; 2]) -> ([C64; 2], [C64; 2]) {
+        let i = &self.interfaces[j];
+        let e2 = e * e;
+        let mut out_g = [C64::new(0.0, 0.0); 2];
+        let mut out_t = out_g;
+        for (pol, (r, t)) in [(i.r_s, i.t_s), (i.r_p, i.t_p)].into_iter().enumerate() {
+            let ge2 = gamma[pol] * e2;
+            let den_inv = (1.0 + r * ge2).inv();
+            out_g[pol] = (r + ge2) * den_inv;
+            out_t[pol] = t * tau[pol] * e * den_inv;
+        }
+        (out_g, out_t)
+    }
+
+    /// Amplitudes at vacuum wavelength `wavelength_nm` for film thicknesses
+    /// `thickness_nm` (one per film, top first).
+    pub fn amplitudes(&self, wavelength_nm: f64, thickness_nm: &[f64]) -> Amplitudes {
+        debug_assert_eq!(thickness_nm.len(), self.films());
+        let k0 = wavenumber(wavelength_nm);
+        let n = self.films();
+        let bottom = &self.interfaces[n];
+        let mut gamma = [bottom.r_s, bottom.r_p];
+        let mut tau = [bottom.t_s, bottom.t_p];
+        for j in (0..n).rev() {
+            let e = self.phase(j + 1, k0, thickness_nm[j]);
+            (gamma, tau) = self.step(j, e, gamma, tau);
+        }
+        Amplitudes {
+            r_s: gamma[0],
+            r_p: gamma[1],
+            t_s: tau[0],
+            t_p: tau[1],
+        }
+    }
+
+    /// Power coefficients from a stack's amplitudes.
+    #[inline]
+    pub fn power(&self, a: &Amplitudes) -> Power {
+        Power {
+            R_s: a.r_s.norm_sqr(),
+            R_p: a.r_p.norm_sqr(),
+            T_s: a.t_s.norm_sqr() * self.factor_s,
+            T_p: a.t_p.norm_sqr() * self.factor_p,
+        }
+    }
+}
+
+/// A thickness sweep of one film at fixed angle and wavelength: the part of the stack
+/// below the varying film is folded into (Γ, τ) once; each thickness then costs one
+/// complex exponential and the recurrence through the films above it.
+struct ThicknessSweep<'a> {
+    prepared: &'a Prepared,
+    k0: f64,
+    /// 1-based medium index of the varying film.
+    film: usize,
+    /// Γ_film, τ_film: composite amplitudes below the varying film.
+    gamma: [C64; 2],
+    tau: [C64; 2],
+    /// e^{iδ_j} of the fixed films above the varying one (index j − 1).
+    above: Vec<C64>,
+}
+
+impl<'a> ThicknessSweep<'a> {
+    fn new(prepared: &'a Prepared, wavelength_nm: f64, thickness_nm: &[f64], film: usize) -> Self {
+        let k0 = wavenumber(wavelength_nm);
+        let n = prepared.films();
+        let bottom = &prepared.interfaces[n];
+        let mut gamma = [bottom.r_s, bottom.r_p];
+        let mut tau = [bottom.t_s, bottom.t_p];
+        for j in (film..n).rev() {
+            let e = prepared.phase(j + 1, k0, thickness_nm[j]);
+            (gamma, tau) = prepared.step(j, e, gamma, tau);
+        }
+        let above = (1..film)
+            .map(|j| prepared.phase(j, k0, thickness_nm[j - 1]))
+            .collect();
+        ThicknessSweep {
+            prepared,
+            k0,
+            film,
+            gamma,
+            tau,
+            above,
+        }
+    }
+
+    /// Powers at thickness `d_nm` of the varying film.
+    #[inline]
+    fn power(&self, d_nm: f64) -> Power {
+        let p = self.prepared;
+        let e = p.phase(self.film, self.k0, d_nm);
+        if self.film == 1 {
+            // Airy fast path (one varying top film): powers from |num|² / |den|², no
+            // complex division. Same formula as `step`.
+            let i = &p.interfaces[0];
+            let e2 = e * e;
+            let e_norm = e.norm_sqr();
+            let mut out = [0.0; 4];
+            for (pol, (r, t)) in [(i.r_s, i.t_s), (i.r_p, i.t_p)].into_iter().enumerate() {
+                let ge2 = self.gamma[pol] * e2;
+                let den = (1.0 + r * ge2).norm_sqr().recip();
+                out[pol] = (r + ge2).norm_sqr() * den;
+                out[2 + pol] = (t * self.tau[pol]).norm_sqr() * e_norm * den;
+            }
+            return Power {
+                R_s: out[0],
+                R_p: out[1],
+                T_s: out[2] * p.factor_s,
+                T_p: out[3] * p.factor_p,
+            };
+        }
+        let (mut gamma, mut tau) = p.step(self.film - 1, e, self.gamma, self.tau);
+        for j in (0..self.film - 1).rev() {
+            (gamma, tau) = p.step(j, self.above[j], gamma, tau);
+        }
+        p.power(&Amplitudes {
+            r_s: gamma[0],
+            r_p: gamma[1],
+            t_s: tau[0],
+            t_p: tau[1],
+        })
+    }
+}
+
+/// An ambient medium, 0..N films (top first) and a substrate.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Stack {
+    ambient: Material,
+    layers: Vec<Layer>,
+    substrate: Material,
+}
+
+impl Stack {
+    /// Builds a stack. Errors when a thickness is negative or not finite, or when a
+    /// constant ambient absorbs (a dispersive ambient is checked per wavelength).
+    pub fn new(ambient: Material, layers: Vec<Layer>, substrate: Material) -> Result<Self> {
+        for (i, layer) in layers.iter().enumerate() {
+            if !(layer.thickness_nm >= 0.0 && layer.thickness_nm.is_finite()) {
+                return Err(Error::InvalidThickness {
+                    layer: i + 1,
+                    material: layer.material.name().to_string(),
+                    thickness_nm: layer.thickness_nm,
+                });
+            }
+        }
+        if ambient.is_constant() {
+            check_ambient(&ambient, 550.0)?;
+        }
+        Ok(Stack {
+            ambient,
+            layers,
+            substrate,
+        })
+    }
+
+    /// The ambient (incidence) medium.
+    pub fn ambient(&self) -> &Material {
+        &self.ambient
+    }
+
+    /// The films, top first.
+    pub fn layers(&self) -> &[Layer] {
+        &self.layers
+    }
+
+    /// The substrate.
+    pub fn substrate(&self) -> &Material {
+        &self.substrate
+    }
+
+    /// Film thicknesses in nm, top first.
+    pub fn thicknesses_nm(&self) -> Vec<f64> {
+        self.layers.iter().map(|l| l.thickness_nm).collect()
+    }
+
+    /// The media's complex indices at `wavelength_nm`: ambient, films (top first), substrate.
+    pub fn indices_at(&self, wavelength_nm: f64) -> Result<Vec<C64>> {
+        let mut out = Vec::with_capacity(self.layers.len() + 2);
+        out.push(check_ambient(&self.ambient, wavelength_nm)?);
+        for layer in &self.layers {
+            out.push(layer.material.index_at(wavelength_nm)?);
+        }
+        out.push(self.substrate.index_at(wavelength_nm)?);
+        Ok(out)
+    }
+
+    /// Amplitudes and powers at incidence `angle_deg` (in the ambient) and vacuum
+    /// wavelength `wavelength_nm`.
+    pub fn evaluate(&self, angle_deg: f64, wavelength_nm: f64) -> Result<Response> {
+        let sin_theta = sin_of_angle(angle_deg)?;
+        let indices = self.indices_at(wavelength_nm)?;
+        let prepared = Prepared::new(&indices, indices[0].re * sin_theta);
+        let amplitudes = prepared.amplitudes(wavelength_nm, &self.thicknesses_nm());
+        Ok(Response {
+            amplitudes,
+            power: prepared.power(&amplitudes),
+        })
+    }
+
+    /// Powers over every (angle, wavelength) pair, angle-major: element
+    /// `a * wavelengths_nm.len() + w`.
+    pub fn sweep(&self, angles_deg: &[f64], wavelengths_nm: &[f64]) -> Result<Vec<Power>> {
+        let thickness = self.thicknesses_nm();
+        let (sines, indices) = self.resolve(angles_deg, wavelengths_nm)?;
+        let rows: Vec<Vec<Power>> = sines
+            .par_iter()
+            .map(|&sin_theta| {
+                let mut cache: Option<Prepared> = None;
+                wavelengths_nm
+                    .iter()
+                    .zip(&indices)
+                    .map(|(&wl, idx)| {
+                        let prepared = reuse(&mut cache, idx, sin_theta);
+                        prepared.power(&prepared.amplitudes(wl, &thickness))
+                    })
+                    .collect()
+            })
+            .collect();
+        Ok(rows.concat())
+    }
+
+    /// Powers over every (angle, wavelength, thickness) triple with film `layer`
+    /// (1-based, top film = 1) taking each of `thicknesses_nm` and the other films as
+    /// given; element `(a * wavelengths.len() + w) * thicknesses.len() + d`.
+    pub fn sweep_thickness(
+        &self,
+        layer: usize,
+        angles_deg: &[f64],
+        wavelengths_nm: &[f64],
+        thicknesses_nm: &[f64],
+    ) -> Result<Vec<Power>> {
+        if layer == 0 || layer > self.layers.len() {
+            return Err(Error::NoSuchLayer {
+                layer,
+                count: self.layers.len(),
+            });
+        }
+        for &d in thicknesses_nm {
+            if !(d >= 0.0 && d.is_finite()) {
+                return Err(Error::InvalidThickness {
+                    layer,
+                    material: self.layers[layer - 1].material.name().to_string(),
+                    thickness_nm: d,
+                });
+            }
+        }
+        let thickness = self.thicknesses_nm();
+        let (sines, indices) = self.resolve(angles_deg, wavelengths_nm)?;
+        let rows: Vec<Vec<Power>> = sines
+            .par_iter()
+            .map(|&sin_theta| {
+                let mut cache: Option<Prepared> = None;
+                let mut out = Vec::with_capacity(wavelengths_nm.len() * thicknesses_nm.len());
+                for (&wl, idx) in wavelengths_nm.iter().zip(&indices) {
+                    let prepared = reuse(&mut cache, idx, sin_theta);
+                    let sweep = ThicknessSweep::new(prepared, wl, &thickness, layer);
+                    out.extend(thicknesses_nm.iter().map(|&d| sweep.power(d)));
+                }
+                out
+            })
+            .collect();
+        Ok(rows.concat())
+    }
+
+    /// Validates angles and resolves indices once per wavelength.
+    fn resolve(&self, angles_deg: &[f64], wavelengths_nm: &[f64]) -> Result<(Vec<f64>, Vec<Vec<C64>>)> {
+        let sines = angles_deg
+            .iter()
+            .map(|&a| sin_of_angle(a))
+            .collect::<Result<Vec<_>>>()?;
+        let indices = wavelengths_nm
+            .iter()
+            .map(|&wl| self.indices_at(wl))
+            .collect::<Result<Vec<_>>>()?;
+        Ok((sines, indices))
+    }
+}
+
+/// Returns a `Prepared` for `indices`, reusing the cached one when the indices have not
+/// changed (non-dispersive media across wavelengths).
+fn reuse<'c>(cache: &'c mut Option<Prepared>, indices: &[C64], sin_theta: f64) -> &'c Prepared {
+    if cache.as_ref().is_none_or(|p| p.indices() != indices) {
+        *cache = Some(Prepared::new(indices, indices[0].re * sin_theta));
+    }
+    cache.as_ref().expect("just filled")
+}
+
+fn sin_of_angle(angle_deg: f64) -> Result<f64> {
+    if !(angle_deg.abs() < 90.0) {
+        return Err(Error::InvalidAngle { angle_deg });
+    }
+    Ok(angle_deg.to_radians().sin())
+}
+
+fn check_ambient(ambient: &Material, wavelength_nm: f64) -> Result<C64> {
+    let n = ambient.index_at(wavelength_nm)?;
+    if n.im != 0.0 {
+        return Err(Error::AbsorbingAmbient {
+            material: ambient.name().to_string(),
+            wavelength_nm,
+            kappa: n.im,
+        });
+    }
+    Ok(n)
+}
