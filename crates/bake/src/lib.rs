@@ -1,1 +1,15 @@
-pub fn x(){}
+//! # nacre-bake
+//!
+//! The front end of nacre: material library and recipes, table generators and writers,
+//! and the `nacre` command-line tool (`src/main.rs`). The physics lives in
+//! [`nacre_optics`]; this crate parses, resolves, calls the core and writes files
+//! atomically.
+
+pub mod error;
+pub mod grid;
+pub mod materials;
+pub mod output;
+pub mod spectrum;
+pub mod stack_spec;
+
+pub use error::{Error, Result};

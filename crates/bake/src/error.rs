@@ -1,0 +1,72 @@
+//! The one error type of `nacre-bake`. Only the `nacre` binary turns it into a message
+//! and an exit status.
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong while reading recipes, resolving materials, computing and
+/// writing tables. Each message names the flag, file and line concerned.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// An error from the physics core.
+    #[error(transparent)]
+    Optics(#[from] nacre_optics::Error),
+    /// The physics core rejected something that came from a named flag or recipe key.
+    #[error("{context}: {source}")]
+    OpticsIn {
+        /// Flag or `file:line` the value came from.
+        context: String,
+        /// What the core said.
+        source: nacre_optics::Error,
+    },
+    /// A command-line flag's value is malformed or out of range.
+    #[error("{flag} `{value}`: {message}")]
+    Flag {
+        /// The flag, e.g. `--angles`.
+        flag: String,
+        /// The value given.
+        value: String,
+        /// What was expected.
+        message: String,
+    },
+    /// A recipe file is malformed.
+    #[error("{}:{line}: {message}", path.display())]
+    Recipe {
+        /// The recipe file.
+        path: PathBuf,
+        /// 1-based line.
+        line: usize,
+        /// What was wrong and what was expected.
+        message: String,
+    },
+    /// A material name that is neither a number, a bundled material nor a data file.
+    #[error("{context}: unknown material `{name}`: expected a number (`1.5`), a complex index (`0.27+2.9i`), a bundled material ({bundled}) or a path to a `.yml`/`.csv` file")]
+    UnknownMaterial {
+        /// Flag or `file:line` the name came from.
+        context: String,
+        /// The name given.
+        name: String,
+        /// The bundled names, comma-separated.
+        bundled: String,
+    },
+    /// Reading or writing a file failed.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The operating-system error.
+        source: std::io::Error,
+    },
+    /// A request larger than the documented limits.
+    #[error("{what}: {count} exceeds the limit of {limit}")]
+    TooLarge {
+        /// What was counted.
+        what: String,
+        /// The requested count.
+        count: u64,
+        /// The limit.
+        limit: u64,
+    },
+}
+
+/// Shorthand for `Result<T, nacre_bake::Error>`.
+pub type Result<T, E = Error> = std::result::Result<T, E>;

@@ -1,0 +1,254 @@
+//! Stack descriptions, from flags (`--ambient`, `--layer M@THICKNESS`, `--substrate`) or
+//! from a recipe file.
+//!
+//! # Stack recipe format (TOML)
+//!
+//! ```toml
+//! # A quarter-wave MgF2 anti-reflection coating on BK7.
+//! ambient = "air"            # material spec; default "air"
+//! substrate = "bk7"          # material spec; default "air"
+//! angles = "0:89:1"          # optional, degrees in the ambient (flags override)
+//! wavelengths = "380:780:5"  # optional, vacuum nm (flags override)
+//!
+//! [[layers]]                 # films, top first; none for a bare interface
+//! material = "mgf2"          # material spec (number, n+ki, bundled name, .yml/.csv path)
+//! thickness_nm = 99.75       # physical thickness in nm, ≥ 0
+//! ```
+//!
+//! Relative material paths are resolved from the recipe's folder. Unknown keys are errors.
+
+use crate::error::{Error, Result};
+use crate::grid::parse_thickness_nm;
+use crate::materials::resolve;
+use nacre_optics::{Layer, Stack};
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+use toml::Spanned;
+
+/// Material used for the ambient and the substrate when none is given.
+pub const DEFAULT_MEDIUM: &str = "air";
+
+/// The default example stack: a 400 nm soap (water) film in air.
+pub const DEFAULT_LAYER: (&str, f64) = ("water", 400.0);
+
+/// A material spec and where it came from (for messages).
+#[derive(Clone, Debug)]
+pub struct MaterialRef {
+    /// The spec text.
+    pub spec: String,
+    /// `--flag` or `file:line`.
+    pub context: String,
+}
+
+/// A stack described by material specs, before the materials are loaded.
+#[derive(Clone, Debug)]
+pub struct StackSpec {
+    /// Ambient medium.
+    pub ambient: MaterialRef,
+    /// Films, top first, with thickness in nm.
+    pub layers: Vec<(MaterialRef, f64)>,
+    /// Substrate.
+    pub substrate: MaterialRef,
+    /// Folder that relative material paths are resolved from.
+    pub base_dir: Option<PathBuf>,
+}
+
+impl StackSpec {
+    /// From command-line values. With no value at all, the default soap film.
+    pub fn from_flags(ambient: Option<&str>, layers: &[String], substrate: Option<&str>) -> Result<Self> {
+        let flag = |spec: &str, context: &str| MaterialRef {
+            spec: spec.to_string(),
+            context: context.to_string(),
+        };
+        let layers = if ambient.is_none() && layers.is_empty() && substrate.is_none() {
+            vec![(flag(DEFAULT_LAYER.0, "default stack"), DEFAULT_LAYER.1)]
+        } else {
+            layers
+                .iter()
+                .map(|text| {
+                    let (m, d) = text.rsplit_once('@').ok_or_else(|| Error::Flag {
+                        flag: "--layer".into(),
+                        value: text.clone(),
+                        message: "expected MATERIAL@THICKNESS, e.g. `water@400nm`".into(),
+                    })?;
+                    if m.trim().is_empty() {
+                        return Err(Error::Flag {
+                            flag: "--layer".into(),
+                            value: text.clone(),
+                            message: "the material before `@` is empty".into(),
+                        });
+                    }
+                    let d = parse_thickness_nm("--layer", d).map_err(|e| match e {
+                        Error::Flag { message, .. } => Error::Flag {
+                            flag: "--layer".into(),
+                            value: text.clone(),
+                            message,
+                        },
+                        other => other,
+                    })?;
+                    Ok((flag(m, "--layer"), d))
+                })
+                .collect::<Result<_>>()?
+        };
+        Ok(StackSpec {
+            ambient: flag(ambient.unwrap_or(DEFAULT_MEDIUM), "--ambient"),
+            layers,
+            substrate: flag(substrate.unwrap_or(DEFAULT_MEDIUM), "--substrate"),
+            base_dir: None,
+        })
+    }
+
+    /// Loads the materials and builds the stack.
+    pub fn build(&self) -> Result<Stack> {
+        let base = self.base_dir.as_deref();
+        let load = |m: &MaterialRef| resolve(&m.spec, &m.context, base);
+        let ambient = load(&self.ambient)?;
+        let layers = self
+            .layers
+            .iter()
+            .map(|(m, d)| {
+                Ok(Layer {
+                    material: load(m)?,
+                    thickness_nm: *d,
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let substrate = load(&self.substrate)?;
+        Stack::new(ambient, layers, substrate).map_err(|source| Error::OpticsIn {
+            context: self.ambient.context.clone(),
+            source,
+        })
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawLayer {
+    material: Spanned<String>,
+    thickness_nm: Spanned<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawStackRecipe {
+    ambient: Option<Spanned<String>>,
+    substrate: Option<Spanned<String>>,
+    #[serde(default)]
+    layers: Vec<RawLayer>,
+    angles: Option<String>,
+    wavelengths: Option<String>,
+}
+
+/// A stack recipe file: the stack plus optional sampling ranges.
+#[derive(Clone, Debug)]
+pub struct StackRecipe {
+    /// The stack.
+    pub stack: StackSpec,
+    /// `angles` range text, if given.
+    pub angles: Option<String>,
+    /// `wavelengths` range text, if given.
+    pub wavelengths: Option<String>,
+}
+
+/// 1-based line of byte offset `at` in `text`.
+pub fn line_of(text: &str, at: usize) -> usize {
+    text.as_bytes()[..at.min(text.len())]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
+        + 1
+}
+
+/// Converts a `toml` error into a recipe error with its line.
+pub fn toml_error(path: &Path, text: &str, e: &toml::de::Error) -> Error {
+    Error::Recipe {
+        path: path.to_path_buf(),
+        line: e.span().map_or(1, |s| line_of(text, s.start)),
+        message: e.message().trim().to_string(),
+    }
+}
+
+impl StackRecipe {
+    /// Reads a stack recipe file.
+    pub fn read(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::parse(path, &text)
+    }
+
+    /// Parses a stack recipe's text; `path` names it in messages and anchors relative
+    /// material paths.
+    pub fn parse(path: &Path, text: &str) -> Result<Self> {
+        let raw: RawStackRecipe = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
+        let at = |span: std::ops::Range<usize>| format!("{}:{}", path.display(), line_of(text, span.start));
+        let mref = |s: &Spanned<String>| MaterialRef {
+            spec: s.get_ref().clone(),
+            context: at(s.span()),
+        };
+        let default = |what: &str| MaterialRef {
+            spec: DEFAULT_MEDIUM.into(),
+            context: format!("{} ({what} default)", path.display()),
+        };
+        let mut layers = Vec::with_capacity(raw.layers.len());
+        for layer in &raw.layers {
+            let d = *layer.thickness_nm.get_ref();
+            if !(d >= 0.0 && d.is_finite()) {
+                return Err(Error::Recipe {
+                    path: path.to_path_buf(),
+                    line: line_of(text, layer.thickness_nm.span().start),
+                    message: format!("thickness_nm = {d}: must be finite and non-negative"),
+                });
+            }
+            layers.push((mref(&layer.material), d));
+        }
+        Ok(StackRecipe {
+            stack: StackSpec {
+                ambient: raw.ambient.as_ref().map_or_else(|| default("ambient"), mref),
+                layers,
+                substrate: raw.substrate.as_ref().map_or_else(|| default("substrate"), mref),
+                base_dir: path.parent().map(Path::to_path_buf),
+            },
+            angles: raw.angles,
+            wavelengths: raw.wavelengths,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn flags_and_defaults() {
+        let s = StackSpec::from_flags(None, &[], None).unwrap();
+        assert_eq!(s.layers.len(), 1);
+        assert_eq!(s.layers[0].0.spec, "water");
+        let s = StackSpec::from_flags(None, &[], Some("bk7")).unwrap();
+        assert!(s.layers.is_empty());
+        let s = StackSpec::from_flags(None, &["mgf2@99.75nm".into(), "1.5+0.1i@10".into()], Some("bk7")).unwrap();
+        assert_eq!(s.layers[0].1, 99.75);
+        assert_eq!(s.layers[1].0.spec, "1.5+0.1i");
+        s.build().unwrap();
+        for bad in ["water", "water@-3", "@5", "water@x"] {
+            let e = StackSpec::from_flags(None, &[bad.into()], None).unwrap_err().to_string();
+            assert!(e.starts_with("--layer `"), "{bad}: {e}");
+        }
+    }
+
+    #[test]
+    fn recipe_errors_have_lines() {
+        let p = Path::new("r.toml");
+        let r = StackRecipe::parse(p, "substrate = \"bk7\"\n[[layers]]\nmaterial = \"mgf2\"\nthickness_nm = 100\n").unwrap();
+        assert_eq!(r.stack.layers[0].1, 100.0);
+        r.stack.build().unwrap();
+        let e = StackRecipe::parse(p, "substrate = \"bk7\"\n[[layers]]\nmaterial = \"mgf2\"\nthickness_nm = -1\n").unwrap_err();
+        assert_eq!(e.to_string(), "r.toml:4: thickness_nm = -1: must be finite and non-negative");
+        let e = StackRecipe::parse(p, "substrate = \"bk7\"\ncolour = 3\n").unwrap_err().to_string();
+        assert!(e.starts_with("r.toml:2: unknown field `colour`"), "{e}");
+        let r = StackRecipe::parse(p, "\n\nsubstrate = \"nope\"\n").unwrap();
+        let e = r.stack.build().unwrap_err().to_string();
+        assert!(e.starts_with("r.toml:3: unknown material `nope`"), "{e}");
+    }
+}
