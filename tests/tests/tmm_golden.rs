@@ -42,7 +42,11 @@ fn spec(case: &Case) -> StackSpec {
     };
     StackSpec {
         ambient: m(&case.ambient),
-        layers: case.layers.iter().map(|l| (m(&l.material), l.thickness_nm)).collect(),
+        layers: case
+            .layers
+            .iter()
+            .map(|l| (m(&l.material), l.thickness_nm))
+            .collect(),
         substrate: m(&case.substrate),
         base_dir: None,
     }
@@ -52,7 +56,10 @@ fn spec(case: &Case) -> StackSpec {
 fn read_golden(path: &Path) -> Vec<[f64; 6]> {
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let mut lines = text.lines().filter(|l| !l.starts_with('#'));
-    assert_eq!(lines.next(), Some("angle_deg,wavelength_nm,R_s,R_p,T_s,T_p"));
+    assert_eq!(
+        lines.next(),
+        Some("angle_deg,wavelength_nm,R_s,R_p,T_s,T_p")
+    );
     lines
         .map(|l| {
             let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
@@ -71,7 +78,9 @@ fn agrees_with_tmm_to_1e_10() {
     let mut worst_t: (f64, String) = (0.0, String::new());
     let mut points = 0;
     for case in &cases.case {
-        let stack = spec(case).build().unwrap_or_else(|e| panic!("{}: {e}", case.name));
+        let stack = spec(case)
+            .build()
+            .unwrap_or_else(|e| panic!("{}: {e}", case.name));
         let golden = read_golden(&dir.join(format!("{}.csv", case.name)));
         let ours = stack.sweep(&case.angles_deg, &case.wavelengths_nm).unwrap();
         assert_eq!(golden.len(), ours.len(), "{}", case.name);
@@ -99,6 +108,16 @@ fn agrees_with_tmm_to_1e_10() {
         worst_t.0,
         worst_t.1
     );
-    assert!(worst_r.0 <= TOLERANCE, "worst |ΔR| {:.3e} at {}", worst_r.0, worst_r.1);
-    assert!(worst_t.0 <= TOLERANCE, "worst |ΔT| {:.3e} at {}", worst_t.0, worst_t.1);
+    assert!(
+        worst_r.0 <= TOLERANCE,
+        "worst |ΔR| {:.3e} at {}",
+        worst_r.0,
+        worst_r.1
+    );
+    assert!(
+        worst_t.0 <= TOLERANCE,
+        "worst |ΔT| {:.3e} at {}",
+        worst_t.0,
+        worst_t.1
+    );
 }

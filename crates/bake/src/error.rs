@@ -39,7 +39,9 @@ pub enum Error {
         message: String,
     },
     /// A material name that is neither a number, a bundled material nor a data file.
-    #[error("{context}: unknown material `{name}`: expected a number (`1.5`), a complex index (`0.27+2.9i`), a bundled material ({bundled}) or a path to a `.yml`/`.csv` file")]
+    #[error(
+        "{context}: unknown material `{name}`: expected a number (`1.5`), a complex index (`0.27+2.9i`), a bundled material ({bundled}) or a path to a `.yml`/`.csv` file"
+    )]
     UnknownMaterial {
         /// Flag or `file:line` the name came from.
         context: String,

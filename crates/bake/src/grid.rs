@@ -22,7 +22,11 @@ pub fn parse_range(flag: &str, text: &str) -> Result<Vec<f64>> {
         s.parse::<f64>()
             .ok()
             .filter(|v| v.is_finite())
-            .ok_or_else(|| err(format!("{what} `{s}` is not a finite number; expected START:END:STEP, e.g. 380:780:5")))
+            .ok_or_else(|| {
+                err(format!(
+                    "{what} `{s}` is not a finite number; expected START:END:STEP, e.g. 380:780:5"
+                ))
+            })
     };
     match parts.as_slice() {
         [single] => Ok(vec![num(single, "value")?]),
@@ -46,7 +50,9 @@ pub fn parse_range(flag: &str, text: &str) -> Result<Vec<f64>> {
                 .map(|i| ((start + i as f64 * step) * GRID_SCALE).round() / GRID_SCALE)
                 .collect())
         }
-        _ => Err(err("expected START:END:STEP (e.g. 0:89:1) or a single value".into())),
+        _ => Err(err(
+            "expected START:END:STEP (e.g. 0:89:1) or a single value".into(),
+        )),
     }
 }
 
@@ -69,10 +75,9 @@ pub fn parse_thickness_nm(context: &str, text: &str) -> Result<f64> {
         value: text.to_string(),
         message: message.to_string(),
     };
-    let v = number
-        .trim()
-        .parse::<f64>()
-        .map_err(|_| err("thickness must be a number of nanometres, e.g. `635` or `635nm` (or `1.2um`)"))?;
+    let v = number.trim().parse::<f64>().map_err(|_| {
+        err("thickness must be a number of nanometres, e.g. `635` or `635nm` (or `1.2um`)")
+    })?;
     let v = v * scale;
     if !v.is_finite() || v < 0.0 {
         return Err(err("thickness must be finite and non-negative"));
@@ -93,10 +98,26 @@ mod tests {
         assert_eq!(v[1], 380.1);
         assert_eq!(v[10], 381.0);
         assert_eq!(parse_range("--a", "45").unwrap(), vec![45.0]);
-        assert_eq!(parse_range("--a", "0:10:3").unwrap(), vec![0.0, 3.0, 6.0, 9.0]);
-        assert_eq!(parse_range("--a", "0:60:30").unwrap(), vec![0.0, 30.0, 60.0]);
+        assert_eq!(
+            parse_range("--a", "0:10:3").unwrap(),
+            vec![0.0, 3.0, 6.0, 9.0]
+        );
+        assert_eq!(
+            parse_range("--a", "0:60:30").unwrap(),
+            vec![0.0, 30.0, 60.0]
+        );
         assert_eq!(parse_range("--a", "0:1:0.1").unwrap()[3], 0.3);
-        for bad in ["", "a:b:c", "0:10", "0:10:0", "0:10:-1", "10:0:1", "0:1e9:1e-3", "0:inf:1", "1:2:3:4"] {
+        for bad in [
+            "",
+            "a:b:c",
+            "0:10",
+            "0:10:0",
+            "0:10:-1",
+            "10:0:1",
+            "0:1e9:1e-3",
+            "0:inf:1",
+            "1:2:3:4",
+        ] {
             let e = parse_range("--angles", bad).unwrap_err().to_string();
             assert!(e.starts_with("--angles `"), "{bad}: {e}");
         }

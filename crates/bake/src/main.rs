@@ -70,10 +70,15 @@ struct SpectrumArgs {
     #[arg(long, value_name = "START:END:STEP", allow_hyphen_values = true)]
     angles: Option<String>,
     /// Vacuum wavelengths in nm: START:END:STEP or one value [default: 380:780:5].
-    #[arg(long, value_name = "START:END:STEP")]
+    #[arg(long, value_name = "START:END:STEP", allow_hyphen_values = true)]
     wavelengths: Option<String>,
     /// Output CSV file, or `-` for standard output.
-    #[arg(short = 'o', long = "output", value_name = "FILE.csv", default_value = "-")]
+    #[arg(
+        short = 'o',
+        long = "output",
+        value_name = "FILE.csv",
+        default_value = "-"
+    )]
     output: PathBuf,
 }
 
@@ -85,7 +90,11 @@ fn load_stack(args: &StackArgs) -> Result<(StackSpec, Option<String>, Option<Str
             Ok((r.stack, r.angles, r.wavelengths))
         }
         None => Ok((
-            StackSpec::from_flags(args.ambient.as_deref(), &args.layers, args.substrate.as_deref())?,
+            StackSpec::from_flags(
+                args.ambient.as_deref(),
+                &args.layers,
+                args.substrate.as_deref(),
+            )?,
             None,
             None,
         )),
@@ -103,10 +112,17 @@ fn run_spectrum(args: &SpectrumArgs) -> Result<()> {
         parse_range(&context, &text)
     };
     let angles = range("--angles", &args.angles, recipe_angles, "0:89:1")?;
-    let wavelengths = range("--wavelengths", &args.wavelengths, recipe_wavelengths, "380:780:5")?;
+    let wavelengths = range(
+        "--wavelengths",
+        &args.wavelengths,
+        recipe_wavelengths,
+        "380:780:5",
+    )?;
     let stack = spec.build()?;
     let powers = spectrum::compute(&stack, &angles, &wavelengths)?;
-    write_atomic(&args.output, |w| spectrum::write_csv(w, &angles, &wavelengths, &powers))
+    write_atomic(&args.output, |w| {
+        spectrum::write_csv(w, &angles, &wavelengths, &powers)
+    })
 }
 
 fn run(cli: Cli) -> Result<()> {
@@ -116,7 +132,10 @@ fn run(cli: Cli) -> Result<()> {
             for b in materials::BUNDLED {
                 let m = materials::load_bundled(b)?;
                 let (lo, hi) = m.range_nm();
-                println!("{:<13} {:>7.1}–{:<8.1} nm  {}", b.name, lo, hi, b.description);
+                println!(
+                    "{:<13} {:>7.1}–{:<8.1} nm  {}",
+                    b.name, lo, hi, b.description
+                );
             }
             Ok(())
         }

@@ -75,7 +75,11 @@ const ALIASES: &[(&str, &str)] = &[
 
 /// Comma-separated bundled names, for messages.
 pub fn bundled_names() -> String {
-    BUNDLED.iter().map(|b| b.name).collect::<Vec<_>>().join(", ")
+    BUNDLED
+        .iter()
+        .map(|b| b.name)
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// Looks up a bundled material by name or alias (case-insensitive).
@@ -120,7 +124,10 @@ pub fn resolve(spec: &str, context: &str, base_dir: Option<&Path>) -> Result<Mat
         return load_bundled(b);
     }
     let lower = spec.to_ascii_lowercase();
-    if [".yml", ".yaml", ".csv"].iter().any(|ext| lower.ends_with(ext)) {
+    if [".yml", ".yaml", ".csv"]
+        .iter()
+        .any(|ext| lower.ends_with(ext))
+    {
         let path = match base_dir {
             Some(dir) if Path::new(spec).is_relative() => dir.join(spec),
             _ => Path::new(spec).to_path_buf(),
@@ -159,11 +166,20 @@ mod tests {
     fn resolution_order_and_messages() {
         assert_eq!(resolve("1.5", "--substrate", None).unwrap().name(), "1.5");
         assert_eq!(resolve("Gold", "--substrate", None).unwrap().name(), "au");
-        let e = resolve("unobtainium", "--layer", None).unwrap_err().to_string();
-        assert!(e.starts_with("--layer: unknown material `unobtainium`"), "{e}");
-        let e = resolve("1.5-0.2i", "--layer", None).unwrap_err().to_string();
+        let e = resolve("unobtainium", "--layer", None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("--layer: unknown material `unobtainium`"),
+            "{e}"
+        );
+        let e = resolve("1.5-0.2i", "--layer", None)
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("--layer: invalid refractive index"), "{e}");
-        let e = resolve("missing.yml", "--layer", None).unwrap_err().to_string();
+        let e = resolve("missing.yml", "--layer", None)
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("missing.yml: "), "{e}");
     }
 }

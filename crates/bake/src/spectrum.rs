@@ -60,15 +60,16 @@ pub fn compute(stack: &Stack, angles_deg: &[f64], wavelengths_nm: &[f64]) -> Res
             });
         }
     }
-    stack.sweep(angles_deg, wavelengths_nm).map_err(|source| match source {
-        nacre_optics::Error::WavelengthOutOfRange { .. } | nacre_optics::Error::AbsorbingAmbient { .. } => {
-            Error::OpticsIn {
+    stack
+        .sweep(angles_deg, wavelengths_nm)
+        .map_err(|source| match source {
+            nacre_optics::Error::WavelengthOutOfRange { .. }
+            | nacre_optics::Error::AbsorbingAmbient { .. } => Error::OpticsIn {
                 context: "--wavelengths".into(),
                 source,
-            }
-        }
-        other => other.into(),
-    })
+            },
+            other => other.into(),
+        })
 }
 
 /// Writes the CSV table.

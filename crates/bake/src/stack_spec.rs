@@ -55,7 +55,11 @@ pub struct StackSpec {
 
 impl StackSpec {
     /// From command-line values. With no value at all, the default soap film.
-    pub fn from_flags(ambient: Option<&str>, layers: &[String], substrate: Option<&str>) -> Result<Self> {
+    pub fn from_flags(
+        ambient: Option<&str>,
+        layers: &[String],
+        substrate: Option<&str>,
+    ) -> Result<Self> {
         let flag = |spec: &str, context: &str| MaterialRef {
             spec: spec.to_string(),
             context: context.to_string(),
@@ -182,7 +186,9 @@ impl StackRecipe {
     /// material paths.
     pub fn parse(path: &Path, text: &str) -> Result<Self> {
         let raw: RawStackRecipe = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
-        let at = |span: std::ops::Range<usize>| format!("{}:{}", path.display(), line_of(text, span.start));
+        let at = |span: std::ops::Range<usize>| {
+            format!("{}:{}", path.display(), line_of(text, span.start))
+        };
         let mref = |s: &Spanned<String>| MaterialRef {
             spec: s.get_ref().clone(),
             context: at(s.span()),
@@ -205,9 +211,15 @@ impl StackRecipe {
         }
         Ok(StackRecipe {
             stack: StackSpec {
-                ambient: raw.ambient.as_ref().map_or_else(|| default("ambient"), mref),
+                ambient: raw
+                    .ambient
+                    .as_ref()
+                    .map_or_else(|| default("ambient"), mref),
                 layers,
-                substrate: raw.substrate.as_ref().map_or_else(|| default("substrate"), mref),
+                substrate: raw
+                    .substrate
+                    .as_ref()
+                    .map_or_else(|| default("substrate"), mref),
                 base_dir: path.parent().map(Path::to_path_buf),
             },
             angles: raw.angles,
@@ -227,12 +239,19 @@ mod tests {
         assert_eq!(s.layers[0].0.spec, "water");
         let s = StackSpec::from_flags(None, &[], Some("bk7")).unwrap();
         assert!(s.layers.is_empty());
-        let s = StackSpec::from_flags(None, &["mgf2@99.75nm".into(), "1.5+0.1i@10".into()], Some("bk7")).unwrap();
+        let s = StackSpec::from_flags(
+            None,
+            &["mgf2@99.75nm".into(), "1.5+0.1i@10".into()],
+            Some("bk7"),
+        )
+        .unwrap();
         assert_eq!(s.layers[0].1, 99.75);
         assert_eq!(s.layers[1].0.spec, "1.5+0.1i");
         s.build().unwrap();
         for bad in ["water", "water@-3", "@5", "water@x"] {
-            let e = StackSpec::from_flags(None, &[bad.into()], None).unwrap_err().to_string();
+            let e = StackSpec::from_flags(None, &[bad.into()], None)
+                .unwrap_err()
+                .to_string();
             assert!(e.starts_with("--layer `"), "{bad}: {e}");
         }
     }
@@ -240,12 +259,25 @@ mod tests {
     #[test]
     fn recipe_errors_have_lines() {
         let p = Path::new("r.toml");
-        let r = StackRecipe::parse(p, "substrate = \"bk7\"\n[[layers]]\nmaterial = \"mgf2\"\nthickness_nm = 100\n").unwrap();
+        let r = StackRecipe::parse(
+            p,
+            "substrate = \"bk7\"\n[[layers]]\nmaterial = \"mgf2\"\nthickness_nm = 100\n",
+        )
+        .unwrap();
         assert_eq!(r.stack.layers[0].1, 100.0);
         r.stack.build().unwrap();
-        let e = StackRecipe::parse(p, "substrate = \"bk7\"\n[[layers]]\nmaterial = \"mgf2\"\nthickness_nm = -1\n").unwrap_err();
-        assert_eq!(e.to_string(), "r.toml:4: thickness_nm = -1: must be finite and non-negative");
-        let e = StackRecipe::parse(p, "substrate = \"bk7\"\ncolour = 3\n").unwrap_err().to_string();
+        let e = StackRecipe::parse(
+            p,
+            "substrate = \"bk7\"\n[[layers]]\nmaterial = \"mgf2\"\nthickness_nm = -1\n",
+        )
+        .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "r.toml:4: thickness_nm = -1: must be finite and non-negative"
+        );
+        let e = StackRecipe::parse(p, "substrate = \"bk7\"\ncolour = 3\n")
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("r.toml:2: unknown field `colour`"), "{e}");
         let r = StackRecipe::parse(p, "\n\nsubstrate = \"nope\"\n").unwrap();
         let e = r.stack.build().unwrap_err().to_string();

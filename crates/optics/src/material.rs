@@ -44,7 +44,10 @@ enum Dispersion {
     /// Independent of wavelength.
     Constant(f64),
     /// Samples at strictly increasing wavelengths (nm), linearly interpolated.
-    Tabulated { wavelength_nm: Vec<f64>, value: Vec<f64> },
+    Tabulated {
+        wavelength_nm: Vec<f64>,
+        value: Vec<f64>,
+    },
     /// A refractiveindex.info dispersion formula evaluated with λ in µm; gives n.
     Formula { kind: u8, coefficients: Vec<f64> },
 }
@@ -201,11 +204,17 @@ impl Material {
             if fields.len() != 3 {
                 return Err(perr(
                     line_no,
-                    format!("expected 3 comma-separated numbers (wavelength_nm,n,k), found {} field(s)", fields.len()),
+                    format!(
+                        "expected 3 comma-separated numbers (wavelength_nm,n,k), found {} field(s)",
+                        fields.len()
+                    ),
                 ));
             }
             let mut v = [0.0; 3];
-            for (slot, (field, what)) in v.iter_mut().zip(fields.iter().zip(["wavelength_nm", "n", "k"])) {
+            for (slot, (field, what)) in
+                v.iter_mut()
+                    .zip(fields.iter().zip(["wavelength_nm", "n", "k"]))
+            {
                 *slot = parse_finite(field).ok_or_else(|| {
                     perr(line_no, format!("{what} `{field}` is not a finite number"))
                 })?;
@@ -233,13 +242,21 @@ impl Material {
         };
         let root = parse_yaml_tree(text).map_err(|(line, m)| perr(line, m))?;
         let Node::Map(entries, _) = &root else {
-            return Err(perr(root.line(), "expected a mapping with a `DATA` key at the top level".into()));
+            return Err(perr(
+                root.line(),
+                "expected a mapping with a `DATA` key at the top level".into(),
+            ));
         };
         let data = entries
             .iter()
             .find(|(k, _)| k == "DATA")
             .map(|(_, v)| v)
-            .ok_or_else(|| perr(1, "no `DATA` key: not a refractiveindex.info material file".into()))?;
+            .ok_or_else(|| {
+                perr(
+                    1,
+                    "no `DATA` key: not a refractiveindex.info material file".into(),
+                )
+            })?;
         let Node::Seq(items, data_line) = data else {
             return Err(perr(data.line(), "`DATA` must be a list of entries".into()));
         };
@@ -250,7 +267,10 @@ impl Material {
         let mut k_part: Option<(Dispersion, (f64, f64))> = None;
         for item in items {
             let Node::Map(fields, item_line) = item else {
-                return Err(perr(item.line(), "each `DATA` entry must be a mapping with a `type`".into()));
+                return Err(perr(
+                    item.line(),
+                    "each `DATA` entry must be a mapping with a `type`".into(),
+                ));
             };
             let get = |key: &str| fields.iter().find(|(k, _)| k == key).map(|(_, v)| v);
             let ty = match get("type") {
@@ -262,14 +282,24 @@ impl Material {
                 let kind: u8 = match kind.trim().parse() {
                     Ok(k @ 1..=9) => k,
                     _ => {
-                        return Err(perr(type_line, format!("unsupported type `{ty}`: expected `formula 1` … `formula 9`, `tabulated nk`, `tabulated n` or `tabulated k`")));
+                        return Err(perr(
+                            type_line,
+                            format!(
+                                "unsupported type `{ty}`: expected `formula 1` … `formula 9`, `tabulated nk`, `tabulated n` or `tabulated k`"
+                            ),
+                        ));
                     }
                 };
                 let coefficients = match get("coefficients") {
                     Some(Node::Scalar(s, _, line)) => parse_numbers(s).map_err(|tok| {
                         perr(*line, format!("coefficient `{tok}` is not a finite number"))
                     })?,
-                    _ => return Err(perr(*item_line, format!("`{ty}` entry without `coefficients`"))),
+                    _ => {
+                        return Err(perr(
+                            *item_line,
+                            format!("`{ty}` entry without `coefficients`"),
+                        ));
+                    }
                 };
                 if coefficients.is_empty() {
                     return Err(perr(*item_line, "`coefficients` is empty".into()));
@@ -277,37 +307,65 @@ impl Material {
                 let range_nm = match get("wavelength_range") {
                     Some(Node::Scalar(s, _, line)) => {
                         let v = parse_numbers(s).map_err(|tok| {
-                            perr(*line, format!("wavelength_range value `{tok}` is not a finite number"))
+                            perr(
+                                *line,
+                                format!("wavelength_range value `{tok}` is not a finite number"),
+                            )
                         })?;
                         if v.len() != 2 || !(v[0] > 0.0 && v[1] > v[0]) {
-                            return Err(perr(*line, format!("`wavelength_range` must be two increasing positive wavelengths in µm, found `{}`", s.trim())));
+                            return Err(perr(
+                                *line,
+                                format!(
+                                    "`wavelength_range` must be two increasing positive wavelengths in µm, found `{}`",
+                                    s.trim()
+                                ),
+                            ));
                         }
                         (v[0] * 1e3, v[1] * 1e3)
                     }
-                    Some(other) => return Err(perr(other.line(), "`wavelength_range` must be two numbers".into())),
+                    Some(other) => {
+                        return Err(perr(
+                            other.line(),
+                            "`wavelength_range` must be two numbers".into(),
+                        ));
+                    }
                     None => (0.0, f64::INFINITY),
                 };
-                (Some((Dispersion::Formula { kind, coefficients }, range_nm)), None)
+                (
+                    Some((Dispersion::Formula { kind, coefficients }, range_nm)),
+                    None,
+                )
             } else {
                 let columns = match ty.as_str() {
                     "tabulated nk" => 3,
                     "tabulated n" | "tabulated k" => 2,
                     _ => {
-                        return Err(perr(type_line, format!("unsupported type `{ty}`: expected `tabulated nk`, `tabulated n`, `tabulated k` or `formula 1` … `formula 9`")));
+                        return Err(perr(
+                            type_line,
+                            format!(
+                                "unsupported type `{ty}`: expected `tabulated nk`, `tabulated n`, `tabulated k` or `formula 1` … `formula 9`"
+                            ),
+                        ));
                     }
                 };
                 let (block, first_line) = match get("data") {
                     Some(Node::Scalar(s, style, line)) => {
                         // yaml-rust2 marks a block scalar at its first non-blank content
                         // line; leading blank lines appear as leading newlines.
-                        let first = if matches!(style, TScalarStyle::Literal | TScalarStyle::Folded) {
+                        let first = if matches!(style, TScalarStyle::Literal | TScalarStyle::Folded)
+                        {
                             line - s.bytes().take_while(|&b| b == b'\n').count()
                         } else {
                             *line
                         };
                         (s.as_str(), first)
                     }
-                    _ => return Err(perr(*item_line, format!("`{ty}` entry without a `data` block"))),
+                    _ => {
+                        return Err(perr(
+                            *item_line,
+                            format!("`{ty}` entry without a `data` block"),
+                        ));
+                    }
                 };
                 let mut w = Vec::new();
                 let mut a = Vec::new();
@@ -317,18 +375,30 @@ impl Material {
                     if row.trim().is_empty() {
                         continue;
                     }
-                    let v = parse_numbers(row).map_err(|tok| {
-                        perr(line_no, format!("`{tok}` is not a finite number"))
-                    })?;
+                    let v = parse_numbers(row)
+                        .map_err(|tok| perr(line_no, format!("`{tok}` is not a finite number")))?;
                     if v.len() != columns {
-                        return Err(perr(line_no, format!("`{ty}` rows need {columns} numbers, found {}", v.len())));
+                        return Err(perr(
+                            line_no,
+                            format!("`{ty}` rows need {columns} numbers, found {}", v.len()),
+                        ));
                     }
                     if !(v[0] > 0.0) {
-                        return Err(perr(line_no, format!("wavelength {} µm must be positive", v[0])));
+                        return Err(perr(
+                            line_no,
+                            format!("wavelength {} µm must be positive", v[0]),
+                        ));
                     }
                     if let Some(&prev) = w.last() {
                         if !(v[0] * 1e3 > prev) {
-                            return Err(perr(line_no, format!("wavelengths must strictly increase ({} µm follows {} µm)", v[0], prev * 1e-3)));
+                            return Err(perr(
+                                line_no,
+                                format!(
+                                    "wavelengths must strictly increase ({} µm follows {} µm)",
+                                    v[0],
+                                    prev * 1e-3
+                                ),
+                            ));
                         }
                     }
                     let (is_n, is_k) = match ty.as_str() {
@@ -380,16 +450,22 @@ impl Material {
             }
         }
         let (n, n_range) = n_part.ok_or_else(|| {
-            perr(*data_line, "no `DATA` entry gives the real index n (only `tabulated k`)".into())
+            perr(
+                *data_line,
+                "no `DATA` entry gives the real index n (only `tabulated k`)".into(),
+            )
         })?;
         let (k, range_nm) = match k_part {
             Some((k, k_range)) => {
                 let range = (n_range.0.max(k_range.0), n_range.1.min(k_range.1));
                 if range.0 > range.1 {
-                    return Err(perr(*data_line, format!(
-                        "the n data ({}–{} nm) and k data ({}–{} nm) do not overlap",
-                        n_range.0, n_range.1, k_range.0, k_range.1
-                    )));
+                    return Err(perr(
+                        *data_line,
+                        format!(
+                            "the n data ({}–{} nm) and k data ({}–{} nm) do not overlap",
+                            n_range.0, n_range.1, k_range.0, k_range.1
+                        ),
+                    ));
                 }
                 (k, range)
             }
@@ -403,11 +479,7 @@ impl Material {
         })
     }
 
-    fn from_rows(
-        name: String,
-        source_name: &str,
-        rows: Vec<(usize, [f64; 3])>,
-    ) -> Result<Self> {
+    fn from_rows(name: String, source_name: &str, rows: Vec<(usize, [f64; 3])>) -> Result<Self> {
         let perr = |line: usize, message: String| Error::Parse {
             source_name: source_name.to_string(),
             line,
@@ -423,7 +495,10 @@ impl Material {
             }
             if let Some(p) = prev {
                 if !(*w > p) {
-                    return Err(perr(*line, format!("wavelengths must strictly increase ({w} nm follows {p} nm)")));
+                    return Err(perr(
+                        *line,
+                        format!("wavelengths must strictly increase ({w} nm follows {p} nm)"),
+                    ));
                 }
             }
             if !(*n > 0.0) {
@@ -512,7 +587,9 @@ fn check_index(name: &str, index: C64) -> Result<()> {
     if !(index.im >= 0.0 && index.im.is_finite()) {
         return Err(Error::InvalidIndex {
             text: name.to_string(),
-            reason: "the extinction coefficient κ must be finite and non-negative (κ < 0 would be gain)".into(),
+            reason:
+                "the extinction coefficient κ must be finite and non-negative (κ < 0 would be gain)"
+                    .into(),
         });
     }
     Ok(())
@@ -538,7 +615,9 @@ fn parse_complex(text: &str) -> Result<C64> {
     };
     let s: String = text.chars().filter(|c| !c.is_whitespace()).collect();
     if s.is_empty() {
-        return Err(err("empty; expected a number such as `1.5` or a complex index such as `0.27+2.9i`"));
+        return Err(err(
+            "empty; expected a number such as `1.5` or a complex index such as `0.27+2.9i`",
+        ));
     }
     let expected = "expected a number such as `1.5` or a complex index such as `0.27+2.9i`";
     if let Some(body) = s.strip_suffix(['i', 'j', 'I', 'J']) {
@@ -630,8 +709,10 @@ impl MarkedEventReceiver for TreeBuilder {
                 }
             }
             Event::Alias(_) => {
-                self.error
-                    .get_or_insert((line, "YAML aliases are not supported in material files".into()));
+                self.error.get_or_insert((
+                    line,
+                    "YAML aliases are not supported in material files".into(),
+                ));
             }
             _ => {}
         }
@@ -647,9 +728,12 @@ fn parse_yaml_tree(text: &str) -> std::result::Result<Node, (usize, String)> {
     if let Some(e) = builder.error {
         return Err(e);
     }
-    builder
-        .root
-        .ok_or_else(|| (1, "empty document: expected a mapping with a `DATA` key".into()))
+    builder.root.ok_or_else(|| {
+        (
+            1,
+            "empty document: expected a mapping with a `DATA` key".into(),
+        )
+    })
 }
 
 #[cfg(test)]
@@ -705,21 +789,32 @@ DATA:
         assert_eq!(e.to_string(), "m.yml:6: `x2.0` is not a finite number");
         let bad = METAL.replace("0.50 1.0 2.0", "0.30 1.0 2.0");
         let e = Material::from_refractiveindex_yaml("m", "m.yml", &bad).unwrap_err();
-        assert!(e.to_string().starts_with("m.yml:6: wavelengths must strictly increase"), "{e}");
+        assert!(
+            e.to_string()
+                .starts_with("m.yml:6: wavelengths must strictly increase"),
+            "{e}"
+        );
         let bad = METAL.replace("data: |\n", "data: |\n\n");
         let bad = bad.replace("0.50 1.0 2.0", "0.50 1.0 x2.0");
         let e = Material::from_refractiveindex_yaml("m", "m.yml", &bad).unwrap_err();
         assert_eq!(e.to_string(), "m.yml:7: `x2.0` is not a finite number");
         let bad = METAL.replace("0.60 0.5 3.0", "0.60 0.5 -3.0");
         let e = Material::from_refractiveindex_yaml("m", "m.yml", &bad).unwrap_err();
-        assert!(e.to_string().starts_with("m.yml:7: k = -3 must be non-negative"), "{e}");
+        assert!(
+            e.to_string()
+                .starts_with("m.yml:7: k = -3 must be non-negative"),
+            "{e}"
+        );
         let e = Material::from_refractiveindex_yaml("m", "m.yml", "DATA: [").unwrap_err();
         assert!(e.to_string().contains("malformed YAML"), "{e}");
         let e = Material::from_refractiveindex_yaml("m", "m.yml", "FOO: 1").unwrap_err();
         assert!(e.to_string().contains("no `DATA` key"), "{e}");
         let bad = SILICA.replace("formula 1", "formula 12");
         let e = Material::from_refractiveindex_yaml("m", "m.yml", &bad).unwrap_err();
-        assert!(e.to_string().starts_with("m.yml:4: unsupported type"), "{e}");
+        assert!(
+            e.to_string().starts_with("m.yml:4: unsupported type"),
+            "{e}"
+        );
     }
 
     #[test]
@@ -750,26 +845,45 @@ DATA:
         let e = Material::from_nk_csv("c", "c.csv", "wavelength_nm,n,k\n400,1.5\n").unwrap_err();
         assert!(e.to_string().starts_with("c.csv:2: expected 3"), "{e}");
         let e = Material::from_nk_csv("c", "c.csv", "lambda,n,k\n").unwrap_err();
-        assert!(e.to_string().starts_with("c.csv:1: expected the header"), "{e}");
+        assert!(
+            e.to_string().starts_with("c.csv:1: expected the header"),
+            "{e}"
+        );
         let e = Material::from_nk_csv("c", "c.csv", "wavelength_nm,n,k\n400,1.5,0\n300,1.5,0\n")
             .unwrap_err();
-        assert!(e.to_string().starts_with("c.csv:3: wavelengths must strictly increase"), "{e}");
-        let e = Material::from_nk_csv("c", "c.csv", "wavelength_nm,n,k\n400,1.5,nan\n").unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("c.csv:3: wavelengths must strictly increase"),
+            "{e}"
+        );
+        let e =
+            Material::from_nk_csv("c", "c.csv", "wavelength_nm,n,k\n400,1.5,nan\n").unwrap_err();
         assert!(e.to_string().starts_with("c.csv:2: k `nan`"), "{e}");
     }
 
     #[test]
     fn index_literals() {
-        assert_eq!(Material::parse_index("1.33").unwrap().index_at(500.0).unwrap(), C64::new(1.33, 0.0));
+        assert_eq!(
+            Material::parse_index("1.33")
+                .unwrap()
+                .index_at(500.0)
+                .unwrap(),
+            C64::new(1.33, 0.0)
+        );
         for text in ["0.27+2.9i", "0.27 + 2.9i", "0.27+2.9j", "2.7e-1+2.9i"] {
             let m = Material::parse_index(text).unwrap();
             assert_eq!(m.index_at(500.0).unwrap(), C64::new(0.27, 2.9), "{text}");
         }
         assert_eq!(
-            Material::parse_index("1.5+1e-2i").unwrap().index_at(1.0).unwrap(),
+            Material::parse_index("1.5+1e-2i")
+                .unwrap()
+                .index_at(1.0)
+                .unwrap(),
             C64::new(1.5, 0.01)
         );
-        for bad in ["", "abc", "1.5-0.1i", "-1.5", "0", "1.5+i", "inf", "nan", "1.5+2.0"] {
+        for bad in [
+            "", "abc", "1.5-0.1i", "-1.5", "0", "1.5+i", "inf", "nan", "1.5+2.0",
+        ] {
             assert!(Material::parse_index(bad).is_err(), "{bad} accepted");
         }
         let e = Material::parse_index("1.5-0.1i").unwrap_err();

@@ -1,0 +1,175 @@
+//! End-to-end tests of the `nacre` binary: outputs, and bad input that must give exit
+//! status 2, one clear message, no panic and no output (an existing file survives).
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn nacre(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_nacre"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("run nacre")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn default_spectrum_to_stdout() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = nacre(&["spectrum"], dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8(o.stdout).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next(),
+        Some("angle_deg,wavelength_nm,R_s,R_p,R,T_s,T_p,T,A")
+    );
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 90 * 81);
+    assert_eq!((rows[0][0], rows[0][1]), (0.0, 380.0));
+    assert_eq!((rows[81][0], rows[81][1]), (1.0, 380.0));
+    assert_eq!(
+        (rows.last().unwrap()[0], rows.last().unwrap()[1]),
+        (89.0, 780.0)
+    );
+    for r in &rows {
+        // A lossless soap film: R + T = 1, R = (R_s + R_p)/2.
+        assert!((r[4] + r[7] - 1.0).abs() < 1e-10 && (r[4] - 0.5 * (r[2] + r[3])).abs() < 1e-11);
+    }
+    assert!(nacre(&["spectrum", "--help"], dir.path()).status.success());
+}
+
+#[test]
+fn recipe_and_flags_agree_and_write_a_file() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("ar.toml"),
+        "substrate = \"bk7\"\nangles = \"0:80:10\"\n[[layers]]\nmaterial = \"mgf2\"\nthickness_nm = 99.75\n",
+    )
+    .unwrap();
+    let a = nacre(
+        &["spectrum", "--recipe", "ar.toml", "-o", "a.csv"],
+        dir.path(),
+    );
+    assert!(a.status.success(), "{}", stderr(&a));
+    let b = nacre(
+        &[
+            "spectrum",
+            "--layer",
+            "mgf2@99.75nm",
+            "--substrate",
+            "bk7",
+            "--angles",
+            "0:80:10",
+            "-o",
+            "b.csv",
+        ],
+        dir.path(),
+    );
+    assert!(b.status.success(), "{}", stderr(&b));
+    let a = std::fs::read(dir.path().join("a.csv")).unwrap();
+    assert_eq!(a, std::fs::read(dir.path().join("b.csv")).unwrap());
+    assert_eq!(String::from_utf8(a).unwrap().lines().count(), 1 + 9 * 81);
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().starts_with(".nacre-"))
+        .collect();
+    assert!(leftovers.is_empty(), "temporary files left behind");
+}
+
+#[test]
+fn bad_input_exits_2_with_a_message_and_keeps_existing_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(
+        d.join("bad.yml"),
+        "DATA:\n  - type: tabulated nk\n    data: |\n        0.4 1.5 0.1\n        0.5 oops 0.1\n",
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("bad.csv"),
+        "wavelength_nm,n,k\n400,1.5,0.1\n500,1.5\n",
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("bad.toml"),
+        "substrate = \"bk7\"\n[[layers]]\nmaterial = \"mgf2\"\nthickness = 5\n",
+    )
+    .unwrap();
+    std::fs::write(d.join("unclosed.toml"), "substrate = \"bk7\n").unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        (&["--angles", "0:95:1"], "--angles"),
+        (&["--angles", "abc"], "--angles `abc`"),
+        (&["--angles", "0:1e9:0.0001"], "exceed the limit"),
+        (&["--wavelengths", "380:780:0"], "--wavelengths `380:780:0`"),
+        (
+            &["--wavelengths", "780:380:5"],
+            "END must not be below START",
+        ),
+        (
+            &["--wavelengths", "100:200:1"],
+            "--wavelengths: material `air` has no data at 100 nm",
+        ),
+        (&["--wavelengths", "-5"], "--wavelengths"),
+        (&["--layer", "water@-5"], "--layer `water@-5`"),
+        (&["--layer", "water"], "MATERIAL@THICKNESS"),
+        (&["--layer", "1.5-0.1i@100"], "κ"),
+        (&["--layer", "1.5+0.1k@100"], "invalid refractive index"),
+        (&["--ambient", "au"], "ambient medium `au` absorbs"),
+        (&["--ambient", "1.5+0.1i"], "must be non-absorbing"),
+        (
+            &["--substrate", "unobtainium"],
+            "unknown material `unobtainium`",
+        ),
+        (&["--substrate", "missing.yml"], "missing.yml"),
+        (
+            &["--substrate", "bad.yml"],
+            "bad.yml:5: `oops` is not a finite number",
+        ),
+        (&["--substrate", "bad.csv"], "bad.csv:3: expected 3"),
+        (
+            &["--recipe", "bad.toml"],
+            "bad.toml:4: unknown field `thickness`",
+        ),
+        (&["--recipe", "unclosed.toml"], "unclosed.toml:1:"),
+        (&["--recipe", "nope.toml"], "nope.toml"),
+        (
+            &["--recipe", "bad.toml", "--substrate", "bk7"],
+            "cannot be used with",
+        ),
+        (&["--frobnicate"], "--frobnicate"),
+    ];
+    for (args, needle) in cases {
+        std::fs::write(d.join("out.csv"), "previous").unwrap();
+        let mut full = vec!["spectrum"];
+        full.extend_from_slice(args);
+        full.extend_from_slice(&["-o", "out.csv"]);
+        let o = nacre(&full, d);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains(needle),
+            "{args:?}: expected `{needle}` in: {err}"
+        );
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        assert_eq!(
+            std::fs::read_to_string(d.join("out.csv")).unwrap(),
+            "previous",
+            "{args:?}"
+        );
+        // and without an existing file, none is created
+        std::fs::remove_file(d.join("out.csv")).unwrap();
+        let o = nacre(&full, d);
+        assert_eq!(o.status.code(), Some(2));
+        assert!(!d.join("out.csv").exists(), "{args:?} created output");
+    }
+    let o = nacre(&["spectrum", "-o", "no/such/dir/out.csv"], d);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("no/such/dir/out.csv"), "{}", stderr(&o));
+}
