@@ -5,6 +5,9 @@
 //! [`nacre_optics`]; this crate parses, resolves, calls the core and writes files
 //! atomically.
 
+// `!(x > 0.0)` is how this crate rejects NaN together with out-of-range values.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod error;
 pub mod grid;
 pub mod materials;

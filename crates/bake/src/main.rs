@@ -1,5 +1,8 @@
 //! `nacre`: bake thin-film interference tables and spectra.
 
+// `!(x > 0.0)` is how this crate rejects NaN together with out-of-range values.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use clap::{Args, Parser, Subcommand};
 use nacre_bake::error::Result;
 use nacre_bake::grid::parse_range;

@@ -91,6 +91,16 @@ pub enum Error {
         /// Number of films in the stack.
         count: usize,
     },
+    /// A name (observer, illuminant, colour space) that is not one of the known ones.
+    #[error("unknown {what} `{name}`: expected one of {expected}")]
+    UnknownName {
+        /// What kind of name was asked for, e.g. `observer`.
+        what: &'static str,
+        /// The name given.
+        name: String,
+        /// The accepted names, e.g. `1931, 1964`.
+        expected: &'static str,
+    },
 }
 
 /// Shorthand for `Result<T, nacre_optics::Error>`.

@@ -17,11 +17,16 @@
 //! # Ok::<(), nacre_optics::Error>(())
 //! ```
 
+// `!(x > 0.0)` is how this crate rejects NaN together with out-of-range values.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+pub mod colour;
 pub mod error;
 pub mod fresnel;
 pub mod material;
 pub mod stack;
 
+pub use colour::{Colorimeter, Illuminant, Observer, OutputSpace, RgbSpace};
 pub use error::{Error, Result};
 pub use material::Material;
 pub use num_complex::Complex64 as C64;

@@ -389,32 +389,32 @@ impl Material {
                             format!("wavelength {} µm must be positive", v[0]),
                         ));
                     }
-                    if let Some(&prev) = w.last() {
-                        if !(v[0] * 1e3 > prev) {
-                            return Err(perr(
-                                line_no,
-                                format!(
-                                    "wavelengths must strictly increase ({} µm follows {} µm)",
-                                    v[0],
-                                    prev * 1e-3
-                                ),
-                            ));
-                        }
+                    if let Some(&prev) = w.last()
+                        && !(v[0] * 1e3 > prev)
+                    {
+                        return Err(perr(
+                            line_no,
+                            format!(
+                                "wavelengths must strictly increase ({} µm follows {} µm)",
+                                v[0],
+                                prev * 1e-3
+                            ),
+                        ));
                     }
                     let (is_n, is_k) = match ty.as_str() {
                         "tabulated nk" => (Some(v[1]), Some(v[2])),
                         "tabulated n" => (Some(v[1]), None),
                         _ => (None, Some(v[1])),
                     };
-                    if let Some(n) = is_n {
-                        if !(n > 0.0) {
-                            return Err(perr(line_no, format!("n = {n} must be positive")));
-                        }
+                    if let Some(n) = is_n
+                        && !(n > 0.0)
+                    {
+                        return Err(perr(line_no, format!("n = {n} must be positive")));
                     }
-                    if let Some(k) = is_k {
-                        if !(k >= 0.0) {
-                            return Err(perr(line_no, format!("k = {k} must be non-negative")));
-                        }
+                    if let Some(k) = is_k
+                        && !(k >= 0.0)
+                    {
+                        return Err(perr(line_no, format!("k = {k} must be non-negative")));
                     }
                     w.push(v[0] * 1e3);
                     a.push(v[1]);
@@ -493,13 +493,13 @@ impl Material {
             if !(*w > 0.0) {
                 return Err(perr(*line, format!("wavelength {w} nm must be positive")));
             }
-            if let Some(p) = prev {
-                if !(*w > p) {
-                    return Err(perr(
-                        *line,
-                        format!("wavelengths must strictly increase ({w} nm follows {p} nm)"),
-                    ));
-                }
+            if let Some(p) = prev
+                && !(*w > p)
+            {
+                return Err(perr(
+                    *line,
+                    format!("wavelengths must strictly increase ({w} nm follows {p} nm)"),
+                ));
             }
             if !(*n > 0.0) {
                 return Err(perr(*line, format!("n = {n} must be positive")));

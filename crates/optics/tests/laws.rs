@@ -58,7 +58,7 @@ proptest! {
             prop_assert!((-1e-12..=1.0 + 1e-12).contains(&v), "{p:?}");
         }
         for a in [1.0 - p.R_s - p.T_s, 1.0 - p.R_p - p.T_p] {
-            prop_assert!(a >= -1e-12 && a <= 1.0 + 1e-12, "{p:?}");
+            prop_assert!((-1e-12..=1.0 + 1e-12).contains(&a), "{p:?}");
         }
     }
 
