@@ -24,10 +24,12 @@ pub mod colour;
 pub mod error;
 pub mod fresnel;
 pub mod material;
+pub mod spectral;
 pub mod stack;
 
 pub use colour::{Colorimeter, Illuminant, Observer, OutputSpace, RgbSpace};
 pub use error::{Error, Result};
 pub use material::Material;
 pub use num_complex::Complex64 as C64;
+pub use spectral::{FilmColours, SpectralRule};
 pub use stack::{Amplitudes, Layer, Power, Prepared, Response, Stack};

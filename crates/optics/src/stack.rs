@@ -230,7 +230,7 @@ impl Prepared {
 /// A thickness sweep of one film at fixed angle and wavelength: the part of the stack
 /// below the varying film is folded into (Γ, τ) once; each thickness then costs one
 /// complex exponential and the recurrence through the films above it.
-struct ThicknessSweep<'a> {
+pub(crate) struct ThicknessSweep<'a> {
     prepared: &'a Prepared,
     k0: f64,
     /// 1-based medium index of the varying film.
@@ -247,7 +247,12 @@ struct ThicknessSweep<'a> {
 }
 
 impl<'a> ThicknessSweep<'a> {
-    fn new(prepared: &'a Prepared, wavelength_nm: f64, thickness_nm: &[f64], film: usize) -> Self {
+    pub(crate) fn new(
+        prepared: &'a Prepared,
+        wavelength_nm: f64,
+        thickness_nm: &[f64],
+        film: usize,
+    ) -> Self {
         let k0 = wavenumber(wavelength_nm);
         let n = prepared.films();
         let bottom = &prepared.interfaces[n];
@@ -283,7 +288,7 @@ impl<'a> ThicknessSweep<'a> {
     /// are uniformly spaced by `uniform_step_nm`, the top-film path advances the phasor
     /// e^{2iδ} by one complex multiplication per step instead of a `sin_cos`, re-anchoring
     /// on the exact value every [`RESYNC`] steps (R and T stay within 1e-12 of the pointwise values, tested).
-    fn fill(&self, thickness_nm: &[f64], uniform_step_nm: Option<f64>, row: &mut [Power]) {
+    pub(crate) fn fill(&self, thickness_nm: &[f64], uniform_step_nm: Option<f64>, row: &mut [Power]) {
         if self.film != 1 {
             for (slot, &d) in row.iter_mut().zip(thickness_nm) {
                 *slot = self.power(d);
@@ -460,21 +465,7 @@ impl Stack {
         wavelengths_nm: &[f64],
         thicknesses_nm: &[f64],
     ) -> Result<Vec<Power>> {
-        if layer == 0 || layer > self.layers.len() {
-            return Err(Error::NoSuchLayer {
-                layer,
-                count: self.layers.len(),
-            });
-        }
-        for &d in thicknesses_nm {
-            if !(d >= 0.0 && d.is_finite()) {
-                return Err(Error::InvalidThickness {
-                    layer,
-                    material: self.layers[layer - 1].material.name().to_string(),
-                    thickness_nm: d,
-                });
-            }
-        }
+        self.check_layer(layer, thicknesses_nm)?;
         let thickness = self.thicknesses_nm();
         let (sines, indices) = self.resolve(angles_deg, wavelengths_nm)?;
         let uniform_step = uniform_step(thicknesses_nm);
@@ -497,8 +488,28 @@ impl Stack {
         Ok(out)
     }
 
+    /// Checks that film `layer` (1-based) exists and that every thickness is valid.
+    pub(crate) fn check_layer(&self, layer: usize, thicknesses_nm: &[f64]) -> Result<()> {
+        if layer == 0 || layer > self.layers.len() {
+            return Err(Error::NoSuchLayer {
+                layer,
+                count: self.layers.len(),
+            });
+        }
+        for &d in thicknesses_nm {
+            if !(d >= 0.0 && d.is_finite()) {
+                return Err(Error::InvalidThickness {
+                    layer,
+                    material: self.layers[layer - 1].material.name().to_string(),
+                    thickness_nm: d,
+                });
+            }
+        }
+        Ok(())
+    }
+
     /// Validates angles and resolves indices once per wavelength.
-    fn resolve(
+    pub(crate) fn resolve(
         &self,
         angles_deg: &[f64],
         wavelengths_nm: &[f64],
@@ -521,7 +532,7 @@ const RESYNC: usize = 8;
 
 /// The common spacing of `values` when every value lies within a few ulps of
 /// `values[0] + k · step` (so that stepping a phasor is as exact as evaluating it).
-fn uniform_step(values: &[f64]) -> Option<f64> {
+pub(crate) fn uniform_step(values: &[f64]) -> Option<f64> {
     let n = values.len();
     if n < 3 {
         return None;

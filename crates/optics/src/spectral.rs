@@ -1,0 +1,267 @@
+//! Spectral integration that stays exact for thick films.
+//!
+//! A colour is C = ∫ R(λ) s(λ) dλ over 360–830 nm, with s(λ) the output-space sensitivity
+//! of a [`Colorimeter`] (its 1 nm weights, linearly interpolated:
+//! [`Colorimeter::sensitivity_at`]). The interference term of a film oscillates in
+//! wavelength with phase φ(λ) = 2π Δ / λ, Δ the optical path difference (OPD) of the film,
+//! so |dφ/dλ| = 2π Δ / λ²: a 10 µm film of index 2.4 (Δ ≈ 48 µm) turns its phase by
+//! 2.3 rad per nanometre at 360 nm, and the CIE 015 1 nm rectangle rule aliases.
+//!
+//! # Method: composite Gauss–Legendre quadrature on a phase-adapted grid
+//!
+//! Each 1 nm cell [λᵢ, λᵢ + 1] (on which s is linear) is split into
+//! mᵢ = ⌈(2π Δ_max / λᵢ²) / h_max⌉ equal sub-intervals so that the film phase advances by
+//! at most h_max = 0.5 rad across each, and each sub-interval is integrated with the
+//! 2-point Gauss–Legendre rule (nodes at the centre ± h/(2√3), weights h/2; exact for
+//! cubics, error ∝ h⁴ f⁽⁴⁾/4320). This is the standard treatment of oscillatory
+//! integrands by sub-division below the oscillation scale (Davis & Rabinowitz, *Methods of
+//! Numerical Integration*, 2nd ed. 1984, §2.7 and §4.3). The node weights include s(λ), so
+//! a colour is the dot product Σₖ R(λₖ) Wₖ. The weights are finally rescaled per channel
+//! so that R ≡ 1 gives exactly the colorimeter's white (Σₖ Wₖ = Σᵢ wᵢ, the 1 nm sum), which
+//! keeps the result consistent with [`Colorimeter::colour_of`] for slowly varying spectra.
+//!
+//! Measured against a 0.1 nm integration (test `thick_films_match_fine_integration`), films
+//! up to 10 µm stay within ΔE2000 0.01.
+
+use crate::colour::{Colorimeter, SPECTRAL_MAX_NM, SPECTRAL_MIN_NM};
+use crate::error::Result;
+use crate::stack::{Prepared, Stack, ThicknessSweep, uniform_step};
+use std::f64::consts::PI;
+
+/// Largest phase advance of the film term across one quadrature sub-interval, radians.
+const MAX_PHASE_STEP_RAD: f64 = 0.5;
+
+/// Gauss–Legendre 2-point abscissa on [−1, 1]: 1/√3.
+const GL2: f64 = 0.577_350_269_189_625_8;
+
+/// Quadrature nodes and sensitivity-weighted weights: colour = Σₖ f(λₖ) Wₖ.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SpectralRule {
+    wavelengths_nm: Vec<f64>,
+    weights: Vec<[f64; 3]>,
+}
+
+impl SpectralRule {
+    /// The rule for spectra whose interference terms have optical path differences up to
+    /// `max_opd_nm` (0 for smooth spectra), for `colorimeter`'s sensitivities.
+    pub fn new(colorimeter: &Colorimeter, max_opd_nm: f64) -> Self {
+        let max_opd_nm = max_opd_nm.max(0.0);
+        let mut wavelengths_nm = Vec::new();
+        let mut weights = Vec::new();
+        let cells = (SPECTRAL_MAX_NM - SPECTRAL_MIN_NM).round() as usize;
+        for i in 0..cells {
+            let lo = SPECTRAL_MIN_NM + i as f64;
+            let rate = 2.0 * PI * max_opd_nm / (lo * lo);
+            let m = ((rate / MAX_PHASE_STEP_RAD).ceil() as usize).max(1);
+            let h = 1.0 / m as f64;
+            for j in 0..m {
+                let centre = lo + (j as f64 + 0.5) * h;
+                for x in [centre - 0.5 * h * GL2, centre + 0.5 * h * GL2] {
+                    wavelengths_nm.push(x);
+                    weights.push(colorimeter.sensitivity_at(x).map(|s| s * 0.5 * h));
+                }
+            }
+        }
+        // Rescale per channel so that R ≡ 1 gives the colorimeter's white exactly.
+        let target = sum3(colorimeter.weights_1nm().iter().copied());
+        let got = sum3(weights.iter().copied());
+        let scale: [f64; 3] = std::array::from_fn(|c| if got[c] != 0.0 { target[c] / got[c] } else { 1.0 });
+        for w in &mut weights {
+            *w = std::array::from_fn(|c| w[c] * scale[c]);
+        }
+        SpectralRule {
+            wavelengths_nm,
+            weights,
+        }
+    }
+
+    /// The quadrature nodes, nm, increasing.
+    pub fn wavelengths_nm(&self) -> &[f64] {
+        &self.wavelengths_nm
+    }
+
+    /// The weights Wₖ (output space, per node).
+    pub fn weights(&self) -> &[[f64; 3]] {
+        &self.weights
+    }
+
+    /// Σₖ values[k] Wₖ.
+    pub fn colour(&self, values: impl IntoIterator<Item = f64>) -> [f64; 3] {
+        let mut c = [0.0; 3];
+        for (v, w) in values.into_iter().zip(&self.weights) {
+            for (ci, wi) in c.iter_mut().zip(w) {
+                *ci += v * wi;
+            }
+        }
+        c
+    }
+}
+
+fn sum3(it: impl Iterator<Item = [f64; 3]>) -> [f64; 3] {
+    it.fold([0.0; 3], |a, w| [a[0] + w[0], a[1] + w[1], a[2] + w[2]])
+}
+
+/// Reflectance and transmittance colours (unpolarised) over a thickness sweep.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FilmColours {
+    /// Reflectance colour per thickness.
+    pub reflectance: Vec<[f64; 3]>,
+    /// Transmittance colour per thickness.
+    pub transmittance: Vec<[f64; 3]>,
+}
+
+impl Stack {
+    /// An upper bound of the optical path difference Σⱼ 2 dⱼ |ñⱼ| of the films, nm, with
+    /// film `layer` (1-based) at `thickness_nm` instead of its own thickness; indices
+    /// are sampled at 380, 480, … 780 nm where the materials have data.
+    pub fn max_opd_nm(&self, layer: Option<(usize, f64)>) -> f64 {
+        self.layers()
+            .iter()
+            .enumerate()
+            .map(|(j, l)| {
+                let d = match layer {
+                    Some((k, d)) if k == j + 1 => d,
+                    _ => l.thickness_nm,
+                };
+                let n = [380.0, 480.0, 580.0, 680.0, 780.0]
+                    .iter()
+                    .filter_map(|&wl| l.material.index_at(wl).ok())
+                    .map(|n| n.norm())
+                    .fold(0.0f64, f64::max);
+                2.0 * d * n
+            })
+            .sum()
+    }
+
+    /// Unpolarised reflectance and transmittance colours at incidence `angle_deg` for
+    /// film `layer` (1-based) taking each thickness of `thicknesses_nm`, integrated with
+    /// `rule` (which must resolve the largest OPD; see [`SpectralRule::new`]).
+    /// Summation runs over the nodes in increasing order, so results do not depend on
+    /// threading.
+    pub fn colours_over_thickness(
+        &self,
+        layer: usize,
+        angle_deg: f64,
+        rule: &SpectralRule,
+        thicknesses_nm: &[f64],
+    ) -> Result<FilmColours> {
+        // Validates layer, angle and thicknesses, and resolves every index once.
+        let (sines, indices) = self.resolve(&[angle_deg], rule.wavelengths_nm())?;
+        self.check_layer(layer, thicknesses_nm)?;
+        let sin_theta = sines[0];
+        let thickness = self.thicknesses_nm();
+        let step = uniform_step(thicknesses_nm);
+        let n = thicknesses_nm.len();
+        let mut out = FilmColours {
+            reflectance: vec![[0.0; 3]; n],
+            transmittance: vec![[0.0; 3]; n],
+        };
+        let mut row = vec![crate::Power::default(); n];
+        let mut cache: Option<Prepared> = None;
+        for ((&wl, idx), w) in rule.wavelengths_nm().iter().zip(&indices).zip(rule.weights()) {
+            if cache.as_ref().is_none_or(|p| p.indices() != idx.as_slice()) {
+                cache = Some(Prepared::new(idx, idx[0].re * sin_theta));
+            }
+            let prepared = cache.as_ref().expect("just filled");
+            ThicknessSweep::new(prepared, wl, &thickness, layer).fill(thicknesses_nm, step, &mut row);
+            for ((p, r), t) in row.iter().zip(&mut out.reflectance).zip(&mut out.transmittance) {
+                let (rv, tv) = (p.R(), p.T());
+                for c in 0..3 {
+                    r[c] += rv * w[c];
+                    t[c] += tv * w[c];
+                }
+            }
+        }
+        Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::colour::{Illuminant, Observer, OutputSpace, RgbSpace, delta_e_2000, xyz_to_lab};
+    use crate::{C64, Layer, Material};
+
+    fn srgb() -> Colorimeter {
+        Colorimeter::new(Observer::Cie1931_2Deg, Illuminant::D65, OutputSpace::Rgb(RgbSpace::Srgb))
+    }
+
+    fn film_stack(n_film: f64, d: f64, n_base: C64) -> Stack {
+        let m = |n: C64| Material::constant(format!("{n}"), n).unwrap();
+        Stack::new(
+            m(C64::new(1.0, 0.0)),
+            vec![Layer {
+                material: m(C64::new(n_film, 0.0)),
+                thickness_nm: d,
+            }],
+            m(n_base),
+        )
+        .unwrap()
+    }
+
+    /// Brute force: rectangle rule at `step_nm` with linearly interpolated sensitivities,
+    /// normalised like the rule.
+    fn fine(colorimeter: &Colorimeter, stack: &Stack, angle: f64, step_nm: f64) -> [f64; 3] {
+        let n = ((SPECTRAL_MAX_NM - SPECTRAL_MIN_NM) / step_nm).round() as usize;
+        let wl: Vec<f64> = (0..=n).map(|i| SPECTRAL_MIN_NM + i as f64 * step_nm).collect();
+        let p = stack.sweep(&[angle], &wl).unwrap();
+        let mut c = [0.0; 3];
+        let mut norm = [0.0; 3];
+        for (w, p) in wl.iter().zip(&p) {
+            let s = colorimeter.sensitivity_at(*w);
+            for k in 0..3 {
+                c[k] += p.R() * s[k];
+                norm[k] += s[k];
+            }
+        }
+        let target = sum3(colorimeter.weights_1nm().iter().copied());
+        std::array::from_fn(|k| c[k] * target[k] / norm[k])
+    }
+
+    fn delta_e(colorimeter: &Colorimeter, a: [f64; 3], b: [f64; 3]) -> f64 {
+        let white = colorimeter.white_xyz();
+        let lab = |c| xyz_to_lab(colorimeter.xyz_from_output(c), white);
+        delta_e_2000(lab(a), lab(b))
+    }
+
+    #[test]
+    fn perfect_reflector_is_white() {
+        let c = srgb();
+        for opd in [0.0, 1e3, 5e4] {
+            let rule = SpectralRule::new(&c, opd);
+            let w = rule.colour(std::iter::repeat_n(1.0, rule.wavelengths_nm().len()));
+            for v in w {
+                assert!((v - 1.0).abs() < 1e-12, "{w:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn thick_films_match_fine_integration() {
+        let c = srgb();
+        let mut worst: f64 = 0.0;
+        for &(n_film, d, base, angle) in &[
+            (1.33, 400.0, C64::new(1.0, 0.0), 0.0),
+            (1.5, 2000.0, C64::new(1.5, 0.0), 30.0),
+            (2.4, 10_000.0, C64::new(1.0, 0.0), 0.0),
+            (2.4, 10_000.0, C64::new(0.27, 2.9), 60.0),
+            (1.2, 10_000.0, C64::new(2.5, 0.0), 85.0),
+            (1.8, 7_345.0, C64::new(1.0, 0.0), 45.0),
+        ] {
+            let stack = film_stack(n_film, d, base);
+            let rule = SpectralRule::new(&c, stack.max_opd_nm(None));
+            let ours = stack.colours_over_thickness(1, angle, &rule, &[d]).unwrap().reflectance[0];
+            let reference = fine(&c, &stack, angle, 0.1);
+            let de = delta_e(&c, ours, reference);
+            worst = worst.max(de);
+            assert!(de < 0.01, "n={n_film} d={d} angle={angle}: ΔE {de} {ours:?} vs {reference:?}");
+        }
+        eprintln!("worst ΔE2000 against 0.1 nm: {worst:.2e}");
+        // The 1 nm rectangle rule, by contrast, aliases for the 10 µm film.
+        // The 1 nm rectangle rule, by contrast, aliases: ΔE2000 0.077 for a 10 µm film of
+        // index 2.4 on a metal (1.13 at 20 µm).
+        let stack = film_stack(2.4, 10_000.0, C64::new(0.27, 2.9));
+        let coarse = c.colour_of(|wl| stack.evaluate(0.0, wl).unwrap().power.R());
+        assert!(delta_e(&c, coarse, fine(&c, &stack, 0.0, 0.1)) > 0.05);
+    }
+}
