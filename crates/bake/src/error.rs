@@ -68,6 +68,23 @@ pub enum Error {
         /// The limit.
         limit: u64,
     },
+    /// A lookup-table image (OpenEXR or PNG atlas) is malformed, does not match the
+    /// expected dimensions, or a table cannot be written in the requested format.
+    #[error("{}: {message}", path.display())]
+    Table {
+        /// The image file.
+        path: PathBuf,
+        /// What was wrong and what was expected.
+        message: String,
+    },
+    /// A value (usually from a recipe or manifest) that is well-formed but not acceptable.
+    #[error("{context}: {message}")]
+    Invalid {
+        /// File, `file:line`, flag or table name concerned.
+        context: String,
+        /// What was wrong and what was expected.
+        message: String,
+    },
 }
 
 /// Shorthand for `Result<T, nacre_bake::Error>`.

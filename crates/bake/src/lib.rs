@@ -8,11 +8,15 @@
 // `!(x > 0.0)` is how this crate rejects NaN together with out-of-range values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod bake;
+pub mod color;
 pub mod error;
+pub mod film_lut;
 pub mod grid;
 pub mod materials;
 pub mod output;
 pub mod spectrum;
 pub mod stack_spec;
+pub mod table_io;
 
 pub use error::{Error, Result};

@@ -8,7 +8,7 @@ use nacre_bake::error::Result;
 use nacre_bake::grid::parse_range;
 use nacre_bake::output::write_atomic;
 use nacre_bake::stack_spec::{StackRecipe, StackSpec};
-use nacre_bake::{materials, spectrum};
+use nacre_bake::{bake, materials, spectrum};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -28,8 +28,94 @@ enum Command {
     /// Exact reflectance/transmittance of a multilayer stack over angle × wavelength, as CSV.
     #[command(after_help = SPECTRUM_EXAMPLES)]
     Spectrum(SpectrumArgs),
+    /// Colour of a stack's reflectance or transmittance by a chosen method, as CSV.
+    #[command(after_help = COLOR_EXAMPLES)]
+    Color(ColorArgs),
+    /// Bake lookup tables from recipes (default: every recipe in tables/recipes/ into tables/baked/).
+    #[command(after_help = BAKE_EXAMPLES)]
+    Bake(BakeArgs),
+    /// Print a baked table's manifest as JSON.
+    Info {
+        /// A default-set table name (e.g. film-dielectric) or a manifest path.
+        #[arg(value_name = "NAME|PATH")]
+        table: String,
+    },
     /// List the bundled materials.
     Materials,
+}
+
+const BAKE_EXAMPLES: &str = "\
+Examples:
+  # the default set: every recipe in tables/recipes/ into tables/baked/
+  nacre bake
+  # one recipe into another folder
+  nacre bake tables/recipes/film-gold.toml --out /tmp/tables
+The recipe format is documented in the README (\"Table recipes\").";
+
+const COLOR_EXAMPLES: &str = "\
+Methods: spectral (exact reference), lut:NAME|PATH (a baked film-lut, default-set name or
+manifest path), rgb3 (650/510/475 nm), samples:N (N wavelengths over 400-700 nm).
+
+Examples:
+  # colour of a 400 nm soap film over angle, exact
+  nacre color --layer 1.33@400 --angles 0:85:5
+  # the same from the baked default table
+  nacre color --ambient 1.0 --layer 1.33@400 --substrate 1.0 --angles 0:85:5 --method lut:soap-film
+  # points (angle_deg,thickness_nm,film_ior) on the glTF default base, in Rec.2020
+  nacre color --ambient 1.0 --layer 1.5@0 --substrate 1.5 --points points.csv --space rec2020
+  # transmittance colour, CIE 1964 observer under illuminant A
+  nacre color --layer water@600 --quantity t --observer 1964 --illuminant a";
+
+#[derive(Args)]
+struct ColorArgs {
+    #[command(flatten)]
+    stack: StackArgs,
+    /// Incidence angles in the ambient, degrees [default: 0:89:1]; the film keeps its own
+    /// thickness and index.
+    #[arg(
+        long,
+        value_name = "START:END:STEP",
+        allow_hyphen_values = true,
+        conflicts_with = "points"
+    )]
+    angles: Option<String>,
+    /// Points CSV with columns angle_deg,thickness_nm,film_ior; each row overrides the first
+    /// film's thickness and real index.
+    #[arg(long, value_name = "FILE.csv")]
+    points: Option<PathBuf>,
+    /// spectral | lut:NAME|PATH | rgb3 | samples:N.
+    #[arg(long, default_value = "spectral")]
+    method: String,
+    /// r (reflectance) or t (transmittance into the base).
+    #[arg(long, default_value = "r", value_parser = ["r", "t"])]
+    quantity: String,
+    /// CIE observer: 1931 (2°) or 1964 (10°) [default: 1931, or the table's].
+    #[arg(long)]
+    observer: Option<String>,
+    /// Illuminant: d65, d50, a or e [default: d65, or the table's].
+    #[arg(long)]
+    illuminant: Option<String>,
+    /// Output space: xyz, srgb, rec2020, p3 or acescg (linear) [default: srgb, or the table's].
+    #[arg(long)]
+    space: Option<String>,
+    /// Output CSV file, or `-` for standard output.
+    #[arg(
+        short = 'o',
+        long = "output",
+        value_name = "FILE.csv",
+        default_value = "-"
+    )]
+    output: PathBuf,
+}
+
+#[derive(Args)]
+struct BakeArgs {
+    /// Recipe files (TOML) [default: every tables/recipes/*.toml].
+    #[arg(value_name = "RECIPE.toml")]
+    recipes: Vec<PathBuf>,
+    /// Output folder [default: tables/baked].
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
 }
 
 const SPECTRUM_EXAMPLES: &str = "\
@@ -54,7 +140,7 @@ struct StackArgs {
     /// Ambient (incidence) medium; must be non-absorbing [default: air].
     #[arg(long, value_name = "M")]
     ambient: Option<String>,
-    /// A film, top first; repeat for more films [default with no stack flags: water@400].
+    /// A film, top first; repeat for more films (default with no stack flags: water@400).
     #[arg(long = "layer", value_name = "M@THICKNESS")]
     layers: Vec<String>,
     /// Substrate (any index, absorbing allowed) [default: air].
@@ -128,9 +214,161 @@ fn run_spectrum(args: &SpectrumArgs) -> Result<()> {
     })
 }
 
+fn run_color(args: &ColorArgs) -> Result<()> {
+    use nacre_bake::color::{self, LoadedLut, Method, Point, Quantity};
+    use nacre_bake::error::Error;
+    use nacre_optics::colour::Colorimeter;
+    let (spec, recipe_angles, _) = load_stack(&args.stack)?;
+    let method = Method::parse(&args.method)?;
+    let quantity = if args.quantity == "t" {
+        Quantity::Transmittance
+    } else {
+        Quantity::Reflectance
+    };
+    let points: Vec<Point> = match &args.points {
+        Some(path) => {
+            let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+                path: path.clone(),
+                source,
+            })?;
+            color::parse_points(path, &text)?
+        }
+        None => {
+            let text = args
+                .angles
+                .clone()
+                .or(recipe_angles)
+                .unwrap_or_else(|| "0:89:1".into());
+            let angles = parse_range("--angles", &text)?;
+            if let Some(a) = angles.iter().find(|a| !(a.abs() < 90.0)) {
+                return Err(Error::Flag {
+                    flag: "--angles".into(),
+                    value: text,
+                    message: format!("angle {a} must lie strictly between -90 and 90 degrees"),
+                });
+            }
+            angles
+                .into_iter()
+                .map(|angle_deg| Point {
+                    angle_deg,
+                    thickness_nm: None,
+                    film_ior: None,
+                })
+                .collect()
+        }
+    };
+    let stack = spec.build()?;
+    let (lut, colorimeter) = match &method {
+        Method::Lut(path) => {
+            let lut = LoadedLut::load(path)?;
+            lut.check_stack(path, &stack)?;
+            let m = &lut.manifest;
+            for (flag, given, table) in [
+                ("--observer", &args.observer, &m.observer),
+                ("--illuminant", &args.illuminant, &m.illuminant),
+                ("--space", &args.space, &m.space),
+            ] {
+                if let Some(g) = given
+                    && !g.eq_ignore_ascii_case(table)
+                {
+                    return Err(Error::Flag {
+                        flag: flag.into(),
+                        value: g.clone(),
+                        message: format!("table `{}` was baked for `{table}`", m.name),
+                    });
+                }
+            }
+            let c = lut.colorimeter.clone();
+            (Some(lut), c)
+        }
+        _ => {
+            fn flag_err(flag: &'static str, v: &str) -> impl FnOnce(nacre_optics::Error) -> Error {
+                let v = v.to_string();
+                move |e| Error::Flag {
+                    flag: flag.into(),
+                    value: v,
+                    message: e.to_string(),
+                }
+            }
+            let o = args.observer.clone().unwrap_or_else(|| "1931".into());
+            let i = args.illuminant.clone().unwrap_or_else(|| "d65".into());
+            let s = args.space.clone().unwrap_or_else(|| "srgb".into());
+            let c = Colorimeter::new(
+                o.parse().map_err(flag_err("--observer", &o))?,
+                i.parse().map_err(flag_err("--illuminant", &i))?,
+                s.parse().map_err(flag_err("--space", &s))?,
+            );
+            if method == Method::Rgb3 && s == "xyz" {
+                return Err(Error::Flag {
+                    flag: "--method".into(),
+                    value: "rgb3".into(),
+                    message: "rgb3 gives RGB directly: choose an RGB --space".into(),
+                });
+            }
+            (None, c)
+        }
+    };
+    let colours = color::evaluate(
+        &stack,
+        &points,
+        &method,
+        &colorimeter,
+        quantity,
+        lut.as_ref(),
+    )?;
+    write_atomic(&args.output, |w| {
+        color::write_csv(w, &stack, &points, &colours, &colorimeter)
+    })
+}
+
+fn run_bake(args: &BakeArgs) -> Result<()> {
+    use indicatif::{ProgressBar, ProgressStyle};
+    let paths = if args.recipes.is_empty() {
+        bake::default_recipes()?
+    } else {
+        args.recipes.clone()
+    };
+    let out = args.out.clone().unwrap_or_else(bake::default_baked_dir);
+    // Parse and validate every recipe before baking any.
+    let recipes = paths
+        .iter()
+        .map(|p| bake::Recipe::read(p))
+        .collect::<Result<Vec<_>>>()?;
+    for recipe in &recipes {
+        let a = &recipe.job.axes;
+        let bar = ProgressBar::new((a.cos_theta_count * a.ior_count) as u64).with_style(
+            ProgressStyle::with_template("{prefix:>16} [{bar:30}] {pos}/{len} rows {elapsed}")
+                .expect("valid template")
+                .progress_chars("=> "),
+        );
+        bar.set_prefix(recipe.name.clone());
+        let start = std::time::Instant::now();
+        let manifest = bake::bake_recipe(recipe, &out, &|| bar.inc(1))?;
+        bar.finish_and_clear();
+        eprintln!(
+            "baked {} in {:.2} s -> {}",
+            recipe.name,
+            start.elapsed().as_secs_f64(),
+            manifest.display()
+        );
+    }
+    Ok(())
+}
+
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Spectrum(args) => run_spectrum(&args),
+        Command::Bake(args) => run_bake(&args),
+        Command::Color(args) => run_color(&args),
+        Command::Info { table } => {
+            let path = bake::resolve_table(&table);
+            let manifest = bake::Manifest::read(&path)?;
+            println!(
+                "{}",
+                serde_json::to_string_pretty(&manifest).expect("manifest serialises")
+            );
+            Ok(())
+        }
         Command::Materials => {
             for b in materials::BUNDLED {
                 let m = materials::load_bundled(b)?;

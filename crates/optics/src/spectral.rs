@@ -54,7 +54,9 @@ impl SpectralRule {
         let mut lo = SPECTRAL_MIN_NM;
         while lo < SPECTRAL_MAX_NM {
             let rate = 2.0 * PI * max_opd_nm / (lo * lo);
-            let h = (MAX_PHASE_STEP_RAD / rate).min(MAX_CELL_NM).min(SPECTRAL_MAX_NM - lo);
+            let h = (MAX_PHASE_STEP_RAD / rate)
+                .min(MAX_CELL_NM)
+                .min(SPECTRAL_MAX_NM - lo);
             let centre = lo + 0.5 * h;
             for x in [centre - 0.5 * h * GL2, centre + 0.5 * h * GL2] {
                 wavelengths_nm.push(x);
@@ -65,7 +67,13 @@ impl SpectralRule {
         // Rescale per channel so that R ≡ 1 gives the colorimeter's white exactly.
         let target = sum3(colorimeter.weights_1nm().iter().copied());
         let got = sum3(weights.iter().copied());
-        let scale: [f64; 3] = std::array::from_fn(|c| if got[c] != 0.0 { target[c] / got[c] } else { 1.0 });
+        let scale: [f64; 3] = std::array::from_fn(|c| {
+            if got[c] != 0.0 {
+                target[c] / got[c]
+            } else {
+                1.0
+            }
+        });
         for w in &mut weights {
             *w = std::array::from_fn(|c| w[c] * scale[c]);
         }
@@ -158,13 +166,26 @@ impl Stack {
         };
         let mut row = vec![crate::Power::default(); n];
         let mut cache: Option<Prepared> = None;
-        for ((&wl, idx), w) in rule.wavelengths_nm().iter().zip(&indices).zip(rule.weights()) {
+        for ((&wl, idx), w) in rule
+            .wavelengths_nm()
+            .iter()
+            .zip(&indices)
+            .zip(rule.weights())
+        {
             if cache.as_ref().is_none_or(|p| p.indices() != idx.as_slice()) {
                 cache = Some(Prepared::new(idx, idx[0].re * sin_theta));
             }
             let prepared = cache.as_ref().expect("just filled");
-            ThicknessSweep::new(prepared, wl, &thickness, layer).fill(thicknesses_nm, step, &mut row);
-            for ((p, r), t) in row.iter().zip(&mut out.reflectance).zip(&mut out.transmittance) {
+            ThicknessSweep::new(prepared, wl, &thickness, layer).fill(
+                thicknesses_nm,
+                step,
+                &mut row,
+            );
+            for ((p, r), t) in row
+                .iter()
+                .zip(&mut out.reflectance)
+                .zip(&mut out.transmittance)
+            {
                 let (rv, tv) = (p.R(), p.T());
                 for c in 0..3 {
                     r[c] += rv * w[c];
@@ -183,7 +204,11 @@ mod tests {
     use crate::{C64, Layer, Material};
 
     fn srgb() -> Colorimeter {
-        Colorimeter::new(Observer::Cie1931_2Deg, Illuminant::D65, OutputSpace::Rgb(RgbSpace::Srgb))
+        Colorimeter::new(
+            Observer::Cie1931_2Deg,
+            Illuminant::D65,
+            OutputSpace::Rgb(RgbSpace::Srgb),
+        )
     }
 
     fn film_stack(n_film: f64, d: f64, n_base: C64) -> Stack {
@@ -203,7 +228,9 @@ mod tests {
     /// normalised like the rule.
     fn fine(colorimeter: &Colorimeter, stack: &Stack, angle: f64, step_nm: f64) -> [f64; 3] {
         let n = ((SPECTRAL_MAX_NM - SPECTRAL_MIN_NM) / step_nm).round() as usize;
-        let wl: Vec<f64> = (0..=n).map(|i| SPECTRAL_MIN_NM + i as f64 * step_nm).collect();
+        let wl: Vec<f64> = (0..=n)
+            .map(|i| SPECTRAL_MIN_NM + i as f64 * step_nm)
+            .collect();
         let p = stack.sweep(&[angle], &wl).unwrap();
         let mut c = [0.0; 3];
         let mut norm = [0.0; 3];
@@ -250,11 +277,17 @@ mod tests {
         ] {
             let stack = film_stack(n_film, d, base);
             let rule = SpectralRule::new(&c, stack.max_opd_nm(None));
-            let ours = stack.colours_over_thickness(1, angle, &rule, &[d]).unwrap().reflectance[0];
+            let ours = stack
+                .colours_over_thickness(1, angle, &rule, &[d])
+                .unwrap()
+                .reflectance[0];
             let reference = fine(&c, &stack, angle, 0.1);
             let de = delta_e(&c, ours, reference);
             worst = worst.max(de);
-            assert!(de < 0.01, "n={n_film} d={d} angle={angle}: ΔE {de} {ours:?} vs {reference:?}");
+            assert!(
+                de < 0.01,
+                "n={n_film} d={d} angle={angle}: ΔE {de} {ours:?} vs {reference:?}"
+            );
         }
         eprintln!("worst ΔE2000 against 0.1 nm: {worst:.2e}");
         // The 1 nm rectangle rule, by contrast, aliases for the 10 µm film.

@@ -288,7 +288,12 @@ impl<'a> ThicknessSweep<'a> {
     /// are uniformly spaced by `uniform_step_nm`, the top-film path advances the phasor
     /// e^{2iδ} by one complex multiplication per step instead of a `sin_cos`, re-anchoring
     /// on the exact value every [`RESYNC`] steps (R and T stay within 1e-12 of the pointwise values, tested).
-    pub(crate) fn fill(&self, thickness_nm: &[f64], uniform_step_nm: Option<f64>, row: &mut [Power]) {
+    pub(crate) fn fill(
+        &self,
+        thickness_nm: &[f64],
+        uniform_step_nm: Option<f64>,
+        row: &mut [Power],
+    ) {
         if self.film != 1 {
             for (slot, &d) in row.iter_mut().zip(thickness_nm) {
                 *slot = self.power(d);

@@ -1,0 +1,674 @@
+//! `nacre bake`: recipes, the default table set, and manifests.
+//!
+//! # Recipe format (TOML), table kind `film-lut`
+//!
+//! ```toml
+//! kind = "film-lut"                 # required
+//! description = "film on glass"     # optional, copied to the manifest
+//!
+//! [colour]                          # optional; these are the defaults
+//! observer = "1931"                 # 1931 | 1964
+//! illuminant = "d65"                # d65 | d50 | a | e
+//! space = "srgb"                    # xyz | srgb | rec2020 | p3 | acescg (linear)
+//!
+//! [stack]
+//! ambient = "1.0"                   # constant, non-absorbing
+//! film = "thin film"                # optional label; the film index is an axis
+//! base = "1.5"                      # any material spec (number, n+ki, bundled, file)
+//! under = [ { material = "water", thickness_nm = 50.0 } ]   # optional fixed layers under the film
+//!
+//! [axes]
+//! cos_theta_count = 32              # texels along cos θ (square mapping)
+//! thickness_nm = [0.0, 1200.0]      # film thickness range
+//! opd_count = 384                   # texels along the optical path difference
+//! film_ior = [1.0, 2.5]             # film index range (≥ ambient index)
+//! film_ior_count = 32
+//!
+//! [output]                          # optional; these are the defaults
+//! precision = "half"                # half | float (OpenEXR)
+//! png = true                        # also a 16-bit PNG when every value is in [0, 1]
+//! transmittance = "auto"            # auto (when the base transmits) | true | false
+//! ```
+//!
+//! The table is named after the recipe file (`film-gold.toml` → `film-gold`). Outputs in
+//! the output folder: `NAME.json` (the manifest: the only thing the runtime reads),
+//! `NAME.reflectance.exr` (+ `.png`) and, when baked, `NAME.transmittance.exr` (+ `.png`).
+//! Every file is written atomically; the manifest last.
+
+use crate::error::{Error, Result};
+use crate::film_lut::{FilmLut, FilmLutAxes, FilmLutJob, validate_axes};
+use crate::materials::resolve;
+use crate::output::write_atomic;
+use crate::stack_spec::{line_of, toml_error};
+use crate::table_io::{self, Precision, Table3};
+use nacre_optics::colour::{Colorimeter, Illuminant, Observer, OutputSpace};
+use nacre_optics::{Layer, Material};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use toml::Spanned;
+
+/// Most texels one table may have (2²⁴ ≈ 16.8 million: 96 MiB of half-float RGB per
+/// quantity). Larger recipes are refused before any work.
+pub const MAX_TEXELS: u64 = 1 << 24;
+
+/// Manifest format identifier.
+pub const MANIFEST_FORMAT: &str = "nacre-table/1";
+
+/// The `tables/` folder: `./tables` when it exists (running from a checkout), else the
+/// checkout this binary was built from.
+pub fn tables_dir() -> PathBuf {
+    let here = PathBuf::from("tables");
+    if here.join("recipes").is_dir() || here.join("baked").is_dir() {
+        return here;
+    }
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tables")
+}
+
+/// The default recipes folder.
+pub fn default_recipes_dir() -> PathBuf {
+    tables_dir().join("recipes")
+}
+
+/// The default output folder.
+pub fn default_baked_dir() -> PathBuf {
+    tables_dir().join("baked")
+}
+
+/// Resolves a table reference: a manifest path, or the name of a default-set table.
+pub fn resolve_table(name_or_path: &str) -> PathBuf {
+    let p = Path::new(name_or_path);
+    if name_or_path.ends_with(".json") || p.components().count() > 1 {
+        return p.to_path_buf();
+    }
+    default_baked_dir().join(format!("{name_or_path}.json"))
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawColour {
+    observer: Option<Spanned<String>>,
+    illuminant: Option<Spanned<String>>,
+    space: Option<Spanned<String>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawLayer {
+    material: Spanned<String>,
+    thickness_nm: Spanned<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawStack {
+    ambient: Spanned<String>,
+    film: Option<String>,
+    base: Spanned<String>,
+    #[serde(default)]
+    under: Vec<RawLayer>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawAxes {
+    cos_theta_count: usize,
+    thickness_nm: [f64; 2],
+    opd_count: usize,
+    film_ior: [f64; 2],
+    film_ior_count: usize,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, untagged)]
+enum Toggle {
+    Bool(bool),
+    Word(String),
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawOutput {
+    precision: Option<Precision>,
+    png: Option<bool>,
+    transmittance: Option<Toggle>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawRecipe {
+    kind: Spanned<String>,
+    description: Option<String>,
+    colour: Option<RawColour>,
+    stack: RawStack,
+    axes: Spanned<RawAxes>,
+    output: Option<RawOutput>,
+}
+
+/// A parsed `film-lut` recipe.
+pub struct Recipe {
+    /// Table name (the recipe's file stem).
+    pub name: String,
+    /// The recipe file.
+    pub path: PathBuf,
+    /// The recipe's text, recorded in the manifest.
+    pub text: String,
+    /// Description.
+    pub description: String,
+    /// Colour settings.
+    pub colorimeter: Colorimeter,
+    /// Material specs as written.
+    pub ambient_spec: String,
+    /// Film label.
+    pub film_label: String,
+    /// Base spec.
+    pub base_spec: String,
+    /// Fixed layers under the film (spec, thickness).
+    pub under_specs: Vec<(String, f64)>,
+    /// The job.
+    pub job: FilmLutJob,
+    /// Output precision.
+    pub precision: Precision,
+    /// Also write PNGs.
+    pub png: bool,
+}
+
+fn parse_name<T: std::str::FromStr<Err = nacre_optics::Error>>(
+    path: &Path,
+    text: &str,
+    value: &Option<Spanned<String>>,
+    default: T,
+) -> Result<T> {
+    match value {
+        None => Ok(default),
+        Some(s) => s
+            .get_ref()
+            .parse()
+            .map_err(|e: nacre_optics::Error| Error::Recipe {
+                path: path.to_path_buf(),
+                line: line_of(text, s.span().start),
+                message: e.to_string(),
+            }),
+    }
+}
+
+impl Recipe {
+    /// Reads and validates a recipe (nothing is computed yet).
+    pub fn read(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::parse(path, text)
+    }
+
+    /// Parses recipe text; `path` names it and anchors relative material paths.
+    pub fn parse(path: &Path, text: String) -> Result<Self> {
+        let raw: RawRecipe = toml::from_str(&text).map_err(|e| toml_error(path, &text, &e))?;
+        let at = |span: std::ops::Range<usize>| {
+            format!("{}:{}", path.display(), line_of(&text, span.start))
+        };
+        if raw.kind.get_ref() != "film-lut" {
+            return Err(Error::Recipe {
+                path: path.to_path_buf(),
+                line: line_of(&text, raw.kind.span().start),
+                message: format!(
+                    "unknown table kind `{}`: expected `film-lut`",
+                    raw.kind.get_ref()
+                ),
+            });
+        }
+        let name = path
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .filter(|s| !s.is_empty() && s.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_'))
+            .ok_or_else(|| Error::Recipe {
+                path: path.to_path_buf(),
+                line: 1,
+                message: "the recipe's file name (the table name) must use only letters, digits, `-` and `_`".into(),
+            })?
+            .to_string();
+        let colour = raw.colour.unwrap_or(RawColour {
+            observer: None,
+            illuminant: None,
+            space: None,
+        });
+        let observer = parse_name(path, &text, &colour.observer, Observer::Cie1931_2Deg)?;
+        let illuminant = parse_name(path, &text, &colour.illuminant, Illuminant::D65)?;
+        let space = parse_name(
+            path,
+            &text,
+            &colour.space,
+            OutputSpace::Rgb(nacre_optics::colour::RgbSpace::Srgb),
+        )?;
+        let base_dir = path.parent();
+        let ambient = resolve(
+            raw.stack.ambient.get_ref(),
+            &at(raw.stack.ambient.span()),
+            base_dir,
+        )?;
+        let ambient_index = constant_real_index(&ambient).ok_or_else(|| Error::Invalid {
+            context: at(raw.stack.ambient.span()),
+            message: format!(
+                "the ambient of a film-lut must have a constant real index (e.g. \"1.0\"), not `{}`",
+                raw.stack.ambient.get_ref()
+            ),
+        })?;
+        let base = resolve(
+            raw.stack.base.get_ref(),
+            &at(raw.stack.base.span()),
+            base_dir,
+        )?;
+        let mut under = Vec::new();
+        let mut under_specs = Vec::new();
+        for l in &raw.stack.under {
+            let d = *l.thickness_nm.get_ref();
+            if !(d >= 0.0 && d.is_finite()) {
+                return Err(Error::Recipe {
+                    path: path.to_path_buf(),
+                    line: line_of(&text, l.thickness_nm.span().start),
+                    message: format!("thickness_nm = {d}: must be finite and non-negative"),
+                });
+            }
+            under.push(Layer {
+                material: resolve(l.material.get_ref(), &at(l.material.span()), base_dir)?,
+                thickness_nm: d,
+            });
+            under_specs.push((l.material.get_ref().clone(), d));
+        }
+        let ax = raw.axes.get_ref();
+        let axes = FilmLutAxes {
+            cos_theta_count: ax.cos_theta_count,
+            opd_count: ax.opd_count,
+            ior_count: ax.film_ior_count,
+            thickness_min_nm: ax.thickness_nm[0],
+            thickness_max_nm: ax.thickness_nm[1],
+            ior_min: ax.film_ior[0],
+            ior_max: ax.film_ior[1],
+            ambient_index,
+        };
+        validate_axes(&axes, &at(raw.axes.span()), MAX_TEXELS)?;
+        let output = raw.output.unwrap_or(RawOutput {
+            precision: None,
+            png: None,
+            transmittance: None,
+        });
+        let transmits = under
+            .iter()
+            .map(|l| &l.material)
+            .chain(std::iter::once(&base))
+            .all(is_transparent);
+        let transmittance = match output.transmittance {
+            None => transmits,
+            Some(Toggle::Bool(b)) => b,
+            Some(Toggle::Word(w)) if w == "auto" => transmits,
+            Some(Toggle::Word(w)) => {
+                return Err(Error::Invalid {
+                    context: path.display().to_string(),
+                    message: format!(
+                        "[output] transmittance = \"{w}\": expected \"auto\", true or false"
+                    ),
+                });
+            }
+        };
+        Ok(Recipe {
+            name,
+            path: path.to_path_buf(),
+            description: raw.description.unwrap_or_default(),
+            colorimeter: Colorimeter::new(observer, illuminant, space),
+            ambient_spec: raw.stack.ambient.get_ref().clone(),
+            film_label: raw.stack.film.unwrap_or_else(|| "film".into()),
+            base_spec: raw.stack.base.get_ref().clone(),
+            under_specs,
+            job: FilmLutJob {
+                axes,
+                ambient,
+                under,
+                base,
+                colorimeter: Colorimeter::new(observer, illuminant, space),
+                transmittance,
+            },
+            precision: output.precision.unwrap_or(Precision::Half),
+            png: output.png.unwrap_or(true),
+            text,
+        })
+    }
+}
+
+/// The real index of a constant, non-absorbing material.
+fn constant_real_index(m: &Material) -> Option<f64> {
+    if !m.is_constant() {
+        return None;
+    }
+    let n = m.index_at(550.0).ok()?;
+    (n.im == 0.0).then_some(n.re)
+}
+
+/// True when the material is practically transparent (κ ≤ 1e-3) over 360–830 nm.
+fn is_transparent(m: &Material) -> bool {
+    (0..=94).all(|i| {
+        m.index_at(360.0 + 5.0 * f64::from(i))
+            .is_ok_and(|n| n.im <= 1e-3)
+    })
+}
+
+/// One axis as the manifest describes it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AxisRecord {
+    /// Axis name.
+    pub name: String,
+    /// Unit.
+    pub unit: String,
+    /// Texels.
+    pub count: usize,
+    /// Smallest value (at t = 0).
+    pub min: f64,
+    /// Largest value (at t = 1).
+    pub max: f64,
+    /// Mapping name.
+    pub mapping: String,
+    /// Physical value → t.
+    pub forward: String,
+    /// t → physical value.
+    pub inverse: String,
+}
+
+/// One file of a table.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FileRecord {
+    /// `reflectance` or `transmittance`.
+    pub quantity: String,
+    /// `exr` or `png16`.
+    pub format: String,
+    /// File name, relative to the manifest.
+    pub path: String,
+    /// `half`, `float` or `unorm16`.
+    pub encoding: String,
+    /// Channel names.
+    pub channels: Vec<String>,
+    /// Atlas width in pixels.
+    pub width: usize,
+    /// Atlas height in pixels.
+    pub height: usize,
+    /// SHA-256 of the file.
+    pub sha256: String,
+}
+
+/// The JSON manifest written beside every table: the runtime loads tables only through it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Manifest {
+    /// [`MANIFEST_FORMAT`].
+    pub format: String,
+    /// Table name.
+    pub name: String,
+    /// Table kind (`film-lut`).
+    pub kind: String,
+    /// Description from the recipe.
+    pub description: String,
+    /// nacre version that baked it.
+    pub nacre_version: String,
+    /// Recipe file name (no folder).
+    pub recipe_file: String,
+    /// SHA-256 of the recipe text.
+    pub recipe_sha256: String,
+    /// The recipe text.
+    pub recipe: String,
+    /// Observer (`1931` or `1964`).
+    pub observer: String,
+    /// Illuminant (`d65`, `d50`, `a`, `e`).
+    pub illuminant: String,
+    /// Output space (`xyz`, `srgb`, …), linear.
+    pub space: String,
+    /// Convention of the colour values.
+    pub colour_convention: String,
+    /// Ambient material spec.
+    pub ambient: String,
+    /// Film label.
+    pub film: String,
+    /// Fixed layers under the film: (material spec, thickness nm).
+    pub under: Vec<(String, f64)>,
+    /// Base material spec.
+    pub base: String,
+    /// The axes in x, y, z order.
+    pub axes: Vec<AxisRecord>,
+    /// Machine-readable axes of a `film-lut`.
+    pub film_lut: FilmLutAxes,
+    /// Texel-centre convention.
+    pub texel_centres: String,
+    /// Atlas layout of the files.
+    pub atlas: String,
+    /// How a shader rebuilds the result from the channels.
+    pub reconstruction: String,
+    /// The files.
+    pub files: Vec<FileRecord>,
+}
+
+impl Manifest {
+    /// Reads and validates a manifest file.
+    pub fn read(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let m: Manifest = serde_json::from_str(&text).map_err(|e| Error::Recipe {
+            path: path.to_path_buf(),
+            line: e.line(),
+            message: format!("not a nacre table manifest: {e}"),
+        })?;
+        if m.format != MANIFEST_FORMAT {
+            return Err(Error::Invalid {
+                context: path.display().to_string(),
+                message: format!("manifest format `{}` is not `{MANIFEST_FORMAT}`", m.format),
+            });
+        }
+        Ok(m)
+    }
+
+    /// Loads the EXR table of `quantity` listed by this manifest (at `manifest_path`).
+    pub fn load_table(&self, manifest_path: &Path, quantity: &str) -> Result<Option<Table3>> {
+        let Some(f) = self
+            .files
+            .iter()
+            .find(|f| f.quantity == quantity && f.format == "exr")
+        else {
+            return Ok(None);
+        };
+        let dir = manifest_path.parent().unwrap_or(Path::new("."));
+        let a = &self.film_lut;
+        let (table, _) = table_io::read_exr_table(
+            &dir.join(&f.path),
+            a.cos_theta_count,
+            a.opd_count,
+            a.ior_count,
+        )?;
+        Ok(Some(table))
+    }
+
+    /// The colorimeter the table was baked with.
+    pub fn colorimeter(&self, manifest_path: &Path) -> Result<Colorimeter> {
+        let bad = |e: nacre_optics::Error| Error::Invalid {
+            context: manifest_path.display().to_string(),
+            message: e.to_string(),
+        };
+        Ok(Colorimeter::new(
+            self.observer.parse().map_err(bad)?,
+            self.illuminant.parse().map_err(bad)?,
+            self.space.parse().map_err(bad)?,
+        ))
+    }
+}
+
+fn sha256_text(text: &str) -> String {
+    use sha2::{Digest, Sha256};
+    Sha256::digest(text.as_bytes())
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
+fn axis_records(a: &FilmLutAxes) -> Vec<AxisRecord> {
+    vec![
+        AxisRecord {
+            name: "cos_theta".into(),
+            unit: "1".into(),
+            count: a.cos_theta_count,
+            min: 0.0,
+            max: 1.0,
+            mapping: "square".into(),
+            forward: "t = sqrt(cos_theta)".into(),
+            inverse: "cos_theta = t * t".into(),
+        },
+        AxisRecord {
+            name: "opd_nm".into(),
+            unit: "nm".into(),
+            count: a.opd_count,
+            min: 0.0,
+            max: a.opd_max_nm(),
+            mapping: "linear in optical path difference".into(),
+            forward: format!(
+                "t = 2 * thickness_nm * sqrt(film_ior^2 - {}^2 * (1 - cos_theta^2)) / {}",
+                a.ambient_index,
+                a.opd_max_nm()
+            ),
+            inverse: format!("opd_nm = t * {}", a.opd_max_nm()),
+        },
+        AxisRecord {
+            name: "film_ior".into(),
+            unit: "1".into(),
+            count: a.ior_count,
+            min: a.ior_min,
+            max: a.ior_max,
+            mapping:
+                "square root in the film's normal component q = sqrt(film_ior^2 - n0^2 sin^2 theta)"
+                    .into(),
+            forward: format!(
+                "q(n) = sqrt(n^2 - {n0}^2 (1 - cos_theta^2)); t = sqrt((q(film_ior) - q({lo})) / (q({hi}) - q({lo})))",
+                n0 = a.ambient_index,
+                lo = a.ior_min,
+                hi = a.ior_max
+            ),
+            inverse: format!(
+                "q = q({lo}) + t^2 (q({hi}) - q({lo})); film_ior = sqrt(q^2 + {n0}^2 (1 - cos_theta^2))",
+                n0 = a.ambient_index,
+                lo = a.ior_min,
+                hi = a.ior_max
+            ),
+        },
+    ]
+}
+
+/// Bakes one recipe into `out_dir`; returns the manifest path.
+pub fn bake_recipe(
+    recipe: &Recipe,
+    out_dir: &Path,
+    progress: &(dyn Fn() + Sync),
+) -> Result<PathBuf> {
+    let lut: FilmLut = recipe.job.bake(progress)?;
+    std::fs::create_dir_all(out_dir).map_err(|source| Error::Io {
+        path: out_dir.to_path_buf(),
+        source,
+    })?;
+    let a = &lut.axes;
+    let mut files = Vec::new();
+    let channels: Vec<String> = recipe
+        .colorimeter
+        .space()
+        .channel_names()
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let quantities = [
+        ("reflectance", Some(&lut.reflectance)),
+        ("transmittance", lut.transmittance.as_ref()),
+    ];
+    for (quantity, table) in quantities {
+        let Some(table) = table else { continue };
+        let exr = format!("{}.{quantity}.exr", recipe.name);
+        table_io::write_exr(&out_dir.join(&exr), table, recipe.precision)?;
+        files.push(FileRecord {
+            quantity: quantity.into(),
+            format: "exr".into(),
+            path: exr.clone(),
+            encoding: match recipe.precision {
+                Precision::Half => "half",
+                Precision::Float => "float",
+            }
+            .into(),
+            channels: vec!["R".into(), "G".into(), "B".into()],
+            width: table.nx,
+            height: table.ny * table.nz,
+            sha256: table_io::sha256_hex(&out_dir.join(&exr))?,
+        });
+        if recipe.png {
+            let png = format!("{}.{quantity}.png", recipe.name);
+            if table_io::write_png16(&out_dir.join(&png), table)? {
+                files.push(FileRecord {
+                    quantity: quantity.into(),
+                    format: "png16".into(),
+                    path: png.clone(),
+                    encoding: "unorm16".into(),
+                    channels: vec!["R".into(), "G".into(), "B".into()],
+                    width: table.nx,
+                    height: table.ny * table.nz,
+                    sha256: table_io::sha256_hex(&out_dir.join(&png))?,
+                });
+            } else {
+                // A stale PNG from an earlier bake would contradict the manifest.
+                let _ = std::fs::remove_file(out_dir.join(&png));
+            }
+        }
+    }
+    let c = &recipe.colorimeter;
+    let manifest = Manifest {
+        format: MANIFEST_FORMAT.into(),
+        name: recipe.name.clone(),
+        kind: "film-lut".into(),
+        description: recipe.description.clone(),
+        nacre_version: env!("CARGO_PKG_VERSION").into(),
+        recipe_file: recipe
+            .path
+            .file_name()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default(),
+        recipe_sha256: sha256_text(&recipe.text),
+        recipe: recipe.text.clone(),
+        observer: c.observer().to_string(),
+        illuminant: c.illuminant().to_string(),
+        space: c.space().to_string(),
+        colour_convention: format!(
+            "linear {} ({:?} channels {:?}); colour = integral of R(lambda) or T(lambda) x illuminant x CMF over 360-830 nm, normalised so that a perfect reflector has Y = 1 (RGB (1,1,1) after Bradford adaptation to the space's white); unpolarised (mean of s and p)",
+            c.space(), c.space(), channels
+        ),
+        ambient: recipe.ambient_spec.clone(),
+        film: recipe.film_label.clone(),
+        under: recipe.under_specs.clone(),
+        base: recipe.base_spec.clone(),
+        axes: axis_records(a),
+        film_lut: a.clone(),
+        texel_centres: "texel i of an axis with count n holds t = i / (n - 1); a sampler reaches t at u = (t * (n - 1) + 0.5) / n; clamp to edge".into(),
+        atlas: "width = count(cos_theta); height = count(opd_nm) * count(film_ior); slice k (film_ior index) occupies rows [k * count(opd_nm), (k + 1) * count(opd_nm)), row j of the slice is opd_nm index j, top row first".into(),
+        reconstruction: "cos_t = dot(N, V); opd = 2 d sqrt(n_f^2 - n0^2 (1 - cos_t^2)); q(n) = sqrt(n^2 - n0^2 (1 - cos_t^2)); t = (sqrt(cos_t), opd / opd_max, sqrt((q(n_f) - q(ior_min)) / (q(ior_max) - q(ior_min)))); colour = trilinear sample at u = (t (n - 1) + 0.5) / n per axis; specular = colour (replaces the Fresnel term)".into(),
+        files,
+    };
+    let path = out_dir.join(format!("{}.json", recipe.name));
+    let json = serde_json::to_string_pretty(&manifest).expect("manifest serialises");
+    write_atomic(&path, |w| {
+        w.write_all(json.as_bytes())?;
+        w.write_all(b"\n")
+    })?;
+    Ok(path)
+}
+
+/// The recipes of the default set, sorted by name.
+pub fn default_recipes() -> Result<Vec<PathBuf>> {
+    let dir = default_recipes_dir();
+    let entries = std::fs::read_dir(&dir).map_err(|source| Error::Io {
+        path: dir.clone(),
+        source,
+    })?;
+    let mut out: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    out.sort();
+    Ok(out)
+}

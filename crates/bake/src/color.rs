@@ -1,0 +1,503 @@
+//! `nacre color`: the colour of a stack's reflectance or transmittance by a chosen method.
+//!
+//! Methods ([`Method`]):
+//!
+//! * `spectral` — the reference: exact spectral integration ([`nacre_optics::SpectralRule`],
+//!   within ΔE2000 0.01 of a 0.1 nm integration for films up to 10 µm);
+//! * `lut:NAME|PATH` — a baked `film-lut` table, with the trilinear interpolation the GPU
+//!   uses ([`crate::film_lut::FilmLut::lookup`]); the table must have been baked for the
+//!   same ambient, base and fixed layers, and its colour settings are used;
+//! * `rgb3` — one wavelength per channel (R at 650, 510 and 475 nm, taken as linear RGB of
+//!   the output space): the common real-time shortcut;
+//! * `samples:N` — N wavelengths spread uniformly over 400–700 nm (inclusive), weighted by
+//!   the output-space sensitivities there and normalised so that R ≡ 1 is white: the
+//!   shortcut of the real-time thesis (Sussenbach 2013, §4.3).
+//!
+//! Output columns: `angle_deg,thickness_nm,film_ior,X,Y,Z,R,G,B` (XYZ under the illuminant
+//! with a perfect reflector at Y = 1; R, G, B linear in the output space, equal to X, Y, Z
+//! for `--space xyz`).
+
+use crate::bake::{Manifest, resolve_table};
+use crate::error::{Error, Result};
+use crate::film_lut::FilmLut;
+use crate::spectrum::fmt_sig;
+use crate::table_io::Table3;
+use nacre_optics::colour::{Colorimeter, OutputSpace};
+use nacre_optics::{C64, Layer, Material, SpectralRule, Stack};
+use rayon::prelude::*;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// The CSV header line.
+pub const HEADER: &str = "angle_deg,thickness_nm,film_ior,X,Y,Z,R,G,B";
+
+/// Most points one run may evaluate.
+pub const MAX_POINTS: usize = 10_000_000;
+
+/// The wavelengths of the `rgb3` shortcut, nm (R, G, B).
+pub const RGB3_WAVELENGTHS_NM: [f64; 3] = [650.0, 510.0, 475.0];
+
+/// How to turn a stack into colour.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Method {
+    /// Exact spectral integration (the reference).
+    Spectral,
+    /// A baked film LUT (manifest path).
+    Lut(PathBuf),
+    /// One wavelength per channel.
+    Rgb3,
+    /// N wavelengths over 400–700 nm.
+    Samples(usize),
+}
+
+impl Method {
+    /// Parses `spectral`, `lut:NAME|PATH`, `rgb3`, `samples:N`.
+    pub fn parse(text: &str) -> Result<Self> {
+        let err = |message: &str| Error::Flag {
+            flag: "--method".into(),
+            value: text.into(),
+            message: message.into(),
+        };
+        match text.trim() {
+            "spectral" => Ok(Method::Spectral),
+            "rgb3" => Ok(Method::Rgb3),
+            t => {
+                if let Some(name) = t.strip_prefix("lut:") {
+                    if name.is_empty() {
+                        return Err(err("expected lut:NAME or lut:PATH/TO/MANIFEST.json"));
+                    }
+                    Ok(Method::Lut(resolve_table(name)))
+                } else if let Some(n) = t.strip_prefix("samples:") {
+                    match n.parse::<usize>() {
+                        Ok(n @ 1..=10_000) => Ok(Method::Samples(n)),
+                        _ => Err(err("samples:N needs a whole number N from 1 to 10000")),
+                    }
+                } else {
+                    Err(err("expected spectral, lut:NAME|PATH, rgb3 or samples:N"))
+                }
+            }
+        }
+    }
+}
+
+/// Reflectance or transmittance.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Quantity {
+    /// Unpolarised reflectance.
+    Reflectance,
+    /// Unpolarised transmittance into the base.
+    Transmittance,
+}
+
+/// One point: incidence angle, and optionally the first film's thickness and real index.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Point {
+    /// Incidence angle in the ambient, degrees.
+    pub angle_deg: f64,
+    /// First film's thickness, nm (None: the stack's own).
+    pub thickness_nm: Option<f64>,
+    /// First film's real index (None: the stack's own material).
+    pub film_ior: Option<f64>,
+}
+
+/// Reads `--points` CSV: header `angle_deg,thickness_nm,film_ior`, then rows.
+pub fn parse_points(path: &Path, text: &str) -> Result<Vec<Point>> {
+    let perr = |line: usize, message: String| Error::Recipe {
+        path: path.to_path_buf(),
+        line,
+        message,
+    };
+    let mut out = Vec::new();
+    let mut header = false;
+    for (i, raw) in text.lines().enumerate() {
+        let line = raw.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        if !header {
+            let cols: Vec<&str> = line.split(',').map(str::trim).collect();
+            if cols != ["angle_deg", "thickness_nm", "film_ior"] {
+                return Err(perr(
+                    i + 1,
+                    format!(
+                        "expected the header `angle_deg,thickness_nm,film_ior`, found `{line}`"
+                    ),
+                ));
+            }
+            header = true;
+            continue;
+        }
+        let f: Vec<&str> = line.split(',').map(str::trim).collect();
+        if f.len() != 3 {
+            return Err(perr(
+                i + 1,
+                format!(
+                    "expected 3 comma-separated numbers, found {} field(s)",
+                    f.len()
+                ),
+            ));
+        }
+        let num = |s: &str, what: &str| {
+            s.parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| perr(i + 1, format!("{what} `{s}` is not a finite number")))
+        };
+        let (a, d, n) = (
+            num(f[0], "angle_deg")?,
+            num(f[1], "thickness_nm")?,
+            num(f[2], "film_ior")?,
+        );
+        if !(a.abs() < 90.0) {
+            return Err(perr(
+                i + 1,
+                format!("angle_deg {a} must lie strictly between -90 and 90"),
+            ));
+        }
+        if d < 0.0 {
+            return Err(perr(
+                i + 1,
+                format!("thickness_nm {d} must be non-negative"),
+            ));
+        }
+        if !(n > 0.0) {
+            return Err(perr(i + 1, format!("film_ior {n} must be positive")));
+        }
+        out.push(Point {
+            angle_deg: a,
+            thickness_nm: Some(d),
+            film_ior: Some(n),
+        });
+        if out.len() > MAX_POINTS {
+            return Err(Error::TooLarge {
+                what: format!("{}: points", path.display()),
+                count: out.len() as u64,
+                limit: MAX_POINTS as u64,
+            });
+        }
+    }
+    if !header {
+        return Err(perr(
+            0,
+            "no header line `angle_deg,thickness_nm,film_ior` found".into(),
+        ));
+    }
+    Ok(out)
+}
+
+/// The stack with the first film's thickness and index overridden by `point`.
+fn stack_at(stack: &Stack, point: &Point) -> Result<Stack> {
+    let mut layers = stack.layers().to_vec();
+    if let Some(first) = layers.first_mut() {
+        if let Some(d) = point.thickness_nm {
+            first.thickness_nm = d;
+        }
+        if let Some(n) = point.film_ior {
+            first.material = Material::constant(format!("{n}"), C64::new(n, 0.0))?;
+        }
+    } else if point.thickness_nm.is_some() || point.film_ior.is_some() {
+        return Err(Error::Invalid {
+            context: "--points".into(),
+            message: "the stack has no film to override: give at least one --layer".into(),
+        });
+    }
+    Ok(Stack::new(
+        stack.ambient().clone(),
+        layers,
+        stack.substrate().clone(),
+    )?)
+}
+
+/// The (thickness, real index) a point has for the first film, for the output columns.
+pub fn film_columns(stack: &Stack, point: &Point) -> (f64, f64) {
+    match stack.layers().first() {
+        Some(l) => (
+            point.thickness_nm.unwrap_or(l.thickness_nm),
+            point
+                .film_ior
+                .unwrap_or_else(|| l.material.index_at(550.0).map_or(f64::NAN, |n| n.re)),
+        ),
+        None => (
+            0.0,
+            stack.ambient().index_at(550.0).map_or(f64::NAN, |n| n.re),
+        ),
+    }
+}
+
+fn value(p: &nacre_optics::Power, quantity: Quantity) -> f64 {
+    match quantity {
+        Quantity::Reflectance => p.R(),
+        Quantity::Transmittance => p.T(),
+    }
+}
+
+/// A loaded LUT with what is needed to check and use it.
+pub struct LoadedLut {
+    /// The manifest.
+    pub manifest: Manifest,
+    /// Reflectance table.
+    pub reflectance: Table3,
+    /// Transmittance table, if baked.
+    pub transmittance: Option<Table3>,
+    /// The table's colorimeter.
+    pub colorimeter: Colorimeter,
+}
+
+impl LoadedLut {
+    /// Loads a table through its manifest.
+    pub fn load(path: &Path) -> Result<Self> {
+        let manifest = Manifest::read(path)?;
+        let reflectance =
+            manifest
+                .load_table(path, "reflectance")?
+                .ok_or_else(|| Error::Invalid {
+                    context: path.display().to_string(),
+                    message: "the manifest lists no reflectance EXR".into(),
+                })?;
+        let transmittance = manifest.load_table(path, "transmittance")?;
+        let colorimeter = manifest.colorimeter(path)?;
+        Ok(LoadedLut {
+            manifest,
+            reflectance,
+            transmittance,
+            colorimeter,
+        })
+    }
+
+    /// Errors unless `stack` (film first) matches the table's ambient, fixed layers and base.
+    pub fn check_stack(&self, path: &Path, stack: &Stack) -> Result<()> {
+        let m = &self.manifest;
+        let context = format!("--method lut:{}", path.display());
+        let mismatch = |what: &str, ours: String, theirs: &str| Error::Invalid {
+            context: context.clone(),
+            message: format!("the table was baked for {what} `{theirs}`, this stack has `{ours}`"),
+        };
+        let base_dir = path.parent();
+        let same = |a: &Material, spec: &str| -> Result<bool> {
+            let b = crate::materials::resolve(spec, &context, base_dir)?;
+            Ok((0..=20).all(|i| {
+                let wl = 380.0 + 20.0 * f64::from(i);
+                match (a.index_at(wl), b.index_at(wl)) {
+                    (Ok(x), Ok(y)) => (x - y).norm() <= 1e-12,
+                    _ => false,
+                }
+            }))
+        };
+        if !same(stack.ambient(), &m.ambient)? {
+            return Err(mismatch(
+                "ambient",
+                stack.ambient().name().into(),
+                &m.ambient,
+            ));
+        }
+        if !same(stack.substrate(), &m.base)? {
+            return Err(mismatch("base", stack.substrate().name().into(), &m.base));
+        }
+        let layers = stack.layers();
+        if layers.len() != 1 + m.under.len() {
+            return Err(Error::Invalid {
+                context,
+                message: format!(
+                    "the table has one film over {} fixed layer(s); this stack has {} layer(s)",
+                    m.under.len(),
+                    layers.len()
+                ),
+            });
+        }
+        for (l, (spec, d)) in layers[1..].iter().zip(&m.under) {
+            if !same(&l.material, spec)? || (l.thickness_nm - d).abs() > 1e-9 {
+                return Err(mismatch(
+                    "fixed layer",
+                    format!("{}@{}", l.material.name(), l.thickness_nm),
+                    &format!("{spec}@{d}"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Colour at a point (output space of the table).
+    pub fn colour(&self, stack: &Stack, point: &Point, quantity: Quantity) -> Result<[f64; 3]> {
+        let film = stack.layers().first().ok_or_else(|| Error::Invalid {
+            context: "--method lut".into(),
+            message: "a film-lut needs a film: give --layer".into(),
+        })?;
+        let n = match point.film_ior {
+            Some(n) => n,
+            None => {
+                let n = film.material.index_at(550.0)?;
+                if !film.material.is_constant() || n.im != 0.0 {
+                    return Err(Error::Invalid {
+                        context: "--method lut".into(),
+                        message: format!(
+                            "a film-lut takes a constant real film index; `{}` is dispersive or absorbing (give --points with film_ior)",
+                            film.material.name()
+                        ),
+                    });
+                }
+                n.re
+            }
+        };
+        let d = point.thickness_nm.unwrap_or(film.thickness_nm);
+        let table = match quantity {
+            Quantity::Reflectance => &self.reflectance,
+            Quantity::Transmittance => {
+                self.transmittance.as_ref().ok_or_else(|| Error::Invalid {
+                    context: "--quantity t".into(),
+                    message: format!("table `{}` has no transmittance", self.manifest.name),
+                })?
+            }
+        };
+        let cos_theta = point.angle_deg.to_radians().cos();
+        Ok(FilmLut::lookup(
+            &self.manifest.film_lut,
+            table,
+            cos_theta,
+            d,
+            n,
+        ))
+    }
+}
+
+/// Evaluates `points` of `stack` by `method`; returns output-space colours of `colorimeter`
+/// (for `lut:`, of the table's colorimeter).
+pub fn evaluate(
+    stack: &Stack,
+    points: &[Point],
+    method: &Method,
+    colorimeter: &Colorimeter,
+    quantity: Quantity,
+    lut: Option<&LoadedLut>,
+) -> Result<Vec<[f64; 3]>> {
+    if points.len() > MAX_POINTS {
+        return Err(Error::TooLarge {
+            what: "points".into(),
+            count: points.len() as u64,
+            limit: MAX_POINTS as u64,
+        });
+    }
+    points
+        .par_iter()
+        .map(|point| -> Result<[f64; 3]> {
+            match method {
+                Method::Lut(_) => {
+                    let lut = lut.expect("lut loaded by the caller");
+                    lut.colour(stack, point, quantity)
+                }
+                Method::Spectral => {
+                    let s = stack_at(stack, point)?;
+                    if s.layers().is_empty() {
+                        let rule = SpectralRule::new(colorimeter, 0.0);
+                        let p = s.sweep(&[point.angle_deg], rule.wavelengths_nm())?;
+                        return Ok(rule.colour(p.iter().map(|p| value(p, quantity))));
+                    }
+                    let rule = SpectralRule::new(colorimeter, s.max_opd_nm(None));
+                    let d = s.layers()[0].thickness_nm;
+                    let c = s.colours_over_thickness(1, point.angle_deg, &rule, &[d])?;
+                    Ok(match quantity {
+                        Quantity::Reflectance => c.reflectance[0],
+                        Quantity::Transmittance => c.transmittance[0],
+                    })
+                }
+                Method::Rgb3 => {
+                    let s = stack_at(stack, point)?;
+                    let p = s.sweep(&[point.angle_deg], &RGB3_WAVELENGTHS_NM)?;
+                    Ok([0, 1, 2].map(|c| value(&p[c], quantity)))
+                }
+                Method::Samples(n) => {
+                    let s = stack_at(stack, point)?;
+                    let (wl, w) = sample_weights(colorimeter, *n);
+                    let p = s.sweep(&[point.angle_deg], &wl)?;
+                    let mut c = [0.0; 3];
+                    for (p, w) in p.iter().zip(&w) {
+                        for k in 0..3 {
+                            c[k] += value(p, quantity) * w[k];
+                        }
+                    }
+                    Ok(c)
+                }
+            }
+        })
+        .collect()
+}
+
+/// Wavelengths and weights of `samples:N`: λₖ = 400 + 300 k/(N − 1) nm (550 nm for N = 1),
+/// weights s(λₖ) normalised per channel so that Σₖ wₖ equals the colorimeter's white.
+pub fn sample_weights(colorimeter: &Colorimeter, n: usize) -> (Vec<f64>, Vec<[f64; 3]>) {
+    let wl: Vec<f64> = if n == 1 {
+        vec![550.0]
+    } else {
+        (0..n)
+            .map(|k| 400.0 + 300.0 * k as f64 / (n - 1) as f64)
+            .collect()
+    };
+    let raw: Vec<[f64; 3]> = wl.iter().map(|&l| colorimeter.sensitivity_at(l)).collect();
+    let white = colorimeter
+        .weights_1nm()
+        .iter()
+        .fold([0.0; 3], |a, w| [a[0] + w[0], a[1] + w[1], a[2] + w[2]]);
+    let sum = raw
+        .iter()
+        .fold([0.0; 3], |a, w| [a[0] + w[0], a[1] + w[1], a[2] + w[2]]);
+    let w = raw
+        .iter()
+        .map(|r| {
+            std::array::from_fn(|k| {
+                if sum[k] != 0.0 {
+                    r[k] * white[k] / sum[k]
+                } else {
+                    0.0
+                }
+            })
+        })
+        .collect();
+    (wl, w)
+}
+
+/// Writes the CSV.
+pub fn write_csv(
+    w: &mut dyn Write,
+    stack: &Stack,
+    points: &[Point],
+    colours: &[[f64; 3]],
+    colorimeter: &Colorimeter,
+) -> std::io::Result<()> {
+    writeln!(w, "{HEADER}")?;
+    for (p, c) in points.iter().zip(colours) {
+        let xyz = match colorimeter.space() {
+            OutputSpace::Xyz => *c,
+            OutputSpace::Rgb(_) => colorimeter.xyz_from_output(*c),
+        };
+        let (d, n) = film_columns(stack, p);
+        writeln!(
+            w,
+            "{},{},{},{},{},{},{},{},{}",
+            p.angle_deg,
+            d,
+            n,
+            fmt_sig(xyz[0]),
+            fmt_sig(xyz[1]),
+            fmt_sig(xyz[2]),
+            fmt_sig(c[0]),
+            fmt_sig(c[1]),
+            fmt_sig(c[2]),
+        )?;
+    }
+    Ok(())
+}
+
+/// Builds the stack of a film over fixed layers (used by tests and tools).
+pub fn film_stack(
+    ambient: Material,
+    film: Material,
+    thickness_nm: f64,
+    under: Vec<Layer>,
+    base: Material,
+) -> Result<Stack> {
+    let mut layers = vec![Layer {
+        material: film,
+        thickness_nm,
+    }];
+    layers.extend(under);
+    Ok(Stack::new(ambient, layers, base)?)
+}

@@ -1,0 +1,113 @@
+//! Accuracy of the default `film-lut` tables: `lut:` (trilinear, as the GPU samples) against
+//! the exact `spectral` reference at 2000 random in-domain points per table.
+//!
+//! Targets (issue: colorimetry and film-lut tables): ΔE2000 95th percentile ≤ 0.3, maximum
+//! ≤ 1.5, and each default table ≤ 16 MiB.
+
+use nacre_bake::bake::{Manifest, default_baked_dir};
+use nacre_bake::color::{self, LoadedLut, Method, Point, Quantity};
+use nacre_bake::materials::resolve;
+use nacre_optics::colour::{delta_e_2000, xyz_to_lab};
+use nacre_optics::{C64, Material};
+
+/// SplitMix64: a tiny deterministic generator, so the points are the same on every run.
+struct Rng(u64);
+
+impl Rng {
+    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        lo + (hi - lo) * ((z >> 11) as f64 / (1u64 << 53) as f64)
+    }
+}
+
+const POINTS: usize = 2000;
+const DEFAULT_TABLES: [&str; 4] = ["soap-film", "film-dielectric", "film-gold", "oil-slick"];
+
+fn percentile(sorted: &[f64], p: f64) -> f64 {
+    sorted[((sorted.len() - 1) as f64 * p).round() as usize]
+}
+
+#[test]
+fn default_tables_meet_the_accuracy_targets() {
+    let mut report = Vec::new();
+    for name in DEFAULT_TABLES {
+        // NACRE_BAKED_DIR lets a developer measure experimental bakes with this test.
+        let dir = std::env::var_os("NACRE_BAKED_DIR")
+            .map_or_else(default_baked_dir, std::path::PathBuf::from);
+        let path = dir.join(format!("{name}.json"));
+        if !path.exists() && std::env::var_os("NACRE_BAKED_DIR").is_some() {
+            continue;
+        }
+        let manifest = Manifest::read(&path).unwrap();
+        let bytes: u64 = manifest
+            .files
+            .iter()
+            .map(|f| {
+                std::fs::metadata(path.parent().unwrap().join(&f.path))
+                    .unwrap()
+                    .len()
+            })
+            .sum();
+        assert!(bytes <= 16 << 20, "{name}: {bytes} bytes");
+        let lut = LoadedLut::load(&path).unwrap();
+        let a = &manifest.film_lut;
+        let ambient = resolve(&manifest.ambient, "test", None).unwrap();
+        let base = resolve(&manifest.base, "test", None).unwrap();
+        let film = Material::constant("film", C64::new(a.ior_min, 0.0)).unwrap();
+        let stack = color::film_stack(ambient, film, 0.0, vec![], base).unwrap();
+        lut.check_stack(&path, &stack).unwrap();
+        let mut rng = Rng(0x5EED ^ name.len() as u64);
+        let points: Vec<Point> = (0..POINTS)
+            .map(|_| Point {
+                angle_deg: rng.uniform(0.0, 89.0),
+                thickness_nm: Some(rng.uniform(a.thickness_min_nm, a.thickness_max_nm)),
+                film_ior: Some(rng.uniform(a.ior_min, a.ior_max)),
+            })
+            .collect();
+        let c = &lut.colorimeter;
+        let mut quantities = vec![Quantity::Reflectance];
+        if lut.transmittance.is_some() {
+            quantities.push(Quantity::Transmittance);
+        }
+        for q in quantities {
+            let exact = color::evaluate(&stack, &points, &Method::Spectral, c, q, None).unwrap();
+            let baked = color::evaluate(
+                &stack,
+                &points,
+                &Method::Lut(path.clone()),
+                c,
+                q,
+                Some(&lut),
+            )
+            .unwrap();
+            let lab = |rgb: [f64; 3]| xyz_to_lab(c.xyz_from_output(rgb), c.white_xyz());
+            let mut de: Vec<f64> = exact
+                .iter()
+                .zip(&baked)
+                .map(|(e, b)| delta_e_2000(lab(*e), lab(*b)))
+                .collect();
+            if std::env::var("NACRE_DEBUG").is_ok() {
+                let mut idx: Vec<usize> = (0..de.len()).collect();
+                idx.sort_by(|&i, &j| de[j].total_cmp(&de[i]));
+                for &i in idx.iter().take(8) {
+                    eprintln!(
+                        "{name} {q:?} ΔE {:.3} at {:?}: exact {:?} lut {:?}",
+                        de[i], points[i], exact[i], baked[i]
+                    );
+                }
+            }
+            de.sort_by(f64::total_cmp);
+            let (p95, max) = (percentile(&de, 0.95), de[de.len() - 1]);
+            let mean = de.iter().sum::<f64>() / de.len() as f64;
+            report.push(format!(
+                "{name} {q:?}: mean {mean:.3} p95 {p95:.3} max {max:.3} ({bytes} bytes)"
+            ));
+            assert!(p95 <= 0.3 && max <= 1.5, "{}", report.last().unwrap());
+        }
+    }
+    eprintln!("{}", report.join("\n"));
+}
