@@ -136,6 +136,7 @@ struct RawOutput {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawRecipe {
+    #[allow(dead_code)] // checked before the full parse
     kind: Spanned<String>,
     description: Option<String>,
     colour: Option<RawColour>,
@@ -203,20 +204,26 @@ impl Recipe {
 
     /// Parses recipe text; `path` names it and anchors relative material paths.
     pub fn parse(path: &Path, text: String) -> Result<Self> {
+        // The kind decides the schema: check it first for a precise message.
+        #[derive(Deserialize)]
+        struct KindOnly {
+            kind: Spanned<String>,
+        }
+        let kind: KindOnly = toml::from_str(&text).map_err(|e| toml_error(path, &text, &e))?;
+        if kind.kind.get_ref() != "film-lut" {
+            return Err(Error::Recipe {
+                path: path.to_path_buf(),
+                line: line_of(&text, kind.kind.span().start),
+                message: format!(
+                    "unknown table kind `{}`: expected `film-lut`",
+                    kind.kind.get_ref()
+                ),
+            });
+        }
         let raw: RawRecipe = toml::from_str(&text).map_err(|e| toml_error(path, &text, &e))?;
         let at = |span: std::ops::Range<usize>| {
             format!("{}:{}", path.display(), line_of(&text, span.start))
         };
-        if raw.kind.get_ref() != "film-lut" {
-            return Err(Error::Recipe {
-                path: path.to_path_buf(),
-                line: line_of(&text, raw.kind.span().start),
-                message: format!(
-                    "unknown table kind `{}`: expected `film-lut`",
-                    raw.kind.get_ref()
-                ),
-            });
-        }
         let name = path
             .file_stem()
             .and_then(|s| s.to_str())

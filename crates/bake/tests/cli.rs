@@ -173,3 +173,195 @@ fn bad_input_exits_2_with_a_message_and_keeps_existing_output() {
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("no/such/dir/out.csv"), "{}", stderr(&o));
 }
+
+#[test]
+fn color_methods_and_info() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let o = nacre(&["color", "--layer", "1.33@400", "--angles", "0:80:20"], d);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8(o.stdout).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next(),
+        Some("angle_deg,thickness_nm,film_ior,X,Y,Z,R,G,B")
+    );
+    assert_eq!(lines.count(), 5);
+    std::fs::write(
+        d.join("p.csv"),
+        "angle_deg,thickness_nm,film_ior\n0,400,1.33\n45,250.5,1.4\n",
+    )
+    .unwrap();
+    for method in ["spectral", "rgb3", "samples:5", "lut:soap-film"] {
+        // Run from the repository so that `lut:soap-film` finds the default set.
+        let o = Command::new(env!("CARGO_BIN_EXE_nacre"))
+            .args([
+                "color",
+                "--ambient",
+                "1.0",
+                "--layer",
+                "1.33@400",
+                "--substrate",
+                "1.0",
+                "--method",
+                method,
+                "-o",
+            ])
+            .arg(d.join("c.csv"))
+            .arg("--points")
+            .arg(d.join("p.csv"))
+            .current_dir(&repo)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{method}: {}", stderr(&o));
+        let text = std::fs::read_to_string(d.join("c.csv")).unwrap();
+        let rows: Vec<Vec<f64>> = text
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+            .collect();
+        assert_eq!(rows.len(), 2, "{method}");
+        assert_eq!((rows[1][0], rows[1][1], rows[1][2]), (45.0, 250.5, 1.4));
+        assert!(rows.iter().all(|r| r[3..].iter().all(|v| v.is_finite())));
+    }
+    let o = Command::new(env!("CARGO_BIN_EXE_nacre"))
+        .args(["info", "film-gold"])
+        .current_dir(&repo)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8(o.stdout).unwrap();
+    assert!(
+        text.contains("\"kind\": \"film-lut\"") && text.contains("\"base\": \"au\""),
+        "{text}"
+    );
+}
+
+#[test]
+fn color_and_bake_bad_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(
+        d.join("bad-points.csv"),
+        "angle_deg,thickness_nm,film_ior\n0,400,1.33\n95,1,1\n",
+    )
+    .unwrap();
+    std::fs::write(d.join("kind.toml"), "kind = \"cake\"\n").unwrap();
+    std::fs::write(
+        d.join("huge.toml"),
+        "kind = \"film-lut\"\n[stack]\nambient = \"1.0\"\nbase = \"1.5\"\n[axes]\ncos_theta_count = 4096\nthickness_nm = [0.0, 100.0]\nopd_count = 4096\nfilm_ior = [1.0, 2.0]\nfilm_ior_count = 2\n",
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("absorbing.toml"),
+        "kind = \"film-lut\"\n[stack]\nambient = \"au\"\nbase = \"1.5\"\n[axes]\ncos_theta_count = 4\nthickness_nm = [0.0, 100.0]\nopd_count = 4\nfilm_ior = [1.0, 2.0]\nfilm_ior_count = 2\n",
+    )
+    .unwrap();
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let cases: &[(&[&str], &str)] = &[
+        (&["color", "--method", "foo"], "--method `foo`"),
+        (&["color", "--method", "samples:0"], "samples:N"),
+        (&["color", "--method", "lut:nope.json"], "nope.json"),
+        (
+            &[
+                "color",
+                "--layer",
+                "1.33@400",
+                "--substrate",
+                "1.5",
+                "--method",
+                "lut:soap-film",
+            ],
+            "baked for ambient `1.0`",
+        ),
+        (
+            &[
+                "color",
+                "--ambient",
+                "1.0",
+                "--layer",
+                "1.33@400",
+                "--substrate",
+                "1.5",
+                "--method",
+                "lut:soap-film",
+            ],
+            "baked for base",
+        ),
+        (
+            &[
+                "color",
+                "--layer",
+                "1.33@400",
+                "--ambient",
+                "1.0",
+                "--substrate",
+                "au",
+                "--method",
+                "lut:film-gold",
+                "--quantity",
+                "t",
+            ],
+            "no transmittance",
+        ),
+        (
+            &[
+                "color",
+                "--layer",
+                "1.33@400",
+                "--ambient",
+                "1.0",
+                "--substrate",
+                "au",
+                "--method",
+                "lut:film-gold",
+                "--space",
+                "rec2020",
+            ],
+            "--space",
+        ),
+        (&["color", "--space", "lab"], "--space `lab`"),
+        (&["color", "--observer", "1900"], "--observer `1900`"),
+        (&["color", "--illuminant", "d60"], "--illuminant `d60`"),
+        (
+            &["color", "--points", "BAD/bad-points.csv"],
+            "bad-points.csv:3",
+        ),
+        (&["color", "--angles", "0:90:10"], "--angles"),
+        (
+            &["bake", "BAD/kind.toml", "--out", "BAD/out"],
+            "kind.toml:1: unknown table kind `cake`",
+        ),
+        (
+            &["bake", "BAD/huge.toml", "--out", "BAD/out"],
+            "exceeds the limit",
+        ),
+        (
+            &["bake", "BAD/absorbing.toml", "--out", "BAD/out"],
+            "constant real index",
+        ),
+        (
+            &["bake", "BAD/missing.toml", "--out", "BAD/out"],
+            "missing.toml",
+        ),
+        (&["info", "no-such-table"], "no-such-table.json"),
+    ];
+    let bad = d.to_string_lossy().into_owned();
+    for (args, needle) in cases {
+        let args: Vec<String> = args.iter().map(|a| a.replace("BAD", &bad)).collect();
+        let o = Command::new(env!("CARGO_BIN_EXE_nacre"))
+            .args(&args)
+            .current_dir(&repo)
+            .output()
+            .unwrap();
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains(needle),
+            "{args:?}: expected `{needle}` in: {err}"
+        );
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+    }
+    assert!(!d.join("out").exists(), "a failed bake wrote output");
+}
