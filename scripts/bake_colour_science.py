@@ -338,7 +338,8 @@ def compare(label, a, b, m, white):
     de = delta_e_2000(a, b, m, white)
     print(f"  {label}: max |dRGB| {np.nanmax(diff):.3e} ({describe_worst(diff)}); "
           f"CIEDE2000 max {np.nanmax(de):.3g}, 99.9th pct {np.nanpercentile(de, 99.9):.3g}, "
-          f"mean {np.nanmean(de):.3g}")
+          f"mean {np.nanmean(de):.3g}; without the cos theta = 1e-6 column: max |dRGB| "
+          f"{np.nanmax(diff[:, :, 1:]):.3e}, CIEDE2000 max {np.nanmax(de[:, :, 1:]):.3g}")
 
 
 # --- driver ------------------------------------------------------------------------------

@@ -11,7 +11,15 @@
 //!   the output space): the common real-time shortcut;
 //! * `samples:N` — N wavelengths spread uniformly over 400–700 nm (inclusive), weighted by
 //!   the output-space sensitivities there and normalised so that R ≡ 1 is white: the
-//!   shortcut of the real-time thesis (Sussenbach 2013, §4.3).
+//!   shortcut of the real-time thesis (Sussenbach 2013, §4.3);
+//! * `fourier:M`, `fourier:auto`, `fourier:M:SIGMA_NM`, `fourier:auto:SIGMA_NM` — Belcour &
+//!   Barla 2017 Eq. 10 with exact Fresnel amplitudes and phases per polarisation and the
+//!   sensitivities' Fourier transforms evaluated exactly ([`nacre_optics::fourier`]), with M
+//!   harmonics or as many as a 10⁻⁴ tail bound needs, optionally prefiltered for a Gaussian
+//!   thickness distribution of standard deviation SIGMA_NM (one film on a base; reflectance);
+//! * `gaussian` — the Gaussian-fit closed form with Schlick Fresnel and m ≤ 2 of glTF's
+//!   `KHR_materials_iridescence` reference code, for comparison (the base enters through its
+//!   normal-incidence reflectance; the fit ignores `--illuminant`).
 //!
 //! Output columns: `angle_deg,thickness_nm,film_ior,X,Y,Z,R,G,B` (XYZ under the illuminant
 //! with a perfect reflector at Y = 1; R, G, B linear in the output space, equal to X, Y, Z
@@ -22,7 +30,8 @@ use crate::error::{Error, Result};
 use crate::film_lut::FilmLut;
 use crate::spectrum::fmt_sig;
 use crate::table_io::Table3;
-use nacre_optics::colour::{Colorimeter, OutputSpace};
+use nacre_optics::colour::{Colorimeter, OutputSpace, RgbSpace};
+use nacre_optics::fourier::{FilmOnBase, Harmonics, gltf_iridescence};
 use nacre_optics::{C64, Layer, Material, SpectralRule, Stack};
 use rayon::prelude::*;
 use std::io::Write;
@@ -48,6 +57,11 @@ pub enum Method {
     Rgb3,
     /// N wavelengths over 400–700 nm.
     Samples(usize),
+    /// Belcour & Barla 2017 Eq. 10 with exact Fresnel terms, prefiltered for a Gaussian
+    /// thickness distribution of the given standard deviation (nm, 0 for none).
+    Fourier(Harmonics, f64),
+    /// The Gaussian-fit closed form of glTF's `KHR_materials_iridescence`.
+    GaussianFitBelcour2017,
 }
 
 impl Method {
@@ -61,6 +75,7 @@ impl Method {
         match text.trim() {
             "spectral" => Ok(Method::Spectral),
             "rgb3" => Ok(Method::Rgb3),
+            "gaussian" => Ok(Method::GaussianFitBelcour2017),
             t => {
                 if let Some(name) = t.strip_prefix("lut:") {
                     if name.is_empty() {
@@ -72,8 +87,34 @@ impl Method {
                         Ok(n @ 1..=10_000) => Ok(Method::Samples(n)),
                         _ => Err(err("samples:N needs a whole number N from 1 to 10000")),
                     }
+                } else if let Some(rest) = t.strip_prefix("fourier:") {
+                    let bad = || {
+                        err(
+                            "expected fourier:M, fourier:auto, fourier:M:SIGMA_NM or fourier:auto:SIGMA_NM (M from 1 to 512, SIGMA_NM ≥ 0)",
+                        )
+                    };
+                    let (m, sigma) = match rest.split_once(':') {
+                        Some((m, s)) => (
+                            m,
+                            s.parse::<f64>()
+                                .ok()
+                                .filter(|v| *v >= 0.0 && v.is_finite())
+                                .ok_or_else(bad)?,
+                        ),
+                        None => (rest, 0.0),
+                    };
+                    let harmonics = match m {
+                        "auto" => Harmonics::Auto,
+                        m => match m.parse::<usize>() {
+                            Ok(m @ 1..=512) => Harmonics::Fixed(m),
+                            _ => return Err(bad()),
+                        },
+                    };
+                    Ok(Method::Fourier(harmonics, sigma))
                 } else {
-                    Err(err("expected spectral, lut:NAME|PATH, rgb3 or samples:N"))
+                    Err(err(
+                        "expected spectral, lut:NAME|PATH, rgb3, samples:N, fourier:M[:SIGMA_NM], fourier:auto[:SIGMA_NM] or gaussian",
+                    ))
                 }
             }
         }
@@ -404,6 +445,61 @@ pub fn evaluate(
                     let p = s.sweep(&[point.angle_deg], &RGB3_WAVELENGTHS_NM)?;
                     Ok([0, 1, 2].map(|c| value(&p[c], quantity)))
                 }
+                Method::Fourier(harmonics, sigma_d_nm) => {
+                    let (film, cos_theta, d) = film_on_base(stack, point, colorimeter)?;
+                    if quantity == Quantity::Transmittance {
+                        return Err(Error::Invalid {
+                            context: "--method fourier".into(),
+                            message:
+                                "the Fourier method evaluates reflectance only (use --quantity r)"
+                                    .into(),
+                        });
+                    }
+                    match film.fourier_colour(colorimeter, cos_theta, d, *harmonics, *sigma_d_nm) {
+                        Some(c) => Ok(c.colour),
+                        // An evanescent film has no Fourier series in 1/λ: exact reference.
+                        None => evaluate(
+                            stack,
+                            std::slice::from_ref(point),
+                            &Method::Spectral,
+                            colorimeter,
+                            quantity,
+                            None,
+                        )
+                        .map(|v| v[0]),
+                    }
+                }
+                Method::GaussianFitBelcour2017 => {
+                    if quantity == Quantity::Transmittance {
+                        return Err(Error::Invalid {
+                            context: "--method gaussian".into(),
+                            message:
+                                "the Gaussian fit evaluates reflectance only (use --quantity r)"
+                                    .into(),
+                        });
+                    }
+                    let (film, cos_theta, d) = film_on_base(stack, point, colorimeter)?;
+                    // The base enters only through its normal-incidence reflectance F0 (RGB),
+                    // as in glTF.
+                    let bare =
+                        Stack::new(stack.ambient().clone(), vec![], stack.substrate().clone())?;
+                    let rule = SpectralRule::new(colorimeter, 0.0);
+                    let p = bare.sweep(&[0.0], rule.wavelengths_nm())?;
+                    let f0 = rule.colour(p.iter().map(|p| p.R()));
+                    let f0 = match colorimeter.space() {
+                        OutputSpace::Rgb(RgbSpace::Srgb) => f0,
+                        _ => mat3(
+                            RgbSpace::Srgb.xyz_to_rgb_matrix(),
+                            colorimeter.xyz_from_output(f0),
+                        ),
+                    };
+                    let rec709 = gltf_iridescence(film.n_ambient, film.n_film, cos_theta, d, f0);
+                    Ok(match colorimeter.space() {
+                        OutputSpace::Rgb(RgbSpace::Srgb) => rec709,
+                        _ => colorimeter
+                            .output_from_xyz(mat3(RgbSpace::Srgb.rgb_to_xyz_matrix(), rec709)),
+                    })
+                }
                 Method::Samples(n) => {
                     let s = stack_at(stack, point)?;
                     let (wl, w) = sample_weights(colorimeter, *n);
@@ -419,6 +515,81 @@ pub fn evaluate(
             }
         })
         .collect()
+}
+
+fn mat3(m: [[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
+    std::array::from_fn(|r| m[r][0] * v[0] + m[r][1] * v[1] + m[r][2] * v[2])
+}
+
+/// The single film on a base that the Fourier methods need, with the point's angle and
+/// thickness. The base's index is taken per channel at the channel's centroid wavelength
+/// ∫ λ |s_j| dλ / ∫ |s_j| dλ (exact for non-dispersive bases).
+fn film_on_base(
+    stack: &Stack,
+    point: &Point,
+    colorimeter: &Colorimeter,
+) -> Result<(FilmOnBase, f64, f64)> {
+    let context = || "--method fourier/gaussian".to_string();
+    if stack.layers().len() != 1 {
+        return Err(Error::Invalid {
+            context: context(),
+            message: format!(
+                "needs exactly one film on a base; the stack has {} layers",
+                stack.layers().len()
+            ),
+        });
+    }
+    let film = &stack.layers()[0];
+    let n_film = match point.film_ior {
+        Some(n) => n,
+        None => {
+            let n = film.material.index_at(550.0)?;
+            if !film.material.is_constant() || n.im != 0.0 {
+                return Err(Error::Invalid {
+                    context: context(),
+                    message: format!(
+                        "needs a constant real film index; `{}` is dispersive or absorbing",
+                        film.material.name()
+                    ),
+                });
+            }
+            n.re
+        }
+    };
+    let ambient = stack.ambient().index_at(550.0)?;
+    if !stack.ambient().is_constant() {
+        return Err(Error::Invalid {
+            context: context(),
+            message: format!(
+                "needs a constant ambient index; `{}` is dispersive",
+                stack.ambient().name()
+            ),
+        });
+    }
+    let weights = colorimeter.weights_1nm();
+    let centroid_nm: [f64; 3] = std::array::from_fn(|j| {
+        let (num, den) = weights
+            .iter()
+            .enumerate()
+            .fold((0.0, 0.0), |(a, b), (i, w)| {
+                let wl = nacre_optics::colour::spectral_wavelength_nm(i);
+                (a + wl * w[j].abs(), b + w[j].abs())
+            });
+        num / den
+    });
+    let mut base = [C64::new(0.0, 0.0); 3];
+    for (b, wl) in base.iter_mut().zip(centroid_nm) {
+        *b = stack.substrate().index_at(wl)?;
+    }
+    Ok((
+        FilmOnBase {
+            n_ambient: ambient.re,
+            n_film,
+            base,
+        },
+        point.angle_deg.to_radians().cos(),
+        point.thickness_nm.unwrap_or(film.thickness_nm),
+    ))
 }
 
 /// Wavelengths and weights of `samples:N`: λₖ = 400 + 300 k/(N − 1) nm (550 nm for N = 1),

@@ -22,6 +22,7 @@
 
 pub mod colour;
 pub mod error;
+pub mod fourier;
 pub mod fresnel;
 pub mod material;
 pub mod spectral;

@@ -1,0 +1,555 @@
+//! Analytic spectral integration of thin-film colour in the Fourier domain
+//! (Belcour & Barla 2017, "A Practical Extension to Microfacet Theory for the Modeling of
+//! Varying Iridescence", §4, Eq. 5–10), and the Gaussian-fit shortcut used by glTF's
+//! `KHR_materials_iridescence`.
+//!
+//! # Symbols
+//!
+//! | symbol | code | meaning |
+//! |---|---|---|
+//! | s_j(λ) | [`Colorimeter::sensitivity_at`] | output-space sensitivity of channel j (may be negative for RGB) |
+//! | ‖s_j‖ = ∫ s_j dλ | `norm` | the channel's white (1 for RGB) |
+//! | D = 2 d q₂ | `opd_nm` | optical path difference of the film, q₂ = √(n₂² − n₁² sin²θ₁) |
+//! | Φ(λ) = 2π D / λ | | round-trip phase, without the reflection phases |
+//! | Ŝ_j(μ) | [`SensitivitySpectrum::transform`] | Ŝ_j(μ) = ∫ s_j(λ) e^{−2πiμ/λ} dλ / ‖s_j‖ |
+//! | r₁₂, Γ | `r12`, `gamma` | film-top Fresnel amplitude, and base reflection seen from inside the film |
+//!
+//! # Sign convention of the transform
+//!
+//! With ν = 1/λ and S_j(ν) = s_j(1/ν) / (‖s_j‖ ν²) (so that S_j(ν) dν = s_j(λ) dλ / ‖s_j‖,
+//! Belcour & Barla Eq. 8), Ŝ_j(μ) = ∫ S_j(ν) e^{−2πiμν} dν: the forward transform with a
+//! negative exponent, Ŝ_j(0) = 1. A spectral term cos(mΦ + φ) integrates to
+//! Re(e^{iφ} conj Ŝ_j(mD)) (tested in `cosine_integrates_through_the_transform`).
+//!
+//! # The Airy series (Belcour & Barla Eq. 5–6, written in closed form)
+//!
+//! The film's amplitude is r = r₁₂ + Σ_{k≥1} β ρ^{k−1} e^{ikΦ} with β = (1 − r₁₂²) Γ and
+//! ρ = −r₁₂ Γ (the recurrence of [`crate::stack`] unrolled; for non-dispersive media r₁₂ and
+//! Γ do not depend on λ). Hence R = |r|² = c₀ + 2 Σ_{m≥1} Re(c_m e^{imΦ}) with
+//!
+//! ```text
+//! c₀ = |r₁₂|² + |β|² / (1 − |ρ|²)
+//! c_m = ρ^{m−1} K,   K = β r₁₂* + |β|² ρ / (1 − |ρ|²)
+//! ```
+//!
+//! and the colour of channel j is (Eq. 10)
+//! `C_j = ‖s_j‖ [c₀ + 2 Σ_{m=1}^{M} Re(c_m conj Ŝ_j(m D))]`, averaged over s and p.
+//! Reflection phases are carried by the complex c_m: Fresnel amplitudes are exact for
+//! dielectric and conductor bases (not Schlick), and total internal reflection at the base
+//! (|Γ| = 1) needs nothing special. The series converges like |ρ|^M; [`Harmonics::Auto`]
+//! picks the smallest M whose tail bound 2|K||ρ|^M / (1 − |ρ|) is below 10⁻⁵.
+//!
+//! # Prefiltering (Belcour & Barla §5)
+//!
+//! If the thickness within a pixel is Gaussian with standard deviation σ_d, D is Gaussian
+//! with standard deviation τ σ_d, τ = 2 q₂, and the m-th harmonic averages Ŝ_j over a Gaussian
+//! of standard deviation m τ σ_d in μ. In the spectral domain that is the damping
+//! exp(−(2π σ_μ / λ)² / 2) of each wavelength, which [`SensitivitySpectrum::transform`]
+//! applies exactly.
+
+use crate::colour::Colorimeter;
+use crate::fresnel::{Interface, normal_component};
+use crate::spectral::SpectralRule;
+use num_complex::Complex64 as C64;
+use std::f64::consts::PI;
+
+/// Filon cells per nanometre in [`SensitivitySpectrum`].
+pub const SUBCELLS: usize = 8;
+
+/// Largest number of harmonics [`Harmonics::Auto`] will use.
+pub const MAX_AUTO_HARMONICS: usize = 512;
+
+/// Tail bound below which [`Harmonics::Auto`] stops (reflectance units).
+pub const AUTO_TAIL_TOLERANCE: f64 = 1e-5;
+
+/// How many harmonics of the Airy series to sum.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Harmonics {
+    /// m = 1 … M.
+    Fixed(usize),
+    /// As many as the tail bound requires (at most [`MAX_AUTO_HARMONICS`]).
+    Auto,
+}
+
+/// The sensitivities of a colorimeter in the frequency domain ν = 1/λ, ready for Fourier
+/// transforms at any μ.
+///
+/// Ŝ_j(μ) = ∫ S_j(ν) e^{−2πiμν} dν is evaluated by Filon's method (L. N. G. Filon, Proc. R.
+/// Soc. Edinburgh 49, 38–47, 1928; Davis & Rabinowitz §2.10): S_j(ν) = s_j(1/ν)/ν² (s_j the
+/// linearly interpolated 1 nm sensitivities) is interpolated linearly in ν between nodes
+/// 1/[`SUBCELLS`] nm apart over 360–830 nm, and each cell is integrated against the
+/// exponential exactly, so the cost does not grow with μ and there is no aliasing however
+/// large μ is. Ŝ_j(0) = 1 by normalisation. Against a direct Gauss–Legendre quadrature in λ
+/// the difference is below 10⁻⁵ (test `filon_matches_direct_quadrature`; ≈ 4·10⁻⁶, the
+/// reference's own error across the kinks of the 1 nm tables).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SensitivitySpectrum {
+    /// νᵢ in 1/nm, increasing.
+    nu: Vec<f64>,
+    /// S_j(νᵢ) = s_j(λᵢ) λᵢ², unnormalised.
+    values: Vec<[f64; 3]>,
+    /// Σ of the μ = 0 integrals, per channel.
+    norm: [f64; 3],
+}
+
+impl SensitivitySpectrum {
+    /// Prepares `colorimeter`'s output sensitivities.
+    pub fn new(colorimeter: &Colorimeter) -> Self {
+        let w = colorimeter.weights_1nm();
+        let cells = (w.len() - 1) * SUBCELLS;
+        let mut nu = Vec::with_capacity(cells + 1);
+        let mut values = Vec::with_capacity(cells + 1);
+        for k in (0..=cells).rev() {
+            let wl = crate::colour::SPECTRAL_MIN_NM + k as f64 / SUBCELLS as f64;
+            nu.push(1.0 / wl);
+            values.push(colorimeter.sensitivity_at(wl).map(|v| v * wl * wl));
+        }
+        let mut this = SensitivitySpectrum {
+            nu,
+            values,
+            norm: [1.0; 3],
+        };
+        let raw = this.transform(0.0, 0.0);
+        this.norm = raw.map(|v| v.re);
+        this
+    }
+
+    /// Ŝ_j(μ), prefiltered by a Gaussian of standard deviation `sigma_mu_nm` in μ
+    /// (multiplying S_j(ν) by exp(−(2π σ_μ ν)²/2); 0 for none).
+    pub fn transform(&self, mu_nm: f64, sigma_mu_nm: f64) -> [C64; 3] {
+        let omega = 2.0 * PI * mu_nm;
+        let damp = |nu: f64| {
+            if sigma_mu_nm > 0.0 {
+                (-0.5 * (2.0 * PI * sigma_mu_nm * nu).powi(2)).exp()
+            } else {
+                1.0
+            }
+        };
+        let mut sum = [C64::new(0.0, 0.0); 3];
+        for i in 0..self.nu.len() - 1 {
+            let (a, b) = (self.nu[i], self.nu[i + 1]);
+            let h = b - a;
+            let (da, db) = (damp(a), damp(b));
+            let (fa, fb) = (
+                self.values[i].map(|v| v * da),
+                self.values[i + 1].map(|v| v * db),
+            );
+            let (wa, wb) = filon_weights(omega, h);
+            let phase = C64::from_polar(1.0, -omega * a);
+            for j in 0..3 {
+                // ∫ (f_a + (f_b − f_a) t / h) e^{−iω(a + t)} dt = e^{−iωa} (f_a A + (f_b − f_a) B / h)
+                sum[j] += phase * (wa * fa[j] + wb * ((fb[j] - fa[j]) / h));
+            }
+        }
+        std::array::from_fn(|j| sum[j] / self.norm[j])
+    }
+}
+
+/// A = ∫₀ʰ e^{−iωt} dt and B = ∫₀ʰ t e^{−iωt} dt, with Taylor series for small ωh.
+fn filon_weights(omega: f64, h: f64) -> (C64, C64) {
+    let theta = omega * h;
+    let i = C64::new(0.0, 1.0);
+    if theta.abs() < 1e-2 {
+        // A = h Σ (−iθ)^k/(k+1)!, B = h² Σ (−iθ)^k k!… written out to θ⁴.
+        let t = C64::new(0.0, -theta);
+        let a = h * (1.0 + t / 2.0 + t * t / 6.0 + t * t * t / 24.0 + t * t * t * t / 120.0);
+        let b = h * h * (0.5 + t / 3.0 + t * t / 8.0 + t * t * t / 30.0 + t * t * t * t / 144.0);
+        (a, b)
+    } else {
+        let e = C64::from_polar(1.0, -theta);
+        let a = (1.0 - e) / (i * omega);
+        let b = i * h * e / omega - (1.0 - e) / (omega * omega);
+        (a, b)
+    }
+}
+
+/// Ŝ_j(μ) for each channel of `colorimeter`, prefiltered by a Gaussian of standard
+/// deviation `sigma_mu_nm` in μ (0 for none). Convenience wrapper of
+/// [`SensitivitySpectrum`]; prepare one when evaluating many μ.
+pub fn sensitivity_transform(colorimeter: &Colorimeter, mu_nm: f64, sigma_mu_nm: f64) -> [C64; 3] {
+    SensitivitySpectrum::new(colorimeter).transform(mu_nm, sigma_mu_nm)
+}
+
+/// Ŝ_j(μ) by direct adaptive quadrature in λ with `rule` (which must resolve |μ|): the
+/// independent check of [`SensitivitySpectrum`].
+pub fn transform_with_rule(rule: &SpectralRule, mu_nm: f64, sigma_mu_nm: f64) -> [C64; 3] {
+    let mut sum = [C64::new(0.0, 0.0); 3];
+    let mut norm = [0.0; 3];
+    for (&wl, w) in rule.wavelengths_nm().iter().zip(rule.weights()) {
+        let phase = -2.0 * PI * mu_nm / wl;
+        let damping = if sigma_mu_nm > 0.0 {
+            (-0.5 * (2.0 * PI * sigma_mu_nm / wl).powi(2)).exp()
+        } else {
+            1.0
+        };
+        let e = C64::from_polar(damping, phase);
+        for j in 0..3 {
+            sum[j] += e * w[j];
+            norm[j] += w[j];
+        }
+    }
+    std::array::from_fn(|j| sum[j] / norm[j])
+}
+
+/// Closed-form Airy Fourier coefficients of one polarisation: R = c₀ + 2 Σ Re(c_m e^{imΦ}),
+/// c_m = ρ^{m−1} K.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AirySeries {
+    /// The DC term c₀.
+    pub c0: f64,
+    /// K = c₁.
+    pub k: C64,
+    /// The ratio ρ = −r₁₂ Γ.
+    pub rho: C64,
+}
+
+impl AirySeries {
+    fn new(r12: C64, gamma: C64) -> Self {
+        let beta = (1.0 - r12 * r12) * gamma;
+        let rho = -r12 * gamma;
+        let inv = 1.0 / (1.0 - rho.norm_sqr());
+        AirySeries {
+            c0: r12.norm_sqr() + beta.norm_sqr() * inv,
+            k: beta * r12.conj() + beta.norm_sqr() * rho * inv,
+            rho,
+        }
+    }
+
+    /// Harmonics needed for a tail bound below [`AUTO_TAIL_TOLERANCE`].
+    fn auto_harmonics(&self) -> usize {
+        let r = self.rho.norm();
+        if r < 1e-300 {
+            return 1;
+        }
+        let mut tail = 2.0 * self.k.norm() / (1.0 - r).max(1e-12);
+        let mut m = 0;
+        while tail > AUTO_TAIL_TOLERANCE && m < MAX_AUTO_HARMONICS {
+            tail *= r;
+            m += 1;
+        }
+        m.max(1)
+    }
+}
+
+/// A single film (real index `n_film`) between a non-absorbing ambient `n_ambient` and a
+/// base of complex index `base` (per output channel), seen at `cos_theta`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FilmOnBase {
+    /// Ambient index n₁ (real).
+    pub n_ambient: f64,
+    /// Film index n₂ (real).
+    pub n_film: f64,
+    /// Base index per output channel (the base's index at the channel's centroid
+    /// wavelength; the same value thrice for a non-dispersive base).
+    pub base: [C64; 3],
+}
+
+/// The result of [`FilmOnBase::fourier_colour`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FourierColour {
+    /// Output-space colour.
+    pub colour: [f64; 3],
+    /// Harmonics summed (largest over channels and polarisations).
+    pub harmonics: usize,
+}
+
+impl FilmOnBase {
+    /// The film's normal component q₂ = √(n₂² − n₁² sin²θ₁), or None when the film is
+    /// evanescent (n₂ < n₁ sin θ₁), where the spectrum is not a Fourier series in 1/λ.
+    pub fn film_q(&self, cos_theta: f64) -> Option<f64> {
+        let sin2 = 1.0 - cos_theta * cos_theta;
+        let q2 = self.n_film * self.n_film - self.n_ambient * self.n_ambient * sin2;
+        (q2 > 0.0).then(|| q2.sqrt())
+    }
+
+    /// Airy series of channel j for (s, p).
+    fn series(&self, cos_theta: f64, j: usize) -> [AirySeries; 2] {
+        let n1 = C64::new(self.n_ambient, 0.0);
+        let n2 = C64::new(self.n_film, 0.0);
+        let beta = self.n_ambient * (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+        let (q1, q2, q3) = (
+            normal_component(n1, beta),
+            normal_component(n2, beta),
+            normal_component(self.base[j], beta),
+        );
+        let top = Interface::new(n1, q1, n2, q2);
+        let bottom = Interface::new(n2, q2, self.base[j], q3);
+        [
+            AirySeries::new(top.r_s, bottom.r_s),
+            AirySeries::new(top.r_p, bottom.r_p),
+        ]
+    }
+
+    /// Belcour & Barla Eq. 10 with exact Fresnel terms: the colour of the film's
+    /// unpolarised reflectance at thickness `thickness_nm`, optionally prefiltered for a
+    /// Gaussian thickness distribution of standard deviation `sigma_d_nm`.
+    /// Returns None for an evanescent film (use the spectral reference there).
+    pub fn fourier_colour(
+        &self,
+        colorimeter: &Colorimeter,
+        cos_theta: f64,
+        thickness_nm: f64,
+        harmonics: Harmonics,
+        sigma_d_nm: f64,
+    ) -> Option<FourierColour> {
+        let q2 = self.film_q(cos_theta)?;
+        let opd = 2.0 * thickness_nm * q2;
+        let tau = 2.0 * q2;
+        let white = colorimeter
+            .weights_1nm()
+            .iter()
+            .fold([0.0; 3], |a, w| [a[0] + w[0], a[1] + w[1], a[2] + w[2]]);
+        let series: [[AirySeries; 2]; 3] = std::array::from_fn(|j| self.series(cos_theta, j));
+        let m_max = match harmonics {
+            Harmonics::Fixed(m) => m,
+            Harmonics::Auto => series
+                .iter()
+                .flatten()
+                .map(AirySeries::auto_harmonics)
+                .max()
+                .unwrap_or(1),
+        };
+        let spectrum = SensitivitySpectrum::new(colorimeter);
+        let mut colour = [0.0; 3];
+        for (j, c) in colour.iter_mut().enumerate() {
+            *c = 0.5 * (series[j][0].c0 + series[j][1].c0);
+        }
+        let mut cm = [[C64::new(0.0, 0.0); 2]; 3];
+        for m in 1..=m_max {
+            let s_hat = spectrum.transform(m as f64 * opd, m as f64 * tau * sigma_d_nm);
+            for j in 0..3 {
+                let mut sum = 0.0;
+                for pol in 0..2 {
+                    let s = &series[j][pol];
+                    cm[j][pol] = if m == 1 { s.k } else { cm[j][pol] * s.rho };
+                    sum += (cm[j][pol] * s_hat[j].conj()).re;
+                }
+                colour[j] += sum; // 2 Re(…) averaged over two polarisations
+            }
+        }
+        Some(FourierColour {
+            colour: std::array::from_fn(|j| colour[j] * white[j]),
+            harmonics: m_max,
+        })
+    }
+}
+
+/// The Gaussian fit of the XYZ sensitivities' Fourier transforms published with Belcour &
+/// Barla 2017 and used by glTF's `KHR_materials_iridescence` reference implementation: for
+/// an OPD in nm and a phase shift, the linear Rec.709 (sRGB primaries) sensitivity term
+/// `S(OPD, shift)`. Per XYZ channel, a Gaussian of amplitude `val`, centre `pos` (1/m) and
+/// variance `var` (1/m²): `val √(2π var) cos(pos φ + shift) exp(−φ² var)` with
+/// φ = 2π OPD·10⁻⁹, an extra Gaussian for the second lobe of x̄, normalised by 1.0685·10⁻⁷,
+/// then XYZ → Rec.709.
+pub fn gaussian_sensitivity_belcour2017(opd_nm: f64, shift: [f64; 3]) -> [f64; 3] {
+    const VAL: [f64; 3] = [5.4856e-13, 4.4201e-13, 5.2481e-13];
+    const POS: [f64; 3] = [1.6810e+06, 1.7953e+06, 2.2084e+06];
+    const VAR: [f64; 3] = [4.3278e+09, 9.3046e+09, 6.6121e+09];
+    const XYZ_TO_REC709: [[f64; 3]; 3] = [
+        [3.2404542, -1.5371385, -0.4985314],
+        [-0.9692660, 1.8760108, 0.0415560],
+        [0.0556434, -0.2040259, 1.0572252],
+    ];
+    let phase = 2.0 * PI * opd_nm * 1e-9;
+    let mut xyz: [f64; 3] = std::array::from_fn(|i| {
+        VAL[i]
+            * (2.0 * PI * VAR[i]).sqrt()
+            * (POS[i] * phase + shift[i]).cos()
+            * (-phase * phase * VAR[i]).exp()
+    });
+    xyz[0] += 9.7470e-14
+        * (2.0 * PI * 4.5282e+09f64).sqrt()
+        * (2.2399e+06 * phase + shift[0]).cos()
+        * (-4.5282e+09 * phase * phase).exp();
+    let xyz = xyz.map(|v| v / 1.0685e-7);
+    std::array::from_fn(|r| (0..3).map(|c| XYZ_TO_REC709[r][c] * xyz[c]).sum())
+}
+
+/// The `KHR_materials_iridescence` reference thin-film term (Belcour & Barla 2017's
+/// real-time approximation: Schlick Fresnel from F0, π phase flips, unpolarised, m ≤ 2,
+/// Gaussian-fit sensitivities), in linear Rec.709, for an outside index `n_outside`, film
+/// index `n_film`, `cos_theta`, thickness in nm and the base's normal-incidence reflectance
+/// `base_f0` (RGB). As in the glTF reference renderer, the film index is blended to the
+/// outside index by smoothstep(0, 0.03, thickness_nm).
+pub fn gltf_iridescence(
+    n_outside: f64,
+    n_film: f64,
+    cos_theta: f64,
+    thickness_nm: f64,
+    base_f0: [f64; 3],
+) -> [f64; 3] {
+    let smooth = {
+        let t = (thickness_nm / 0.03).clamp(0.0, 1.0);
+        t * t * (3.0 - 2.0 * t)
+    };
+    let ior = n_outside + (n_film - n_outside) * smooth;
+    let sin2_t2 = (n_outside / ior).powi(2) * (1.0 - cos_theta * cos_theta);
+    let cos2_t2 = 1.0 - sin2_t2;
+    if cos2_t2 < 0.0 {
+        return [1.0; 3];
+    }
+    let cos_t2 = cos2_t2.sqrt();
+    let schlick = |f0: f64, c: f64| f0 + (1.0 - f0) * (1.0 - c).clamp(0.0, 1.0).powi(5);
+    let f0_of = |a: f64, b: f64| ((a - b) / (a + b)).powi(2);
+    let r12 = schlick(f0_of(ior, n_outside), cos_theta);
+    let t121 = 1.0 - r12;
+    let phi12 = if ior < n_outside { PI } else { 0.0 };
+    let phi21 = PI - phi12;
+    let opd = 2.0 * ior * thickness_nm * cos_t2;
+    let mut out = [0.0; 3];
+    let mut shifts = [0.0; 3];
+    let mut r123 = [0.0; 3];
+    let mut cm = [0.0; 3];
+    for i in 0..3 {
+        let f0 = base_f0[i].clamp(0.0, 0.9999);
+        let base_ior = (1.0 + f0.sqrt()) / (1.0 - f0.sqrt());
+        let r23 = schlick(f0_of(base_ior, ior), cos_t2);
+        let phi23 = if base_ior < ior { PI } else { 0.0 };
+        shifts[i] = phi21 + phi23;
+        let r123_sq = (r12 * r23).clamp(1e-5, 0.9999);
+        r123[i] = r123_sq.sqrt();
+        let rs = t121 * t121 * r23 / (1.0 - r123_sq);
+        out[i] = r12 + rs;
+        cm[i] = rs - t121;
+    }
+    for m in 1..=2 {
+        let mf = m as f64;
+        let s = gaussian_sensitivity_belcour2017(mf * opd, shifts.map(|p| mf * p));
+        for i in 0..3 {
+            cm[i] *= r123[i];
+            out[i] += cm[i] * 2.0 * s[i];
+        }
+    }
+    out.map(|v| v.max(0.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::colour::{Illuminant, Observer, OutputSpace, RgbSpace};
+    use crate::{Layer, Material, Stack};
+
+    fn srgb() -> Colorimeter {
+        Colorimeter::new(
+            Observer::Cie1931_2Deg,
+            Illuminant::D65,
+            OutputSpace::Rgb(RgbSpace::Srgb),
+        )
+    }
+
+    #[test]
+    fn transform_is_one_at_zero_and_decays() {
+        let c = srgb();
+        let s0 = sensitivity_transform(&c, 0.0, 0.0);
+        for v in s0 {
+            assert!((v - C64::new(1.0, 0.0)).norm() < 1e-12, "{s0:?}");
+        }
+        let far = sensitivity_transform(&c, 50_000.0, 0.0);
+        assert!(far.iter().all(|v| v.norm() < 1e-3), "{far:?}");
+        // Prefiltering only damps.
+        let direct = transform_with_rule(&SpectralRule::new(&c, 0.0), 0.0, 0.0);
+        assert!(
+            direct
+                .iter()
+                .all(|v| (v - C64::new(1.0, 0.0)).norm() < 1e-12)
+        );
+        let a = sensitivity_transform(&c, 800.0, 0.0);
+        let b = sensitivity_transform(&c, 800.0, 100.0);
+        assert!((0..3).all(|j| b[j].norm() < a[j].norm()));
+    }
+
+    #[test]
+    fn filon_matches_direct_quadrature() {
+        let c = srgb();
+        let spectrum = SensitivitySpectrum::new(&c);
+        let mut worst: f64 = 0.0;
+        for &(mu, sigma) in &[
+            (0.0, 0.0),
+            (300.0, 0.0),
+            (1234.5, 0.0),
+            (5000.0, 40.0),
+            (20_000.0, 0.0),
+            (60_000.0, 0.0),
+            (2500.0, 400.0),
+        ] {
+            let a = spectrum.transform(mu, sigma);
+            // A rule 20× finer than needed for the phase (GL2 error ∝ step⁴) as the reference.
+            let b = transform_with_rule(&SpectralRule::new(&c, 20.0 * mu.max(1000.0)), mu, sigma);
+            for j in 0..3 {
+                worst = worst.max((a[j] - b[j]).norm());
+            }
+        }
+        // The residual (≈ 4e-6) is the reference's: its 2 nm Gauss–Legendre cells span the
+        // kinks of the 1 nm sensitivity tables.
+        assert!(worst < 1e-5, "{worst:e}");
+    }
+
+    #[test]
+    fn cosine_integrates_through_the_transform() {
+        // ∫ cos(2π μ/λ + φ) s(λ) dλ / ‖s‖ = Re(e^{iφ} conj Ŝ(μ)), by direct quadrature.
+        let c = srgb();
+        let (mu, phi) = (1234.5, 0.7);
+        let rule = SpectralRule::new(&c, 20.0 * mu);
+        let direct = rule.colour(
+            rule.wavelengths_nm()
+                .iter()
+                .map(|&wl| (2.0 * PI * mu / wl + phi).cos()),
+        );
+        let s = sensitivity_transform(&c, mu, 0.0);
+        for j in 0..3 {
+            let via = (C64::from_polar(1.0, phi) * s[j].conj()).re;
+            assert!(
+                (direct[j] - via).abs() < 1e-5,
+                "{j}: {} vs {via}",
+                direct[j]
+            );
+        }
+    }
+
+    #[test]
+    fn airy_series_sums_to_the_airy_reflectance() {
+        // Sum the series at one wavelength (no spectral integration) and compare with the
+        // stack solver.
+        for &(n2, base, cos_t) in &[
+            (1.5, C64::new(1.0, 0.0), 1.0),
+            (2.2, C64::new(0.27, 2.9), 0.6),
+            (1.33, C64::new(1.5, 0.0), 0.2),
+            (1.8, C64::new(1.2, 0.0), 0.3), // TIR at the base
+        ] {
+            let film = FilmOnBase {
+                n_ambient: 1.0,
+                n_film: n2,
+                base: [base; 3],
+            };
+            let series = film.series(cos_t, 0);
+            let (d, wl) = (321.0, 550.0);
+            let q2 = film.film_q(cos_t).unwrap();
+            let phi = 2.0 * PI * 2.0 * d * q2 / wl;
+            let mut r = [0.0; 2];
+            for pol in 0..2 {
+                let s = &series[pol];
+                r[pol] = s.c0;
+                let mut cm = s.k;
+                for m in 1..2000 {
+                    r[pol] += 2.0 * (cm * C64::from_polar(1.0, m as f64 * phi)).re;
+                    cm *= s.rho;
+                }
+            }
+            let m = |n: C64| Material::constant("m", n).unwrap();
+            let stack = Stack::new(
+                m(C64::new(1.0, 0.0)),
+                vec![Layer {
+                    material: m(C64::new(n2, 0.0)),
+                    thickness_nm: d,
+                }],
+                m(base),
+            )
+            .unwrap();
+            let p = stack.evaluate(cos_t.acos().to_degrees(), wl).unwrap().power;
+            assert!(
+                (r[0] - p.R_s).abs() < 1e-9 && (r[1] - p.R_p).abs() < 1e-9,
+                "{n2} {base}: {r:?} vs {p:?}"
+            );
+        }
+    }
+}
