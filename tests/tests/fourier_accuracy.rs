@@ -7,12 +7,15 @@
 //! * prefiltered, σ_d 5–200 nm: `fourier:3:σ` against the brute-force average of spectral
 //!   colours over the Gaussian thickness distribution, p95 ≤ 0.5.
 
+use nacre_bake::bake::{Manifest, default_baked_dir};
 use nacre_bake::color::{self, Method, Point, Quantity};
+use nacre_bake::fourier_table::FourierTable;
 use nacre_optics::colour::{
     Colorimeter, Illuminant, Observer, OutputSpace, RgbSpace, delta_e_2000, xyz_to_lab,
 };
 use nacre_optics::fourier::Harmonics;
 use nacre_optics::{C64, Layer, Material, SpectralRule, Stack};
+use std::sync::Arc;
 
 struct Rng(u64);
 
@@ -28,6 +31,12 @@ impl Rng {
 }
 
 const POINTS: usize = 2000;
+
+/// The default-set `fourier-srgb` table (the `fourier:` methods sample it as a GPU would).
+fn table() -> Arc<FourierTable> {
+    let path = default_baked_dir().join("fourier-srgb.json");
+    Arc::new(Manifest::read(&path).unwrap().load_fourier(&path).unwrap())
+}
 
 fn srgb() -> Colorimeter {
     Colorimeter::new(
@@ -117,10 +126,24 @@ fn dielectric_base_fourier_3() {
     let cases = random_cases(7, |r| C64::new(r.uniform(1.0, 2.5), 0.0));
     let exact = evaluate(&cases, &Method::Spectral, &c);
     let mut report = Vec::new();
+    let t = table();
     for (name, method) in [
-        ("fourier:1", Method::Fourier(Harmonics::Fixed(1), 0.0)),
-        ("fourier:2", Method::Fourier(Harmonics::Fixed(2), 0.0)),
-        ("fourier:3", Method::Fourier(Harmonics::Fixed(3), 0.0)),
+        (
+            "fourier:1",
+            Method::Fourier(Harmonics::Fixed(1), 0.0, Some(t.clone())),
+        ),
+        (
+            "fourier:2",
+            Method::Fourier(Harmonics::Fixed(2), 0.0, Some(t.clone())),
+        ),
+        (
+            "fourier:3",
+            Method::Fourier(Harmonics::Fixed(3), 0.0, Some(t.clone())),
+        ),
+        (
+            "fourier-exact:3",
+            Method::Fourier(Harmonics::Fixed(3), 0.0, None),
+        ),
         ("gaussian", Method::GaussianFitBelcour2017),
     ] {
         let s = stats(&c, &exact, &evaluate(&cases, &method, &c));
@@ -141,9 +164,20 @@ fn conductor_base_fourier_auto() {
     let cases = random_cases(11, |r| C64::new(r.uniform(0.2, 2.0), r.uniform(0.5, 4.0)));
     let exact = evaluate(&cases, &Method::Spectral, &c);
     let mut report = Vec::new();
+    let t = table();
     for (name, method) in [
-        ("fourier:3", Method::Fourier(Harmonics::Fixed(3), 0.0)),
-        ("fourier:auto", Method::Fourier(Harmonics::Auto, 0.0)),
+        (
+            "fourier:3",
+            Method::Fourier(Harmonics::Fixed(3), 0.0, Some(t.clone())),
+        ),
+        (
+            "fourier:auto",
+            Method::Fourier(Harmonics::Auto, 0.0, Some(t.clone())),
+        ),
+        (
+            "fourier-exact:auto",
+            Method::Fourier(Harmonics::Auto, 0.0, None),
+        ),
         ("gaussian", Method::GaussianFitBelcour2017),
     ] {
         let s = stats(&c, &exact, &evaluate(&cases, &method, &c));
@@ -242,10 +276,11 @@ fn prefiltered_fourier_3_matches_thickness_averaged_spectral() {
             brute_force_average(&c, s, p.angle_deg, p.thickness_nm.unwrap(), *sigma)
         })
         .collect();
+    let t = table();
     let got: Vec<[f64; 3]> = cases
         .par_iter()
         .map(|(s, p, sigma)| {
-            let m = Method::Fourier(Harmonics::Fixed(3), *sigma);
+            let m = Method::Fourier(Harmonics::Fixed(3), *sigma, Some(t.clone()));
             color::evaluate(
                 s,
                 std::slice::from_ref(p),

@@ -54,7 +54,7 @@ fn default_tables_meet_the_accuracy_targets() {
             .sum();
         assert!(bytes <= 16 << 20, "{name}: {bytes} bytes");
         let lut = LoadedLut::load(&path).unwrap();
-        let a = &manifest.film_lut;
+        let a = manifest.film_lut.as_ref().unwrap();
         let ambient = resolve(&manifest.ambient, "test", None).unwrap();
         let base = resolve(&manifest.base, "test", None).unwrap();
         let film = Material::constant("film", C64::new(a.ior_min, 0.0)).unwrap();

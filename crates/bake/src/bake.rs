@@ -37,6 +37,7 @@
 
 use crate::error::{Error, Result};
 use crate::film_lut::{FilmLut, FilmLutAxes, FilmLutJob, validate_axes};
+use crate::fourier_table::{FourierAxes, FourierTable};
 use crate::materials::resolve;
 use crate::output::write_atomic;
 use crate::stack_spec::{line_of, toml_error};
@@ -215,7 +216,7 @@ impl Recipe {
                 path: path.to_path_buf(),
                 line: line_of(&text, kind.kind.span().start),
                 message: format!(
-                    "unknown table kind `{}`: expected `film-lut`",
+                    "unknown table kind `{}`: expected `film-lut` or `fourier`",
                     kind.kind.get_ref()
                 ),
             });
@@ -429,18 +430,26 @@ pub struct Manifest {
     pub space: String,
     /// Convention of the colour values.
     pub colour_convention: String,
-    /// Ambient material spec.
+    /// Ambient material spec (film-lut).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
     pub ambient: String,
-    /// Film label.
+    /// Film label (film-lut).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
     pub film: String,
-    /// Fixed layers under the film: (material spec, thickness nm).
+    /// Fixed layers under the film: (material spec, thickness nm) (film-lut).
+    #[serde(default)]
     pub under: Vec<(String, f64)>,
-    /// Base material spec.
+    /// Base material spec (film-lut).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
     pub base: String,
     /// The axes in x, y, z order.
     pub axes: Vec<AxisRecord>,
     /// Machine-readable axes of a `film-lut`.
-    pub film_lut: FilmLutAxes,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub film_lut: Option<FilmLutAxes>,
+    /// Machine-readable axes of a `fourier` table.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fourier: Option<FourierAxes>,
     /// Texel-centre convention.
     pub texel_centres: String,
     /// Atlas layout of the files.
@@ -482,7 +491,13 @@ impl Manifest {
             return Ok(None);
         };
         let dir = manifest_path.parent().unwrap_or(Path::new("."));
-        let a = &self.film_lut;
+        let a = self.film_lut.as_ref().ok_or_else(|| Error::Invalid {
+            context: manifest_path.display().to_string(),
+            message: format!(
+                "table `{}` is a `{}` table, not a film-lut",
+                self.name, self.kind
+            ),
+        })?;
         let (table, _) = table_io::read_exr_table(
             &dir.join(&f.path),
             a.cos_theta_count,
@@ -656,7 +671,8 @@ pub fn bake_recipe(
         under: recipe.under_specs.clone(),
         base: recipe.base_spec.clone(),
         axes: axis_records(a),
-        film_lut: a.clone(),
+        film_lut: Some(a.clone()),
+        fourier: None,
         texel_centres: "texel i of an axis with count n holds t = i / (n - 1); a sampler reaches t at u = (t * (n - 1) + 0.5) / n; clamp to edge".into(),
         atlas: "width = count(cos_theta); height = count(opd_nm) * count(film_ior); slice k (film_ior index) occupies rows [k * count(opd_nm), (k + 1) * count(opd_nm)), row j of the slice is opd_nm index j, top row first".into(),
         reconstruction: "cos_t = dot(N, V); opd = 2 d sqrt(n_f^2 - n0^2 (1 - cos_t^2)); q(n) = sqrt(n^2 - n0^2 (1 - cos_t^2)); t = (sqrt(cos_t), opd / opd_max, sqrt((q(n_f) - q(ior_min)) / (q(ior_max) - q(ior_min)))); colour = trilinear sample at u = (t (n - 1) + 0.5) / n per axis; specular = colour (replaces the Fresnel term)".into(),
@@ -684,4 +700,291 @@ pub fn default_recipes() -> Result<Vec<PathBuf>> {
         .collect();
     out.sort();
     Ok(out)
+}
+
+/// Parses the `[colour]` section shared by every kind.
+fn parse_colour(path: &Path, text: &str, colour: Option<RawColour>) -> Result<Colorimeter> {
+    let colour = colour.unwrap_or(RawColour {
+        observer: None,
+        illuminant: None,
+        space: None,
+    });
+    Ok(Colorimeter::new(
+        parse_name(path, text, &colour.observer, Observer::Cie1931_2Deg)?,
+        parse_name(path, text, &colour.illuminant, Illuminant::D65)?,
+        parse_name(
+            path,
+            text,
+            &colour.space,
+            OutputSpace::Rgb(nacre_optics::colour::RgbSpace::Srgb),
+        )?,
+    ))
+}
+
+/// The table name of a recipe: its file stem, restricted to letters, digits, `-` and `_`.
+fn table_name(path: &Path) -> Result<String> {
+    path.file_stem()
+        .and_then(|s| s.to_str())
+        .filter(|s| {
+            !s.is_empty()
+                && s.chars()
+                    .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+        })
+        .map(str::to_string)
+        .ok_or_else(|| Error::Recipe {
+            path: path.to_path_buf(),
+            line: 1,
+            message:
+                "the recipe's file name (the table name) must use only letters, digits, `-` and `_`"
+                    .into(),
+        })
+}
+
+/// Most texels of level 0 of a `fourier` table.
+pub const MAX_FOURIER_SAMPLES: usize = 1 << 20;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawFourier {
+    samples: Spanned<usize>,
+    max_opd_nm: Spanned<f64>,
+    levels: Spanned<usize>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawFourierRecipe {
+    #[allow(dead_code)] // checked before the full parse
+    kind: Spanned<String>,
+    description: Option<String>,
+    colour: Option<RawColour>,
+    fourier: RawFourier,
+}
+
+/// A parsed `fourier` recipe.
+///
+/// ```toml
+/// kind = "fourier"
+/// description = "..."
+/// [colour]                 # as for film-lut
+/// space = "srgb"
+/// [fourier]
+/// samples = 8192           # texels of level 0 (each level halves it)
+/// max_opd_nm = 160000.0    # D_max: the μ range, nm
+/// levels = 8               # mip levels (level k prefiltered with σ_k = D_max / N_k)
+/// ```
+pub struct FourierRecipe {
+    /// Table name.
+    pub name: String,
+    /// Recipe file.
+    pub path: PathBuf,
+    /// Recipe text.
+    pub text: String,
+    /// Description.
+    pub description: String,
+    /// Colour settings.
+    pub colorimeter: Colorimeter,
+    /// Axes.
+    pub axes: FourierAxes,
+}
+
+impl FourierRecipe {
+    fn parse(path: &Path, text: String) -> Result<Self> {
+        let raw: RawFourierRecipe =
+            toml::from_str(&text).map_err(|e| toml_error(path, &text, &e))?;
+        let colorimeter = parse_colour(path, &text, raw.colour)?;
+        let f = &raw.fourier;
+        let bad = |span: std::ops::Range<usize>, message: String| Error::Recipe {
+            path: path.to_path_buf(),
+            line: line_of(&text, span.start),
+            message,
+        };
+        let samples = *f.samples.get_ref();
+        if !(64..=MAX_FOURIER_SAMPLES).contains(&samples) {
+            return Err(bad(
+                f.samples.span(),
+                format!("samples = {samples}: expected 64 to {MAX_FOURIER_SAMPLES}"),
+            ));
+        }
+        let max_opd = *f.max_opd_nm.get_ref();
+        if !(max_opd > 0.0 && max_opd <= 1e7) {
+            return Err(bad(
+                f.max_opd_nm.span(),
+                format!("max_opd_nm = {max_opd}: expected a positive length up to 1e7 nm"),
+            ));
+        }
+        let levels = *f.levels.get_ref();
+        if levels == 0 || samples >> (levels - 1) < 2 {
+            return Err(bad(
+                f.levels.span(),
+                format!(
+                    "levels = {levels}: expected 1 or more, leaving at least 2 texels in the last level"
+                ),
+            ));
+        }
+        Ok(FourierRecipe {
+            name: table_name(path)?,
+            path: path.to_path_buf(),
+            description: raw.description.unwrap_or_default(),
+            axes: FourierAxes::new(&colorimeter, samples, max_opd, levels),
+            colorimeter,
+            text,
+        })
+    }
+
+    /// Bakes and writes the table; returns the manifest path.
+    pub fn bake(&self, out_dir: &Path, progress: &(dyn Fn() + Sync)) -> Result<PathBuf> {
+        let table = FourierTable::bake(&self.colorimeter, self.axes.clone());
+        std::fs::create_dir_all(out_dir).map_err(|source| Error::Io {
+            path: out_dir.to_path_buf(),
+            source,
+        })?;
+        let mut files = Vec::new();
+        for k in 0..table.levels.len() {
+            let file = format!("{}.level{k}.exr", self.name);
+            let path = out_dir.join(&file);
+            table.write_level(k, &path)?;
+            files.push(FileRecord {
+                quantity: format!("level {k}"),
+                format: "exr".into(),
+                path: file,
+                encoding: "float".into(),
+                channels: vec!["R".into(), "G".into(), "B".into()],
+                width: table.levels[k].len(),
+                height: 2,
+                sha256: table_io::sha256_hex(&path)?,
+            });
+            progress();
+        }
+        let a = &self.axes;
+        let c = &self.colorimeter;
+        let manifest = Manifest {
+            format: MANIFEST_FORMAT.into(),
+            generated_by: format!(
+                "generated by `nacre bake` from the recipe {} (in tables/recipes/ for the default set, which `nacre bake` with no arguments regenerates); do not edit",
+                self.path.file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
+            ),
+            name: self.name.clone(),
+            kind: "fourier".into(),
+            description: self.description.clone(),
+            nacre_version: env!("CARGO_PKG_VERSION").into(),
+            recipe_file: self.path.file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default(),
+            recipe_sha256: sha256_text(&self.text),
+            recipe: self.text.clone(),
+            observer: c.observer().to_string(),
+            illuminant: c.illuminant().to_string(),
+            space: c.space().to_string(),
+            colour_convention: format!(
+                "sensitivities s_j of linear {} (channels {:?}): perfect reflector = white {:?}; Ŝ_j(μ) = ∫ s_j(λ) exp(-2πiμ/λ) dλ / ∫ s_j dλ (forward transform in ν = 1/λ with a negative exponent; Ŝ_j(0) = 1)",
+                c.space(),
+                c.space().channel_names(),
+                a.white
+            ),
+            ambient: String::new(),
+            film: String::new(),
+            under: Vec::new(),
+            base: String::new(),
+            axes: vec![AxisRecord {
+                name: "opd_nm".into(),
+                unit: "nm".into(),
+                count: a.samples,
+                min: 0.0,
+                max: a.max_opd_nm,
+                mapping: "linear".into(),
+                forward: format!("u = opd_nm / {}", a.max_opd_nm),
+                inverse: format!("opd_nm = u * {}", a.max_opd_nm),
+            }],
+            film_lut: None,
+            fourier: Some(a.clone()),
+            texel_centres: "texel i of level k (N_k = level_samples[k] texels) holds μ = (i + 0.5) D_max / N_k: the usual mip-map convention, u = μ / D_max at every level; clamp to edge".into(),
+            atlas: "one OpenEXR file per mip level, width N_k, height 2: row 0 holds Re A_j, row 1 holds Im A_j for the channels R, G, B (the output space's channels in order)".into(),
+            reconstruction: "A = trilinear sample at (u = μ / D_max, lod), lod = σ_μ < σ_1 ? σ_μ / σ_1 : 1 + log2(σ_μ / σ_1); Ŝ_j(μ) = A_j exp(-2πi μ carrier_nu_per_nm[j]); colour_j = white_j [c0 + 2 Σ_m Re(c_m conj Ŝ_j(m D, m τ σ_d))] (Belcour & Barla 2017 Eq. 10; nacre_optics::fourier)".into(),
+            files,
+        };
+        let path = out_dir.join(format!("{}.json", self.name));
+        let json = serde_json::to_string_pretty(&manifest).expect("manifest serialises");
+        write_atomic(&path, |w| {
+            w.write_all(json.as_bytes())?;
+            w.write_all(b"\n")
+        })?;
+        Ok(path)
+    }
+}
+
+/// A recipe of any table kind.
+pub enum AnyRecipe {
+    /// `film-lut`.
+    FilmLut(Recipe),
+    /// `fourier`.
+    Fourier(FourierRecipe),
+}
+
+impl AnyRecipe {
+    /// Reads a recipe, dispatching on its `kind`.
+    pub fn read(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        #[derive(Deserialize)]
+        struct KindOnly {
+            kind: Spanned<String>,
+        }
+        let kind: KindOnly = toml::from_str(&text).map_err(|e| toml_error(path, &text, &e))?;
+        match kind.kind.get_ref().as_str() {
+            "fourier" => Ok(AnyRecipe::Fourier(FourierRecipe::parse(path, text)?)),
+            _ => Ok(AnyRecipe::FilmLut(Recipe::parse(path, text)?)),
+        }
+    }
+
+    /// The table name.
+    pub fn name(&self) -> &str {
+        match self {
+            AnyRecipe::FilmLut(r) => &r.name,
+            AnyRecipe::Fourier(r) => &r.name,
+        }
+    }
+
+    /// Units of work (for progress bars).
+    pub fn work(&self) -> u64 {
+        match self {
+            AnyRecipe::FilmLut(r) => (r.job.axes.cos_theta_count * r.job.axes.ior_count) as u64,
+            AnyRecipe::Fourier(r) => r.axes.level_samples.len() as u64,
+        }
+    }
+
+    /// Bakes into `out_dir`; returns the manifest path.
+    pub fn bake(&self, out_dir: &Path, progress: &(dyn Fn() + Sync)) -> Result<PathBuf> {
+        match self {
+            AnyRecipe::FilmLut(r) => bake_recipe(r, out_dir, progress),
+            AnyRecipe::Fourier(r) => r.bake(out_dir, progress),
+        }
+    }
+}
+
+impl Manifest {
+    /// Loads the `fourier` table this manifest (at `manifest_path`) describes.
+    pub fn load_fourier(&self, manifest_path: &Path) -> Result<FourierTable> {
+        let axes = self.fourier.clone().ok_or_else(|| Error::Invalid {
+            context: manifest_path.display().to_string(),
+            message: format!(
+                "table `{}` is a `{}` table, not a fourier table",
+                self.name, self.kind
+            ),
+        })?;
+        let dir = manifest_path.parent().unwrap_or(Path::new("."));
+        let paths: Vec<PathBuf> = (0..axes.level_samples.len())
+            .map(|k| {
+                self.files
+                    .iter()
+                    .find(|f| f.quantity == format!("level {k}"))
+                    .map(|f| dir.join(&f.path))
+                    .ok_or_else(|| Error::Invalid {
+                        context: manifest_path.display().to_string(),
+                        message: format!("the manifest lists no file for level {k}"),
+                    })
+            })
+            .collect::<Result<_>>()?;
+        FourierTable::read(axes, &paths)
+    }
 }

@@ -28,6 +28,7 @@
 use crate::bake::{Manifest, resolve_table};
 use crate::error::{Error, Result};
 use crate::film_lut::FilmLut;
+use crate::fourier_table::FourierTable;
 use crate::spectrum::fmt_sig;
 use crate::table_io::Table3;
 use nacre_optics::colour::{Colorimeter, OutputSpace, RgbSpace};
@@ -36,6 +37,7 @@ use nacre_optics::{C64, Layer, Material, SpectralRule, Stack};
 use rayon::prelude::*;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// The CSV header line.
 pub const HEADER: &str = "angle_deg,thickness_nm,film_ior,X,Y,Z,R,G,B";
@@ -58,8 +60,10 @@ pub enum Method {
     /// N wavelengths over 400–700 nm.
     Samples(usize),
     /// Belcour & Barla 2017 Eq. 10 with exact Fresnel terms, prefiltered for a Gaussian
-    /// thickness distribution of the given standard deviation (nm, 0 for none).
-    Fourier(Harmonics, f64),
+    /// thickness distribution of the given standard deviation (nm, 0 for none), with the
+    /// sensitivities' transforms sampled from a baked `fourier` table as a GPU would, or
+    /// computed exactly when the table is None (`fourier-exact:`).
+    Fourier(Harmonics, f64, Option<Arc<FourierTable>>),
     /// The Gaussian-fit closed form of glTF's `KHR_materials_iridescence`.
     GaussianFitBelcour2017,
 }
@@ -87,10 +91,13 @@ impl Method {
                         Ok(n @ 1..=10_000) => Ok(Method::Samples(n)),
                         _ => Err(err("samples:N needs a whole number N from 1 to 10000")),
                     }
-                } else if let Some(rest) = t.strip_prefix("fourier:") {
+                } else if let Some(rest) = t
+                    .strip_prefix("fourier:")
+                    .or_else(|| t.strip_prefix("fourier-exact:"))
+                {
                     let bad = || {
                         err(
-                            "expected fourier:M, fourier:auto, fourier:M:SIGMA_NM or fourier:auto:SIGMA_NM (M from 1 to 512, SIGMA_NM ≥ 0)",
+                            "expected fourier:M, fourier:auto, fourier:M:SIGMA_NM or fourier:auto:SIGMA_NM (M from 1 to 512, SIGMA_NM ≥ 0), or fourier-exact: with the same forms",
                         )
                     };
                     let (m, sigma) = match rest.split_once(':') {
@@ -110,10 +117,10 @@ impl Method {
                             _ => return Err(bad()),
                         },
                     };
-                    Ok(Method::Fourier(harmonics, sigma))
+                    Ok(Method::Fourier(harmonics, sigma, None))
                 } else {
                     Err(err(
-                        "expected spectral, lut:NAME|PATH, rgb3, samples:N, fourier:M[:SIGMA_NM], fourier:auto[:SIGMA_NM] or gaussian",
+                        "expected spectral, lut:NAME|PATH, rgb3, samples:N, fourier:M[:SIGMA_NM], fourier:auto[:SIGMA_NM], fourier-exact:… or gaussian",
                     ))
                 }
             }
@@ -288,6 +295,15 @@ impl LoadedLut {
     /// Loads a table through its manifest.
     pub fn load(path: &Path) -> Result<Self> {
         let manifest = Manifest::read(path)?;
+        if manifest.film_lut.is_none() {
+            return Err(Error::Invalid {
+                context: path.display().to_string(),
+                message: format!(
+                    "table `{}` is a `{}` table, not a film-lut",
+                    manifest.name, manifest.kind
+                ),
+            });
+        }
         let reflectance =
             manifest
                 .load_table(path, "reflectance")?
@@ -391,7 +407,7 @@ impl LoadedLut {
         };
         let cos_theta = point.angle_deg.to_radians().cos();
         Ok(FilmLut::lookup(
-            &self.manifest.film_lut,
+            self.manifest.film_lut.as_ref().expect("checked at load"),
             table,
             cos_theta,
             d,
@@ -445,7 +461,7 @@ pub fn evaluate(
                     let p = s.sweep(&[point.angle_deg], &RGB3_WAVELENGTHS_NM)?;
                     Ok([0, 1, 2].map(|c| value(&p[c], quantity)))
                 }
-                Method::Fourier(harmonics, sigma_d_nm) => {
+                Method::Fourier(harmonics, sigma_d_nm, table) => {
                     let (film, cos_theta, d) = film_on_base(stack, point, colorimeter)?;
                     if quantity == Quantity::Transmittance {
                         return Err(Error::Invalid {
@@ -455,7 +471,20 @@ pub fn evaluate(
                                     .into(),
                         });
                     }
-                    match film.fourier_colour(colorimeter, cos_theta, d, *harmonics, *sigma_d_nm) {
+                    let result = match table {
+                        Some(t) => film.fourier_colour_with(
+                            colorimeter,
+                            cos_theta,
+                            d,
+                            *harmonics,
+                            *sigma_d_nm,
+                            |mu, s| t.sample(mu, s),
+                        ),
+                        None => {
+                            film.fourier_colour(colorimeter, cos_theta, d, *harmonics, *sigma_d_nm)
+                        }
+                    };
+                    match result {
                         Some(c) => Ok(c.colour),
                         // An evanescent film has no Fourier series in 1/λ: exact reference.
                         None => evaluate(

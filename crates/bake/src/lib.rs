@@ -12,6 +12,7 @@ pub mod bake;
 pub mod color;
 pub mod error;
 pub mod film_lut;
+pub mod fourier_table;
 pub mod grid;
 pub mod materials;
 pub mod output;

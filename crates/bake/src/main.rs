@@ -54,7 +54,11 @@ The recipe format is documented in the README (\"Table recipes\").";
 
 const COLOR_EXAMPLES: &str = "\
 Methods: spectral (exact reference), lut:NAME|PATH (a baked film-lut, default-set name or
-manifest path), rgb3 (650/510/475 nm), samples:N (N wavelengths over 400-700 nm).
+manifest path), rgb3 (650/510/475 nm), samples:N (N wavelengths over 400-700 nm),
+fourier:M | fourier:auto [:SIGMA_NM] (Belcour & Barla 2017 Eq. 10 with exact Fresnel, the
+baked fourier table sampled as a GPU would, optional prefiltering for a thickness standard
+deviation), fourier-exact:… (the same with exact transforms), gaussian (the glTF
+KHR_materials_iridescence Gaussian-fit approximation).
 
 Examples:
   # colour of a 400 nm soap film over angle, exact
@@ -86,6 +90,10 @@ struct ColorArgs {
     /// spectral | lut:NAME|PATH | rgb3 | samples:N.
     #[arg(long, default_value = "spectral")]
     method: String,
+    /// The fourier table for fourier:… methods: a default-set name or a manifest path
+    /// [default: the default-set table matching --space, --illuminant and --observer].
+    #[arg(long, value_name = "NAME|PATH")]
+    fourier_table: Option<String>,
     /// r (reflectance) or t (transmittance into the base).
     #[arg(long, default_value = "r", value_parser = ["r", "t"])]
     quantity: String,
@@ -219,7 +227,7 @@ fn run_color(args: &ColorArgs) -> Result<()> {
     use nacre_bake::error::Error;
     use nacre_optics::colour::Colorimeter;
     let (spec, recipe_angles, _) = load_stack(&args.stack)?;
-    let method = Method::parse(&args.method)?;
+    let mut method = Method::parse(&args.method)?;
     let quantity = if args.quantity == "t" {
         Quantity::Transmittance
     } else {
@@ -305,6 +313,12 @@ fn run_color(args: &ColorArgs) -> Result<()> {
                     message: "rgb3 gives RGB directly: choose an RGB --space".into(),
                 });
             }
+            if let Method::Fourier(h, sigma, None) = &method
+                && args.method.trim().starts_with("fourier:")
+            {
+                let table = load_fourier_table(args.fourier_table.as_deref(), &c)?;
+                method = Method::Fourier(*h, *sigma, Some(std::sync::Arc::new(table)));
+            }
             (None, c)
         }
     };
@@ -321,6 +335,74 @@ fn run_color(args: &ColorArgs) -> Result<()> {
     })
 }
 
+/// The `fourier` table named by `--fourier-table`, or the default-set one baked for the same
+/// observer, illuminant and space as `colorimeter`.
+fn load_fourier_table(
+    given: Option<&str>,
+    colorimeter: &nacre_optics::colour::Colorimeter,
+) -> Result<nacre_bake::fourier_table::FourierTable> {
+    use nacre_bake::error::Error;
+    let settings = (
+        colorimeter.observer().to_string(),
+        colorimeter.illuminant().to_string(),
+        colorimeter.space().to_string(),
+    );
+    let path = match given {
+        Some(name) => bake::resolve_table(name),
+        None => {
+            let dir = bake::default_baked_dir();
+            let mut found = None;
+            if let Ok(entries) = std::fs::read_dir(&dir) {
+                let mut paths: Vec<PathBuf> = entries
+                    .filter_map(|e| e.ok().map(|e| e.path()))
+                    .filter(|p| p.extension().is_some_and(|x| x == "json"))
+                    .collect();
+                paths.sort();
+                for p in paths {
+                    if let Ok(m) = bake::Manifest::read(&p)
+                        && m.kind == "fourier"
+                        && (m.observer.clone(), m.illuminant.clone(), m.space.clone()) == settings
+                    {
+                        found = Some(p);
+                        break;
+                    }
+                }
+            }
+            found.ok_or_else(|| Error::Invalid {
+                context: "--method fourier".into(),
+                message: format!(
+                    "no fourier table for observer {}, illuminant {}, space {} in {}: bake one (kind = \"fourier\") and pass --fourier-table, or use fourier-exact:",
+                    settings.0,
+                    settings.1,
+                    settings.2,
+                    dir.display()
+                ),
+            })?
+        }
+    };
+    let manifest = bake::Manifest::read(&path)?;
+    if (
+        manifest.observer.clone(),
+        manifest.illuminant.clone(),
+        manifest.space.clone(),
+    ) != settings
+    {
+        return Err(Error::Invalid {
+            context: format!("--fourier-table {}", path.display()),
+            message: format!(
+                "the table was baked for observer {}, illuminant {}, space {}; this run uses {}, {}, {}",
+                manifest.observer,
+                manifest.illuminant,
+                manifest.space,
+                settings.0,
+                settings.1,
+                settings.2
+            ),
+        });
+    }
+    manifest.load_fourier(&path)
+}
+
 fn run_bake(args: &BakeArgs) -> Result<()> {
     use indicatif::{ProgressBar, ProgressStyle};
     let paths = if args.recipes.is_empty() {
@@ -332,22 +414,21 @@ fn run_bake(args: &BakeArgs) -> Result<()> {
     // Parse and validate every recipe before baking any.
     let recipes = paths
         .iter()
-        .map(|p| bake::Recipe::read(p))
+        .map(|p| bake::AnyRecipe::read(p))
         .collect::<Result<Vec<_>>>()?;
     for recipe in &recipes {
-        let a = &recipe.job.axes;
-        let bar = ProgressBar::new((a.cos_theta_count * a.ior_count) as u64).with_style(
-            ProgressStyle::with_template("{prefix:>16} [{bar:30}] {pos}/{len} rows {elapsed}")
+        let bar = ProgressBar::new(recipe.work()).with_style(
+            ProgressStyle::with_template("{prefix:>16} [{bar:30}] {pos}/{len} {elapsed}")
                 .expect("valid template")
                 .progress_chars("=> "),
         );
-        bar.set_prefix(recipe.name.clone());
+        bar.set_prefix(recipe.name().to_string());
         let start = std::time::Instant::now();
-        let manifest = bake::bake_recipe(recipe, &out, &|| bar.inc(1))?;
+        let manifest = recipe.bake(&out, &|| bar.inc(1))?;
         bar.finish_and_clear();
         eprintln!(
             "baked {} in {:.2} s -> {}",
-            recipe.name,
+            recipe.name(),
             start.elapsed().as_secs_f64(),
             manifest.display()
         );

@@ -114,6 +114,22 @@ impl SensitivitySpectrum {
         this
     }
 
+    /// The centroid frequency ν̄_j = ∫ ν |S_j(ν)| dν / ∫ |S_j(ν)| dν of each channel, 1/nm:
+    /// the carrier that [`SensitivitySpectrum::transform`] oscillates at. Multiplying Ŝ_j(μ)
+    /// by e^{+2πiμν̄_j} leaves a slowly varying envelope that interpolates well.
+    pub fn centroid_nu(&self) -> [f64; 3] {
+        std::array::from_fn(|j| {
+            let (mut num, mut den) = (0.0, 0.0);
+            for i in 0..self.nu.len() - 1 {
+                let h = self.nu[i + 1] - self.nu[i];
+                let (a, b) = (self.values[i][j].abs(), self.values[i + 1][j].abs());
+                num += 0.5 * h * (a * self.nu[i] + b * self.nu[i + 1]);
+                den += 0.5 * h * (a + b);
+            }
+            num / den
+        })
+    }
+
     /// Ŝ_j(μ), prefiltered by a Gaussian of standard deviation `sigma_mu_nm` in μ
     /// (multiplying S_j(ν) by exp(−(2π σ_μ ν)²/2); 0 for none).
     pub fn transform(&self, mu_nm: f64, sigma_mu_nm: f64) -> [C64; 3] {
@@ -292,6 +308,28 @@ impl FilmOnBase {
         harmonics: Harmonics,
         sigma_d_nm: f64,
     ) -> Option<FourierColour> {
+        let spectrum = SensitivitySpectrum::new(colorimeter);
+        self.fourier_colour_with(
+            colorimeter,
+            cos_theta,
+            thickness_nm,
+            harmonics,
+            sigma_d_nm,
+            |mu, sigma| spectrum.transform(mu, sigma),
+        )
+    }
+
+    /// [`FilmOnBase::fourier_colour`] with Ŝ_j(μ, σ_μ) supplied by `transform` (e.g. a baked,
+    /// mip-mapped table sampled as a GPU would).
+    pub fn fourier_colour_with(
+        &self,
+        colorimeter: &Colorimeter,
+        cos_theta: f64,
+        thickness_nm: f64,
+        harmonics: Harmonics,
+        sigma_d_nm: f64,
+        transform: impl Fn(f64, f64) -> [C64; 3],
+    ) -> Option<FourierColour> {
         let q2 = self.film_q(cos_theta)?;
         let opd = 2.0 * thickness_nm * q2;
         let tau = 2.0 * q2;
@@ -309,14 +347,13 @@ impl FilmOnBase {
                 .max()
                 .unwrap_or(1),
         };
-        let spectrum = SensitivitySpectrum::new(colorimeter);
         let mut colour = [0.0; 3];
         for (j, c) in colour.iter_mut().enumerate() {
             *c = 0.5 * (series[j][0].c0 + series[j][1].c0);
         }
         let mut cm = [[C64::new(0.0, 0.0); 2]; 3];
         for m in 1..=m_max {
-            let s_hat = spectrum.transform(m as f64 * opd, m as f64 * tau * sigma_d_nm);
+            let s_hat = transform(m as f64 * opd, m as f64 * tau * sigma_d_nm);
             for j in 0..3 {
                 let mut sum = 0.0;
                 for pol in 0..2 {
