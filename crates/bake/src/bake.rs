@@ -914,7 +914,7 @@ impl FourierRecipe {
 /// A recipe of any table kind.
 pub enum AnyRecipe {
     /// `film-lut`.
-    FilmLut(Recipe),
+    FilmLut(Box<Recipe>),
     /// `fourier`.
     Fourier(FourierRecipe),
 }
@@ -933,7 +933,7 @@ impl AnyRecipe {
         let kind: KindOnly = toml::from_str(&text).map_err(|e| toml_error(path, &text, &e))?;
         match kind.kind.get_ref().as_str() {
             "fourier" => Ok(AnyRecipe::Fourier(FourierRecipe::parse(path, text)?)),
-            _ => Ok(AnyRecipe::FilmLut(Recipe::parse(path, text)?)),
+            _ => Ok(AnyRecipe::FilmLut(Box::new(Recipe::parse(path, text)?))),
         }
     }
 
