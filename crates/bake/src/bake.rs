@@ -916,7 +916,7 @@ pub enum AnyRecipe {
     /// `film-lut`.
     FilmLut(Box<Recipe>),
     /// `fourier`.
-    Fourier(FourierRecipe),
+    Fourier(Box<FourierRecipe>),
 }
 
 impl AnyRecipe {
@@ -932,7 +932,9 @@ impl AnyRecipe {
         }
         let kind: KindOnly = toml::from_str(&text).map_err(|e| toml_error(path, &text, &e))?;
         match kind.kind.get_ref().as_str() {
-            "fourier" => Ok(AnyRecipe::Fourier(FourierRecipe::parse(path, text)?)),
+            "fourier" => Ok(AnyRecipe::Fourier(Box::new(FourierRecipe::parse(
+                path, text,
+            )?))),
             _ => Ok(AnyRecipe::FilmLut(Box::new(Recipe::parse(path, text)?))),
         }
     }
