@@ -155,7 +155,49 @@ fn dielectric_base_fourier_3() {
             assert!(s.p95 <= 0.1 && s.max <= 0.5, "{}", report.join("\n"));
         }
     }
+    // Transmittance into the dielectric base (Belcour & Barla's appendix), fourier:3.
+    let exact_t: Vec<[f64; 3]> = {
+        use rayon::prelude::*;
+        cases
+            .par_iter()
+            .map(|(s, p)| {
+                color::evaluate(
+                    s,
+                    std::slice::from_ref(p),
+                    &Method::Spectral,
+                    &c,
+                    Quantity::Transmittance,
+                    None,
+                )
+                .unwrap()[0]
+            })
+            .collect()
+    };
+    let got_t: Vec<[f64; 3]> = {
+        use rayon::prelude::*;
+        let m = Method::Fourier(Harmonics::Fixed(3), 0.0, Some(t.clone()));
+        cases
+            .par_iter()
+            .map(|(s, p)| {
+                color::evaluate(
+                    s,
+                    std::slice::from_ref(p),
+                    &m,
+                    &c,
+                    Quantity::Transmittance,
+                    None,
+                )
+                .unwrap()[0]
+            })
+            .collect()
+    };
+    let st = stats(&c, &exact_t, &got_t);
+    report.push(format!(
+        "dielectric transmittance fourier:3: mean {:.4} p95 {:.4} max {:.4}",
+        st.mean, st.p95, st.max
+    ));
     eprintln!("{}", report.join("\n"));
+    assert!(st.p95 <= 0.1 && st.max <= 0.5, "{}", report.join("\n"));
 }
 
 #[test]
@@ -204,6 +246,7 @@ fn conductor_base_fourier_auto() {
                 p.thickness_nm.unwrap(),
                 Harmonics::Auto,
                 0.0,
+                false,
             )
             .unwrap()
             .harmonics

@@ -463,12 +463,11 @@ pub fn evaluate(
                 }
                 Method::Fourier(harmonics, sigma_d_nm, table) => {
                     let (film, cos_theta, d) = film_on_base(stack, point, colorimeter)?;
-                    if quantity == Quantity::Transmittance {
+                    let transmittance = quantity == Quantity::Transmittance;
+                    if transmittance && film.base.iter().any(|b| b.im != 0.0) {
                         return Err(Error::Invalid {
-                            context: "--method fourier".into(),
-                            message:
-                                "the Fourier method evaluates reflectance only (use --quantity r)"
-                                    .into(),
+                            context: "--method fourier --quantity t".into(),
+                            message: "transmittance needs a non-absorbing (dielectric) base".into(),
                         });
                     }
                     let result = match table {
@@ -478,11 +477,17 @@ pub fn evaluate(
                             d,
                             *harmonics,
                             *sigma_d_nm,
+                            transmittance,
                             |mu, s| t.sample(mu, s),
                         ),
-                        None => {
-                            film.fourier_colour(colorimeter, cos_theta, d, *harmonics, *sigma_d_nm)
-                        }
+                        None => film.fourier_colour(
+                            colorimeter,
+                            cos_theta,
+                            d,
+                            *harmonics,
+                            *sigma_d_nm,
+                            transmittance,
+                        ),
                     };
                     match result {
                         Some(c) => Ok(c.colour),

@@ -48,13 +48,17 @@
 //! applies exactly.
 
 use crate::colour::Colorimeter;
-use crate::fresnel::{Interface, normal_component};
+use crate::fresnel::{Interface, normal_component, power_factor_p, power_factor_s};
 use crate::spectral::SpectralRule;
 use num_complex::Complex64 as C64;
 use std::f64::consts::PI;
 
 /// Filon cells per nanometre in [`SensitivitySpectrum`].
 pub const SUBCELLS: usize = 8;
+
+/// Thickness below which fixed-harmonic evaluation blends the film index towards the
+/// ambient's (Belcour & Barla 2017 §4), nm.
+pub const THIN_FILM_BLEND_NM: f64 = 30.0;
 
 /// Largest number of harmonics [`Harmonics::Auto`] will use.
 pub const MAX_AUTO_HARMONICS: usize = 512;
@@ -278,10 +282,19 @@ impl FilmOnBase {
         (q2 > 0.0).then(|| q2.sqrt())
     }
 
-    /// Airy series of channel j for (s, p).
-    fn series(&self, cos_theta: f64, j: usize) -> [AirySeries; 2] {
+    /// Airy series of channel j for (s, p): of the reflectance, or of the transmittance
+    /// into the base, T = A / |1 − ρ e^{iΦ}|² = A/(1 − |ρ|²) [1 + 2 Σ Re(ρ^m e^{imΦ})] with
+    /// A = |t₁₂ t₂₃|² × the power factor of [`crate::fresnel`] (Belcour & Barla 2017,
+    /// appendix, in closed form).
+    fn series(
+        &self,
+        n_film: f64,
+        cos_theta: f64,
+        j: usize,
+        transmittance: bool,
+    ) -> [AirySeries; 2] {
         let n1 = C64::new(self.n_ambient, 0.0);
-        let n2 = C64::new(self.n_film, 0.0);
+        let n2 = C64::new(n_film, 0.0);
         let beta = self.n_ambient * (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
         let (q1, q2, q3) = (
             normal_component(n1, beta),
@@ -290,15 +303,39 @@ impl FilmOnBase {
         );
         let top = Interface::new(n1, q1, n2, q2);
         let bottom = Interface::new(n2, q2, self.base[j], q3);
-        [
+        let reflect = [
             AirySeries::new(top.r_s, bottom.r_s),
             AirySeries::new(top.r_p, bottom.r_p),
-        ]
+        ];
+        if !transmittance {
+            return reflect;
+        }
+        let factor = [
+            power_factor_s(q1, q3),
+            power_factor_p(n1, q1, self.base[j], q3),
+        ];
+        let t = [(top.t_s, bottom.t_s), (top.t_p, bottom.t_p)];
+        std::array::from_fn(|pol| {
+            let rho = reflect[pol].rho;
+            let a = (t[pol].0 * t[pol].1).norm_sqr() * factor[pol] / (1.0 - rho.norm_sqr());
+            AirySeries {
+                c0: a,
+                k: a * rho,
+                rho,
+            }
+        })
     }
 
     /// Belcour & Barla Eq. 10 with exact Fresnel terms: the colour of the film's
-    /// unpolarised reflectance at thickness `thickness_nm`, optionally prefiltered for a
+    /// unpolarised reflectance (or, with `transmittance`, its transmittance into the base,
+    /// for bases that transmit) at thickness `thickness_nm`, optionally prefiltered for a
     /// Gaussian thickness distribution of standard deviation `sigma_d_nm`.
+    ///
+    /// With a fixed number of harmonics the film index is blended towards the ambient's as
+    /// the film vanishes, n₂' = n₁ + (n₂ − n₁) smoothstep(0, 30 nm, d) (Belcour & Barla §4:
+    /// "we force η₂ → 1 when d → 0"): a truncated series cannot reproduce the bare base at
+    /// d = 0, while with n₂' = n₁ the film term vanishes and the result is exact there.
+    /// [`Harmonics::Auto`] converges and needs no blend.
     /// Returns None for an evanescent film (use the spectral reference there).
     pub fn fourier_colour(
         &self,
@@ -307,6 +344,7 @@ impl FilmOnBase {
         thickness_nm: f64,
         harmonics: Harmonics,
         sigma_d_nm: f64,
+        transmittance: bool,
     ) -> Option<FourierColour> {
         let spectrum = SensitivitySpectrum::new(colorimeter);
         self.fourier_colour_with(
@@ -315,12 +353,14 @@ impl FilmOnBase {
             thickness_nm,
             harmonics,
             sigma_d_nm,
+            transmittance,
             |mu, sigma| spectrum.transform(mu, sigma),
         )
     }
 
     /// [`FilmOnBase::fourier_colour`] with Ŝ_j(μ, σ_μ) supplied by `transform` (e.g. a baked,
     /// mip-mapped table sampled as a GPU would).
+    #[allow(clippy::too_many_arguments)]
     pub fn fourier_colour_with(
         &self,
         colorimeter: &Colorimeter,
@@ -328,16 +368,29 @@ impl FilmOnBase {
         thickness_nm: f64,
         harmonics: Harmonics,
         sigma_d_nm: f64,
+        transmittance: bool,
         transform: impl Fn(f64, f64) -> [C64; 3],
     ) -> Option<FourierColour> {
-        let q2 = self.film_q(cos_theta)?;
+        let n_film = match harmonics {
+            Harmonics::Fixed(_) => {
+                let t = (thickness_nm / THIN_FILM_BLEND_NM).clamp(0.0, 1.0);
+                self.n_ambient + (self.n_film - self.n_ambient) * t * t * (3.0 - 2.0 * t)
+            }
+            Harmonics::Auto => self.n_film,
+        };
+        let blended = FilmOnBase {
+            n_film,
+            ..self.clone()
+        };
+        let q2 = blended.film_q(cos_theta)?;
         let opd = 2.0 * thickness_nm * q2;
         let tau = 2.0 * q2;
         let white = colorimeter
             .weights_1nm()
             .iter()
             .fold([0.0; 3], |a, w| [a[0] + w[0], a[1] + w[1], a[2] + w[2]]);
-        let series: [[AirySeries; 2]; 3] = std::array::from_fn(|j| self.series(cos_theta, j));
+        let series: [[AirySeries; 2]; 3] =
+            std::array::from_fn(|j| self.series(n_film, cos_theta, j, transmittance));
         let m_max = match harmonics {
             Harmonics::Fixed(m) => m,
             Harmonics::Auto => series
@@ -544,6 +597,64 @@ mod tests {
     }
 
     #[test]
+    fn transmittance_series_and_thin_film_limit() {
+        let c = srgb();
+        let film = FilmOnBase {
+            n_ambient: 1.0,
+            n_film: 1.8,
+            base: [C64::new(1.5, 0.0); 3],
+        };
+        let m = |n: f64| Material::constant("m", C64::new(n, 0.0)).unwrap();
+        for &(cos_t, d) in &[(1.0f64, 420.0), (0.5, 1234.0), (0.15, 777.0)] {
+            let stack = Stack::new(
+                m(1.0),
+                vec![Layer {
+                    material: m(1.8),
+                    thickness_nm: d,
+                }],
+                m(1.5),
+            )
+            .unwrap();
+            let rule = SpectralRule::new(&c, stack.max_opd_nm(None));
+            let exact = stack
+                .colours_over_thickness(1, cos_t.acos().to_degrees(), &rule, &[d])
+                .unwrap();
+            let r = film
+                .fourier_colour(&c, cos_t, d, Harmonics::Auto, 0.0, false)
+                .unwrap()
+                .colour;
+            let t = film
+                .fourier_colour(&c, cos_t, d, Harmonics::Auto, 0.0, true)
+                .unwrap()
+                .colour;
+            for j in 0..3 {
+                assert!(
+                    (r[j] - exact.reflectance[0][j]).abs() < 1e-4,
+                    "{r:?} {:?}",
+                    exact.reflectance[0]
+                );
+                assert!(
+                    (t[j] - exact.transmittance[0][j]).abs() < 1e-4,
+                    "{t:?} {:?}",
+                    exact.transmittance[0]
+                );
+            }
+        }
+        // At zero thickness the blended fixed-harmonic result is the bare base exactly.
+        let bare = Stack::new(m(1.0), vec![], m(1.5)).unwrap();
+        let rule = SpectralRule::new(&c, 0.0);
+        let p = bare.sweep(&[60.0], rule.wavelengths_nm()).unwrap();
+        let want = rule.colour(p.iter().map(|p| p.R()));
+        let got = film
+            .fourier_colour(&c, 0.5, 0.0, Harmonics::Fixed(3), 0.0, false)
+            .unwrap()
+            .colour;
+        for j in 0..3 {
+            assert!((got[j] - want[j]).abs() < 1e-9, "{got:?} vs {want:?}");
+        }
+    }
+
+    #[test]
     fn airy_series_sums_to_the_airy_reflectance() {
         // Sum the series at one wavelength (no spectral integration) and compare with the
         // stack solver.
@@ -558,7 +669,7 @@ mod tests {
                 n_film: n2,
                 base: [base; 3],
             };
-            let series = film.series(cos_t, 0);
+            let series = film.series(n2, cos_t, 0, false);
             let (d, wl) = (321.0, 550.0);
             let q2 = film.film_q(cos_t).unwrap();
             let phi = 2.0 * PI * 2.0 * d * q2 / wl;
