@@ -10,6 +10,7 @@
 
 pub mod bake;
 pub mod color;
+pub mod compare;
 pub mod error;
 pub mod film_lut;
 pub mod fourier_table;

@@ -34,6 +34,9 @@ enum Command {
     /// Bake lookup tables from recipes (default: every recipe in tables/recipes/ into tables/baked/).
     #[command(after_help = BAKE_EXAMPLES)]
     Bake(BakeArgs),
+    /// Compare the real-time methods with the exact colour over angle × thickness (CSV + PNG).
+    #[command(after_help = COMPARE_EXAMPLES)]
+    Compare(CompareArgs),
     /// Print a baked table's manifest as JSON.
     Info {
         /// A default-set table name (e.g. film-dielectric) or a manifest path.
@@ -113,6 +116,30 @@ struct ColorArgs {
         value_name = "FILE.csv",
         default_value = "-"
     )]
+    output: PathBuf,
+}
+
+const COMPARE_EXAMPLES: &str = "\
+Cases: fig7 (Belcour & Barla 2017 Fig. 7: film 1.5 on base 1.09), dielectric (film 1.5 on
+1.5), gold (film 1.5 on gold), soap (film 1.33 in air).
+
+Examples:
+  nacre compare -o compare-fig7
+  nacre compare --case gold --thicknesses 0:2000:20 -o compare-gold";
+
+#[derive(Args)]
+struct CompareArgs {
+    /// Named case: fig7, dielectric, gold or soap.
+    #[arg(long, default_value = "fig7")]
+    case: String,
+    /// Incidence angles, degrees.
+    #[arg(long, value_name = "START:END:STEP", default_value = "0:85:2.5")]
+    angles: String,
+    /// Film thicknesses, nm.
+    #[arg(long, value_name = "START:END:STEP", default_value = "0:1000:10")]
+    thicknesses: String,
+    /// Output folder: compare.csv and compare.png.
+    #[arg(short = 'o', long = "output", value_name = "DIR")]
     output: PathBuf,
 }
 
@@ -403,6 +430,76 @@ fn load_fourier_table(
     manifest.load_fourier(&path)
 }
 
+fn run_compare(args: &CompareArgs) -> Result<()> {
+    use nacre_bake::compare;
+    use nacre_bake::error::Error;
+    let case = compare::CASES
+        .iter()
+        .find(|c| c.name == args.case)
+        .ok_or_else(|| Error::Flag {
+            flag: "--case".into(),
+            value: args.case.clone(),
+            message: format!(
+                "expected one of {}",
+                compare::CASES
+                    .iter()
+                    .map(|c| c.name)
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        })?;
+    let angles = parse_range("--angles", &args.angles)?;
+    if let Some(a) = angles.iter().find(|a| !(a.abs() < 90.0)) {
+        return Err(Error::Flag {
+            flag: "--angles".into(),
+            value: args.angles.clone(),
+            message: format!("angle {a} must lie strictly between -90 and 90 degrees"),
+        });
+    }
+    let thicknesses = parse_range("--thicknesses", &args.thicknesses)?;
+    if let Some(d) = thicknesses.iter().find(|d| !(**d >= 0.0)) {
+        return Err(Error::Flag {
+            flag: "--thicknesses".into(),
+            value: args.thicknesses.clone(),
+            message: format!("thickness {d} must be non-negative"),
+        });
+    }
+    let points = angles.len() as u64 * thicknesses.len() as u64;
+    if points > 200_000 {
+        return Err(Error::TooLarge {
+            what: "--angles × --thicknesses points".into(),
+            count: points,
+            limit: 200_000,
+        });
+    }
+    let results = compare::compare(case, &angles, &thicknesses)?;
+    std::fs::create_dir_all(&args.output).map_err(|source| Error::Io {
+        path: args.output.clone(),
+        source,
+    })?;
+    compare::write_csv(
+        &args.output.join("compare.csv"),
+        &angles,
+        &thicknesses,
+        &results,
+    )?;
+    compare::write_png(
+        &args.output.join("compare.png"),
+        case,
+        &angles,
+        &thicknesses,
+        &results,
+    )?;
+    println!("{}", case.description);
+    println!("| method | mean ΔE2000 | p95 | max |");
+    println!("|---|---|---|---|");
+    for r in &results {
+        let (mean, p95, max) = r.summary();
+        println!("| `{}` | {mean:.3} | {p95:.3} | {max:.3} |", r.label);
+    }
+    Ok(())
+}
+
 fn run_bake(args: &BakeArgs) -> Result<()> {
     use indicatif::{ProgressBar, ProgressStyle};
     let paths = if args.recipes.is_empty() {
@@ -441,6 +538,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Spectrum(args) => run_spectrum(&args),
         Command::Bake(args) => run_bake(&args),
         Command::Color(args) => run_color(&args),
+        Command::Compare(args) => run_compare(&args),
         Command::Info { table } => {
             let path = bake::resolve_table(&table);
             let manifest = bake::Manifest::read(&path)?;

@@ -365,3 +365,43 @@ fn color_and_bake_bad_input() {
     }
     assert!(!d.join("out").exists(), "a failed bake wrote output");
 }
+
+#[test]
+fn compare_writes_csv_and_png() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = nacre(
+        &[
+            "compare",
+            "--case",
+            "dielectric",
+            "--angles",
+            "0:80:40",
+            "--thicknesses",
+            "100:500:200",
+            "-o",
+            "out",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let table = String::from_utf8(o.stdout).unwrap();
+    for m in [
+        "rgb3",
+        "samples:5",
+        "gaussian",
+        "fourier:1",
+        "fourier:2",
+        "fourier:3",
+        "lut",
+    ] {
+        assert!(table.contains(&format!("| `{m}` |")), "{table}");
+    }
+    let csv = std::fs::read_to_string(dir.path().join("out/compare.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 7 * 3 * 3);
+    let png = std::fs::read(dir.path().join("out/compare.png")).unwrap();
+    assert!(png.starts_with(b"\x89PNG") && png.len() > 10_000);
+    let o = nacre(&["compare", "--case", "nope", "-o", "out2"], dir.path());
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("--case `nope`"));
+    assert!(!dir.path().join("out2").exists());
+}
