@@ -1,0 +1,22 @@
+//! # nacre-runtime
+//!
+//! A small wgpu library that a host engine uses with its own device: it loads baked nacre
+//! tables through their manifests ([`TableSet::load`]), uploads them as textures, and
+//! provides the WGSL modules under `shaders/` ([`shaders`]) that sample them, plus a headless
+//! renderer for `nacre render` and the GPU = CPU probe used by the tests.
+
+pub mod bindings;
+pub mod context;
+pub mod error;
+pub mod params;
+pub mod probe;
+pub mod readback;
+pub mod shaders;
+pub mod tables;
+
+pub use bindings::{TechniqueBinding, TechniqueOptions};
+pub use context::GpuContext;
+pub use error::{Error, Result};
+pub use params::{FilmInput, FilmOutput};
+pub use shaders::Technique;
+pub use tables::TableSet;

@@ -1,0 +1,184 @@
+//! Host-side mirrors of the WGSL structs in `shaders/` (`#[repr(C)]`, `bytemuck`), with the
+//! byte layouts the shaders document.
+
+use bytemuck::{Pod, Zeroable};
+
+/// Mirror of `FilmInput` (`shaders/common.wgsl`): 64 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct FilmInput {
+    /// cos θᵢ in the ambient.
+    pub cos_theta_i: f32,
+    /// Film thickness d, nm.
+    pub thickness_nm: f32,
+    /// Real film index n₂.
+    pub film_ior: f32,
+    /// Standard deviation of d within the pixel, nm (prefiltering; `film_fourier`).
+    pub sigma_thickness_nm: f32,
+    /// Ambient index n₁.
+    pub ambient_ior: f32,
+    /// Padding.
+    pub _pad0: [f32; 3],
+    /// Base index per output channel, real part.
+    pub base_ior: [f32; 3],
+    /// Padding.
+    pub _pad3: f32,
+    /// Base index per output channel, imaginary part κ ≥ 0.
+    pub base_kappa: [f32; 3],
+    /// Padding.
+    pub _pad4: f32,
+}
+
+/// Mirror of `FilmOutput`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FilmOutput {
+    /// Reflectance colour.
+    pub reflectance: [f32; 3],
+    /// Transmittance colour.
+    pub transmittance: [f32; 3],
+}
+
+/// Mirror of `FilmLutParams` (`shaders/lut_mapping.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct FilmLutParams {
+    /// Texel counts along x (cos θ), y (Δ), z (n).
+    pub counts: [f32; 3],
+    /// 1 when the table has a transmittance, else 0.
+    pub has_transmittance: f32,
+    /// Smallest thickness, nm.
+    pub thickness_min_nm: f32,
+    /// Largest thickness, nm.
+    pub thickness_max_nm: f32,
+    /// Smallest film index.
+    pub ior_min: f32,
+    /// Largest film index.
+    pub ior_max: f32,
+    /// Ambient index n₀.
+    pub ambient_index: f32,
+    /// Padding.
+    pub _pad: [f32; 3],
+}
+
+impl FilmLutParams {
+    /// From a table's axes.
+    pub fn new(axes: &nacre_bake::film_lut::FilmLutAxes, has_transmittance: bool) -> Self {
+        FilmLutParams {
+            counts: [
+                axes.cos_theta_count as f32,
+                axes.opd_count as f32,
+                axes.ior_count as f32,
+            ],
+            has_transmittance: if has_transmittance { 1.0 } else { 0.0 },
+            thickness_min_nm: axes.thickness_min_nm as f32,
+            thickness_max_nm: axes.thickness_max_nm as f32,
+            ior_min: axes.ior_min as f32,
+            ior_max: axes.ior_max as f32,
+            ambient_index: axes.ambient_index as f32,
+            _pad: [0.0; 3],
+        }
+    }
+}
+
+/// Mirror of `FourierParams` (`shaders/film_fourier.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct FourierParams {
+    /// D_max, nm.
+    pub max_opd_nm: f32,
+    /// Mip levels.
+    pub level_count: u32,
+    /// σ of level 1, nm.
+    pub sigma1_nm: f32,
+    /// Harmonics M (0: automatic).
+    pub harmonics: u32,
+    /// Carrier ν̄_j, 1/nm.
+    pub carrier_nu_per_nm: [f32; 3],
+    /// Padding.
+    pub _pad0: f32,
+    /// ‖s_j‖: colour of a perfect reflector.
+    pub white: [f32; 3],
+    /// Padding.
+    pub _pad1: f32,
+}
+
+impl FourierParams {
+    /// From a table's axes and the harmonics to sum (0: automatic).
+    pub fn new(axes: &nacre_bake::fourier_table::FourierAxes, harmonics: u32) -> Self {
+        FourierParams {
+            max_opd_nm: axes.max_opd_nm as f32,
+            level_count: axes.level_samples.len() as u32,
+            sigma1_nm: axes.level_sigma_nm.get(1).copied().unwrap_or(0.0) as f32,
+            harmonics,
+            carrier_nu_per_nm: axes.carrier_nu_per_nm.map(|v| v as f32),
+            _pad0: 0.0,
+            white: axes.white.map(|v| v as f32),
+            _pad1: 0.0,
+        }
+    }
+}
+
+/// Mirror of `SpectralSample` (`shaders/film_spectral.wgsl`): 32 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct SpectralSample {
+    /// λ, nm.
+    pub wavelength_nm: f32,
+    /// Base index at λ, real part.
+    pub base_ior: f32,
+    /// Base index at λ, imaginary part.
+    pub base_kappa: f32,
+    /// Padding.
+    pub _pad: f32,
+    /// Weight per channel (Σ over samples = white); w unused.
+    pub weight: [f32; 4],
+}
+
+/// Mirror of `SpectralParams`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct SpectralParams {
+    /// Samples N.
+    pub count: u32,
+    /// Padding.
+    pub _pad: [u32; 3],
+}
+
+impl SpectralParams {
+    /// For `count` samples.
+    pub fn new(count: usize) -> Self {
+        SpectralParams {
+            count: count as u32,
+            _pad: [0; 3],
+        }
+    }
+}
+
+/// The samples of `film_spectral` for `setup`: the wavelengths and weights of `nacre color
+/// --method samples:N` ([`nacre_bake::color::sample_weights`]) and the base's index at each.
+pub fn spectral_samples(
+    colorimeter: &nacre_optics::colour::Colorimeter,
+    setup: &crate::bindings::SpectralSetup,
+) -> crate::Result<Vec<SpectralSample>> {
+    if !(1..=4096).contains(&setup.samples) {
+        return Err(crate::Error::Invalid {
+            context: "spectral technique".into(),
+            message: format!("{} wavelengths (expected 1 to 4096)", setup.samples),
+        });
+    }
+    let (wavelengths, weights) = nacre_bake::color::sample_weights(colorimeter, setup.samples);
+    wavelengths
+        .iter()
+        .zip(&weights)
+        .map(|(&wl, w)| {
+            let n = setup.base.index_at(wl).map_err(nacre_bake::Error::from)?;
+            Ok(SpectralSample {
+                wavelength_nm: wl as f32,
+                base_ior: n.re as f32,
+                base_kappa: n.im as f32,
+                _pad: 0.0,
+                weight: [w[0] as f32, w[1] as f32, w[2] as f32, 0.0],
+            })
+        })
+        .collect()
+}

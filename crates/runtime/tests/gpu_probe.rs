@@ -1,0 +1,251 @@
+//! GPU = CPU: every technique's `film_colour`, rendered by the probe pass into a float
+//! target on whatever adapter wgpu finds (Mesa's lavapipe in CI), against the CPU methods
+//! of `nacre color` (`lut:`, `fourier:M`, `samples:N`) at the same points.
+//!
+//! A missing adapter fails these tests: they never skip.
+
+use nacre_bake::bake::{Manifest, default_baked_dir};
+use nacre_bake::color::{self, Method, Point, Quantity};
+use nacre_bake::film_lut::FilmLut;
+use nacre_bake::materials;
+use nacre_optics::fourier::Harmonics;
+use nacre_optics::{C64, Material};
+use nacre_runtime::bindings::{SpectralSetup, TechniqueBinding, TechniqueOptions};
+use nacre_runtime::probe::run_probe;
+use nacre_runtime::{FilmInput, GpuContext, TableSet, Technique};
+use std::sync::{Arc, OnceLock};
+
+fn ctx() -> &'static GpuContext {
+    static CTX: OnceLock<GpuContext> = OnceLock::new();
+    CTX.get_or_init(|| {
+        let ctx = GpuContext::new_headless().unwrap_or_else(|e| {
+            panic!("the GPU tests need an adapter (CI installs mesa-vulkan-drivers): {e}")
+        });
+        eprintln!("adapter: {}", ctx.describe());
+        ctx
+    })
+}
+
+/// Deterministic uniform numbers in [0, 1).
+struct Lcg(u64);
+impl Lcg {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+fn input(cos_theta: f64, d: f64, n: f64, sigma: f64, ambient: f64, base: C64) -> FilmInput {
+    FilmInput {
+        cos_theta_i: cos_theta as f32,
+        thickness_nm: d as f32,
+        film_ior: n as f32,
+        sigma_thickness_nm: sigma as f32,
+        ambient_ior: ambient as f32,
+        base_ior: [base.re as f32; 3],
+        base_kappa: [base.im as f32; 3],
+        ..Default::default()
+    }
+}
+
+fn manifest(name: &str) -> std::path::PathBuf {
+    default_baked_dir().join(format!("{name}.json"))
+}
+
+fn max_diff(a: &[[f64; 3]], b: &[[f32; 3]]) -> (f64, usize) {
+    let mut worst = (0.0f64, 0usize);
+    for (i, (x, y)) in a.iter().zip(b).enumerate() {
+        for c in 0..3 {
+            let d = (x[c] - f64::from(y[c])).abs();
+            if !(d <= worst.0) {
+                worst = (d, i);
+            }
+        }
+    }
+    worst
+}
+
+#[test]
+fn film_lut_matches_the_cpu_lookup() {
+    let ctx = ctx();
+    for name in ["film-dielectric", "soap-film", "film-gold"] {
+        let path = manifest(name);
+        let tables = TableSet::load(ctx, &path).unwrap();
+        let m = Manifest::read(&path).unwrap();
+        let axes = m.film_lut.clone().unwrap();
+        let refl = m.load_table(&path, "reflectance").unwrap().unwrap();
+        let trans = m.load_table(&path, "transmittance").unwrap();
+        let binding = TechniqueBinding::new(
+            ctx,
+            &tables,
+            Technique::Lut,
+            &TechniqueOptions::default(),
+            &tables.colorimeter().unwrap(),
+        )
+        .unwrap();
+        let mut rng = Lcg(7);
+        let mut points = Vec::new();
+        for _ in 0..3000 {
+            let c = rng.next();
+            let d = axes.thickness_min_nm + rng.next() * (axes.thickness_max_nm - axes.thickness_min_nm);
+            let n = axes.ior_min + rng.next() * (axes.ior_max - axes.ior_min);
+            points.push((c, d, n));
+        }
+        // Texel centres and the domain's edges too.
+        points.push((1.0, 0.0, axes.ior_min));
+        points.push((0.0, axes.thickness_max_nm, axes.ior_max));
+        let inputs: Vec<FilmInput> = points
+            .iter()
+            .map(|&(c, d, n)| input(c, d, n, 0.0, axes.ambient_index, C64::new(1.5, 0.0)))
+            .collect();
+        let gpu = run_probe(ctx, &binding, &inputs).unwrap();
+        let cpu_r: Vec<[f64; 3]> = points
+            .iter()
+            .map(|&(c, d, n)| FilmLut::lookup(&axes, &refl, c, d, n))
+            .collect();
+        let gpu_r: Vec<[f32; 3]> = gpu.iter().map(|o| o.reflectance).collect();
+        let (worst, at) = max_diff(&cpu_r, &gpu_r);
+        eprintln!("{name} reflectance: max |GPU − CPU| = {worst:.2e}");
+        assert!(worst <= 2e-3, "{name}: {worst:e} at {:?}", points[at]);
+        if let Some(trans) = trans {
+            let cpu_t: Vec<[f64; 3]> = points
+                .iter()
+                .map(|&(c, d, n)| FilmLut::lookup(&axes, &trans, c, d, n))
+                .collect();
+            let gpu_t: Vec<[f32; 3]> = gpu.iter().map(|o| o.transmittance).collect();
+            let (worst, at) = max_diff(&cpu_t, &gpu_t);
+            eprintln!("{name} transmittance: max |GPU − CPU| = {worst:.2e}");
+            assert!(worst <= 2e-3, "{name} T: {worst:e} at {:?}", points[at]);
+        }
+    }
+}
+
+/// CPU colours of `method` for one film (ambient 1.0) on `base` at the given points.
+fn cpu_colours(
+    method: &Method,
+    base: &Material,
+    points: &[(f64, f64, f64)],
+    quantity: Quantity,
+    colorimeter: &nacre_optics::colour::Colorimeter,
+) -> Vec<[f64; 3]> {
+    let ambient = Material::constant("1.0", C64::new(1.0, 0.0)).unwrap();
+    let film = Material::constant("1.5", C64::new(1.5, 0.0)).unwrap();
+    let stack = color::film_stack(ambient, film, 100.0, vec![], base.clone()).unwrap();
+    let pts: Vec<Point> = points
+        .iter()
+        .map(|&(c, d, n)| Point {
+            angle_deg: c.clamp(0.0, 1.0).acos().to_degrees(),
+            thickness_nm: Some(d),
+            film_ior: Some(n),
+        })
+        .collect();
+    color::evaluate(&stack, &pts, method, colorimeter, quantity, None).unwrap()
+}
+
+fn random_points(seed: u64, count: usize, d_max: f64) -> Vec<(f64, f64, f64)> {
+    let mut rng = Lcg(seed);
+    (0..count)
+        .map(|_| {
+            let angle = rng.next() * 85.0;
+            (
+                angle.to_radians().cos(),
+                rng.next() * d_max,
+                1.2 + rng.next() * 1.2,
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn film_fourier_matches_the_cpu_series() {
+    let ctx = ctx();
+    let path = manifest("fourier-srgb");
+    let tables = TableSet::load(ctx, &path).unwrap();
+    let colorimeter = tables.colorimeter().unwrap();
+    let table = Arc::new(Manifest::read(&path).unwrap().load_fourier(&path).unwrap());
+    let bases = [C64::new(1.5, 0.0), C64::new(2.2, 0.0), C64::new(0.27, 2.9), C64::new(1.2, 1.5)];
+    for (harmonics, sigma) in [(1u32, 0.0), (2, 0.0), (3, 0.0), (3, 40.0), (0, 0.0)] {
+        let options = TechniqueOptions {
+            harmonics,
+            ..Default::default()
+        };
+        let binding =
+            TechniqueBinding::new(ctx, &tables, Technique::Fourier, &options, &colorimeter).unwrap();
+        let h = if harmonics == 0 {
+            Harmonics::Auto
+        } else {
+            Harmonics::Fixed(harmonics as usize)
+        };
+        let method = Method::Fourier(h, sigma, Some(table.clone()));
+        for base in bases {
+            let points = random_points(11 + harmonics as u64, 400, 3000.0);
+            let inputs: Vec<FilmInput> = points
+                .iter()
+                .map(|&(c, d, n)| input(c, d, n, sigma, 1.0, base))
+                .collect();
+            let gpu = run_probe(ctx, &binding, &inputs).unwrap();
+            let material = Material::constant("base", base).unwrap();
+            let cpu = cpu_colours(&method, &material, &points, Quantity::Reflectance, &colorimeter);
+            let gpu_r: Vec<[f32; 3]> = gpu.iter().map(|o| o.reflectance).collect();
+            let (worst, at) = max_diff(&cpu, &gpu_r);
+            eprintln!("fourier M={harmonics} σ={sigma} base {base}: R max |GPU − CPU| = {worst:.2e}");
+            assert!(
+                worst <= 1e-4,
+                "M={harmonics} base {base}: {worst:e} at {:?}: CPU {:?} GPU {:?}",
+                points[at],
+                cpu[at],
+                gpu_r[at]
+            );
+            if base.im == 0.0 {
+                let cpu =
+                    cpu_colours(&method, &material, &points, Quantity::Transmittance, &colorimeter);
+                let gpu_t: Vec<[f32; 3]> = gpu.iter().map(|o| o.transmittance).collect();
+                let (worst, at) = max_diff(&cpu, &gpu_t);
+                eprintln!("fourier M={harmonics} σ={sigma} base {base}: T max |GPU − CPU| = {worst:.2e}");
+                assert!(worst <= 1e-4, "T M={harmonics} base {base}: {worst:e} at {:?}", points[at]);
+            }
+        }
+    }
+}
+
+#[test]
+fn film_spectral_matches_samples_n() {
+    let ctx = ctx();
+    let tables = TableSet::load(ctx, &manifest("fourier-srgb")).unwrap();
+    let colorimeter = tables.colorimeter().unwrap();
+    let gold = materials::resolve("au", "test", None).unwrap();
+    let glass = Material::constant("1.5", C64::new(1.5, 0.0)).unwrap();
+    for (samples, base) in [(30usize, glass.clone()), (30, gold), (5, glass)] {
+        let options = TechniqueOptions {
+            spectral: SpectralSetup {
+                samples,
+                base: base.clone(),
+            },
+            ..Default::default()
+        };
+        let binding =
+            TechniqueBinding::new(ctx, &tables, Technique::Spectral, &options, &colorimeter).unwrap();
+        let points = random_points(23, 600, 2000.0);
+        let inputs: Vec<FilmInput> = points
+            .iter()
+            .map(|&(c, d, n)| input(c, d, n, 0.0, 1.0, C64::new(1.5, 0.0)))
+            .collect();
+        let gpu = run_probe(ctx, &binding, &inputs).unwrap();
+        for quantity in [Quantity::Reflectance, Quantity::Transmittance] {
+            let cpu = cpu_colours(&Method::Samples(samples), &base, &points, quantity, &colorimeter);
+            let g: Vec<[f32; 3]> = gpu
+                .iter()
+                .map(|o| match quantity {
+                    Quantity::Reflectance => o.reflectance,
+                    Quantity::Transmittance => o.transmittance,
+                })
+                .collect();
+            let (worst, at) = max_diff(&cpu, &g);
+            eprintln!("spectral N={samples} base {}: {quantity:?} max |GPU − CPU| = {worst:.2e}", base.name());
+            assert!(worst <= 1e-4, "N={samples} {quantity:?}: {worst:e} at {:?}", points[at]);
+        }
+    }
+}
