@@ -1,5 +1,20 @@
 #!/usr/bin/env bash
-# The whole test suite (the README's test command). Installs what the tests need first.
+# The whole test suite (the README's test command). Installs what the tests need first:
+# the GPU tests run on whatever Vulkan adapter wgpu finds, and on machines without a GPU
+# that is Mesa's software rasteriser lavapipe (Debian package mesa-vulkan-drivers).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+
+if ! ls /usr/share/vulkan/icd.d/lvp_icd.*.json >/dev/null 2>&1 \
+    && ! ls /etc/vulkan/icd.d/*.json >/dev/null 2>&1 \
+    && ! ls /usr/share/vulkan/icd.d/nvidia*.json >/dev/null 2>&1; then
+    echo "scripts/test.sh: installing mesa-vulkan-drivers (software Vulkan for the GPU tests)" >&2
+    SUDO=""
+    if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+    if ! $SUDO apt-get install -y --no-install-recommends mesa-vulkan-drivers >/dev/null; then
+        $SUDO apt-get update >/dev/null
+        $SUDO apt-get install -y --no-install-recommends mesa-vulkan-drivers >/dev/null
+    fi
+fi
+
 cargo test --workspace --locked
