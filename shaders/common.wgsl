@@ -100,7 +100,8 @@ struct FilmInput {
 }
 
 // Colour of the film's unpolarised reflectance and of its transmittance into the base, in the
-// tables' output space (a perfect reflector = white). Finite and non-negative.
+// tables' output space (a perfect reflector = white). Always finite; a channel may be negative
+// for colours outside the gamut of a linear RGB output space.
 struct FilmOutput {
     reflectance: vec3<f32>,
     transmittance: vec3<f32>,
@@ -180,12 +181,14 @@ fn sanitize_base_index(n: f32, kappa: f32) -> vec2<f32> {
     return vec2<f32>(re, im);
 }
 
-// Every channel that is NaN, ±∞ or negative becomes 0.
+// Every channel that is NaN or ±∞ becomes 0. Negative channels are kept: they are the
+// out-of-gamut colours of linear RGB spaces, exactly as the CPU methods return them (a
+// consumer clamps after lighting and tone mapping, not before).
 fn sanitize_output(output: FilmOutput) -> FilmOutput {
     var o: FilmOutput;
     let zero = vec3<f32>(0.0);
-    o.reflectance = select(zero, max(output.reflectance, zero), vec3_is_finite(output.reflectance));
-    o.transmittance = select(zero, max(output.transmittance, zero), vec3_is_finite(output.transmittance));
+    o.reflectance = select(zero, output.reflectance, vec3_is_finite(output.reflectance));
+    o.transmittance = select(zero, output.transmittance, vec3_is_finite(output.transmittance));
     return o;
 }
 

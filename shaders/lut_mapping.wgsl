@@ -42,7 +42,7 @@
 //       20    4 ior_min: f32
 //       24    4 ior_max: f32
 //       28    4 ambient_index: f32
-//       32    4 has_transmittance: u32  1 when binding 1 holds a baked transmittance table
+//       32    4 has_transmittance: u32  1 when binding 1 holds a baked transmittance table, else 0
 //       36   12 _pad0, _pad1, _pad2: u32
 //
 // The counts must equal the dimensions of the bound textures.
@@ -63,7 +63,7 @@ struct FilmLutParams {
 
 // Texel counts (x, y, z) as floats, at least 1.
 fn lut_counts(p: FilmLutParams) -> vec3<f32> {
-    return vec3<f32>(vec3<u32>(max(p.cos_theta_count, 1u), max(p.opd_count, 1u), max(p.ior_count, 1u)));
+    return vec3<f32>(max(vec3<u32>(p.cos_theta_count, p.opd_count, p.ior_count), vec3<u32>(1u)));
 }
 
 // Δ_max = 2 d_max n_max, nm.

@@ -619,7 +619,9 @@ mod tests {
         ] {
             let spectrum = SensitivitySpectrum::new(&c);
             let mut worst: f64 = 0.0;
-            for mu in [0.0, 150.0, 777.0, 2500.0, 9000.0, 30_000.0, 80_000.0, 160_000.0] {
+            for mu in [
+                0.0, 150.0, 777.0, 2500.0, 9000.0, 30_000.0, 80_000.0, 160_000.0,
+            ] {
                 let (a, b) = (spectrum.transform(mu, 0.0), knot_aligned_transform(&c, mu));
                 for j in 0..3 {
                     worst = worst.max((a[j] - b[j]).norm());

@@ -136,111 +136,123 @@ impl TechniqueBinding {
             context: format!("technique `{}`", technique.name()),
             message: format!("needs a `{kind}` table in the table set"),
         };
-        let bind_group = ctx.checked("creating a table bind group", || -> Result<wgpu::BindGroup> {
-            Ok(match technique {
-                Technique::Lut => {
-                    let lut = tables.film_lut.as_ref().ok_or_else(|| missing("film-lut"))?;
-                    let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                        label: Some("FilmLutParams"),
-                        contents: bytemuck::bytes_of(&params::FilmLutParams::new(
-                            &lut.axes,
-                            lut.has_transmittance,
-                        )),
-                        usage: wgpu::BufferUsages::UNIFORM,
-                    });
-                    let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-                        label: Some("film-lut trilinear"),
-                        address_mode_u: wgpu::AddressMode::ClampToEdge,
-                        address_mode_v: wgpu::AddressMode::ClampToEdge,
-                        address_mode_w: wgpu::AddressMode::ClampToEdge,
-                        mag_filter: wgpu::FilterMode::Linear,
-                        min_filter: wgpu::FilterMode::Linear,
-                        mipmap_filter: wgpu::MipmapFilterMode::Linear,
-                        ..Default::default()
-                    });
-                    let r = lut.reflectance.create_view(&Default::default());
-                    let t = lut.transmittance.create_view(&Default::default());
-                    device.create_bind_group(&wgpu::BindGroupDescriptor {
-                        label: Some("film-lut tables"),
-                        layout: &layout,
-                        entries: &[
-                            wgpu::BindGroupEntry {
-                                binding: 0,
-                                resource: wgpu::BindingResource::TextureView(&r),
-                            },
-                            wgpu::BindGroupEntry {
-                                binding: 1,
-                                resource: wgpu::BindingResource::TextureView(&t),
-                            },
-                            wgpu::BindGroupEntry {
-                                binding: 2,
-                                resource: wgpu::BindingResource::Sampler(&sampler),
-                            },
-                            wgpu::BindGroupEntry {
-                                binding: 3,
-                                resource: uniform.as_entire_binding(),
-                            },
-                        ],
-                    })
-                }
-                Technique::Fourier => {
-                    let f = tables.fourier.as_ref().ok_or_else(|| missing("fourier"))?;
-                    let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                        label: Some("FourierParams"),
-                        contents: bytemuck::bytes_of(&params::FourierParams::new(
-                            &f.axes,
-                            options.harmonics,
-                        )),
-                        usage: wgpu::BufferUsages::UNIFORM,
-                    });
-                    let view = f.texture.create_view(&wgpu::TextureViewDescriptor {
-                        dimension: Some(wgpu::TextureViewDimension::D2Array),
-                        ..Default::default()
-                    });
-                    device.create_bind_group(&wgpu::BindGroupDescriptor {
-                        label: Some("fourier tables"),
-                        layout: &layout,
-                        entries: &[
-                            wgpu::BindGroupEntry {
-                                binding: 0,
-                                resource: wgpu::BindingResource::TextureView(&view),
-                            },
-                            wgpu::BindGroupEntry {
-                                binding: 1,
-                                resource: uniform.as_entire_binding(),
-                            },
-                        ],
-                    })
-                }
-                Technique::Spectral => {
-                    let samples = params::spectral_samples(colorimeter, &options.spectral)?;
-                    let storage = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                        label: Some("SpectralSample[]"),
-                        contents: bytemuck::cast_slice(&samples),
-                        usage: wgpu::BufferUsages::STORAGE,
-                    });
-                    let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                        label: Some("SpectralParams"),
-                        contents: bytemuck::bytes_of(&params::SpectralParams::new(samples.len())),
-                        usage: wgpu::BufferUsages::UNIFORM,
-                    });
-                    device.create_bind_group(&wgpu::BindGroupDescriptor {
-                        label: Some("spectral tables"),
-                        layout: &layout,
-                        entries: &[
-                            wgpu::BindGroupEntry {
-                                binding: 0,
-                                resource: storage.as_entire_binding(),
-                            },
-                            wgpu::BindGroupEntry {
-                                binding: 1,
-                                resource: uniform.as_entire_binding(),
-                            },
-                        ],
-                    })
-                }
-            })
-        })??;
+        let bind_group = ctx.checked(
+            "creating a table bind group",
+            || -> Result<wgpu::BindGroup> {
+                Ok(match technique {
+                    Technique::Lut => {
+                        let lut = tables
+                            .film_lut
+                            .as_ref()
+                            .ok_or_else(|| missing("film-lut"))?;
+                        let uniform =
+                            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                                label: Some("FilmLutParams"),
+                                contents: bytemuck::bytes_of(&params::FilmLutParams::new(
+                                    &lut.axes,
+                                    lut.has_transmittance,
+                                )),
+                                usage: wgpu::BufferUsages::UNIFORM,
+                            });
+                        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+                            label: Some("film-lut trilinear"),
+                            address_mode_u: wgpu::AddressMode::ClampToEdge,
+                            address_mode_v: wgpu::AddressMode::ClampToEdge,
+                            address_mode_w: wgpu::AddressMode::ClampToEdge,
+                            mag_filter: wgpu::FilterMode::Linear,
+                            min_filter: wgpu::FilterMode::Linear,
+                            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+                            ..Default::default()
+                        });
+                        let r = lut.reflectance.create_view(&Default::default());
+                        let t = lut.transmittance.create_view(&Default::default());
+                        device.create_bind_group(&wgpu::BindGroupDescriptor {
+                            label: Some("film-lut tables"),
+                            layout: &layout,
+                            entries: &[
+                                wgpu::BindGroupEntry {
+                                    binding: 0,
+                                    resource: wgpu::BindingResource::TextureView(&r),
+                                },
+                                wgpu::BindGroupEntry {
+                                    binding: 1,
+                                    resource: wgpu::BindingResource::TextureView(&t),
+                                },
+                                wgpu::BindGroupEntry {
+                                    binding: 2,
+                                    resource: wgpu::BindingResource::Sampler(&sampler),
+                                },
+                                wgpu::BindGroupEntry {
+                                    binding: 3,
+                                    resource: uniform.as_entire_binding(),
+                                },
+                            ],
+                        })
+                    }
+                    Technique::Fourier => {
+                        let f = tables.fourier.as_ref().ok_or_else(|| missing("fourier"))?;
+                        let uniform =
+                            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                                label: Some("FourierParams"),
+                                contents: bytemuck::bytes_of(&params::FourierParams::new(
+                                    &f.axes,
+                                    options.harmonics,
+                                )),
+                                usage: wgpu::BufferUsages::UNIFORM,
+                            });
+                        let view = f.texture.create_view(&wgpu::TextureViewDescriptor {
+                            dimension: Some(wgpu::TextureViewDimension::D2Array),
+                            ..Default::default()
+                        });
+                        device.create_bind_group(&wgpu::BindGroupDescriptor {
+                            label: Some("fourier tables"),
+                            layout: &layout,
+                            entries: &[
+                                wgpu::BindGroupEntry {
+                                    binding: 0,
+                                    resource: wgpu::BindingResource::TextureView(&view),
+                                },
+                                wgpu::BindGroupEntry {
+                                    binding: 1,
+                                    resource: uniform.as_entire_binding(),
+                                },
+                            ],
+                        })
+                    }
+                    Technique::Spectral => {
+                        let samples = params::spectral_samples(colorimeter, &options.spectral)?;
+                        let storage =
+                            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                                label: Some("SpectralSample[]"),
+                                contents: bytemuck::cast_slice(&samples),
+                                usage: wgpu::BufferUsages::STORAGE,
+                            });
+                        let uniform =
+                            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                                label: Some("SpectralParams"),
+                                contents: bytemuck::bytes_of(&params::SpectralParams::new(
+                                    samples.len(),
+                                )),
+                                usage: wgpu::BufferUsages::UNIFORM,
+                            });
+                        device.create_bind_group(&wgpu::BindGroupDescriptor {
+                            label: Some("spectral tables"),
+                            layout: &layout,
+                            entries: &[
+                                wgpu::BindGroupEntry {
+                                    binding: 0,
+                                    resource: storage.as_entire_binding(),
+                                },
+                                wgpu::BindGroupEntry {
+                                    binding: 1,
+                                    resource: uniform.as_entire_binding(),
+                                },
+                            ],
+                        })
+                    }
+                })
+            },
+        )??;
         Ok(TechniqueBinding {
             technique,
             layout,

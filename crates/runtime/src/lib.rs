@@ -5,6 +5,7 @@
 //! provides the WGSL modules under `shaders/` ([`shaders`]) that sample them, plus a headless
 //! renderer for `nacre render` and the GPU = CPU probe used by the tests.
 
+pub mod bench;
 pub mod bindings;
 pub mod context;
 pub mod error;

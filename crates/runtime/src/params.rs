@@ -38,14 +38,16 @@ pub struct FilmOutput {
     pub transmittance: [f32; 3],
 }
 
-/// Mirror of `FilmLutParams` (`shaders/lut_mapping.wgsl`).
+/// Mirror of `FilmLutParams` (`shaders/lut_mapping.wgsl`): 48 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct FilmLutParams {
-    /// Texel counts along x (cos θ), y (Δ), z (n).
-    pub counts: [f32; 3],
-    /// 1 when the table has a transmittance, else 0.
-    pub has_transmittance: f32,
+    /// Texels along x (cos θ).
+    pub cos_theta_count: u32,
+    /// Texels along y (Δ).
+    pub opd_count: u32,
+    /// Texels along z (film index).
+    pub ior_count: u32,
     /// Smallest thickness, nm.
     pub thickness_min_nm: f32,
     /// Largest thickness, nm.
@@ -56,26 +58,26 @@ pub struct FilmLutParams {
     pub ior_max: f32,
     /// Ambient index n₀.
     pub ambient_index: f32,
+    /// 1 when the table has a transmittance, else 0.
+    pub has_transmittance: u32,
     /// Padding.
-    pub _pad: [f32; 3],
+    pub _pad: [u32; 3],
 }
 
 impl FilmLutParams {
     /// From a table's axes.
     pub fn new(axes: &nacre_bake::film_lut::FilmLutAxes, has_transmittance: bool) -> Self {
         FilmLutParams {
-            counts: [
-                axes.cos_theta_count as f32,
-                axes.opd_count as f32,
-                axes.ior_count as f32,
-            ],
-            has_transmittance: if has_transmittance { 1.0 } else { 0.0 },
+            cos_theta_count: axes.cos_theta_count as u32,
+            opd_count: axes.opd_count as u32,
+            ior_count: axes.ior_count as u32,
             thickness_min_nm: axes.thickness_min_nm as f32,
             thickness_max_nm: axes.thickness_max_nm as f32,
             ior_min: axes.ior_min as f32,
             ior_max: axes.ior_max as f32,
             ambient_index: axes.ambient_index as f32,
-            _pad: [0.0; 3],
+            has_transmittance: u32::from(has_transmittance),
+            _pad: [0; 3],
         }
     }
 }

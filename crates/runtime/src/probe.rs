@@ -74,7 +74,11 @@ pub fn run_probe(
         });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("probe"),
-            bind_group_layouts: &[Some(&view_layout), Some(&binding.layout), Some(&probe_layout)],
+            bind_group_layouts: &[
+                Some(&view_layout),
+                Some(&binding.layout),
+                Some(&probe_layout),
+            ],
             immediate_size: 0,
         });
         let target = Some(wgpu::ColorTargetState {
@@ -152,8 +156,14 @@ pub fn run_probe(
                 view_formats: &[],
             })
         };
-        let (r, t) = (make_target("probe reflectance"), make_target("probe transmittance"));
-        let (rv, tv) = (r.create_view(&Default::default()), t.create_view(&Default::default()));
+        let (r, t) = (
+            make_target("probe reflectance"),
+            make_target("probe transmittance"),
+        );
+        let (rv, tv) = (
+            r.create_view(&Default::default()),
+            t.create_view(&Default::default()),
+        );
         let attachment = |view| {
             Some(wgpu::RenderPassColorAttachment {
                 view,

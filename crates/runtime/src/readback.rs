@@ -5,10 +5,15 @@ use crate::error::{Error, Result};
 
 /// Reads mip level 0 of a 2-D `texture` whose texels are `bytes_per_texel` bytes, returning
 /// tightly packed rows, top row first.
-pub fn read_texture(ctx: &GpuContext, texture: &wgpu::Texture, bytes_per_texel: u32) -> Result<Vec<u8>> {
+pub fn read_texture(
+    ctx: &GpuContext,
+    texture: &wgpu::Texture,
+    bytes_per_texel: u32,
+) -> Result<Vec<u8>> {
     let (width, height) = (texture.width(), texture.height());
     let row = width * bytes_per_texel;
-    let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let padded =
+        row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
     let buffer = ctx.checked("reading a texture back", || {
         let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
@@ -42,7 +47,7 @@ pub fn read_texture(ctx: &GpuContext, texture: &wgpu::Texture, bytes_per_texel: 
         let _ = sender.send(r);
     });
     ctx.wait("reading a texture back")?;
-    let mapped = receiver
+    receiver
         .recv()
         .map_err(|e| e.to_string())
         .and_then(|r| r.map_err(|e| e.to_string()))
@@ -50,7 +55,6 @@ pub fn read_texture(ctx: &GpuContext, texture: &wgpu::Texture, bytes_per_texel: 
             context: "mapping the readback buffer".into(),
             message,
         })?;
-    let _: () = mapped;
     let view = buffer.get_mapped_range(..).map_err(|e| Error::Gpu {
         context: "mapping the readback buffer".into(),
         message: e.to_string(),

@@ -16,6 +16,10 @@ pub const FILM_FOURIER: &str = include_str!("../../../shaders/film_fourier.wgsl"
 /// Technique: brute-force loop over N wavelengths.
 pub const FILM_SPECTRAL: &str = include_str!("../../../shaders/film_spectral.wgsl");
 
+/// Baseline "technique" without a film (Schlick Fresnel) for `nacre bench-gpu`.
+pub const PLAIN: &str = include_str!("../../../shaders/plain.wgsl");
+/// Consumer: the full-screen GGX pass of `nacre bench-gpu`.
+pub const BENCH: &str = include_str!("../../../shaders/bench.wgsl");
 /// Consumer: the GPU = CPU probe pass.
 pub const PROBE: &str = include_str!("../../../shaders/probe.wgsl");
 
@@ -55,8 +59,13 @@ impl Technique {
 
 /// The full source of a pipeline: common + mapping + `technique` + `consumer`.
 pub fn compose(technique: Technique, consumer: &[&str]) -> String {
+    compose_source(technique.source(), consumer)
+}
+
+/// [`compose`] with any module that defines `film_colour` (e.g. [`PLAIN`]).
+pub fn compose_source(technique_source: &str, consumer: &[&str]) -> String {
     let mut s = String::with_capacity(64 * 1024);
-    for part in [COMMON, LUT_MAPPING, technique.source()]
+    for part in [COMMON, LUT_MAPPING, technique_source]
         .into_iter()
         .chain(consumer.iter().copied())
     {

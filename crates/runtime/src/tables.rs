@@ -181,7 +181,12 @@ fn upload_film_lut(
         ("OPD axis", axes.opd_count),
         ("index axis", axes.ior_count),
     ] {
-        check_limit(ctx, &format!("film-lut `{}` {name}", manifest.name), n as u64, limit)?;
+        check_limit(
+            ctx,
+            &format!("film-lut `{}` {name}", manifest.name),
+            n as u64,
+            limit,
+        )?;
     }
     let reflectance = manifest
         .load_table(manifest_path, "reflectance")?
@@ -304,9 +309,8 @@ fn upload_fourier(
                 let texels: Vec<f32> = level
                     .iter()
                     .flat_map(|a| {
-                        let v = |c: nacre_optics::C64| {
-                            (if layer == 0 { c.re } else { c.im }) as f32
-                        };
+                        let v =
+                            |c: nacre_optics::C64| (if layer == 0 { c.re } else { c.im }) as f32;
                         [v(a[0]), v(a[1]), v(a[2]), 0.0]
                     })
                     .collect();

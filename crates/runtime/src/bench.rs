@@ -1,0 +1,336 @@
+//! `nacre bench-gpu`: the cost of each technique's film term in a full-screen GGX pass,
+//! against the same pass with Schlick's Fresnel and no film (`shaders/plain.wgsl`,
+//! `shaders/bench.wgsl`).
+//!
+//! Each pass draws one full-screen triangle into an `Rgba8Unorm` target. With
+//! `TIMESTAMP_QUERY` the GPU time of every pass comes from timestamps written at the
+//! beginning and end of the render pass (converted with the queue's timestamp period);
+//! otherwise from the wall-clock time of submit + wait, per frame. The median over the
+//! measured frames is reported, after warm-up frames that are discarded.
+
+use crate::bindings::{TechniqueBinding, TechniqueOptions};
+use crate::context::GpuContext;
+use crate::error::{Error, Result};
+use crate::shaders::{self, Technique};
+use crate::tables::TableSet;
+use std::time::Instant;
+use wgpu::util::DeviceExt;
+
+/// What one bench pass shades.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BenchPass {
+    /// GGX + Schlick, no film.
+    Plain,
+    /// GGX with the technique's film term in place of Fresnel.
+    Film(Technique),
+}
+
+impl BenchPass {
+    /// Name for reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            BenchPass::Plain => "plain GGX + Schlick",
+            BenchPass::Film(Technique::Lut) => "film_lut",
+            BenchPass::Film(Technique::Fourier) => "film_fourier",
+            BenchPass::Film(Technique::Spectral) => "film_spectral",
+        }
+    }
+}
+
+/// Settings of a bench run.
+#[derive(Clone, Debug)]
+pub struct BenchOptions {
+    /// Target width in pixels.
+    pub width: u32,
+    /// Target height in pixels.
+    pub height: u32,
+    /// Frames measured per pass.
+    pub frames: u32,
+    /// Frames drawn first and discarded.
+    pub warmup: u32,
+    /// Technique settings (harmonics, spectral wavelengths and base).
+    pub technique: TechniqueOptions,
+}
+
+impl Default for BenchOptions {
+    fn default() -> Self {
+        BenchOptions {
+            width: 1920,
+            height: 1080,
+            frames: 30,
+            warmup: 3,
+            technique: TechniqueOptions::default(),
+        }
+    }
+}
+
+/// The result of one pass.
+#[derive(Clone, Debug)]
+pub struct BenchResult {
+    /// The pass.
+    pub pass: BenchPass,
+    /// Median time per frame, ms.
+    pub median_ms: f64,
+    /// Fastest frame, ms.
+    pub min_ms: f64,
+    /// Whether the times are GPU timestamps (else wall clock).
+    pub timestamps: bool,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct BenchParams {
+    resolution: [f32; 2],
+    roughness: f32,
+    film_ior: f32,
+    base_ior: [f32; 3],
+    ambient_ior: f32,
+    base_kappa: [f32; 3],
+    pad: f32,
+}
+
+/// Times `passes` on `ctx` with the tables of `tables` (a `film-lut` table for
+/// [`Technique::Lut`], a `fourier` table for the others' colorimeter).
+pub fn run_bench(
+    ctx: &GpuContext,
+    tables: &TableSet,
+    passes: &[BenchPass],
+    options: &BenchOptions,
+) -> Result<Vec<BenchResult>> {
+    let limit = ctx.device.limits().max_texture_dimension_2d;
+    if options.width == 0 || options.height == 0 || options.width > limit || options.height > limit
+    {
+        return Err(Error::Invalid {
+            context: "bench-gpu".into(),
+            message: format!(
+                "a {}×{} target (each side 1 to {limit} on this device)",
+                options.width, options.height
+            ),
+        });
+    }
+    if options.frames == 0 {
+        return Err(Error::Invalid {
+            context: "bench-gpu".into(),
+            message: "0 frames (expected at least 1)".into(),
+        });
+    }
+    let colorimeter = tables.colorimeter()?;
+    let timestamps = ctx
+        .device
+        .features()
+        .contains(wgpu::Features::TIMESTAMP_QUERY);
+    let device = &ctx.device;
+    let target = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("bench target"),
+        size: wgpu::Extent3d {
+            width: options.width,
+            height: options.height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba8Unorm,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+        view_formats: &[],
+    });
+    let view = target.create_view(&Default::default());
+    let params = BenchParams {
+        resolution: [options.width as f32, options.height as f32],
+        roughness: 0.3,
+        film_ior: 1.45,
+        base_ior: [1.5; 3],
+        ambient_ior: 1.0,
+        base_kappa: [0.0; 3],
+        pad: 0.0,
+    };
+    let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("BenchParams"),
+        contents: bytemuck::bytes_of(&params),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let view_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("bench view"),
+        entries: &[wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        }],
+    });
+    let view_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("bench view"),
+        layout: &view_layout,
+        entries: &[wgpu::BindGroupEntry {
+            binding: 0,
+            resource: uniform.as_entire_binding(),
+        }],
+    });
+    let empty_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("no tables"),
+        entries: &[],
+    });
+    let empty_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("no tables"),
+        layout: &empty_layout,
+        entries: &[],
+    });
+
+    let mut results = Vec::new();
+    for &pass in passes {
+        let binding = match pass {
+            BenchPass::Plain => None,
+            BenchPass::Film(t) => Some(TechniqueBinding::new(
+                ctx,
+                tables,
+                t,
+                &options.technique,
+                &colorimeter,
+            )?),
+        };
+        let (source, table_layout, table_group) = match (&binding, pass) {
+            (Some(b), BenchPass::Film(t)) => (
+                shaders::compose(t, &[shaders::BENCH]),
+                &b.layout,
+                &b.bind_group,
+            ),
+            _ => (
+                shaders::compose_source(shaders::PLAIN, &[shaders::BENCH]),
+                &empty_layout,
+                &empty_group,
+            ),
+        };
+        let pipeline = ctx.checked("building a bench pipeline", || {
+            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some(pass.name()),
+                source: wgpu::ShaderSource::Wgsl(source.as_str().into()),
+            });
+            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(pass.name()),
+                bind_group_layouts: &[Some(&view_layout), Some(table_layout)],
+                immediate_size: 0,
+            });
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(pass.name()),
+                layout: Some(&layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("bench_vs"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: Default::default(),
+                depth_stencil: None,
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some("bench_fs"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: wgpu::TextureFormat::Rgba8Unorm,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        })?;
+        let mut times_ms = Vec::new();
+        for frame in 0..options.warmup + options.frames {
+            let query = timestamps.then(|| {
+                (
+                    device.create_query_set(&wgpu::QuerySetDescriptor {
+                        label: Some("bench timestamps"),
+                        ty: wgpu::QueryType::Timestamp,
+                        count: 2,
+                    }),
+                    device.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some("bench timestamps"),
+                        size: 16,
+                        usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                        mapped_at_creation: false,
+                    }),
+                    device.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some("bench timestamps readback"),
+                        size: 16,
+                        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                        mapped_at_creation: false,
+                    }),
+                )
+            });
+            let start = Instant::now();
+            ctx.checked("drawing a bench frame", || {
+                let mut encoder = device.create_command_encoder(&Default::default());
+                {
+                    let mut rp = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                        label: Some(pass.name()),
+                        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                            view: &view,
+                            depth_slice: None,
+                            resolve_target: None,
+                            ops: wgpu::Operations {
+                                load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                                store: wgpu::StoreOp::Store,
+                            },
+                        })],
+                        depth_stencil_attachment: None,
+                        timestamp_writes: query.as_ref().map(|(q, _, _)| {
+                            wgpu::RenderPassTimestampWrites {
+                                query_set: q,
+                                beginning_of_pass_write_index: Some(0),
+                                end_of_pass_write_index: Some(1),
+                            }
+                        }),
+                        occlusion_query_set: None,
+                        multiview_mask: None,
+                    });
+                    rp.set_pipeline(&pipeline);
+                    rp.set_bind_group(0, &view_group, &[]);
+                    rp.set_bind_group(1, table_group, &[]);
+                    rp.draw(0..3, 0..1);
+                }
+                if let Some((q, resolve, readback)) = &query {
+                    encoder.resolve_query_set(q, 0..2, resolve, 0);
+                    encoder.copy_buffer_to_buffer(resolve, 0, readback, 0, 16);
+                }
+                ctx.queue.submit([encoder.finish()]);
+            })?;
+            let ms = match &query {
+                Some((_, _, readback)) => {
+                    readback.map_async(wgpu::MapMode::Read, .., |_| {});
+                    ctx.wait("timing a bench frame")?;
+                    let view = readback.get_mapped_range(..).map_err(|e| Error::Gpu {
+                        context: "reading timestamps".into(),
+                        message: e.to_string(),
+                    })?;
+                    let t: [u64; 2] = bytemuck::pod_read_unaligned(&view[..16]);
+                    drop(view);
+                    readback.unmap();
+                    t[1].saturating_sub(t[0]) as f64
+                        * f64::from(ctx.queue.get_timestamp_period())
+                        * 1e-6
+                }
+                None => {
+                    ctx.wait("timing a bench frame")?;
+                    start.elapsed().as_secs_f64() * 1e3
+                }
+            };
+            if frame >= options.warmup {
+                times_ms.push(ms);
+            }
+        }
+        times_ms.sort_by(f64::total_cmp);
+        results.push(BenchResult {
+            pass,
+            median_ms: times_ms[times_ms.len() / 2],
+            min_ms: times_ms[0],
+            timestamps,
+        });
+    }
+    Ok(results)
+}

@@ -1,0 +1,348 @@
+//! Every WGSL composition under `shaders/` parses, validates and translates to every backend
+//! (SPIR-V, MSL, HLSL, GLSL 4.50 core and GLSL ES 3.10) with naga — no GPU needed. Also
+//! checks the bind-group contract of the technique modules, the byte layouts that the Rust
+//! `bytemuck` mirrors rely on, and that every `.wgsl` file opens with a comment header.
+
+use nacre_runtime::shaders::{COMMON, LUT_MAPPING, Technique, compose};
+use naga::back::{glsl, hlsl, msl, spv};
+use naga::valid::{Capabilities, ModuleInfo, ValidationFlags, Validator};
+use std::path::PathBuf;
+
+/// A tiny consumer: a fragment entry point fed from a group-2 uniform and the fragment
+/// position, writing reflectance and transmittance so that nothing is dead code, and a compute
+/// entry point that round-trips the film-lut mappings and evaluates the technique too.
+const CONSUMER: &str = r#"
+// Test consumer (crates/runtime/tests/wgsl.rs).
+@group(2) @binding(0) var<uniform> test_film: FilmInput;
+@group(2) @binding(1) var<storage, read_write> test_out: array<vec4<f32>>;
+
+struct TestFragment {
+    @location(0) reflectance: vec4<f32>,
+    @location(1) transmittance: vec4<f32>,
+}
+
+@fragment
+fn fs_test(@builtin(position) frag: vec4<f32>) -> TestFragment {
+    var input = test_film;
+    input.cos_theta_i = input.cos_theta_i * fract(frag.x / 64.0);
+    input.thickness_nm = input.thickness_nm + frag.y;
+    let film = film_colour(input);
+    var out: TestFragment;
+    out.reflectance = vec4<f32>(film.reflectance, 1.0);
+    out.transmittance = vec4<f32>(film.transmittance, 1.0);
+    return out;
+}
+
+@compute @workgroup_size(1)
+fn cs_test(@builtin(global_invocation_id) id: vec3<u32>) {
+    let axes = FilmLutParams(17u, 33u, 9u, 0.0, 1200.0, 1.0, 2.5, 1.0, 0u, 0u, 0u, 0u);
+    let t = vec3<f32>(f32(id.x) / 16.0, f32(id.y) / 32.0, f32(id.z) / 8.0);
+    let physical = lut_inverse(axes, t);
+    let q = lut_film_q(axes, physical.x, physical.z);
+    let d = select(0.0, physical.y / (2.0 * q), q > 0.0);
+    let back = lut_forward(axes, physical.x, d, physical.z);
+    let uvw = lut_texture_coordinate(back, lut_counts(axes));
+    var input = test_film;
+    input.cos_theta_i = physical.x;
+    input.thickness_nm = d;
+    input.film_ior = physical.z;
+    let film = film_colour(input);
+    let i = id.x + 17u * (id.y + 33u * id.z);
+    test_out[2u * i] = vec4<f32>(uvw, lut_opd_nm(axes, physical.x, d, physical.z));
+    test_out[2u * i + 1u] = vec4<f32>(film.reflectance + film.transmittance, 0.0);
+}
+"#;
+
+/// Extra consumer for `film_fourier`: the prefilter width from screen-space derivatives.
+const FOURIER_CONSUMER: &str = r#"
+// Test consumer for film_fourier (crates/runtime/tests/wgsl.rs).
+@fragment
+fn fs_test_prefiltered(@location(0) thickness_nm: f32) -> @location(0) vec4<f32> {
+    var input = test_film;
+    input.thickness_nm = thickness_nm;
+    input.sigma_thickness_nm = fourier_sigma_from_derivatives(dpdx(thickness_nm), dpdy(thickness_nm), test_film.sigma_thickness_nm);
+    let film = film_colour(input);
+    return vec4<f32>(film.reflectance, 1.0);
+}
+"#;
+
+/// A consumer that declares no bindings: what remains belongs to the technique.
+const BINDINGLESS_CONSUMER: &str = r#"
+@fragment
+fn fs_bindingless() -> @location(0) vec4<f32> {
+    var input: FilmInput;
+    input.cos_theta_i = 0.5;
+    input.thickness_nm = 300.0;
+    input.film_ior = 1.33;
+    input.ambient_ior = 1.0;
+    input.base_ior = vec3<f32>(1.5);
+    let film = film_colour(input);
+    return vec4<f32>(film.reflectance + film.transmittance, 1.0);
+}
+"#;
+
+fn shaders_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shaders")
+}
+
+/// The composition of `technique` and `consumer`, with a map from its lines to the modules
+/// they came from ("lines 1–250 common.wgsl, …") for error reports.
+fn composition(technique: Technique, consumer: &[(&str, &str)]) -> (String, String) {
+    let source = compose(
+        technique,
+        &consumer.iter().map(|&(_, text)| text).collect::<Vec<_>>(),
+    );
+    let technique_file = format!("film_{}.wgsl", technique.name());
+    let parts = [
+        ("common.wgsl", COMMON),
+        ("lut_mapping.wgsl", LUT_MAPPING),
+        (technique_file.as_str(), technique.source()),
+    ];
+    let mut map = Vec::new();
+    let mut line = 1;
+    for (name, text) in parts.into_iter().chain(consumer.iter().copied()) {
+        // `compose` appends a newline to every part.
+        let lines = text.matches('\n').count() + 1;
+        map.push(format!("lines {line}–{} {name}", line + lines - 1));
+        line += lines;
+    }
+    (source, map.join(", "))
+}
+
+/// Parses and validates `source`, panicking with naga's annotated report (line and column in
+/// the composed source; `map` says which module a line belongs to) on failure.
+fn validate(name: &str, source: &str, map: &str) -> (naga::Module, ModuleInfo) {
+    let module = naga::front::wgsl::parse_str(source).unwrap_or_else(|e| {
+        panic!(
+            "{name}: WGSL parse error\n{}\ncomposed source: {map}",
+            e.emit_to_string(source)
+        )
+    });
+    let info = Validator::new(ValidationFlags::all(), Capabilities::default())
+        .validate(&module)
+        .unwrap_or_else(|e| {
+            panic!(
+                "{name}: validation error\n{}\ncomposed source: {map}",
+                e.emit_to_string(source)
+            )
+        });
+    (module, info)
+}
+
+/// Translates to SPIR-V, MSL, HLSL and GLSL (4.50 core and ES 3.10, per entry point).
+fn translate(name: &str, module: &naga::Module, info: &ModuleInfo) {
+    spv::write_vec(module, info, &spv::Options::default(), None)
+        .unwrap_or_else(|e| panic!("{name}: SPIR-V: {e}"));
+
+    let msl_options = msl::Options {
+        lang_version: (2, 0),
+        ..msl::Options::default()
+    };
+    msl::write_string(module, info, &msl_options, &msl::PipelineOptions::default())
+        .unwrap_or_else(|e| panic!("{name}: MSL: {e}"));
+
+    let mut hlsl_out = String::new();
+    let hlsl_options = hlsl::Options::default();
+    let hlsl_pipeline = hlsl::PipelineOptions::default();
+    hlsl::Writer::new(&mut hlsl_out, &hlsl_options, &hlsl_pipeline)
+        .write(module, info, None)
+        .unwrap_or_else(|e| panic!("{name}: HLSL: {e}"));
+
+    for version in [glsl::Version::Desktop(450), glsl::Version::new_gles(310)] {
+        for entry in &module.entry_points {
+            let options = glsl::Options {
+                version,
+                ..glsl::Options::default()
+            };
+            let pipeline = glsl::PipelineOptions {
+                shader_stage: entry.stage,
+                entry_point: entry.name.clone(),
+                multiview: None,
+            };
+            let mut out = String::new();
+            glsl::Writer::new(
+                &mut out,
+                module,
+                info,
+                &options,
+                &pipeline,
+                naga::proc::BoundsCheckPolicies::default(),
+            )
+            .and_then(|mut w| w.write())
+            .unwrap_or_else(|e| panic!("{name}: GLSL {version} `{}`: {e}", entry.name));
+        }
+    }
+}
+
+#[test]
+fn every_composition_validates_and_translates() {
+    for technique in Technique::ALL {
+        let mut consumer = vec![("test consumer", CONSUMER)];
+        if technique == Technique::Fourier {
+            consumer.push(("fourier test consumer", FOURIER_CONSUMER));
+        }
+        let (source, map) = composition(technique, &consumer);
+        let name = format!("film_{} + test consumer", technique.name());
+        let (module, info) = validate(&name, &source, &map);
+        assert!(
+            module
+                .functions
+                .iter()
+                .any(|(_, f)| f.name.as_deref() == Some("film_colour")),
+            "{name}: no `fn film_colour`"
+        );
+        translate(&name, &module, &info);
+    }
+}
+
+#[test]
+fn techniques_bind_only_group_1() {
+    for technique in Technique::ALL {
+        let (source, map) =
+            composition(technique, &[("bindingless consumer", BINDINGLESS_CONSUMER)]);
+        let name = format!("film_{}", technique.name());
+        let (module, info) = validate(&name, &source, &map);
+        let groups: Vec<(String, u32, u32)> = module
+            .global_variables
+            .iter()
+            .filter_map(|(_, g)| {
+                let b = g.binding.as_ref()?;
+                Some((g.name.clone().unwrap_or_default(), b.group, b.binding))
+            })
+            .collect();
+        assert!(!groups.is_empty(), "{name}: binds nothing");
+        for (var, group, binding) in &groups {
+            assert_eq!(
+                *group, 1,
+                "{name}: `{var}` is in group {group} (binding {binding}); techniques own group 1 only"
+            );
+        }
+        translate(&name, &module, &info);
+    }
+}
+
+/// A struct's name, size in bytes, and (member, offset) list.
+type StructLayout = (&'static str, u32, &'static [(&'static str, u32)]);
+
+/// The member offsets and sizes that the Rust `#[repr(C)]` mirrors in `nacre_runtime` must
+/// reproduce (see the layout comments in the `.wgsl` files).
+#[test]
+fn uniform_layouts_match_the_documented_ones() {
+    let expected: [StructLayout; 5] = [
+        (
+            "FilmInput",
+            64,
+            &[
+                ("cos_theta_i", 0),
+                ("thickness_nm", 4),
+                ("film_ior", 8),
+                ("sigma_thickness_nm", 12),
+                ("ambient_ior", 16),
+                ("_pad0", 20),
+                ("_pad1", 24),
+                ("_pad2", 28),
+                ("base_ior", 32),
+                ("_pad3", 44),
+                ("base_kappa", 48),
+                ("_pad4", 60),
+            ],
+        ),
+        (
+            "FilmLutParams",
+            48,
+            &[
+                ("cos_theta_count", 0),
+                ("opd_count", 4),
+                ("ior_count", 8),
+                ("thickness_min_nm", 12),
+                ("thickness_max_nm", 16),
+                ("ior_min", 20),
+                ("ior_max", 24),
+                ("ambient_index", 28),
+                ("has_transmittance", 32),
+                ("_pad0", 36),
+                ("_pad1", 40),
+                ("_pad2", 44),
+            ],
+        ),
+        (
+            "FourierParams",
+            48,
+            &[
+                ("max_opd_nm", 0),
+                ("level_count", 4),
+                ("sigma1_nm", 8),
+                ("harmonics", 12),
+                ("carrier_nu_per_nm", 16),
+                ("_pad0", 28),
+                ("white", 32),
+                ("_pad1", 44),
+            ],
+        ),
+        (
+            "SpectralSample",
+            32,
+            &[
+                ("wavelength_nm", 0),
+                ("base_ior", 4),
+                ("base_kappa", 8),
+                ("_pad", 12),
+                ("weight", 16),
+            ],
+        ),
+        (
+            "SpectralParams",
+            16,
+            &[("count", 0), ("_pad0", 4), ("_pad1", 8), ("_pad2", 12)],
+        ),
+    ];
+    let modules: Vec<naga::Module> = Technique::ALL
+        .iter()
+        .map(|&t| {
+            let (source, map) = composition(t, &[("bindingless consumer", BINDINGLESS_CONSUMER)]);
+            validate(t.name(), &source, &map).0
+        })
+        .collect();
+    for (struct_name, span, members) in expected {
+        let found = modules
+            .iter()
+            .flat_map(|m| m.types.iter())
+            .find(|(_, ty)| ty.name.as_deref() == Some(struct_name))
+            .unwrap_or_else(|| panic!("struct {struct_name} not declared"));
+        let naga::TypeInner::Struct {
+            members: ref actual,
+            span: actual_span,
+        } = found.1.inner
+        else {
+            panic!("{struct_name} is not a struct");
+        };
+        let actual: Vec<(&str, u32)> = actual
+            .iter()
+            .map(|m| (m.name.as_deref().unwrap_or(""), m.offset))
+            .collect();
+        assert_eq!(actual, members, "{struct_name}: member offsets");
+        assert_eq!(actual_span, span, "{struct_name}: size");
+    }
+}
+
+#[test]
+fn every_shader_file_opens_with_a_comment_header() {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(shaders_dir())
+        .expect("shaders/ exists")
+        .map(|e| e.expect("readable entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == "wgsl"))
+        .collect();
+    files.sort();
+    assert!(
+        files.len() >= 5,
+        "expected the shader modules, found {files:?}"
+    );
+    for path in files {
+        let text = std::fs::read_to_string(&path).expect("readable shader");
+        assert!(
+            text.starts_with("//"),
+            "{} does not begin with a `//` comment header",
+            path.display()
+        );
+    }
+}
