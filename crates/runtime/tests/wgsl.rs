@@ -346,3 +346,20 @@ fn every_shader_file_opens_with_a_comment_header() {
         );
     }
 }
+
+/// The consumers the runtime itself composes (probe, bench; the plain baseline).
+#[test]
+fn the_runtimes_own_pipelines_validate_and_translate() {
+    use nacre_runtime::shaders::{BENCH, PLAIN, PROBE, compose_source};
+    for technique in Technique::ALL {
+        for (consumer_name, consumer) in [("probe.wgsl", PROBE), ("bench.wgsl", BENCH)] {
+            let (source, map) = composition(technique, &[(consumer_name, consumer)]);
+            let name = format!("film_{} + {consumer_name}", technique.name());
+            let (module, info) = validate(&name, &source, &map);
+            translate(&name, &module, &info);
+        }
+    }
+    let source = compose_source(PLAIN, &[BENCH]);
+    let (module, info) = validate("plain + bench", &source, "common, lut_mapping, plain, bench");
+    translate("plain + bench", &module, &info);
+}
