@@ -40,7 +40,7 @@ pub enum Error {
     },
     /// A material name that is neither a number, a bundled material nor a data file.
     #[error(
-        "{context}: unknown material `{name}`: expected a number (`1.5`), a complex index (`0.27+2.9i`), a bundled material ({bundled}) or a path to a `.yml`/`.csv` file"
+        "{context}: unknown material `{name}`: expected a number (`1.5`), a complex index (`0.27+2.9i`), a bundled material ({bundled}), a path to a `.yml`/`.csv` file or a refractiveindex.info page SHELF/BOOK/PAGE (with --material-db)"
     )]
     UnknownMaterial {
         /// Flag or `file:line` the name came from.
@@ -49,6 +49,19 @@ pub enum Error {
         name: String,
         /// The bundled names, comma-separated.
         bundled: String,
+    },
+    /// A refractiveindex.info page (`shelf/book/page`) that the material database does not
+    /// have, or that was asked for with no database set.
+    #[error("{context}: {message}")]
+    MaterialDb {
+        /// Flag or `file:line` the spec came from.
+        context: String,
+        /// The spec given.
+        spec: String,
+        /// The paths looked at, in order.
+        tried: Vec<PathBuf>,
+        /// What was wrong, with the paths tried and how to set the database.
+        message: String,
     },
     /// Reading or writing a file failed.
     #[error("{}: {source}", path.display())]

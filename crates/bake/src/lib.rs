@@ -11,12 +11,14 @@
 pub mod bake;
 pub mod color;
 pub mod compare;
+pub mod conformance;
 pub mod error;
 pub mod film_lut;
 pub mod fourier_table;
 pub mod grid;
 pub mod materials;
 pub mod output;
+pub mod plot;
 pub mod spectrum;
 pub mod stack_spec;
 pub mod table_io;

@@ -7,14 +7,35 @@
 //! 2. a bundled material name, case-insensitive (see [`BUNDLED`]; a few common aliases
 //!    such as `gold` or `sio2` are accepted);
 //! 3. a path to a refractiveindex.info `.yml`/`.yaml` file or a `wavelength_nm,n,k` `.csv`
-//!    file (relative paths in a recipe are taken relative to the recipe's folder).
+//!    file (relative paths in a recipe are taken relative to the recipe's folder);
+//! 4. a refractiveindex.info page `shelf/book/page` (`main/Au/Johnson`), looked up in a
+//!    local copy of the database ([`MaterialDb`]; the `nacre` flag `--material-db DIR` or
+//!    the environment variable `NACRE_MATERIAL_DB` sets it with [`set_database`]).
+//!
+//! # The refractiveindex.info database layout
+//!
+//! The database repository (<https://github.com/polyanskiy/refractiveindex.info-database>)
+//! keeps its files under `database/`: the library catalog `catalog-nk.yml` (shelves, books,
+//! pages, each page with a `data:` path relative to the data folder) and the data files.
+//! Their layout changed over time, and [`MaterialDb`] accepts each:
+//!
+//! | versions | page `main/Au/Johnson` |
+//! |---|---|
+//! | older | `database/data-nk/main/Au/Johnson.yml` |
+//! | 2024 | `database/data/main/Au/Johnson.yml` |
+//! | 2025 on | `database/data/main/Au/nk/Johnson.yml` |
+//!
+//! The folder given may be the repository root or its `database/` folder. A page is looked
+//! for at those paths first, then through the catalog's `data:` entry (some page names
+//! differ from their file names, e.g. `Walling-α` → `Walling-alpha.yml`).
 //!
 //! The bundled data files live in `tables/materials/` with their sources and licences;
 //! they are embedded into the binary at build time so that `nacre` works from any folder.
 
 use crate::error::{Error, Result};
 use nacre_optics::Material;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::RwLock;
 
 /// A bundled material: its name, what it is, and its data file's text.
 pub struct Bundled {
@@ -106,9 +127,183 @@ fn parse_material_text(name: &str, source: &str, text: &str) -> nacre_optics::Re
     }
 }
 
-/// Resolves a material specification (see module docs). `context` names where it came
-/// from (a flag or `recipe.toml:12`) for messages; `base_dir` anchors relative paths.
+/// A local copy of the refractiveindex.info database (see the module docs for the layouts
+/// it accepts).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct MaterialDb {
+    /// The folder given: the repository root or its `database/` folder.
+    pub dir: PathBuf,
+    /// Where the setting came from, for messages: `--material-db` or `NACRE_MATERIAL_DB`.
+    pub origin: String,
+}
+
+/// The process-wide database used by [`resolve`]; None until [`set_database`].
+static DATABASE: RwLock<Option<MaterialDb>> = RwLock::new(None);
+
+/// Sets (or, with None, clears) the database that [`resolve`] looks `shelf/book/page`
+/// specifications up in. The `nacre` binary calls it once, before any work.
+pub fn set_database(db: Option<MaterialDb>) {
+    *DATABASE.write().unwrap_or_else(|e| e.into_inner()) = db;
+}
+
+/// The database set by [`set_database`], if any.
+pub fn database() -> Option<MaterialDb> {
+    DATABASE.read().unwrap_or_else(|e| e.into_inner()).clone()
+}
+
+/// `shelf/book/page` when `spec` has that form: three non-empty `/`-separated parts, none
+/// `.` or `..`.
+pub fn database_page(spec: &str) -> Option<(&str, &str, &str)> {
+    let mut parts = spec.split('/');
+    let (shelf, book, page) = (parts.next()?, parts.next()?, parts.next()?);
+    let ok = |p: &str| !p.is_empty() && p != "." && p != ".." && !p.contains('\\');
+    (parts.next().is_none() && ok(shelf) && ok(book) && ok(page)).then_some((shelf, book, page))
+}
+
+impl MaterialDb {
+    /// A database at `dir`, set by `origin` (a flag or variable name, for messages).
+    pub fn new(dir: impl Into<PathBuf>, origin: impl Into<String>) -> Self {
+        MaterialDb {
+            dir: dir.into(),
+            origin: origin.into(),
+        }
+    }
+
+    /// The folder that holds `catalog-nk.yml` and the data folders: `DIR/database` when
+    /// there is one (DIR is the repository), else DIR.
+    fn root(&self) -> PathBuf {
+        let inner = self.dir.join("database");
+        if inner.is_dir() {
+            inner
+        } else {
+            self.dir.clone()
+        }
+    }
+
+    /// The data file of page `shelf/book/page`, and every path tried (in order) when
+    /// there is none.
+    pub fn locate(&self, shelf: &str, book: &str, page: &str) -> (Option<PathBuf>, Vec<PathBuf>) {
+        let root = self.root();
+        let file = format!("{page}.yml");
+        let book_dir = |data: &str| root.join(data).join(shelf).join(book);
+        let mut tried = Vec::new();
+        for path in [
+            book_dir("data").join("nk").join(&file),
+            book_dir("data").join(&file),
+            book_dir("data-nk").join(&file),
+        ] {
+            if path.is_file() {
+                return (Some(path), tried);
+            }
+            tried.push(path);
+        }
+        let catalog = root.join("catalog-nk.yml");
+        if let Ok(text) = std::fs::read_to_string(&catalog) {
+            tried.push(catalog);
+            if let Some(rel) = catalog_lookup(&text, shelf, book, page) {
+                for data in ["data", "data-nk"] {
+                    let path = root.join(data).join(&rel);
+                    if path.is_file() {
+                        return (Some(path), tried);
+                    }
+                    tried.push(path);
+                }
+            }
+        }
+        (None, tried)
+    }
+
+    /// Loads page `spec` = `shelf/book/page`; `context` names where the spec came from.
+    pub fn load(&self, spec: &str, context: &str) -> Result<Material> {
+        let Some((shelf, book, page)) = database_page(spec) else {
+            return Err(Error::MaterialDb {
+                context: context.to_string(),
+                spec: spec.to_string(),
+                tried: vec![],
+                message:
+                    "expected a refractiveindex.info page SHELF/BOOK/PAGE, e.g. main/Au/Johnson"
+                        .into(),
+            });
+        };
+        let (found, tried) = self.locate(shelf, book, page);
+        let Some(path) = found else {
+            let dir = self.dir.display();
+            let origin = &self.origin;
+            let message = if !self.dir.is_dir() {
+                format!("the material database folder {dir} ({origin}) does not exist")
+            } else {
+                format!(
+                    "refractiveindex.info page `{spec}` not found in the material database {dir} ({origin}, the database repository or its database/ folder); tried {}",
+                    tried
+                        .iter()
+                        .map(|p| p.display().to_string())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )
+            };
+            return Err(Error::MaterialDb {
+                context: context.to_string(),
+                spec: spec.to_string(),
+                tried,
+                message,
+            });
+        };
+        let text = std::fs::read_to_string(&path).map_err(|source| Error::Io {
+            path: path.clone(),
+            source,
+        })?;
+        let shown = path.display().to_string();
+        Ok(Material::from_refractiveindex_yaml(spec, &shown, &text)?)
+    }
+}
+
+/// The `data:` path of `shelf/book/page` in a `catalog-nk.yml` text. The catalog is a YAML
+/// list of `- SHELF:`, `- BOOK:`, `- PAGE:` entries, each page with a `data:` line; a line
+/// scan suffices for the file the database generates.
+fn catalog_lookup(text: &str, shelf: &str, book: &str, page: &str) -> Option<String> {
+    fn value<'a>(line: &'a str, key: &str) -> Option<&'a str> {
+        let v = line.strip_prefix(key)?.strip_prefix(':')?.trim();
+        let v = v
+            .strip_prefix('"')
+            .and_then(|v| v.strip_suffix('"'))
+            .or_else(|| v.strip_prefix('\'').and_then(|v| v.strip_suffix('\'')))
+            .unwrap_or(v);
+        Some(v)
+    }
+    let (mut s, mut b, mut p) = ("", "", "");
+    for line in text.lines() {
+        let t = line.trim();
+        let t = t.strip_prefix("- ").unwrap_or(t).trim_start();
+        if let Some(v) = value(t, "SHELF") {
+            (s, b, p) = (v, "", "");
+        } else if let Some(v) = value(t, "BOOK") {
+            (b, p) = (v, "");
+        } else if let Some(v) = value(t, "PAGE") {
+            p = v;
+        } else if let Some(v) = value(t, "data")
+            && (s, b, p) == (shelf, book, page)
+        {
+            return Some(v.to_string());
+        }
+    }
+    None
+}
+
+/// Resolves a material specification (see module docs) with the database set by
+/// [`set_database`]. `context` names where it came from (a flag or `recipe.toml:12`) for
+/// messages; `base_dir` anchors relative paths.
 pub fn resolve(spec: &str, context: &str, base_dir: Option<&Path>) -> Result<Material> {
+    resolve_with(spec, context, base_dir, database().as_ref())
+}
+
+/// [`resolve`] with an explicit database (None: `shelf/book/page` specifications are an
+/// error that says how to set one).
+pub fn resolve_with(
+    spec: &str,
+    context: &str,
+    base_dir: Option<&Path>,
+    db: Option<&MaterialDb>,
+) -> Result<Material> {
     let spec = spec.trim();
     let looks_numeric = spec
         .chars()
@@ -138,6 +333,19 @@ pub fn resolve(spec: &str, context: &str, base_dir: Option<&Path>) -> Result<Mat
         })?;
         let shown = path.display().to_string();
         return Ok(parse_material_text(spec, &shown, &text)?);
+    }
+    if database_page(spec).is_some() {
+        return match db {
+            Some(db) => db.load(spec, context),
+            None => Err(Error::MaterialDb {
+                context: context.to_string(),
+                spec: spec.to_string(),
+                tried: vec![],
+                message: format!(
+                    "`{spec}` looks like a refractiveindex.info page (SHELF/BOOK/PAGE) but no material database is set: pass --material-db DIR or set NACRE_MATERIAL_DB to a local copy of https://github.com/polyanskiy/refractiveindex.info-database"
+                ),
+            }),
+        };
     }
     Err(Error::UnknownMaterial {
         context: context.to_string(),
@@ -181,5 +389,110 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.starts_with("missing.yml: "), "{e}");
+    }
+
+    /// A refractiveindex.info page with constant n and κ over 0.3–1.0 µm.
+    fn page(n: f64, k: f64) -> String {
+        format!(
+            "DATA:\n  - type: tabulated nk\n    data: |\n        0.3 {n} {k}\n        1.0 {n} {k}\n"
+        )
+    }
+
+    fn write(path: &Path, text: &str) {
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(path, text).unwrap();
+    }
+
+    #[test]
+    fn database_pages_in_every_layout() {
+        let dir = tempfile::tempdir().unwrap();
+        let db = dir.path().join("database");
+        // 2025 on: data/SHELF/BOOK/nk/PAGE.yml; 2024: data/SHELF/BOOK/PAGE.yml; older:
+        // data-nk/SHELF/BOOK/PAGE.yml; a page whose file name differs, via the catalog.
+        write(&db.join("data/main/Au/nk/Johnson.yml"), &page(0.5, 2.0));
+        write(&db.join("data/main/Ag/Johnson.yml"), &page(0.1, 3.0));
+        write(&db.join("data-nk/main/Cu/Johnson.yml"), &page(0.9, 2.5));
+        write(
+            &db.join("data-nk/main/BeAl2O4/Walling-alpha.yml"),
+            &page(1.7, 0.0),
+        );
+        write(
+            &db.join("catalog-nk.yml"),
+            "- DIVIDER: \"Research data\"\n- SHELF: main\n  name: \"MAIN\"\n  content:\n    - BOOK: BeAl2O4\n      content:\n        - PAGE: Walling-α\n          name: \"Walling et al. 1980\"\n          data: \"main/BeAl2O4/Walling-alpha.yml\"\n",
+        );
+        // The repository root and its database/ folder both work.
+        for root in [dir.path().to_path_buf(), db.clone()] {
+            let db = MaterialDb::new(&root, "--material-db");
+            for (spec, n, k) in [
+                ("main/Au/Johnson", 0.5, 2.0),
+                ("main/Ag/Johnson", 0.1, 3.0),
+                ("main/Cu/Johnson", 0.9, 2.5),
+                ("main/BeAl2O4/Walling-α", 1.7, 0.0),
+            ] {
+                let m = resolve_with(spec, "--substrate", None, Some(&db))
+                    .unwrap_or_else(|e| panic!("{spec}: {e}"));
+                assert_eq!(m.name(), spec);
+                let i = m.index_at(550.0).unwrap();
+                assert!(
+                    (i.re - n).abs() < 1e-12 && (i.im - k).abs() < 1e-12,
+                    "{spec}: {i}"
+                );
+            }
+            // Bundled names, numbers and paths come first.
+            let au = resolve_with("au", "--substrate", None, Some(&db)).unwrap();
+            assert_eq!(au.name(), "au");
+            assert!((au.index_at(550.0).unwrap().re - 0.5).abs() > 1e-3);
+        }
+    }
+
+    #[test]
+    fn database_errors_name_the_spec_the_paths_and_the_flag() {
+        let dir = tempfile::tempdir().unwrap();
+        write(
+            &dir.path().join("database/data/main/Au/nk/Johnson.yml"),
+            &page(0.5, 2.0),
+        );
+        let db = MaterialDb::new(dir.path(), "--material-db");
+        let e = resolve_with("main/Au/Nobody", "--layer", None, Some(&db)).unwrap_err();
+        let Error::MaterialDb { spec, tried, .. } = &e else {
+            panic!("{e:?}");
+        };
+        assert_eq!(spec, "main/Au/Nobody");
+        assert!(tried.contains(&dir.path().join("database/data/main/Au/nk/Nobody.yml")));
+        assert!(tried.contains(&dir.path().join("database/data-nk/main/Au/Nobody.yml")));
+        let e = e.to_string();
+        assert!(
+            e.starts_with("--layer: refractiveindex.info page `main/Au/Nobody` not found"),
+            "{e}"
+        );
+        assert!(
+            e.contains("--material-db") && e.contains("Nobody.yml"),
+            "{e}"
+        );
+        // No database set: say how to set one.
+        let e = resolve_with("main/Au/Johnson", "--layer", None, None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("--material-db DIR") && e.contains("NACRE_MATERIAL_DB"),
+            "{e}"
+        );
+        // A database folder that does not exist.
+        let gone = MaterialDb::new(dir.path().join("nope"), "NACRE_MATERIAL_DB");
+        let e = resolve_with("main/Au/Johnson", "--layer", None, Some(&gone))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("does not exist") && e.contains("NACRE_MATERIAL_DB"),
+            "{e}"
+        );
+        // Not a page: two parts, or `..`.
+        assert!(database_page("main/Au").is_none());
+        assert!(database_page("main/../x").is_none());
+        assert!(database_page("a/b/c/d").is_none());
+        assert_eq!(
+            database_page("main/Au/Johnson"),
+            Some(("main", "Au", "Johnson"))
+        );
     }
 }

@@ -1,4 +1,4 @@
-//! `nacre`: bake thin-film interference tables and spectra.
+//! `nacre`: bake thin-film interference tables and spectra, and render them on the GPU.
 
 // `!(x > 0.0)` is how this crate rejects NaN together with out-of-range values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -12,6 +12,8 @@ use nacre_bake::{bake, materials, spectrum};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+mod plot;
+
 #[derive(Parser)]
 #[command(
     name = "nacre",
@@ -21,6 +23,11 @@ use std::process::ExitCode;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// A local copy of the refractiveindex.info database (the repository or its database/
+    /// folder): material specs SHELF/BOOK/PAGE, e.g. main/Au/Johnson, are read from it
+    /// [default: the NACRE_MATERIAL_DB environment variable].
+    #[arg(long, global = true, value_name = "DIR")]
+    material_db: Option<PathBuf>,
 }
 
 #[derive(Subcommand)]
@@ -37,6 +44,13 @@ enum Command {
     /// Compare the real-time methods with the exact colour over angle × thickness (CSV + PNG).
     #[command(after_help = COMPARE_EXAMPLES)]
     Compare(CompareArgs),
+    /// Pictures (PNG or SVG): spectra, the chromaticity diagram with film trajectories,
+    /// swatch charts of film colours, slices of baked tables.
+    Plot(plot::PlotArgs),
+    /// Reference data for glTF KHR_materials_iridescence renderers: exact colours over the
+    /// extension's parameter space (CSV), the glTF approximation's error, swatch charts.
+    #[command(after_help = CONFORMANCE_EXAMPLES)]
+    Conformance(ConformanceArgs),
     /// Print a baked table's manifest as JSON.
     Info {
         /// A default-set table name (e.g. film-dielectric) or a manifest path.
@@ -45,6 +59,10 @@ enum Command {
     },
     /// List the bundled materials.
     Materials,
+    /// Render a film-coated sphere, a soap bubble or an oil film on a plane to a PNG (GPU;
+    /// any Vulkan/Metal/DX12/GL adapter, including Mesa's software lavapipe).
+    #[command(after_help = RENDER_EXAMPLES)]
+    Render(RenderArgs),
 }
 
 const BAKE_EXAMPLES: &str = "\
@@ -143,6 +161,66 @@ struct CompareArgs {
     output: PathBuf,
 }
 
+const RENDER_EXAMPLES: &str = "\
+Scenes: sphere (a film of index 1.9 on a black glazed dielectric; on gold with --tables
+film-gold), bubble (a draining soap film in air, reflection and transmission), plane (an oil
+film on water to the horizon, the thickness map minified towards it). Techniques: lut
+(trilinear lookup in the film-lut table), fourier (Belcour & Barla 2017 Eq. 10 with the
+fourier table, prefiltered by the thickness's pixel footprint), spectral (N wavelengths, brute
+force). The base, ambient and film index range come from the film-lut table. The environment
+is an equirectangular OpenEXR (default tables/env/studio.exr); the thickness map an 8/16-bit
+greyscale PNG (default: built-in swirls). Output: 8-bit sRGB PNG (Khronos PBR Neutral tone
+mapping).
+
+Examples:
+  # the film-coated sphere with the default tables
+  nacre render -o sphere.png
+  # a soap bubble, brute-force spectral with 40 wavelengths
+  nacre render --scene bubble --technique spectral --wavelengths 40 -o bubble.png
+  # the oil slick, Fourier with automatic harmonics, half a stop darker
+  nacre render --scene plane --technique fourier --harmonics 0 --exposure -0.5 -o plane.png
+  # a film on gold, your own environment and thickness map
+  nacre render --tables film-gold --tables fourier-srgb --env sky.exr --thickness-map swirl.png -o gold.png";
+
+#[derive(Args)]
+struct RenderArgs {
+    /// Scene: sphere, bubble or plane.
+    #[arg(long, default_value = "sphere", value_parser = ["sphere", "bubble", "plane"])]
+    scene: String,
+    /// A table to load (repeatable): default-set name or manifest path [default: the scene's
+    /// film-lut (sphere film-dielectric, bubble soap-film, plane oil-slick) + fourier-srgb].
+    #[arg(long = "tables", value_name = "NAME|PATH")]
+    tables: Vec<String>,
+    /// Technique: lut, fourier or spectral.
+    #[arg(long, default_value = "lut", value_parser = ["lut", "fourier", "spectral"])]
+    technique: String,
+    /// Image width, pixels (1 to 8192).
+    #[arg(long, default_value_t = 800)]
+    width: u32,
+    /// Image height, pixels (1 to 8192).
+    #[arg(long, default_value_t = 600)]
+    height: u32,
+    /// Equirectangular HDR environment (OpenEXR, RGB, row 0 = zenith) [default:
+    /// tables/env/studio.exr].
+    #[arg(long, value_name = "FILE.exr")]
+    env: Option<PathBuf>,
+    /// Greyscale thickness map (8- or 16-bit PNG) [default: built-in swirls].
+    #[arg(long, value_name = "FILE.png")]
+    thickness_map: Option<PathBuf>,
+    /// Exposure in EV stops (radiance × 2^EV before tone mapping).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    exposure: f32,
+    /// Harmonics M of the fourier technique (0 = automatic) [default: 3].
+    #[arg(long, value_name = "M")]
+    harmonics: Option<u32>,
+    /// Wavelengths N of the spectral technique (1 to 4096) [default: 30].
+    #[arg(long, value_name = "N")]
+    wavelengths: Option<usize>,
+    /// Output PNG file.
+    #[arg(short = 'o', long = "output", value_name = "FILE.png")]
+    output: PathBuf,
+}
+
 #[derive(Args)]
 struct BakeArgs {
     /// Recipe files (TOML) [default: every tables/recipes/*.toml].
@@ -155,8 +233,9 @@ struct BakeArgs {
 
 const SPECTRUM_EXAMPLES: &str = "\
 Materials (M): a real index `1.33`, a complex index `0.27+2.9i`, a bundled name
-(`nacre materials` lists them), or a path to a refractiveindex.info .yml or a
-wavelength_nm,n,k .csv file. Thickness: nanometres, `635` or `635nm` (or `1.2um`).
+(`nacre materials` lists them), a path to a refractiveindex.info .yml or a
+wavelength_nm,n,k .csv file, or a refractiveindex.info page SHELF/BOOK/PAGE
+(`main/Au/Johnson`) with --material-db DIR. Thickness: nanometres, `635` or `635nm` (or `1.2um`).
 
 Examples:
   # the default: a 400 nm soap film in air, 0:89:1 degrees × 380:780:5 nm, to stdout
@@ -533,12 +612,163 @@ fn run_bake(args: &BakeArgs) -> Result<()> {
     Ok(())
 }
 
+/// A runtime error as the CLI's error type (the message unchanged).
+fn runtime_error(e: nacre_runtime::Error) -> nacre_bake::error::Error {
+    use nacre_bake::error::Error;
+    match e {
+        nacre_runtime::Error::Table(e) => e,
+        nacre_runtime::Error::Io { path, source } => Error::Io { path, source },
+        other => Error::Invalid {
+            context: "render".into(),
+            message: other.to_string(),
+        },
+    }
+}
+
+fn run_render(args: &RenderArgs) -> Result<()> {
+    use nacre_runtime::render::{SceneKind, SceneOptions, render_scene};
+    use nacre_runtime::{GpuContext, TableSet, Technique};
+    let scene: SceneKind = args.scene.parse().map_err(runtime_error)?;
+    let technique = match args.technique.as_str() {
+        "fourier" => Technique::Fourier,
+        "spectral" => Technique::Spectral,
+        _ => Technique::Lut,
+    };
+    let names: Vec<String> = if args.tables.is_empty() {
+        let lut = match scene {
+            SceneKind::Sphere => "film-dielectric",
+            SceneKind::Bubble => "soap-film",
+            SceneKind::Plane => "oil-slick",
+        };
+        vec![lut.into(), "fourier-srgb".into()]
+    } else {
+        args.tables.clone()
+    };
+    let mut options = SceneOptions::new(scene);
+    options.width = args.width;
+    options.height = args.height;
+    options.environment = args.env.clone();
+    options.thickness_map = args.thickness_map.clone();
+    options.exposure_ev = args.exposure;
+    if let Some(m) = args.harmonics {
+        options.harmonics = m;
+    }
+    if let Some(n) = args.wavelengths {
+        options.spectral_samples = n;
+    }
+    // Check the settings and read every input before starting the GPU: bad input fails fast.
+    options.validate().map_err(runtime_error)?;
+    for name in &names {
+        bake::Manifest::read(&bake::resolve_table(name))?;
+    }
+    if let Some(path) = &options.environment {
+        nacre_runtime::render::EnvironmentMap::load(path).map_err(runtime_error)?;
+    }
+    if let Some(path) = &options.thickness_map {
+        nacre_runtime::render::ThicknessMap::load_png(path).map_err(runtime_error)?;
+    }
+    let ctx = GpuContext::new_headless().map_err(runtime_error)?;
+    eprintln!("adapter: {}", ctx.describe());
+    let mut tables = TableSet::default();
+    for name in &names {
+        tables
+            .add(&ctx, &bake::resolve_table(name))
+            .map_err(runtime_error)?;
+    }
+    options.fit_to_tables(&tables).map_err(runtime_error)?;
+    let start = std::time::Instant::now();
+    let image = render_scene(&ctx, &tables, technique, &options).map_err(runtime_error)?;
+    let total = start.elapsed().as_secs_f64();
+    let png = image.encode_png().map_err(runtime_error)?;
+    write_atomic(&args.output, |w| w.write_all(&png))?;
+    eprintln!(
+        "rendered {} ({}) at {}x{} in {:.2} s (render pass {:.2} s) -> {}",
+        scene.name(),
+        technique.name(),
+        image.width,
+        image.height,
+        total,
+        image.gpu_seconds,
+        args.output.display()
+    );
+    Ok(())
+}
+
+const CONFORMANCE_EXAMPLES: &str = "\
+Writes DIR/conformance.csv (base_ior,angle_deg,thickness_nm,film_ior,X,Y,Z,R,G,B: exact
+unpolarised reflectance colour of air | film | base, CIE 1931 2 deg, D65, Y = 1 for a perfect
+reflector, linear sRGB), DIR/gltf-reference-error.csv (the glTF reference approximation and
+its CIEDE2000), DIR/swatches-<base>.png and DIR/README.md (conventions, glTF mapping, how to
+compare a renderer). Bases (base_ior) 1, 1.25, 1.5, 1.75, 2, 2.5, au, ag, cu, al; film index
+1.0-2.333; thickness 0-1200 nm; angles 0-89 deg. Every file is written to a temporary file
+first and renamed only when all are complete.
+
+Examples:
+  # the default grid (48 510 rows, 5 MB of CSV; the copy in docs/conformance/)
+  nacre conformance -o docs/conformance
+  # a denser grid (202 730 rows, about 21 MB)
+  nacre conformance --fine -o conformance-fine
+  # a coarse grid for quick checks (2 080 rows)
+  nacre conformance --quick -o /tmp/conformance";
+
+#[derive(Args)]
+struct ConformanceArgs {
+    /// A coarse grid for tests: angles 0, 30, 60, 85; thickness step 100 nm; film index 1.0,
+    /// 1.3, 1.5, 2.333.
+    #[arg(long, conflicts_with = "fine")]
+    quick: bool,
+    /// A denser grid: angles 0-85 step 5 and 89; thickness step 12.5 nm; film index 1.0-1.8
+    /// step 0.1, 2.0, 2.333.
+    #[arg(long)]
+    fine: bool,
+    /// Output folder (created if needed; files of the same names are replaced).
+    #[arg(short = 'o', long = "output", value_name = "DIR")]
+    output: PathBuf,
+}
+
+fn run_conformance(args: &ConformanceArgs) -> Result<()> {
+    use nacre_bake::conformance::{self, GridSize};
+    let size = if args.quick {
+        GridSize::Quick
+    } else if args.fine {
+        GridSize::Fine
+    } else {
+        GridSize::Default
+    };
+    let start = std::time::Instant::now();
+    let set = conformance::write(&args.output, size)?;
+    eprintln!(
+        "wrote conformance.csv ({} rows), gltf-reference-error.csv, {} swatch charts and README.md in {:.1} s -> {}",
+        set.bases.len() * set.grid.points_per_base(),
+        set.bases.len(),
+        start.elapsed().as_secs_f64(),
+        args.output.display()
+    );
+    Ok(())
+}
+
+/// Sets the material database from --material-db, else from NACRE_MATERIAL_DB.
+fn set_material_db(flag: Option<&std::path::Path>) {
+    use nacre_bake::materials::{MaterialDb, set_database};
+    let db = match flag {
+        Some(dir) => Some(MaterialDb::new(dir, "--material-db")),
+        None => std::env::var_os("NACRE_MATERIAL_DB")
+            .filter(|v| !v.is_empty())
+            .map(|dir| MaterialDb::new(PathBuf::from(dir), "NACRE_MATERIAL_DB")),
+    };
+    set_database(db);
+}
+
 fn run(cli: Cli) -> Result<()> {
+    set_material_db(cli.material_db.as_deref());
     match cli.command {
         Command::Spectrum(args) => run_spectrum(&args),
         Command::Bake(args) => run_bake(&args),
         Command::Color(args) => run_color(&args),
         Command::Compare(args) => run_compare(&args),
+        Command::Plot(args) => plot::run(&args),
+        Command::Conformance(args) => run_conformance(&args),
+        Command::Render(args) => run_render(&args),
         Command::Info { table } => {
             let path = bake::resolve_table(&table);
             let manifest = bake::Manifest::read(&path)?;

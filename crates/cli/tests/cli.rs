@@ -405,3 +405,158 @@ fn compare_writes_csv_and_png() {
     assert!(stderr(&o).contains("--case `nope`"));
     assert!(!dir.path().join("out2").exists());
 }
+
+/// Width and height from a PNG's IHDR chunk.
+fn png_size(bytes: &[u8]) -> (u32, u32) {
+    assert!(bytes.starts_with(b"\x89PNG\r\n\x1a\n"), "not a PNG");
+    let be =
+        |at: usize| u32::from_be_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]);
+    (be(16), be(20))
+}
+
+#[test]
+fn render_writes_a_png() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // With only -o: the sphere with the default tables (small here to keep the test quick).
+    let o = nacre(
+        &[
+            "render",
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "-o",
+            "sphere.png",
+        ],
+        d,
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("adapter: "), "{}", stderr(&o));
+    let png = std::fs::read(d.join("sphere.png")).unwrap();
+    assert_eq!(png_size(&png), (64, 48));
+    for (scene, technique, extra) in [
+        ("bubble", "spectral", &["--wavelengths", "12"][..]),
+        (
+            "plane",
+            "fourier",
+            &["--harmonics", "0", "--exposure", "-0.5"][..],
+        ),
+    ] {
+        let out = format!("{scene}.png");
+        let mut args = vec![
+            "render",
+            "--scene",
+            scene,
+            "--technique",
+            technique,
+            "--width",
+            "40",
+            "--height",
+            "30",
+            "-o",
+            &out,
+        ];
+        args.extend_from_slice(extra);
+        let o = nacre(&args, d);
+        assert!(o.status.success(), "{scene}: {}", stderr(&o));
+        assert_eq!(png_size(&std::fs::read(d.join(&out)).unwrap()), (40, 30));
+    }
+    // Explicit tables: a film on gold.
+    let o = nacre(
+        &[
+            "render",
+            "--tables",
+            "film-gold",
+            "--tables",
+            "fourier-srgb",
+            "--technique",
+            "lut",
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "-o",
+            "gold.png",
+        ],
+        d,
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let help = nacre(&["render", "--help"], d);
+    assert!(help.status.success());
+    assert!(String::from_utf8_lossy(&help.stdout).contains("Examples:"));
+    let leftovers: Vec<_> = std::fs::read_dir(d)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().starts_with(".nacre-"))
+        .collect();
+    assert!(leftovers.is_empty(), "temporary files left behind");
+}
+
+#[test]
+fn render_bad_input_exits_2_without_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("junk.exr"), b"not an OpenEXR file").unwrap();
+    std::fs::write(d.join("junk.png"), b"not a PNG file").unwrap();
+    // A valid 2x2 8-bit RGB PNG: colour, not a greyscale thickness map.
+    const RGB_PNG: [u8; 73] = [
+        137, 80, 78, 71, 13, 10, 26, 10, 0, 0, 0, 13, 73, 72, 68, 82, 0, 0, 0, 2, 0, 0, 0, 2, 8, 2,
+        0, 0, 0, 253, 212, 154, 115, 0, 0, 0, 16, 73, 68, 65, 84, 120, 156, 99, 104, 112, 80, 0,
+        34, 6, 8, 5, 0, 26, 14, 3, 129, 156, 14, 57, 199, 0, 0, 0, 0, 73, 69, 78, 68, 174, 66, 96,
+        130,
+    ];
+    std::fs::write(d.join("rgb.png"), RGB_PNG).unwrap();
+    let small = ["--width", "16", "--height", "12"];
+    let cases: &[(&[&str], &str)] = &[
+        (&["--scene", "cube"], "--scene"),
+        (&["--technique", "raytrace"], "--technique"),
+        (&["--width", "0"], "width"),
+        (&["--height", "9000"], "8192"),
+        (&["--width", "-3"], "-3"),
+        (&["--env", "missing.exr"], "missing.exr"),
+        (&["--env", "junk.exr"], "junk.exr"),
+        (&["--thickness-map", "missing.png"], "missing.png"),
+        (&["--thickness-map", "junk.png"], "junk.png"),
+        (&["--thickness-map", "rgb.png"], "greyscale"),
+        (&["--tables", "no-such-table"], "no-such-table"),
+        (
+            &["--technique", "fourier", "--tables", "film-dielectric"],
+            "fourier",
+        ),
+        (
+            &["--technique", "spectral", "--wavelengths", "0"],
+            "wavelengths",
+        ),
+        (&["--exposure", "nan"], "exposure"),
+        (
+            &["--scene", "bubble", "--tables", "film-gold"],
+            "transmittance",
+        ),
+    ];
+    for (extra, expect) in cases {
+        let mut args = vec!["render"];
+        if !extra.iter().any(|a| *a == "--width" || *a == "--height") {
+            args.extend_from_slice(&small);
+        }
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&["-o", "out.png"]);
+        let o = nacre(&args, d);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}: {err}");
+        assert!(
+            err.contains(expect),
+            "{extra:?}: expected `{expect}` in: {err}"
+        );
+        assert!(!err.contains("panicked"), "{extra:?}: {err}");
+        assert!(!d.join("out.png").exists(), "{extra:?} wrote an output");
+    }
+    // -o is required.
+    let o = nacre(&["render"], d);
+    assert_eq!(o.status.code(), Some(2));
+    // An existing output survives a failed render.
+    std::fs::write(d.join("keep.png"), b"keep").unwrap();
+    let o = nacre(&["render", "--env", "junk.exr", "-o", "keep.png"], d);
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(std::fs::read(d.join("keep.png")).unwrap(), b"keep");
+}

@@ -12,6 +12,7 @@ pub mod error;
 pub mod params;
 pub mod probe;
 pub mod readback;
+pub mod render;
 pub mod shaders;
 pub mod tables;
 
@@ -19,5 +20,6 @@ pub use bindings::{TechniqueBinding, TechniqueOptions};
 pub use context::GpuContext;
 pub use error::{Error, Result};
 pub use params::{FilmInput, FilmOutput};
+pub use render::{RenderedImage, Renderer, SceneKind, SceneOptions, render_scene};
 pub use shaders::Technique;
 pub use tables::TableSet;

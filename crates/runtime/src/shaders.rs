@@ -22,6 +22,11 @@ pub const PLAIN: &str = include_str!("../../../shaders/plain.wgsl");
 pub const BENCH: &str = include_str!("../../../shaders/bench.wgsl");
 /// Consumer: the GPU = CPU probe pass.
 pub const PROBE: &str = include_str!("../../../shaders/probe.wgsl");
+/// Consumer: the thin-film microfacet material (GGX + film, environment, light, tone
+/// mapping; groups 0 and 2). Compose it before [`SCENE`].
+pub const MATERIAL: &str = include_str!("../../../shaders/material.wgsl");
+/// Consumer: the ray-cast analytic scenes of `nacre render` (sphere, bubble, plane).
+pub const SCENE: &str = include_str!("../../../shaders/scene.wgsl");
 
 /// How the film colour is computed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

@@ -360,6 +360,10 @@ fn the_runtimes_own_pipelines_validate_and_translate() {
         }
     }
     let source = compose_source(PLAIN, &[BENCH]);
-    let (module, info) = validate("plain + bench", &source, "common, lut_mapping, plain, bench");
+    let (module, info) = validate(
+        "plain + bench",
+        &source,
+        "common, lut_mapping, plain, bench",
+    );
     translate("plain + bench", &module, &info);
 }

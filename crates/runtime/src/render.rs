@@ -1,0 +1,1750 @@
+//! The headless scene renderer behind `nacre render`: analytic scenes (a film-coated sphere,
+//! a soap bubble, an oil film on a plane) ray-cast in a fragment shader, shaded by the
+//! thin-film microfacet material of `shaders/material.wgsl` with any technique, lit by a
+//! directional light and an equirectangular HDR environment, tone-mapped and read back as
+//! sRGB-encoded RGBA8 pixels.
+//!
+//! Bind groups (`shaders/README.md`): 0 = the view ([`ViewUniform`], the environment and its
+//! sampler), 1 = the technique's tables ([`TechniqueBinding`]), 2 = the material
+//! ([`MaterialUniform`], the thickness map and its sampler). The pipeline's source is
+//! `shaders::compose(technique, &[MATERIAL, SCENE])`.
+//!
+//! CPU-side inputs:
+//!
+//! * the environment ([`EnvironmentMap`]): an OpenEXR equirectangular image (row 0 = the
+//!   zenith, u = 0.5 looks down −z), or the default `tables/env/studio.exr`, which is
+//!   [`procedural_environment`]`(256, 128)` written once in half floats (project-made, CC0;
+//!   `tables/env/README.md`). Uploaded as `Rgba16Float` with a full mip chain of 2×2 box
+//!   filters built here;
+//! * the thickness map ([`ThicknessMap`]): an 8- or 16-bit greyscale PNG, or
+//!   [`procedural_thickness_map`]. Uploaded as `Rg16Float` holding (g, g²) with a full mip
+//!   chain, so that the shader can recover the thickness variance that filtering removed.
+//!
+//! ```no_run
+//! use nacre_runtime::render::{SceneKind, SceneOptions, render_scene};
+//! use nacre_runtime::{GpuContext, TableSet, Technique};
+//! # fn main() -> nacre_runtime::Result<()> {
+//! let ctx = GpuContext::new_headless()?;
+//! let mut tables = TableSet::load(&ctx, "tables/baked/film-dielectric.json".as_ref())?;
+//! tables.add(&ctx, "tables/baked/fourier-srgb.json".as_ref())?;
+//! let mut options = SceneOptions::new(SceneKind::Sphere);
+//! options.fit_to_tables(&tables)?;
+//! let image = render_scene(&ctx, &tables, Technique::Fourier, &options)?;
+//! image.write_png("sphere.png".as_ref())?;
+//! # Ok(()) }
+//! ```
+
+use crate::bindings::{SpectralSetup, TechniqueBinding, TechniqueOptions};
+use crate::context::GpuContext;
+use crate::error::{Error, Result};
+use crate::readback::read_texture;
+use crate::shaders::{self, MATERIAL, SCENE, Technique};
+use crate::tables::TableSet;
+use bytemuck::{Pod, Zeroable};
+use half::f16;
+use nacre_optics::{C64, Material};
+use std::io::Cursor;
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+use wgpu::util::DeviceExt;
+
+/// Largest width or height of a rendered image, an environment map or a thickness map.
+pub const MAX_DIMENSION: u32 = 8192;
+
+/// Size of the default environment, texels (width × height).
+pub const DEFAULT_ENVIRONMENT_SIZE: (usize, usize) = (256, 128);
+
+/// Size of the built-in thickness map, texels (square).
+pub const DEFAULT_THICKNESS_MAP_SIZE: usize = 256;
+
+/// The render target format: 8-bit RGBA holding sRGB-encoded values written by the shader
+/// (`material_display`), not an `…Srgb` format: the bytes read back are the bytes of the PNG.
+pub const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+
+// ─── Scene description ─────────────────────────────────────────────────────────────────────
+
+/// Which analytic scene `shaders/scene.wgsl` ray-casts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum SceneKind {
+    /// A film-coated sphere (radius 1 at (0, 1, 0)) on a dielectric or metal base.
+    Sphere,
+    /// The same sphere as a soap bubble: a thin transparent shell, both walls reflecting and
+    /// transmitting, the film draining towards the bottom.
+    Bubble,
+    /// The plane y = 0 to the horizon with the thickness map tiled across it (an oil slick).
+    Plane,
+}
+
+impl SceneKind {
+    /// Every scene.
+    pub const ALL: [SceneKind; 3] = [SceneKind::Sphere, SceneKind::Bubble, SceneKind::Plane];
+
+    /// The name used on the command line and in file names.
+    pub fn name(self) -> &'static str {
+        match self {
+            SceneKind::Sphere => "sphere",
+            SceneKind::Bubble => "bubble",
+            SceneKind::Plane => "plane",
+        }
+    }
+
+    /// `ViewParams.scene` in `shaders/scene.wgsl`.
+    fn id(self) -> u32 {
+        match self {
+            SceneKind::Sphere => 0,
+            SceneKind::Bubble => 1,
+            SceneKind::Plane => 2,
+        }
+    }
+}
+
+impl FromStr for SceneKind {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        SceneKind::ALL
+            .into_iter()
+            .find(|k| k.name().eq_ignore_ascii_case(s.trim()))
+            .ok_or_else(|| Error::Invalid {
+                context: format!("scene `{s}`"),
+                message: "expected sphere, bubble or plane".into(),
+            })
+    }
+}
+
+/// A pinhole camera.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    /// Eye position, world units.
+    pub eye: [f32; 3],
+    /// The point looked at, world units.
+    pub target: [f32; 3],
+    /// Up direction (need not be unit or orthogonal to the view direction).
+    pub up: [f32; 3],
+    /// Vertical field of view, degrees, in (0, 180).
+    pub fov_y_deg: f32,
+}
+
+impl Camera {
+    /// The default camera of `scene`.
+    pub fn for_scene(scene: SceneKind) -> Camera {
+        match scene {
+            SceneKind::Sphere | SceneKind::Bubble => Camera {
+                eye: [0.0, 1.45, 3.9],
+                target: [0.0, 1.0, 0.0],
+                up: [0.0, 1.0, 0.0],
+                fov_y_deg: 36.0,
+            },
+            SceneKind::Plane => Camera {
+                eye: [0.0, 1.1, 3.0],
+                target: [0.0, 0.0, -2.5],
+                up: [0.0, 1.0, 0.0],
+                fov_y_deg: 55.0,
+            },
+        }
+    }
+
+    /// The inverse of projection × view for an image of aspect ratio `aspect` (width /
+    /// height), as WGSL columns: clip space (x, y ∈ [−1, 1], z ∈ [0, 1] from near to far) →
+    /// world.
+    pub fn inverse_view_projection(&self, aspect: f64) -> Result<[[f32; 4]; 4]> {
+        let bad = |message: String| Error::Invalid {
+            context: "camera".into(),
+            message,
+        };
+        let v = |a: [f32; 3]| a.map(f64::from);
+        let (eye, target, up) = (v(self.eye), v(self.target), v(self.up));
+        if !eye.iter().chain(&target).chain(&up).all(|x| x.is_finite()) {
+            return Err(bad(format!("non-finite eye, target or up: {self:?}")));
+        }
+        let fov = f64::from(self.fov_y_deg);
+        if !(fov > 0.0 && fov < 180.0) {
+            return Err(bad(format!(
+                "vertical field of view {fov} degrees (expected between 0 and 180)"
+            )));
+        }
+        if !(aspect > 0.0 && aspect.is_finite()) {
+            return Err(bad(format!("aspect ratio {aspect}")));
+        }
+        let forward = normalize(sub(target, eye)).ok_or_else(|| bad("eye equals target".into()))?;
+        let right = normalize(cross(forward, up))
+            .ok_or_else(|| bad("up is parallel to the view direction".into()))?;
+        let true_up = cross(right, forward);
+        // Camera to world: columns right, up, −forward (the camera looks down −z), eye.
+        let c = [
+            [right[0], true_up[0], -forward[0], eye[0]],
+            [right[1], true_up[1], -forward[1], eye[1]],
+            [right[2], true_up[2], -forward[2], eye[2]],
+            [0.0, 0.0, 0.0, 1.0],
+        ];
+        // Inverse of the right-handed perspective projection with depth in [0, 1]:
+        // P = [[f/a, 0, 0, 0], [0, f, 0, 0], [0, 0, A, B], [0, 0, −1, 0]],
+        // A = far/(near − far), B = near·far/(near − far), f = 1/tan(fov/2).
+        let (near, far) = (0.05, 1000.0);
+        let f = 1.0 / (0.5 * fov.to_radians()).tan();
+        let b = near * far / (near - far);
+        let p_inv = [
+            [aspect / f, 0.0, 0.0, 0.0],
+            [0.0, 1.0 / f, 0.0, 0.0],
+            [0.0, 0.0, 0.0, -1.0],
+            [0.0, 0.0, 1.0 / b, 1.0 / near],
+        ];
+        let mut m = [[0.0f64; 4]; 4];
+        for (i, row) in m.iter_mut().enumerate() {
+            for (j, x) in row.iter_mut().enumerate() {
+                *x = (0..4).map(|k| c[i][k] * p_inv[k][j]).sum();
+            }
+        }
+        // WGSL matrices are column-major.
+        Ok(std::array::from_fn(|col| {
+            std::array::from_fn(|row| m[row][col] as f32)
+        }))
+    }
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn normalize(a: [f64; 3]) -> Option<[f64; 3]> {
+    let len = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+    (len > 1e-12 && len.is_finite()).then(|| a.map(|x| x / len))
+}
+
+/// A directional light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Light {
+    /// Direction from the scene towards the light (need not be unit).
+    pub direction: [f32; 3],
+    /// Linear RGB colour.
+    pub colour: [f32; 3],
+    /// Irradiance at normal incidence = colour × intensity.
+    pub intensity: f32,
+}
+
+/// Direction of the default light and of the sun in [`procedural_environment`] (towards the
+/// light: up, left and in front of the default cameras).
+pub const SUN_DIRECTION: [f64; 3] = [-0.45, 0.70, 0.55];
+
+impl Default for Light {
+    /// The sun of the default environment: [`SUN_DIRECTION`], warm white, intensity 3.
+    fn default() -> Self {
+        Light {
+            direction: SUN_DIRECTION.map(|x| x as f32),
+            colour: [1.0, 0.95, 0.88],
+            intensity: 3.0,
+        }
+    }
+}
+
+/// How the greyscale thickness map value g ∈ [0, 1] becomes the film thickness d.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ThicknessMapping {
+    /// Spatially varying thickness, Sussenbach 2013 §4.2 (Eq. 4.3–4.4):
+    /// d = d_avg + d_rel (2g − 1).
+    Svt {
+        /// Average thickness d_avg, nm.
+        average_nm: f32,
+        /// Relative thickness d_rel, nm (d spans d_avg ± d_rel).
+        relative_nm: f32,
+    },
+    /// glTF `KHR_materials_iridescence`: d = mix(d_min, d_max, g).
+    Gltf {
+        /// Thickness at g = 0, nm.
+        min_nm: f32,
+        /// Thickness at g = 1, nm.
+        max_nm: f32,
+    },
+}
+
+impl ThicknessMapping {
+    /// The largest thickness the mapping produces (before drainage), nm.
+    pub fn max_nm(&self) -> f32 {
+        match *self {
+            ThicknessMapping::Svt {
+                average_nm,
+                relative_nm,
+            } => average_nm + relative_nm.abs(),
+            ThicknessMapping::Gltf { min_nm, max_nm } => min_nm.max(max_nm),
+        }
+    }
+}
+
+/// Whether the base under the film is a dielectric (with a Lambertian diffuse) or a metal.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BaseKind {
+    /// Dielectric: a Lambertian diffuse of albedo `base_colour` under the film, weighted by
+    /// 1 − the film's reflectance.
+    Dielectric,
+    /// Metal: no diffuse; the film term already contains the metal's reflectance.
+    Metal,
+}
+
+impl BaseKind {
+    /// [`BaseKind::Metal`] when the material's extinction coefficient κ at 550 nm is at
+    /// least 0.1, else [`BaseKind::Dielectric`].
+    pub fn of(base: &Material) -> BaseKind {
+        match base.index_at(550.0) {
+            Ok(n) if n.im >= 0.1 => BaseKind::Metal,
+            _ => BaseKind::Dielectric,
+        }
+    }
+}
+
+/// The film-coated material of a scene (`MaterialParams` in `shaders/material.wgsl`).
+#[derive(Clone, Debug)]
+pub struct MaterialOptions {
+    /// Real film index n₂.
+    pub film_ior: f32,
+    /// Ambient index n₁ (a `film-lut` table bakes it: it must match the table's).
+    pub ambient_ior: f32,
+    /// How the thickness map becomes a thickness.
+    pub thickness: ThicknessMapping,
+    /// Sub-pixel standard deviation of the thickness, nm (film_fourier prefiltering).
+    pub thickness_roughness_nm: f32,
+    /// Extra thickness at the bottom of the object (0 at the top, linear in height), nm:
+    /// a draining soap film.
+    pub drain_nm: f32,
+    /// Scale s of the triplanar thickness-map projection: one map tile spans 2/s units of the
+    /// scene's map coordinate (the sphere's unit normal, the plane's world x and z).
+    pub thickness_map_scale: f32,
+    /// The base under the film: its index feeds `film_fourier` (at each channel's centroid
+    /// wavelength) and `film_spectral` (at every wavelength); `film_lut` bakes it.
+    pub base: Material,
+    /// Dielectric (with diffuse) or metal.
+    pub base_kind: BaseKind,
+    /// Diffuse albedo of a dielectric base, linear RGB.
+    pub base_colour: [f32; 3],
+    /// GGX roughness α (= perceptual roughness²), in [0.001, 1].
+    pub roughness_alpha: f32,
+    /// A thin transparent shell (the bubble): transmits the film's transmittance.
+    pub transmission: bool,
+}
+
+impl MaterialOptions {
+    /// The default material of `scene`:
+    ///
+    /// * sphere: a film of index 1.9 (SVT 380 ± 220 nm) on a black glazed dielectric of index
+    ///   1.5, α = 0.06;
+    /// * bubble: a soap film of index 1.33 in air (SVT 170 ± 80 nm plus 700 nm of drainage
+    ///   towards the bottom), a mirror (α = 0.001), transmitting;
+    /// * plane: an oil film of index 1.47 (glTF mapping 100–700 nm) on water over a dark
+    ///   bottom, α = 0.02, the map repeating every 3 units.
+    pub fn for_scene(scene: SceneKind) -> MaterialOptions {
+        let constant = |n: f64| {
+            Material::constant(format!("{n}"), C64::new(n, 0.0))
+                .expect("a positive real index is a valid material")
+        };
+        match scene {
+            SceneKind::Sphere => MaterialOptions {
+                film_ior: 1.9,
+                ambient_ior: 1.0,
+                thickness: ThicknessMapping::Svt {
+                    average_nm: 380.0,
+                    relative_nm: 220.0,
+                },
+                thickness_roughness_nm: 0.0,
+                drain_nm: 0.0,
+                thickness_map_scale: 1.5,
+                base: constant(1.5),
+                base_kind: BaseKind::Dielectric,
+                base_colour: [0.02, 0.02, 0.025],
+                roughness_alpha: 0.06,
+                transmission: false,
+            },
+            SceneKind::Bubble => MaterialOptions {
+                film_ior: 1.33,
+                ambient_ior: 1.0,
+                thickness: ThicknessMapping::Svt {
+                    average_nm: 170.0,
+                    relative_nm: 80.0,
+                },
+                thickness_roughness_nm: 0.0,
+                drain_nm: 700.0,
+                thickness_map_scale: 1.0,
+                base: constant(1.0),
+                base_kind: BaseKind::Dielectric,
+                base_colour: [0.0; 3],
+                roughness_alpha: 0.001,
+                transmission: true,
+            },
+            SceneKind::Plane => MaterialOptions {
+                film_ior: 1.47,
+                ambient_ior: 1.0,
+                thickness: ThicknessMapping::Gltf {
+                    min_nm: 100.0,
+                    max_nm: 700.0,
+                },
+                thickness_roughness_nm: 0.0,
+                drain_nm: 0.0,
+                thickness_map_scale: 2.0 / 3.0,
+                base: constant(1.333),
+                base_kind: BaseKind::Dielectric,
+                base_colour: [0.015, 0.02, 0.025],
+                roughness_alpha: 0.02,
+                transmission: false,
+            },
+        }
+    }
+
+    /// Replaces the base (and its kind, [`BaseKind::of`]).
+    pub fn set_base(&mut self, base: Material) {
+        self.base_kind = BaseKind::of(&base);
+        self.base = base;
+    }
+
+    /// The largest thickness the material produces, nm.
+    pub fn max_thickness_nm(&self) -> f32 {
+        self.thickness.max_nm() + self.drain_nm.max(0.0)
+    }
+
+    fn validate(&self) -> Result<()> {
+        let bad = |message: String| {
+            Err(Error::Invalid {
+                context: "material".into(),
+                message,
+            })
+        };
+        let positive = [
+            ("film index", self.film_ior),
+            ("ambient index", self.ambient_ior),
+        ];
+        for (name, v) in positive {
+            if !(v > 0.0 && v.is_finite()) {
+                return bad(format!("{name} {v} (expected a positive number)"));
+            }
+        }
+        let (a, b) = match self.thickness {
+            ThicknessMapping::Svt {
+                average_nm,
+                relative_nm,
+            } => (average_nm, relative_nm),
+            ThicknessMapping::Gltf { min_nm, max_nm } => (min_nm, max_nm),
+        };
+        let finite = [
+            ("thickness", a),
+            ("thickness", b),
+            ("drainage", self.drain_nm),
+            ("thickness roughness", self.thickness_roughness_nm),
+            ("thickness map scale", self.thickness_map_scale),
+        ];
+        for (name, v) in finite {
+            if !(v.is_finite() && v.abs() <= 1e6) {
+                return bad(format!("{name} {v} (expected a finite number within ±1e6)"));
+            }
+        }
+        if !(self.thickness_roughness_nm >= 0.0 && self.drain_nm >= 0.0) {
+            return bad("thickness roughness and drainage must be non-negative".into());
+        }
+        if !(self.roughness_alpha >= 0.0 && self.roughness_alpha <= 1.0) {
+            return bad(format!(
+                "GGX roughness α {} (expected 0 to 1)",
+                self.roughness_alpha
+            ));
+        }
+        if !self.base_colour.iter().all(|c| (0.0..=1.0).contains(c)) {
+            return bad(format!(
+                "base colour {:?} (expected 0 to 1 per channel)",
+                self.base_colour
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Everything a render needs besides the tables and the technique.
+#[derive(Clone, Debug)]
+pub struct SceneOptions {
+    /// The scene.
+    pub scene: SceneKind,
+    /// Image width, pixels (1 to [`MAX_DIMENSION`]; default 800).
+    pub width: u32,
+    /// Image height, pixels (1 to [`MAX_DIMENSION`]; default 600).
+    pub height: u32,
+    /// The camera (default: [`Camera::for_scene`]).
+    pub camera: Camera,
+    /// An OpenEXR equirectangular environment, or `None` for the default
+    /// ([`EnvironmentMap::default_map`]).
+    pub environment: Option<PathBuf>,
+    /// Scale of the environment's radiance (default 1).
+    pub env_intensity: f32,
+    /// A greyscale PNG thickness map, or `None` for [`procedural_thickness_map`].
+    pub thickness_map: Option<PathBuf>,
+    /// The material (default: [`MaterialOptions::for_scene`]).
+    pub material: MaterialOptions,
+    /// The directional light (default: [`Light::default`]).
+    pub light: Light,
+    /// Exposure, EV stops: radiance is scaled by 2^EV before tone mapping (default 0).
+    pub exposure_ev: f32,
+    /// Harmonics M of `film_fourier` (0 = automatic; default 3).
+    pub harmonics: u32,
+    /// Wavelengths N of `film_spectral` (default 30).
+    pub spectral_samples: usize,
+}
+
+impl SceneOptions {
+    /// The defaults of `scene` at 800 × 600.
+    pub fn new(scene: SceneKind) -> SceneOptions {
+        let technique = TechniqueOptions::default();
+        SceneOptions {
+            scene,
+            width: 800,
+            height: 600,
+            camera: Camera::for_scene(scene),
+            environment: None,
+            env_intensity: 1.0,
+            thickness_map: None,
+            material: MaterialOptions::for_scene(scene),
+            light: Light::default(),
+            exposure_ev: 0.0,
+            harmonics: technique.harmonics,
+            spectral_samples: technique.spectral.samples,
+        }
+    }
+
+    /// Adapts the material to the loaded `film-lut` table, if any: the base becomes the
+    /// table's (its manifest's `base` material), the ambient index the table's, and the
+    /// film index is clamped into the table's index range, so that every technique renders
+    /// the film the table describes.
+    pub fn fit_to_tables(&mut self, tables: &TableSet) -> Result<()> {
+        let Some(lut) = &tables.film_lut else {
+            return Ok(());
+        };
+        let dir = lut.manifest_path.parent();
+        let context = format!("{} (base)", lut.manifest_path.display());
+        let base = nacre_bake::materials::resolve(&lut.manifest.base, &context, dir)?;
+        self.material.set_base(base);
+        self.material.ambient_ior = lut.axes.ambient_index as f32;
+        self.material.film_ior = self
+            .material
+            .film_ior
+            .clamp(lut.axes.ior_min as f32, lut.axes.ior_max as f32);
+        Ok(())
+    }
+
+    /// The group-1 options: harmonics, wavelengths and the material's base.
+    pub fn technique_options(&self) -> TechniqueOptions {
+        TechniqueOptions {
+            harmonics: self.harmonics,
+            spectral: SpectralSetup {
+                samples: self.spectral_samples,
+                base: self.material.base.clone(),
+            },
+        }
+    }
+
+    /// Checks sizes, exposure, intensities, the light and the material (not the files, not
+    /// the tables): [`Renderer::render`] calls it first.
+    pub fn validate(&self) -> Result<()> {
+        for (name, v) in [("width", self.width), ("height", self.height)] {
+            if !(1..=MAX_DIMENSION).contains(&v) {
+                return Err(Error::Invalid {
+                    context: format!("image {name}"),
+                    message: format!("{v} pixels (expected 1 to {MAX_DIMENSION})"),
+                });
+            }
+        }
+        for (name, v) in [
+            ("exposure", self.exposure_ev),
+            ("environment intensity", self.env_intensity),
+            ("light intensity", self.light.intensity),
+        ] {
+            if !(v.is_finite() && v.abs() <= 1e4) {
+                return Err(Error::Invalid {
+                    context: name.into(),
+                    message: format!("{v} (expected a finite number within ±1e4)"),
+                });
+            }
+        }
+        if self.env_intensity < 0.0 || self.light.intensity < 0.0 {
+            return Err(Error::Invalid {
+                context: "lighting".into(),
+                message: "intensities must be non-negative".into(),
+            });
+        }
+        if self.exposure_ev.abs() > 64.0 {
+            return Err(Error::Invalid {
+                context: "exposure".into(),
+                message: format!("{} EV (expected −64 to 64)", self.exposure_ev),
+            });
+        }
+        if !self
+            .light
+            .direction
+            .iter()
+            .chain(&self.light.colour)
+            .all(|x| x.is_finite())
+            || self.light.colour.iter().any(|&c| c < 0.0)
+        {
+            return Err(Error::Invalid {
+                context: "light".into(),
+                message: format!(
+                    "{:?} (expected finite values, a non-negative colour)",
+                    self.light
+                ),
+            });
+        }
+        self.material.validate()
+    }
+}
+
+// ─── Uniforms (mirrors of shaders/material.wgsl) ───────────────────────────────────────────
+
+/// Mirror of `ViewParams` (`shaders/material.wgsl`): 128 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct ViewUniform {
+    /// Clip → world, column-major.
+    pub inv_view_proj: [[f32; 4]; 4],
+    /// Eye position.
+    pub eye_position: [f32; 3],
+    /// Linear exposure factor 2^EV.
+    pub exposure: f32,
+    /// Unit direction towards the light.
+    pub light_direction: [f32; 3],
+    /// Light intensity.
+    pub light_intensity: f32,
+    /// Light colour, linear RGB.
+    pub light_colour: [f32; 3],
+    /// Environment intensity.
+    pub env_intensity: f32,
+    /// Target size, pixels.
+    pub resolution: [f32; 2],
+    /// Scene id (0 sphere, 1 bubble, 2 plane).
+    pub scene: u32,
+    /// Last mip level of the environment texture.
+    pub env_lod_max: f32,
+}
+
+/// Mirror of `MaterialParams` (`shaders/material.wgsl`): 80 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct MaterialUniform {
+    /// Film index.
+    pub film_ior: f32,
+    /// Ambient index.
+    pub ambient_ior: f32,
+    /// SVT d_avg or glTF d_min, nm.
+    pub thickness_a_nm: f32,
+    /// SVT d_rel or glTF d_max, nm.
+    pub thickness_b_nm: f32,
+    /// 0 SVT, 1 glTF.
+    pub thickness_mode: u32,
+    /// Thickness roughness, nm.
+    pub thickness_roughness_nm: f32,
+    /// Drainage, nm.
+    pub thickness_drain_nm: f32,
+    /// GGX α.
+    pub roughness_alpha: f32,
+    /// Base index per channel, real part.
+    pub base_ior: [f32; 3],
+    /// 0 dielectric, 1 metal.
+    pub base_kind: u32,
+    /// Base index per channel, κ.
+    pub base_kappa: [f32; 3],
+    /// 1: thin transparent shell.
+    pub transmission: u32,
+    /// Diffuse albedo.
+    pub base_colour: [f32; 3],
+    /// Triplanar projection scale (a tile spans 2/scale map units).
+    pub thickness_map_scale: f32,
+}
+
+impl ViewUniform {
+    /// The view uniform of `options` for an environment of `env_levels` mip levels.
+    pub fn new(options: &SceneOptions, env_levels: usize) -> Result<ViewUniform> {
+        let aspect = f64::from(options.width) / f64::from(options.height);
+        let light =
+            normalize(options.light.direction.map(f64::from)).ok_or_else(|| Error::Invalid {
+                context: "light".into(),
+                message: "zero direction".into(),
+            })?;
+        Ok(ViewUniform {
+            inv_view_proj: options.camera.inverse_view_projection(aspect)?,
+            eye_position: options.camera.eye,
+            exposure: 2f32.powf(options.exposure_ev),
+            light_direction: light.map(|x| x as f32),
+            light_intensity: options.light.intensity,
+            light_colour: options.light.colour,
+            env_intensity: options.env_intensity,
+            resolution: [options.width as f32, options.height as f32],
+            scene: options.scene.id(),
+            env_lod_max: env_levels.saturating_sub(1) as f32,
+        })
+    }
+}
+
+/// Wavelengths (nm) at which the base index is taken for `film_fourier` when no `fourier`
+/// table gives the channels' centroids (red, green, blue).
+const FALLBACK_CHANNEL_WAVELENGTHS_NM: [f64; 3] = [610.0, 550.0, 465.0];
+
+impl MaterialUniform {
+    /// The material uniform of `m`; the base index per channel is taken at the channel
+    /// centroid wavelengths 1/ν̄_j of the `fourier` table in `tables`, if any.
+    pub fn new(m: &MaterialOptions, tables: &TableSet) -> Result<MaterialUniform> {
+        let wavelengths = match &tables.fourier {
+            Some(f) => {
+                let nu = f.axes.carrier_nu_per_nm;
+                std::array::from_fn(|j| {
+                    if nu[j] > 1e-6 && nu[j].is_finite() {
+                        1.0 / nu[j]
+                    } else {
+                        FALLBACK_CHANNEL_WAVELENGTHS_NM[j]
+                    }
+                })
+            }
+            None => FALLBACK_CHANNEL_WAVELENGTHS_NM,
+        };
+        let mut base_ior = [0.0f32; 3];
+        let mut base_kappa = [0.0f32; 3];
+        for j in 0..3 {
+            let n = m
+                .base
+                .index_at(wavelengths[j])
+                .map_err(nacre_bake::Error::from)?;
+            base_ior[j] = n.re as f32;
+            base_kappa[j] = n.im as f32;
+        }
+        let (mode, a, b) = match m.thickness {
+            ThicknessMapping::Svt {
+                average_nm,
+                relative_nm,
+            } => (0, average_nm, relative_nm),
+            ThicknessMapping::Gltf { min_nm, max_nm } => (1, min_nm, max_nm),
+        };
+        Ok(MaterialUniform {
+            film_ior: m.film_ior,
+            ambient_ior: m.ambient_ior,
+            thickness_a_nm: a,
+            thickness_b_nm: b,
+            thickness_mode: mode,
+            thickness_roughness_nm: m.thickness_roughness_nm,
+            thickness_drain_nm: m.drain_nm,
+            roughness_alpha: m.roughness_alpha,
+            base_ior,
+            base_kind: match m.base_kind {
+                BaseKind::Dielectric => 0,
+                BaseKind::Metal => 1,
+            },
+            base_kappa,
+            transmission: u32::from(m.transmission),
+            base_colour: m.base_colour,
+            thickness_map_scale: m.thickness_map_scale,
+        })
+    }
+}
+
+// ─── CPU images and mip chains ─────────────────────────────────────────────────────────────
+
+/// One mip level: width, height, texels (row-major, top row first).
+pub type Level<const C: usize> = (usize, usize, Vec<[f32; C]>);
+
+/// The full mip chain of an image down to 1 × 1: level k + 1 averages (2×2 box filter) the
+/// texels 2x, 2x + 1 (clamped to the edge for odd sizes) of level k. An empty or inconsistent
+/// image is returned as its only level.
+fn mip_chain<const C: usize>(width: usize, height: usize, texels: Vec<[f32; C]>) -> Vec<Level<C>> {
+    let empty = width == 0 || height == 0 || texels.len() != width * height;
+    let mut levels = vec![(width, height, texels)];
+    if empty {
+        return levels;
+    }
+    loop {
+        let (w, h, src) = levels.last().expect("at least one level");
+        let (w, h) = (*w, *h);
+        if w == 1 && h == 1 {
+            break;
+        }
+        let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
+        let mut dst = Vec::with_capacity(nw * nh);
+        for y in 0..nh {
+            let (y0, y1) = ((2 * y).min(h - 1), (2 * y + 1).min(h - 1));
+            for x in 0..nw {
+                let (x0, x1) = ((2 * x).min(w - 1), (2 * x + 1).min(w - 1));
+                let mut acc = [0.0f32; C];
+                for (xx, yy) in [(x0, y0), (x1, y0), (x0, y1), (x1, y1)] {
+                    let t = src[yy * w + xx];
+                    for c in 0..C {
+                        acc[c] += t[c];
+                    }
+                }
+                dst.push(acc.map(|v| 0.25 * v));
+            }
+        }
+        levels.push((nw, nh, dst));
+    }
+    levels
+}
+
+fn check_image_size(path: &Path, what: &str, width: usize, height: usize) -> Result<()> {
+    let max = MAX_DIMENSION as usize;
+    if width == 0 || height == 0 || width > max || height > max {
+        return Err(Error::Invalid {
+            context: path.display().to_string(),
+            message: format!(
+                "{what} of {width}x{height} texels (expected 1 to {max} texels on each side)"
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// An equirectangular HDR environment: linear RGB radiance, row 0 the zenith (+y), column
+/// u = (i + 0.5)/width at azimuth φ = 2π(u − 0.5) from −z towards +x.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EnvironmentMap {
+    /// Width, texels.
+    pub width: usize,
+    /// Height, texels.
+    pub height: usize,
+    /// `width × height` texels, row-major, top row first.
+    pub rgb: Vec<[f32; 3]>,
+}
+
+/// The committed default environment: `tables/env/studio.exr`.
+pub fn default_environment_path() -> PathBuf {
+    nacre_bake::bake::tables_dir()
+        .join("env")
+        .join("studio.exr")
+}
+
+impl EnvironmentMap {
+    /// Reads an OpenEXR equirectangular image (half or float `R`, `G`, `B` channels; other
+    /// channels ignored). Negative values become 0.
+    ///
+    /// # Errors
+    /// [`Error::Io`] or [`Error::Table`] when the file cannot be read or is not a valid flat
+    /// single-part RGB OpenEXR image with finite values; [`Error::Invalid`] when a side is 0
+    /// or larger than [`MAX_DIMENSION`] (checked before the pixels are decoded).
+    pub fn load(path: &Path) -> Result<EnvironmentMap> {
+        let bytes = std::fs::read(path).map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let header = std::panic::catch_unwind(|| {
+            exr::meta::MetaData::read_from_buffered(Cursor::new(&bytes[..]), false)
+        });
+        let meta = match header {
+            Ok(Ok(meta)) => meta,
+            Ok(Err(e)) => {
+                return Err(Error::Invalid {
+                    context: path.display().to_string(),
+                    message: format!("not a valid OpenEXR file: {e}"),
+                });
+            }
+            Err(_) => {
+                return Err(Error::Invalid {
+                    context: path.display().to_string(),
+                    message: "malformed OpenEXR header (the decoder failed)".into(),
+                });
+            }
+        };
+        if let Some(h) = meta.headers.first() {
+            check_image_size(path, "an environment", h.layer_size.0, h.layer_size.1)?;
+        }
+        let (atlas, _) = nacre_bake::table_io::read_exr(path)?;
+        check_image_size(path, "an environment", atlas.width, atlas.height)?;
+        Ok(EnvironmentMap {
+            width: atlas.width,
+            height: atlas.height,
+            rgb: atlas
+                .data
+                .chunks_exact(3)
+                .map(|c| [c[0].max(0.0), c[1].max(0.0), c[2].max(0.0)])
+                .collect(),
+        })
+    }
+
+    /// The default environment: [`default_environment_path`] when it exists, else the same
+    /// image computed by [`procedural_environment`] and rounded to half floats.
+    pub fn default_map() -> Result<EnvironmentMap> {
+        let path = default_environment_path();
+        if path.is_file() {
+            return EnvironmentMap::load(&path);
+        }
+        let (w, h) = DEFAULT_ENVIRONMENT_SIZE;
+        let mut env = procedural_environment(w, h);
+        for t in &mut env.rgb {
+            *t = t.map(|v| f16::from_f32(v).to_f32());
+        }
+        Ok(env)
+    }
+
+    /// Writes the environment as a half-float, ZIP-compressed OpenEXR file (atomically).
+    pub fn write_exr(&self, path: &Path) -> Result<()> {
+        let table = nacre_bake::table_io::Table3 {
+            nx: self.width,
+            ny: self.height,
+            nz: 1,
+            data: self.rgb.iter().flatten().copied().collect(),
+        };
+        Ok(nacre_bake::table_io::write_exr(
+            path,
+            &table,
+            nacre_bake::table_io::Precision::Half,
+        )?)
+    }
+
+    /// The mip chain uploaded to the GPU (RGBA, alpha 1).
+    pub fn mip_chain(&self) -> Vec<Level<4>> {
+        // Rgba16Float holds at most 65504: brighter texels saturate there (not to infinity).
+        let texels = self
+            .rgb
+            .iter()
+            .map(|c| [c[0], c[1], c[2]].map(|v| v.clamp(0.0, 65504.0)))
+            .map(|c| [c[0], c[1], c[2], 1.0])
+            .collect();
+        mip_chain(self.width, self.height, texels)
+    }
+}
+
+fn smoothstep(e0: f64, e1: f64, x: f64) -> f64 {
+    let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
+/// The default environment, computed: a "studio under an open sky" in linear Rec. 709 RGB
+/// radiance (1 = a white diffuse surface under unit irradiance × π), equirectangular as
+/// [`EnvironmentMap`] describes:
+///
+/// * sky: a gradient from a light grey horizon (0.75) to a blue zenith (0.14, 0.26, 0.58);
+/// * a sun-like hot spot towards [`SUN_DIRECTION`] (peak 60, angular radius ≈ 2°, plus a
+///   wide glow);
+/// * five soft rectangular area lights ("softboxes", radiance 2.2 to 6, edges blurred over
+///   ≈ 3°): two behind the default cameras (what the sphere reflects), an overhead strip, a
+///   large panel ahead and above (what the plane reflects) and a tall narrow strip ahead on
+///   the left;
+/// * a ground of warm grey tiles (a soft-edged 2-unit checker seen from 1.5 units up, ±22 %),
+///   fading to its mean (0.15) with distance, below a soft horizon.
+///
+/// Every value is finite, non-negative and below the half-float limit. `tables/env/studio.exr`
+/// is this function at 256 × 128 in half floats.
+pub fn procedural_environment(width: usize, height: usize) -> EnvironmentMap {
+    use std::f64::consts::PI;
+    let sun = normalize(SUN_DIRECTION).expect("non-zero");
+    // Softboxes: (azimuth from, to; elevation from, to) in degrees, radiance RGB. Azimuth 0
+    // looks down −z, +90 towards +x, ±180 towards +z (behind the default cameras).
+    let boxes: [(f64, f64, f64, f64, [f64; 3]); 5] = [
+        (140.0, 162.0, 8.0, 48.0, [6.0, 5.8, 5.4]),
+        (-165.0, -128.0, 22.0, 58.0, [3.2, 3.6, 4.2]),
+        (-70.0, 70.0, 72.0, 84.0, [4.0, 4.0, 4.0]),
+        (-52.0, -40.0, 2.0, 40.0, [3.0, 2.9, 2.7]),
+        (-60.0, 60.0, 20.0, 62.0, [2.2, 2.2, 2.3]),
+    ];
+    let mut rgb = Vec::with_capacity(width * height);
+    for j in 0..height {
+        let theta = PI * (j as f64 + 0.5) / height as f64;
+        for i in 0..width {
+            let phi = 2.0 * PI * ((i as f64 + 0.5) / width as f64 - 0.5);
+            let dir = [
+                theta.sin() * phi.sin(),
+                theta.cos(),
+                -theta.sin() * phi.cos(),
+            ];
+            let y = dir[1];
+            // Sky.
+            let t = y.max(0.0).powf(0.4);
+            let horizon = [0.75, 0.73, 0.7];
+            let zenith = [0.14, 0.26, 0.58];
+            let sky: [f64; 3] = std::array::from_fn(|c| horizon[c] + (zenith[c] - horizon[c]) * t);
+            // Ground: soft-edged checker tiles 2 units wide, 1.5 units below the viewer.
+            let down = (-y).max(1e-4);
+            let (gx, gz) = (dir[0] * 1.5 / down, dir[2] * 1.5 / down);
+            let square = |x: f64| (4.0 * (2.0 * PI * x / 4.0).sin()).clamp(-1.0, 1.0);
+            let distance = (gx * gx + gz * gz).sqrt();
+            let contrast = 1.0 - smoothstep(6.0, 30.0, distance);
+            let tile = 1.0 + 0.22 * square(gx) * square(gz) * contrast;
+            let ground = [0.15 * tile, 0.135 * tile, 0.12 * tile];
+            let w = smoothstep(-0.012, 0.012, y);
+            let mut c: [f64; 3] = std::array::from_fn(|k| ground[k] + (sky[k] - ground[k]) * w);
+            // Sun and glow.
+            let cos_gamma = (dir[0] * sun[0] + dir[1] * sun[1] + dir[2] * sun[2]).clamp(-1.0, 1.0);
+            let gamma = cos_gamma.acos();
+            let sun_radiance =
+                60.0 * (-(gamma / 0.035).powi(2)).exp() + 1.5 * (-(gamma / 0.3).powi(2)).exp();
+            let sun_colour = [1.0, 0.93, 0.82];
+            for k in 0..3 {
+                c[k] += sun_radiance * sun_colour[k];
+            }
+            // Softboxes.
+            let azimuth = phi.to_degrees();
+            let elevation = 90.0 - theta.to_degrees();
+            for &(a0, a1, e0, e1, radiance) in &boxes {
+                let edge = 3.0;
+                let wa = smoothstep(a0 - edge, a0 + edge, azimuth)
+                    * (1.0 - smoothstep(a1 - edge, a1 + edge, azimuth));
+                let we = smoothstep(e0 - edge, e0 + edge, elevation)
+                    * (1.0 - smoothstep(e1 - edge, e1 + edge, elevation));
+                for k in 0..3 {
+                    c[k] += wa * we * radiance[k];
+                }
+            }
+            rgb.push(c.map(|v| v.clamp(0.0, 60000.0) as f32));
+        }
+    }
+    EnvironmentMap { width, height, rgb }
+}
+
+/// A greyscale thickness map: values g ∈ [0, 1], row-major, top row first. Values are data,
+/// not colours: a PNG's gamma or sRGB chunks are ignored.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ThicknessMap {
+    /// Width, texels.
+    pub width: usize,
+    /// Height, texels.
+    pub height: usize,
+    /// `width × height` values in [0, 1].
+    pub values: Vec<f32>,
+}
+
+impl ThicknessMap {
+    /// Reads an 8- or 16-bit greyscale PNG (grey + alpha too: alpha ignored; 1-, 2- and 4-bit
+    /// greyscale are expanded to 8 bits), g = value / (2^bits − 1).
+    ///
+    /// # Errors
+    /// [`Error::Io`] when the file cannot be read; [`Error::Invalid`] when it is not a valid
+    /// PNG, not greyscale, or a side is 0 or larger than [`MAX_DIMENSION`] (checked before the
+    /// pixels are decoded).
+    pub fn load_png(path: &Path) -> Result<ThicknessMap> {
+        let bytes = std::fs::read(path).map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let invalid = |message: String| Error::Invalid {
+            context: path.display().to_string(),
+            message,
+        };
+        let decode = || -> Result<ThicknessMap> {
+            let bad = |e: png::DecodingError| invalid(format!("not a valid PNG file: {e}"));
+            let mut decoder = png::Decoder::new_with_limits(
+                Cursor::new(&bytes[..]),
+                png::Limits { bytes: 1 << 29 },
+            );
+            decoder.set_transformations(png::Transformations::EXPAND);
+            let info = decoder.read_header_info().map_err(bad)?;
+            let (width, height) = (info.width as usize, info.height as usize);
+            check_image_size(path, "a thickness map", width, height)?;
+            let mut reader = decoder.read_info().map_err(bad)?;
+            let (colour, depth) = reader.output_color_type();
+            let channels = match colour {
+                png::ColorType::Grayscale => 1,
+                png::ColorType::GrayscaleAlpha => 2,
+                other => {
+                    return Err(invalid(format!(
+                        "a {other:?} PNG; a thickness map must be greyscale (8 or 16 bits)"
+                    )));
+                }
+            };
+            let bytes_per_sample = match depth {
+                png::BitDepth::Eight => 1,
+                png::BitDepth::Sixteen => 2,
+                other => {
+                    return Err(invalid(format!(
+                        "{} bits per sample; expected 8 or 16",
+                        other as u8
+                    )));
+                }
+            };
+            let size = reader
+                .output_buffer_size()
+                .ok_or_else(|| invalid("image too large".into()))?;
+            let mut buf = vec![0u8; size];
+            let frame = reader.next_frame(&mut buf).map_err(bad)?;
+            reader.finish().map_err(bad)?;
+            let stride = channels * bytes_per_sample;
+            let mut values = Vec::with_capacity(width * height);
+            for y in 0..height {
+                let row = &buf[y * frame.line_size..];
+                for x in 0..width {
+                    let at = x * stride;
+                    values.push(if bytes_per_sample == 2 {
+                        f32::from(u16::from_be_bytes([row[at], row[at + 1]])) / 65535.0
+                    } else {
+                        f32::from(row[at]) / 255.0
+                    });
+                }
+            }
+            Ok(ThicknessMap {
+                width,
+                height,
+                values,
+            })
+        };
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(decode))
+            .unwrap_or_else(|_| Err(invalid("malformed PNG data (the decoder failed)".into())))
+    }
+
+    /// The mip chain of (g, g²) uploaded to the GPU.
+    pub fn mip_chain(&self) -> Vec<Level<2>> {
+        let texels = self
+            .values
+            .iter()
+            .map(|&g| {
+                let g = if g.is_finite() {
+                    g.clamp(0.0, 1.0)
+                } else {
+                    0.5
+                };
+                [g, g * g]
+            })
+            .collect();
+        mip_chain(self.width, self.height, texels)
+    }
+}
+
+/// The built-in thickness map: `size` × `size` marbled swirls, tileable (every term is
+/// periodic with period 1 in both coordinates), normalised to span [0, 1].
+///
+/// g(x, y) = ½ + ½ Σ_k a_k sin(2π(m_k u + n_k v) + φ_k) after three rounds of domain warping
+/// (u, v) ← (u, v) + A sin(2π(integer frequencies) + phase).
+pub fn procedural_thickness_map(size: usize) -> ThicknessMap {
+    use std::f64::consts::TAU;
+    let size = size.max(1);
+    // Warps: amplitude; integer frequencies (x, y) and phase of the u displacement; of the v one.
+    type Warp = (f64, [f64; 2], f64, [f64; 2], f64);
+    let warps: [Warp; 3] = [
+        (0.12, [1.0, 2.0], 0.3, [2.0, -1.0], 1.7),
+        (0.07, [3.0, -2.0], 2.1, [-1.0, 3.0], 0.4),
+        (0.035, [4.0, 5.0], 4.0, [5.0, -3.0], 2.9),
+    ];
+    let waves: [(f64, [f64; 2], f64); 4] = [
+        (0.55, [2.0, 1.0], 0.0),
+        (0.35, [-1.0, 3.0], 1.0),
+        (0.2, [4.0, -2.0], 2.2),
+        (0.1, [5.0, 6.0], 0.7),
+    ];
+    let mut raw = Vec::with_capacity(size * size);
+    for j in 0..size {
+        for i in 0..size {
+            let (mut u, mut v) = (
+                (i as f64 + 0.5) / size as f64,
+                (j as f64 + 0.5) / size as f64,
+            );
+            for &(a, fu, pu, fv, pv) in &warps {
+                let du = a * (TAU * (fu[0] * u + fu[1] * v) + pu).sin();
+                let dv = a * (TAU * (fv[0] * u + fv[1] * v) + pv).sin();
+                u += du;
+                v += dv;
+            }
+            let g: f64 = waves
+                .iter()
+                .map(|&(a, f, p)| a * (TAU * (f[0] * u + f[1] * v) + p).sin())
+                .sum();
+            raw.push(g);
+        }
+    }
+    let lo = raw.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = raw.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let span = (hi - lo).max(1e-12);
+    ThicknessMap {
+        width: size,
+        height: size,
+        values: raw.iter().map(|&g| ((g - lo) / span) as f32).collect(),
+    }
+}
+
+// ─── GPU ───────────────────────────────────────────────────────────────────────────────────
+
+/// An image rendered by [`Renderer::render`].
+#[derive(Clone, Debug)]
+pub struct RenderedImage {
+    /// Width, pixels.
+    pub width: u32,
+    /// Height, pixels.
+    pub height: u32,
+    /// RGBA8, sRGB-encoded, alpha 255, row-major, top row first.
+    pub pixels: Vec<u8>,
+    /// Wall-clock seconds from submitting the render pass to its completion (excludes
+    /// pipeline creation, uploads and the readback; includes any shader compilation the driver
+    /// defers to the first draw, as lavapipe does without a warm shader cache).
+    pub gpu_seconds: f64,
+}
+
+impl RenderedImage {
+    /// The image as an 8-bit RGB PNG with an sRGB chunk.
+    pub fn encode_png(&self) -> Result<Vec<u8>> {
+        let err = |e: png::EncodingError| Error::Invalid {
+            context: "encoding the PNG".into(),
+            message: e.to_string(),
+        };
+        let rgb: Vec<u8> = self
+            .pixels
+            .chunks_exact(4)
+            .flat_map(|p| [p[0], p[1], p[2]])
+            .collect();
+        let mut bytes = Vec::new();
+        {
+            let mut encoder = png::Encoder::new(&mut bytes, self.width, self.height);
+            encoder.set_color(png::ColorType::Rgb);
+            encoder.set_depth(png::BitDepth::Eight);
+            encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+            encoder.set_compression(png::Compression::Balanced);
+            let mut writer = encoder.write_header().map_err(err)?;
+            writer.write_image_data(&rgb).map_err(err)?;
+            writer.finish().map_err(err)?;
+        }
+        Ok(bytes)
+    }
+
+    /// Writes [`RenderedImage::encode_png`] to `path` atomically.
+    pub fn write_png(&self, path: &Path) -> Result<()> {
+        let bytes = self.encode_png()?;
+        Ok(nacre_bake::output::write_atomic(path, |w| {
+            w.write_all(&bytes)
+        })?)
+    }
+}
+
+/// A technique's scene pipeline: group-1 tables, group-0/2 layouts, the render pipeline.
+pub struct Renderer {
+    technique: Technique,
+    binding: TechniqueBinding,
+    view_layout: wgpu::BindGroupLayout,
+    material_layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::RenderPipeline,
+}
+
+fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+fn texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+fn sampler_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+        count: None,
+    }
+}
+
+/// Group 0 and group 2 share a shape: 0 uniform, 1 filterable 2-D texture, 2 sampler.
+fn group_layout(device: &wgpu::Device, label: &str) -> wgpu::BindGroupLayout {
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries: &[uniform_entry(0), texture_entry(1), sampler_entry(2)],
+    })
+}
+
+/// Uploads a mip chain as a 2-D half-float texture of `format` (C channels of 2 bytes).
+fn upload_mips<const C: usize>(
+    ctx: &GpuContext,
+    label: &str,
+    format: wgpu::TextureFormat,
+    levels: &[Level<C>],
+) -> Result<wgpu::Texture> {
+    let (width, height, _) = &levels[0];
+    let limit = ctx.device.limits().max_texture_dimension_2d;
+    for n in [*width, *height] {
+        if n as u64 > u64::from(limit) {
+            return Err(Error::Limit {
+                what: label.to_string(),
+                needed: n as u64,
+                limit: u64::from(limit),
+                adapter: ctx.info.name.clone(),
+            });
+        }
+    }
+    ctx.checked(&format!("uploading {label}"), || {
+        let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d {
+                width: *width as u32,
+                height: *height as u32,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: levels.len() as u32,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        for (k, (w, h, texels)) in levels.iter().enumerate() {
+            let halves: Vec<u16> = texels
+                .iter()
+                .flat_map(|t| t.map(|v| f16::from_f32(v).to_bits()))
+                .collect();
+            ctx.queue.write_texture(
+                wgpu::TexelCopyTextureInfo {
+                    texture: &texture,
+                    mip_level: k as u32,
+                    origin: wgpu::Origin3d::ZERO,
+                    aspect: wgpu::TextureAspect::All,
+                },
+                bytemuck::cast_slice(&halves),
+                wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some((*w * C * 2) as u32),
+                    rows_per_image: Some(*h as u32),
+                },
+                wgpu::Extent3d {
+                    width: *w as u32,
+                    height: *h as u32,
+                    depth_or_array_layers: 1,
+                },
+            );
+        }
+        texture
+    })
+}
+
+fn linear_sampler(device: &wgpu::Device, label: &str, repeat_v: bool) -> wgpu::Sampler {
+    device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some(label),
+        address_mode_u: wgpu::AddressMode::Repeat,
+        address_mode_v: if repeat_v {
+            wgpu::AddressMode::Repeat
+        } else {
+            wgpu::AddressMode::ClampToEdge
+        },
+        address_mode_w: wgpu::AddressMode::ClampToEdge,
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        mipmap_filter: wgpu::MipmapFilterMode::Linear,
+        ..Default::default()
+    })
+}
+
+impl Renderer {
+    /// Compiles the scene pipeline of `technique` (`shaders::compose(technique, &[MATERIAL,
+    /// SCENE])`) and builds its group-1 tables from `tables` with `options`.
+    pub fn new(
+        ctx: &GpuContext,
+        tables: &TableSet,
+        technique: Technique,
+        options: &TechniqueOptions,
+    ) -> Result<Renderer> {
+        let colorimeter = tables.colorimeter()?;
+        let binding = TechniqueBinding::new(ctx, tables, technique, options, &colorimeter)?;
+        let device = &ctx.device;
+        let source = shaders::compose(technique, &[MATERIAL, SCENE]);
+        let (view_layout, material_layout, pipeline) =
+            ctx.checked("creating the scene pipeline", || {
+                let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                    label: Some("scene"),
+                    source: wgpu::ShaderSource::Wgsl(source.as_str().into()),
+                });
+                let view_layout = group_layout(device, "scene view");
+                let material_layout = group_layout(device, "scene material");
+                let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                    label: Some("scene"),
+                    bind_group_layouts: &[
+                        Some(&view_layout),
+                        Some(&binding.layout),
+                        Some(&material_layout),
+                    ],
+                    immediate_size: 0,
+                });
+                let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                    label: Some("scene"),
+                    layout: Some(&layout),
+                    vertex: wgpu::VertexState {
+                        module: &module,
+                        entry_point: Some("scene_vs"),
+                        compilation_options: Default::default(),
+                        buffers: &[],
+                    },
+                    primitive: Default::default(),
+                    depth_stencil: None,
+                    multisample: Default::default(),
+                    fragment: Some(wgpu::FragmentState {
+                        module: &module,
+                        entry_point: Some("scene_fs"),
+                        compilation_options: Default::default(),
+                        targets: &[Some(wgpu::ColorTargetState {
+                            format: TARGET_FORMAT,
+                            blend: None,
+                            write_mask: wgpu::ColorWrites::ALL,
+                        })],
+                    }),
+                    multiview_mask: None,
+                    cache: None,
+                });
+                (view_layout, material_layout, pipeline)
+            })?;
+        Ok(Renderer {
+            technique,
+            binding,
+            view_layout,
+            material_layout,
+            pipeline,
+        })
+    }
+
+    /// The technique.
+    pub fn technique(&self) -> Technique {
+        self.technique
+    }
+
+    /// Renders `options`, loading its environment and thickness map.
+    pub fn render(
+        &self,
+        ctx: &GpuContext,
+        tables: &TableSet,
+        options: &SceneOptions,
+    ) -> Result<RenderedImage> {
+        options.validate()?;
+        let environment = match &options.environment {
+            Some(path) => EnvironmentMap::load(path)?,
+            None => EnvironmentMap::default_map()?,
+        };
+        let thickness = match &options.thickness_map {
+            Some(path) => ThicknessMap::load_png(path)?,
+            None => procedural_thickness_map(DEFAULT_THICKNESS_MAP_SIZE),
+        };
+        self.render_with(ctx, tables, options, &environment, &thickness)
+    }
+
+    /// Renders `options` with an environment and a thickness map already in memory
+    /// (`options.environment` and `options.thickness_map` are not read).
+    pub fn render_with(
+        &self,
+        ctx: &GpuContext,
+        tables: &TableSet,
+        options: &SceneOptions,
+        environment: &EnvironmentMap,
+        thickness: &ThicknessMap,
+    ) -> Result<RenderedImage> {
+        options.validate()?;
+        for (what, w, h, n) in [
+            (
+                "environment",
+                environment.width,
+                environment.height,
+                environment.rgb.len(),
+            ),
+            (
+                "thickness map",
+                thickness.width,
+                thickness.height,
+                thickness.values.len(),
+            ),
+        ] {
+            check_image_size(Path::new(what), what, w, h)?;
+            if n != w * h {
+                return Err(Error::Invalid {
+                    context: what.into(),
+                    message: format!("{n} texels for {w}x{h}"),
+                });
+            }
+        }
+        if self.technique == Technique::Lut {
+            check_film_lut(tables, &options.material)?;
+        }
+        let (width, height) = (options.width, options.height);
+        let limit = ctx.device.limits().max_texture_dimension_2d;
+        if width.max(height) > limit {
+            return Err(Error::Limit {
+                what: "render target".into(),
+                needed: u64::from(width.max(height)),
+                limit: u64::from(limit),
+                adapter: ctx.info.name.clone(),
+            });
+        }
+        let env_mips = environment.mip_chain();
+        let view_uniform = ViewUniform::new(options, env_mips.len())?;
+        let material_uniform = MaterialUniform::new(&options.material, tables)?;
+        let env_texture = upload_mips(
+            ctx,
+            "environment",
+            wgpu::TextureFormat::Rgba16Float,
+            &env_mips,
+        )?;
+        let thickness_texture = upload_mips(
+            ctx,
+            "thickness map",
+            wgpu::TextureFormat::Rg16Float,
+            &thickness.mip_chain(),
+        )?;
+        let device = &ctx.device;
+        let (target, submitted) = ctx.checked("rendering the scene", || {
+            let group = |layout: &wgpu::BindGroupLayout,
+                         label: &str,
+                         contents: &[u8],
+                         texture: &wgpu::Texture,
+                         repeat_v: bool| {
+                let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents,
+                    usage: wgpu::BufferUsages::UNIFORM,
+                });
+                let view = texture.create_view(&Default::default());
+                let sampler = linear_sampler(device, label, repeat_v);
+                device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some(label),
+                    layout,
+                    entries: &[
+                        wgpu::BindGroupEntry {
+                            binding: 0,
+                            resource: uniform.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 1,
+                            resource: wgpu::BindingResource::TextureView(&view),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 2,
+                            resource: wgpu::BindingResource::Sampler(&sampler),
+                        },
+                    ],
+                })
+            };
+            let view_group = group(
+                &self.view_layout,
+                "scene view",
+                bytemuck::bytes_of(&view_uniform),
+                &env_texture,
+                false,
+            );
+            let material_group = group(
+                &self.material_layout,
+                "scene material",
+                bytemuck::bytes_of(&material_uniform),
+                &thickness_texture,
+                true,
+            );
+            let target = device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("scene target"),
+                size: wgpu::Extent3d {
+                    width,
+                    height,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: TARGET_FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            });
+            let target_view = target.create_view(&Default::default());
+            let mut encoder = device.create_command_encoder(&Default::default());
+            {
+                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("scene"),
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view: &target_view,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    })],
+                    depth_stencil_attachment: None,
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_pipeline(&self.pipeline);
+                pass.set_bind_group(0, &view_group, &[]);
+                pass.set_bind_group(1, &self.binding.bind_group, &[]);
+                pass.set_bind_group(2, &material_group, &[]);
+                pass.draw(0..3, 0..1);
+            }
+            // Let the uploads finish first, so that the time measured is the pass's.
+            let _ = device.poll(wgpu::PollType::wait_indefinitely());
+            let submitted = std::time::Instant::now();
+            ctx.queue.submit([encoder.finish()]);
+            (target, submitted)
+        })?;
+        ctx.wait("rendering the scene")?;
+        let gpu_seconds = submitted.elapsed().as_secs_f64();
+        let mut pixels = read_texture(ctx, &target, 4)?;
+        for p in pixels.chunks_exact_mut(4) {
+            p[3] = 255;
+        }
+        Ok(RenderedImage {
+            width,
+            height,
+            pixels,
+            gpu_seconds,
+        })
+    }
+}
+
+/// Checks that a `film-lut` table can render `material`: the table exists, its ambient is
+/// the material's, the film index and the thicknesses lie inside the table, and a
+/// transmitting material has a table with a transmittance.
+fn check_film_lut(tables: &TableSet, material: &MaterialOptions) -> Result<()> {
+    let Some(lut) = &tables.film_lut else {
+        return Err(Error::Invalid {
+            context: "technique `lut`".into(),
+            message: "needs a `film-lut` table in the table set".into(),
+        });
+    };
+    let axes = &lut.axes;
+    let context = format!("film-lut `{}`", lut.name);
+    let tol = 1e-4;
+    if (f64::from(material.ambient_ior) - axes.ambient_index).abs() > tol {
+        return Err(Error::Invalid {
+            context,
+            message: format!(
+                "the table was baked for ambient index {}, the material has {}",
+                axes.ambient_index, material.ambient_ior
+            ),
+        });
+    }
+    let n = f64::from(material.film_ior);
+    if n < axes.ior_min - tol || n > axes.ior_max + tol {
+        return Err(Error::Invalid {
+            context,
+            message: format!(
+                "film index {n} lies outside the table's {}–{}",
+                axes.ior_min, axes.ior_max
+            ),
+        });
+    }
+    let d = f64::from(material.max_thickness_nm());
+    if d > axes.thickness_max_nm * (1.0 + tol) {
+        return Err(Error::Invalid {
+            context,
+            message: format!(
+                "the material reaches {d} nm, beyond the table's {} nm",
+                axes.thickness_max_nm
+            ),
+        });
+    }
+    if material.transmission && !lut.has_transmittance {
+        return Err(Error::Invalid {
+            context,
+            message: "a transmitting material (the bubble) needs a table with a transmittance (e.g. soap-film)".into(),
+        });
+    }
+    Ok(())
+}
+
+/// Renders `options` with `technique` from `tables`: [`Renderer::new`] with
+/// [`SceneOptions::technique_options`], then [`Renderer::render`].
+pub fn render_scene(
+    ctx: &GpuContext,
+    tables: &TableSet,
+    technique: Technique,
+    options: &SceneOptions,
+) -> Result<RenderedImage> {
+    options.validate()?;
+    let renderer = Renderer::new(ctx, tables, technique, &options.technique_options())?;
+    renderer.render(ctx, tables, options)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn uniform_sizes_match_the_wgsl_layouts() {
+        assert_eq!(std::mem::size_of::<ViewUniform>(), 128);
+        assert_eq!(std::mem::size_of::<MaterialUniform>(), 80);
+        assert_eq!(std::mem::offset_of!(MaterialUniform, base_ior), 32);
+        assert_eq!(std::mem::offset_of!(MaterialUniform, base_kappa), 48);
+        assert_eq!(std::mem::offset_of!(MaterialUniform, base_colour), 64);
+        assert_eq!(std::mem::offset_of!(ViewUniform, eye_position), 64);
+        assert_eq!(std::mem::offset_of!(ViewUniform, resolution), 112);
+    }
+
+    #[test]
+    fn camera_ray_through_the_centre_looks_at_the_target() {
+        let cam = Camera::for_scene(SceneKind::Sphere);
+        let m = cam.inverse_view_projection(4.0 / 3.0).unwrap();
+        let apply = |v: [f32; 4]| -> [f64; 3] {
+            let mut out = [0.0f64; 4];
+            for (col, &x) in m.iter().zip(&v) {
+                for r in 0..4 {
+                    out[r] += f64::from(col[r]) * f64::from(x);
+                }
+            }
+            [out[0] / out[3], out[1] / out[3], out[2] / out[3]]
+        };
+        let near = apply([0.0, 0.0, 0.0, 1.0]);
+        let far = apply([0.0, 0.0, 1.0, 1.0]);
+        let dir = normalize(sub(far, near)).unwrap();
+        let expect = normalize(sub(cam.target.map(f64::from), cam.eye.map(f64::from))).unwrap();
+        for k in 0..3 {
+            assert!((dir[k] - expect[k]).abs() < 1e-4, "{dir:?} vs {expect:?}");
+        }
+        // The near point is the eye pushed 0.05 along the view direction.
+        for k in 0..3 {
+            assert!((near[k] - (f64::from(cam.eye[k]) + 0.05 * expect[k])).abs() < 1e-3);
+        }
+        // The top edge of the image is fov/2 above the centre.
+        let top = normalize(sub(apply([0.0, 1.0, 1.0, 1.0]), near)).unwrap();
+        let angle = (top[0] * dir[0] + top[1] * dir[1] + top[2] * dir[2])
+            .acos()
+            .to_degrees();
+        assert!((angle - 18.0).abs() < 1e-3, "{angle}");
+        let mut bad = cam;
+        bad.target = bad.eye;
+        assert!(bad.inverse_view_projection(1.0).is_err());
+        bad = cam;
+        bad.fov_y_deg = 180.0;
+        assert!(bad.inverse_view_projection(1.0).is_err());
+    }
+
+    #[test]
+    fn mip_chain_averages_and_ends_at_one_texel() {
+        let texels: Vec<[f32; 1]> = (0..15).map(|i| [i as f32]).collect();
+        let chain = mip_chain(5, 3, texels);
+        let sizes: Vec<(usize, usize)> = chain.iter().map(|l| (l.0, l.1)).collect();
+        assert_eq!(sizes, vec![(5, 3), (2, 1), (1, 1)]);
+        // Level 1 texel 0 averages (0, 0), (1, 0), (0, 1), (1, 1) = 0, 1, 5, 6.
+        assert_eq!(chain[1].2[0][0], 3.0);
+    }
+
+    #[test]
+    fn procedural_images_are_finite_and_in_range() {
+        let env = procedural_environment(64, 32);
+        assert!(
+            env.rgb
+                .iter()
+                .flatten()
+                .all(|v| v.is_finite() && *v >= 0.0 && *v < 65504.0)
+        );
+        let map = procedural_thickness_map(64);
+        assert!(map.values.iter().all(|v| (0.0..=1.0).contains(v)));
+        // Tileable: the first and the last column differ as little as neighbours do.
+        let step = |a: usize, b: usize| (map.values[a] - map.values[b]).abs();
+        let wrap: f32 = (0..64)
+            .map(|y| step(y * 64, y * 64 + 63))
+            .fold(0.0, f32::max);
+        let inner: f32 = (0..64)
+            .map(|y| step(y * 64, y * 64 + 1))
+            .fold(0.0, f32::max);
+        assert!(wrap <= 2.0 * inner + 1e-3, "{wrap} vs {inner}");
+    }
+
+    #[test]
+    fn scene_names_parse() {
+        for k in SceneKind::ALL {
+            assert_eq!(k.name().parse::<SceneKind>().unwrap(), k);
+        }
+        assert!("cube".parse::<SceneKind>().is_err());
+    }
+}

@@ -1,0 +1,453 @@
+// nacre · shaders/material.wgsl — consumer: a thin-film microfacet material
+//
+// A GGX specular lobe whose Fresnel term is the technique's film colour, over a Lambertian
+// (dielectric) or metallic base, lit by one directional light and by an equirectangular HDR
+// environment, with optional transmission through a thin transparent shell (soap bubble),
+// exposure, the Khronos PBR Neutral tone mapper and an sRGB encoding. Composed after
+// common.wgsl, lut_mapping.wgsl and one technique module (which supplies `film_colour`),
+// and before scene.wgsl, which ray-casts the geometry and calls `material_shade`
+// (crates/runtime/src/render.rs; shaders/README.md).
+//
+// Symbols
+//
+//   symbol        code                         meaning
+//   n, v, l, h    normal, view, light, half    unit vectors at the shading point; v and l point
+//                                              away from the surface, h = (v + l)/|v + l|
+//   α             roughness_alpha              GGX roughness (α = perceptual roughness²)
+//   D(h)          ggx_distribution             GGX / Trowbridge–Reitz normal distribution
+//   Λ(ω)          (inside ggx_visibility)      Smith auxiliary function of GGX
+//   G₂(v, l)      (inside ggx_visibility)      height-correlated masking-shadowing
+//   V(v, l)       ggx_visibility               G₂ / (4 |n·v| |n·l|)
+//   R_f(cos θ)    FilmOutput.reflectance       film reflectance colour (replaces Fresnel F)
+//   T_f(cos θ)    FilmOutput.transmittance     film transmittance colour (thin shells)
+//   E_GGX(α)      ggx_albedo_scale             directional albedo of the GGX lobe with F = 1
+//   L_env(ω, k)   env_radiance                 environment radiance towards ω at mip level k
+//   E_l           light_colour × intensity     irradiance of the directional light at normal
+//                                              incidence (linear RGB)
+//   d             thickness_nm                 film thickness at the shading point, nm
+//   g             thickness map value          greyscale value ∈ [0, 1]
+//   σ_d           sigma_thickness_nm           std. dev. of d inside the pixel (film_fourier)
+//
+// Specular, one light (Walter et al. 2007, Eq. 33 for D; Heitz 2014, "Understanding the
+// Masking-Shadowing Function in Microfacet-Based BRDFs", JCGT 3(2), Eq. 72 for Λ and Eq. 99
+// for the height-correlated G₂):
+//
+//   f_s = D(h) G₂(v, l) R_f(v·h) / (4 n·v n·l)
+//   D(h) = α² / (π ((n·h)² (α² − 1) + 1)²)
+//   Λ(ω) = (−1 + √(1 + α² tan² θ_ω)) / 2,   G₂ = 1 / (1 + Λ(v) + Λ(l))
+//   ⇒ V = G₂ / (4 n·v n·l) = 0.5 / (n·l √((n·v)²(1 − α²) + α²) + n·v √((n·l)²(1 − α²) + α²))
+//
+// The film term sits where Fresnel sits and is evaluated at the microfacet's incidence v·h;
+// for a metal base the film lies on the metal, and R_f already contains the metal's
+// reflectance (film_lut bakes the base; film_fourier and film_spectral get its complex index).
+// Diffuse, dielectric base only: a Lambertian base of albedo ρ under the film, weighted by
+// what the film does not reflect: f_d = ρ/π (1 − R_f(v·h)) for the light, ρ (1 − R_f(n·v))
+// for the environment. Metal bases and thin shells have no diffuse term.
+//
+// Image-based lighting (no split-sum table): the environment's mip chain (a 2×2 box filter
+// built on the CPU, `render::EnvironmentMap::mip_chain`) stands in for the pre-convolved
+// radiance, and the GGX lobe's directional albedo becomes one scale:
+//
+//   L_spec ≈ L_env(reflect(−v, n), k(α)) · R_f(n·v) · E_GGX(α)
+//   E_GGX(α) = 1 − 0.55 √α
+//   k(α) = log2(max(2 α H / π, 1))     (H: environment height in texels; the reflected lobe's
+//                                       half-width ≈ 2α radians spans 2αH/π texels at level 0)
+//   L_diff ≈ L_env(n, k_max − 2) · ρ (1 − R_f(n·v))   (a 4×8-texel-wide box ≈ the cosine lobe)
+//
+// E_GGX is the F = 1 limit (A + B) of B. Karis, "Physically Based Shading on Mobile" (Unreal
+// Engine blog, 2014), EnvBRDFApprox, after D. Lazarov (2013): it ignores the view angle and
+// the multiple scattering between microfacets, and the film is evaluated once, at n·v.
+//
+// Thin transparent shells (MaterialParams.transmission = 1, the soap bubble): the surface
+// reflects as above and passes T_f(n·v) of the light behind it straight through (no refraction
+// offset: both faces of a thin shell are parallel); `material_shade` returns T_f and the
+// scene multiplies what lies behind by it.
+//
+// Spatially varying thickness from a greyscale map (MaterialParams.thickness_mode):
+//
+//   0  SVT, Sussenbach 2013 §4.2 Eq. 4.3–4.4:   d = d_avg + d_rel (2g − 1)
+//   1  glTF KHR_materials_iridescence:          d = mix(d_min, d_max, g)
+//
+// plus a drainage term d += drain (1 − h)/2 for a normalised object height h ∈ [−1, 1]
+// (gravity pulls a soap film down: 0 at the top, `drain` nm at the bottom); d ≥ 0.
+//
+// Prefiltering (film_fourier; the other techniques ignore σ_d): σ_d comes from the
+// screen-space derivatives of d and from the sub-pixel variance of the map
+// (`material_thickness_sigma`, the formula of film_fourier.wgsl's
+// fourier_sigma_from_derivatives, redefined here so that this module composes with every
+// technique):
+//
+//   σ_d = √(max((∂d/∂x)², (∂d/∂y)²)/12 + σ_r²),   σ_r² = roughness² + (∂d/∂g)² Var(g)
+//
+// where Var(g) = E[g²] − E[g]² is read from the map's mip chain, which stores (g, g²) per
+// texel: the mip level the sampler picks for the pixel's footprint averages both, so the
+// variance of the thickness the filtering removed is not lost (mean-and-second-moment
+// mipmapping as in variance shadow maps, Donnelly & Lauritzen 2006).
+//
+// Output: exposure (a factor 2^EV), tone mapping by Khronos PBR Neutral
+// (KhronosGroup/ToneMapping, PBR_Neutral, 2024), then the sRGB transfer function
+// (IEC 61966-2-1) applied here: the render target is Rgba8Unorm and holds sRGB-encoded bytes.
+//
+// NaN guards: every film evaluation is sanitised by the technique; vectors are normalised
+// with a fallback; the final colour replaces non-finite channels by 0 before tone mapping.
+
+// ─── Group 0: the view (changes per frame) ───────────────────────────────────────────────
+//
+// 128 bytes, uniform (mirrored by `ViewUniform` in crates/runtime/src/render.rs):
+//
+//   offset size field
+//        0   64 inv_view_proj: mat4x4<f32>    clip (x, y ∈ [−1, 1], z ∈ [0, 1]) → world
+//       64   12 eye_position: vec3<f32>       camera position, world units
+//       76    4 exposure: f32                 linear factor 2^EV before tone mapping
+//       80   12 light_direction: vec3<f32>    unit vector from the surface towards the light
+//       92    4 light_intensity: f32          scale of light_colour
+//       96   12 light_colour: vec3<f32>       linear RGB
+//      108    4 env_intensity: f32            scale of the environment radiance
+//      112    8 resolution: vec2<f32>         render target size, pixels
+//      120    4 scene: u32                    scene.wgsl: 0 sphere, 1 bubble, 2 plane
+//      124    4 env_lod_max: f32              last mip level of env_map (GLSL ES cannot query it)
+struct ViewParams {
+    inv_view_proj: mat4x4<f32>,
+    eye_position: vec3<f32>,
+    exposure: f32,
+    light_direction: vec3<f32>,
+    light_intensity: f32,
+    light_colour: vec3<f32>,
+    env_intensity: f32,
+    resolution: vec2<f32>,
+    scene: u32,
+    env_lod_max: f32,
+}
+
+@group(0) @binding(0) var<uniform> view: ViewParams;
+// Equirectangular HDR environment, Rgba16Float with a full mip chain. Row 0 is the zenith
+// (+y); u = 0.5 looks down −z, u increases towards +x (env_direction_to_uv).
+@group(0) @binding(1) var env_map: texture_2d<f32>;
+// Linear min/mag/mip; u repeats, v clamps.
+@group(0) @binding(2) var env_sampler: sampler;
+
+// ─── Group 2: the material (changes per draw) ────────────────────────────────────────────
+//
+// 80 bytes, uniform (mirrored by `MaterialUniform` in crates/runtime/src/render.rs):
+//
+//   offset size field
+//        0    4 film_ior: f32                 real film index n₂
+//        4    4 ambient_ior: f32              ambient index n₁
+//        8    4 thickness_a_nm: f32           SVT: d_avg; glTF: d_min (nm)
+//       12    4 thickness_b_nm: f32           SVT: d_rel; glTF: d_max (nm)
+//       16    4 thickness_mode: u32           0 SVT, 1 glTF
+//       20    4 thickness_roughness_nm: f32   sub-pixel std. dev. of d, nm
+//       24    4 thickness_drain_nm: f32       extra thickness at the bottom (h = −1), nm
+//       28    4 roughness_alpha: f32          GGX α
+//       32   12 base_ior: vec3<f32>           base index per output channel, real part
+//       44    4 base_kind: u32                0 dielectric (Lambertian diffuse), 1 metal
+//       48   12 base_kappa: vec3<f32>         base index per output channel, κ
+//       60    4 transmission: u32             1: thin transparent shell
+//       64   12 base_colour: vec3<f32>        diffuse albedo ρ (linear RGB, dielectric base)
+//       76    4 thickness_map_scale: f32      s: a map tile spans 2/s units of the scene's map coordinate
+struct MaterialParams {
+    film_ior: f32,
+    ambient_ior: f32,
+    thickness_a_nm: f32,
+    thickness_b_nm: f32,
+    thickness_mode: u32,
+    thickness_roughness_nm: f32,
+    thickness_drain_nm: f32,
+    roughness_alpha: f32,
+    base_ior: vec3<f32>,
+    base_kind: u32,
+    base_kappa: vec3<f32>,
+    transmission: u32,
+    base_colour: vec3<f32>,
+    thickness_map_scale: f32,
+}
+
+@group(2) @binding(0) var<uniform> material_params: MaterialParams;
+// Thickness map, Rg16Float with a full mip chain: r = g, g = g² (mean and second moment).
+@group(2) @binding(1) var thickness_map: texture_2d<f32>;
+// Linear min/mag/mip, repeat.
+@group(2) @binding(2) var thickness_sampler: sampler;
+
+const MATERIAL_THICKNESS_SVT: u32 = 0u;
+const MATERIAL_THICKNESS_GLTF: u32 = 1u;
+const MATERIAL_BASE_DIELECTRIC: u32 = 0u;
+const MATERIAL_BASE_METAL: u32 = 1u;
+// Smallest GGX α (a mirror-like α keeps D finite in f32).
+const MATERIAL_ALPHA_MIN: f32 = 1e-3;
+// Smallest |n·v| and |n·l| used in the BRDF (grazing guard).
+const MATERIAL_COS_MIN: f32 = 1e-4;
+// Variance of a unit-width box footprint (as FOURIER_BOX_VARIANCE).
+const MATERIAL_BOX_VARIANCE: f32 = 0.0833333333333333;
+// Largest radiance passed to the tone mapper (keeps f32 arithmetic finite).
+const MATERIAL_RADIANCE_MAX: f32 = 65504.0;
+
+// ─── Small helpers ───────────────────────────────────────────────────────────────────────
+
+// v / |v|, or `fallback` when v is zero or not finite.
+fn safe_normalize(v: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
+    let len2 = dot(v, v);
+    if !(len2 > 1e-30) || !f32_is_finite(len2) {
+        return fallback;
+    }
+    return v * inverseSqrt(len2);
+}
+
+// Every non-finite or negative channel → 0, the rest clamped to MATERIAL_RADIANCE_MAX.
+fn sanitize_radiance(c: vec3<f32>) -> vec3<f32> {
+    let zero = vec3<f32>(0.0);
+    return select(zero, clamp(c, zero, vec3<f32>(MATERIAL_RADIANCE_MAX)), vec3_is_finite(c));
+}
+
+// ─── Thickness ───────────────────────────────────────────────────────────────────────────
+
+// Film thickness d (nm) for a map value g ∈ [0, 1] (NaN → 0.5, clamped) at normalised object
+// height h ∈ [−1, 1] (h = 1 at the top; NaN → 1: no drainage).
+fn material_thickness_nm(g_raw: f32, h_raw: f32) -> f32 {
+    let p = material_params;
+    let g = clamp(finite_or(g_raw, 0.5), 0.0, 1.0);
+    let h = clamp(finite_or(h_raw, 1.0), -1.0, 1.0);
+    var d: f32;
+    if p.thickness_mode == MATERIAL_THICKNESS_GLTF {
+        d = mix(p.thickness_a_nm, p.thickness_b_nm, g);
+    } else {
+        d = p.thickness_a_nm + p.thickness_b_nm * (2.0 * g - 1.0);
+    }
+    d += p.thickness_drain_nm * 0.5 * (1.0 - h);
+    return clamp(finite_or(d, 0.0), 0.0, THICKNESS_MAX_NM);
+}
+
+// ∂d/∂g of the current thickness mode (nm per unit of g).
+fn material_thickness_slope_nm() -> f32 {
+    let p = material_params;
+    if p.thickness_mode == MATERIAL_THICKNESS_GLTF {
+        return finite_or(p.thickness_b_nm - p.thickness_a_nm, 0.0);
+    }
+    return finite_or(2.0 * p.thickness_b_nm, 0.0);
+}
+
+// σ_d (nm) from the screen-space derivatives of d (nm per pixel) and a sub-pixel thickness
+// roughness (nm): √(max(∂d/∂x, ∂d/∂y)²/12 + roughness²) — the formula of
+// fourier_sigma_from_derivatives (film_fourier.wgsl). Non-finite inputs count as 0; the
+// result is at most THICKNESS_MAX_NM.
+fn material_thickness_sigma(d_thickness_dx: f32, d_thickness_dy: f32, roughness_nm: f32) -> f32 {
+    let gx = finite_or(d_thickness_dx, 0.0);
+    let gy = finite_or(d_thickness_dy, 0.0);
+    let r = finite_or(roughness_nm, 0.0);
+    let g2 = max(gx * gx, gy * gy);
+    return min(sqrt(g2 * MATERIAL_BOX_VARIANCE + r * r), THICKNESS_MAX_NM);
+}
+
+// The thickness map's (E[g], E[g²]) at `uv` for a footprint given by the uv derivatives
+// (textureSampleGrad: no implicit derivatives, so it may be called in non-uniform control
+// flow). Non-finite uv → the map's centre.
+fn material_sample_thickness_map(uv: vec2<f32>, duv_dx: vec2<f32>, duv_dy: vec2<f32>) -> vec2<f32> {
+    let ok = f32_is_finite(uv.x) && f32_is_finite(uv.y);
+    let st = select(vec2<f32>(0.5), uv, ok);
+    let gx = select(vec2<f32>(0.0), duv_dx, vec3_is_finite(vec3<f32>(duv_dx, 0.0)).xy);
+    let gy = select(vec2<f32>(0.0), duv_dy, vec3_is_finite(vec3<f32>(duv_dy, 0.0)).xy);
+    let m = textureSampleGrad(thickness_map, thickness_sampler, st, gx, gy).rg;
+    return select(vec2<f32>(0.5, 0.25), m, vec3_is_finite(vec3<f32>(m, 0.0)).xy);
+}
+
+// The sub-pixel thickness std. dev. (nm) that the map's filtering removed, combined with the
+// material's thickness roughness: √(roughness² + (∂d/∂g)² (E[g²] − E[g]²)).
+fn material_thickness_roughness_nm(moments: vec2<f32>) -> f32 {
+    let var_g = max(moments.y - moments.x * moments.x, 0.0);
+    let slope = material_thickness_slope_nm();
+    let r = finite_or(material_params.thickness_roughness_nm, 0.0);
+    return sqrt(r * r + slope * slope * var_g);
+}
+
+// ─── Environment ─────────────────────────────────────────────────────────────────────────
+
+// Equirectangular coordinates of a unit direction: u = 0.5 + atan2(x, −z)/(2π),
+// v = acos(y)/π (v = 0 at the zenith).
+fn env_direction_to_uv(dir: vec3<f32>) -> vec2<f32> {
+    let d = safe_normalize(dir, vec3<f32>(0.0, 1.0, 0.0));
+    let u = 0.5 + atan2(d.x, -d.z) / TWO_PI;
+    let v = acos(clamp(d.y, -1.0, 1.0)) / PI;
+    return vec2<f32>(u, v);
+}
+
+// The last mip level of the environment (from the uniform: GLSL ES has no textureQueryLevels).
+fn env_lod_max() -> f32 {
+    return max(finite_or(view.env_lod_max, 0.0), 0.0);
+}
+
+// Environment radiance towards `dir` at mip level `lod` (clamped), times env_intensity.
+fn env_radiance(dir: vec3<f32>, lod: f32) -> vec3<f32> {
+    let uv = env_direction_to_uv(dir);
+    let k = clamp(finite_or(lod, 0.0), 0.0, env_lod_max());
+    let c = textureSampleLevel(env_map, env_sampler, uv, k).rgb;
+    return sanitize_radiance(c * max(finite_or(view.env_intensity, 0.0), 0.0));
+}
+
+// Mip level k(α) = log2(max(2αH/π, 1)) for the reflected lobe of a GGX surface.
+fn env_specular_lod(alpha: f32) -> f32 {
+    let h = f32(max(textureDimensions(env_map, 0u).y, 1u));
+    return log2(max(2.0 * alpha * h / PI, 1.0));
+}
+
+// Mip level used for the diffuse (cosine-weighted) lookup.
+fn env_diffuse_lod() -> f32 {
+    return max(env_lod_max() - 2.0, 0.0);
+}
+
+// ─── GGX ─────────────────────────────────────────────────────────────────────────────────
+
+// D(h) = α² / (π ((n·h)² (α² − 1) + 1)²).
+fn ggx_distribution(n_dot_h: f32, alpha: f32) -> f32 {
+    let a2 = alpha * alpha;
+    let c = clamp(n_dot_h, 0.0, 1.0);
+    let k = c * c * (a2 - 1.0) + 1.0;
+    return a2 / max(PI * k * k, 1e-30);
+}
+
+// V = G₂(v, l) / (4 n·v n·l), height-correlated Smith (Heitz 2014 Eq. 99 with Eq. 72).
+fn ggx_visibility(n_dot_v: f32, n_dot_l: f32, alpha: f32) -> f32 {
+    let a2 = alpha * alpha;
+    let v = max(n_dot_v, MATERIAL_COS_MIN);
+    let l = max(n_dot_l, MATERIAL_COS_MIN);
+    let lambda_v = l * sqrt(v * v * (1.0 - a2) + a2);
+    let lambda_l = v * sqrt(l * l * (1.0 - a2) + a2);
+    return 0.5 / max(lambda_v + lambda_l, 1e-30);
+}
+
+// E_GGX(α) = 1 − 0.55 √α (Karis 2014, EnvBRDFApprox with F = 1).
+fn ggx_albedo_scale(alpha: f32) -> f32 {
+    return clamp(1.0 - 0.55 * sqrt(alpha), 0.0, 1.0);
+}
+
+// ─── Film ────────────────────────────────────────────────────────────────────────────────
+
+// The technique's input for incidence cos θ and the point's thickness statistics.
+fn material_film_input(cos_theta: f32, thickness_nm: f32, sigma_thickness_nm: f32) -> FilmInput {
+    let p = material_params;
+    var input: FilmInput;
+    input.cos_theta_i = cos_theta;
+    input.thickness_nm = thickness_nm;
+    input.film_ior = p.film_ior;
+    input.sigma_thickness_nm = sigma_thickness_nm;
+    input.ambient_ior = p.ambient_ior;
+    input.base_ior = p.base_ior;
+    input.base_kappa = p.base_kappa;
+    return input;
+}
+
+// ─── Shading ─────────────────────────────────────────────────────────────────────────────
+
+// One shading point, as scene.wgsl finds it.
+struct SurfacePoint {
+    // Unit normal on the viewer's side.
+    normal: vec3<f32>,
+    // Unit vector from the point towards the viewer.
+    view_dir: vec3<f32>,
+    // Film thickness d at the point, nm.
+    thickness_nm: f32,
+    // Std. dev. of d inside the pixel, nm.
+    sigma_thickness_nm: f32,
+}
+
+// What the surface sends towards the viewer, and what it lets through.
+struct ShadeResult {
+    // Reflected radiance (specular + diffuse), linear RGB.
+    radiance: vec3<f32>,
+    // Colour transmitted straight through a thin shell (0 unless transmission = 1).
+    transmittance: vec3<f32>,
+}
+
+// Shades one point of the film-coated surface (see the header for the model).
+//
+// Compile-time care: `film_colour` is called from exactly one place, inside a loop whose trip
+// count (1, or 2 when the light is above the surface) is not a compile-time constant, so that
+// shader compilers that inline every call (Mesa's NIR → LLVM in lavapipe) see one copy of the
+// technique — film_fourier's loops, inlined several times, make LLVM's loop analyses take
+// minutes. scene.wgsl likewise calls material_shade from one loop.
+fn material_shade(s: SurfacePoint) -> ShadeResult {
+    let p = material_params;
+    let n = safe_normalize(s.normal, vec3<f32>(0.0, 1.0, 0.0));
+    let v = safe_normalize(s.view_dir, n);
+    let alpha = clamp(finite_or(p.roughness_alpha, 0.0), MATERIAL_ALPHA_MIN, 1.0);
+    let n_dot_v = clamp(dot(n, v), MATERIAL_COS_MIN, 1.0);
+    let diffuse_on = p.base_kind == MATERIAL_BASE_DIELECTRIC && p.transmission == 0u;
+    let albedo = select(vec3<f32>(0.0), clamp(p.base_colour, vec3<f32>(0.0), vec3<f32>(1.0)), diffuse_on && all(vec3_is_finite(p.base_colour)));
+    let l = safe_normalize(view.light_direction, vec3<f32>(0.0, 1.0, 0.0));
+    let n_dot_l = dot(n, l);
+    let h = safe_normalize(v + l, n);
+    let v_dot_h = clamp(dot(v, h), 0.0, 1.0);
+
+    // The film at n·v (environment, transmission) and, when the light is above the surface,
+    // at v·h (the light).
+    var film_v: FilmOutput;
+    var film_h: FilmOutput;
+    let evaluations = select(1u, 2u, n_dot_l > 0.0);
+    for (var k = 0u; k < evaluations; k++) {
+        let cos_theta = select(n_dot_v, v_dot_h, k == 1u);
+        let film = film_colour(material_film_input(cos_theta, s.thickness_nm, s.sigma_thickness_nm));
+        if k == 0u {
+            film_v = film;
+        } else {
+            film_h = film;
+        }
+    }
+
+    // Environment: specular at reflect(−v, n) with the film at n·v, diffuse at n.
+    let one = vec3<f32>(1.0);
+    let r = reflect(-v, n);
+    var radiance = env_radiance(r, env_specular_lod(alpha)) * film_v.reflectance * ggx_albedo_scale(alpha);
+    radiance += env_radiance(n, env_diffuse_lod()) * albedo * max(one - film_v.reflectance, vec3<f32>(0.0));
+
+    // The directional light.
+    if n_dot_l > 0.0 {
+        let e_l = sanitize_radiance(view.light_colour * finite_or(view.light_intensity, 0.0));
+        let specular = ggx_distribution(dot(n, h), alpha) * ggx_visibility(n_dot_v, n_dot_l, alpha) * film_h.reflectance;
+        let diffuse = albedo / PI * max(one - film_h.reflectance, vec3<f32>(0.0));
+        radiance += (specular + diffuse) * e_l * n_dot_l;
+    }
+
+    var out: ShadeResult;
+    out.radiance = sanitize_radiance(radiance);
+    out.transmittance = vec3<f32>(0.0);
+    if p.transmission != 0u {
+        out.transmittance = clamp(film_v.transmittance, vec3<f32>(0.0), one);
+    }
+    return out;
+}
+
+// ─── Output ──────────────────────────────────────────────────────────────────────────────
+
+// Khronos PBR Neutral tone mapping (KhronosGroup/ToneMapping, PBR_Neutral; linear in,
+// linear out, [0, 1]): hue-preserving, identity below 0.76 apart from a small black offset.
+fn tone_map_pbr_neutral(colour: vec3<f32>) -> vec3<f32> {
+    let start_compression = 0.8 - 0.04;
+    let desaturation = 0.15;
+    var c = colour;
+    let x = min(c.r, min(c.g, c.b));
+    let offset = select(0.04, x - 6.25 * x * x, x < 0.08);
+    c -= offset;
+    let peak = max(c.r, max(c.g, c.b));
+    if peak < start_compression {
+        return c;
+    }
+    let d = 1.0 - start_compression;
+    let new_peak = 1.0 - d * d / (peak + d - start_compression);
+    c *= new_peak / peak;
+    let g = 1.0 - 1.0 / (desaturation * (peak - new_peak) + 1.0);
+    return mix(c, vec3<f32>(new_peak), g);
+}
+
+// The sRGB transfer function (IEC 61966-2-1), linear [0, 1] → encoded [0, 1].
+fn srgb_encode(linear: vec3<f32>) -> vec3<f32> {
+    let c = clamp(linear, vec3<f32>(0.0), vec3<f32>(1.0));
+    let lo = c * 12.92;
+    let hi = 1.055 * pow(c, vec3<f32>(1.0 / 2.4)) - 0.055;
+    return select(hi, lo, c <= vec3<f32>(0.0031308));
+}
+
+// Linear scene radiance → the sRGB-encoded colour written to the Rgba8Unorm target:
+// exposure, PBR Neutral, sRGB. Non-finite or negative channels count as 0.
+fn material_display(radiance: vec3<f32>) -> vec4<f32> {
+    let exposed = sanitize_radiance(radiance * max(finite_or(view.exposure, 1.0), 0.0));
+    let mapped = tone_map_pbr_neutral(exposed);
+    return vec4<f32>(srgb_encode(mapped), 1.0);
+}
