@@ -63,6 +63,44 @@ enum Command {
     /// any Vulkan/Metal/DX12/GL adapter, including Mesa's software lavapipe).
     #[command(after_help = RENDER_EXAMPLES)]
     Render(RenderArgs),
+    /// Time full-screen passes of each technique against a plain GGX + Schlick material on
+    /// the same adapter (GPU timestamps where supported) and report the ratios.
+    #[command(name = "bench-gpu", after_help = BENCH_GPU_EXAMPLES)]
+    BenchGpu(BenchGpuArgs),
+}
+
+const BENCH_GPU_EXAMPLES: &str = "\
+Every pass shades each pixel of a WIDTHxHEIGHT target with the same GGX microfacet material
+(shaders/bench.wgsl); only the Fresnel term differs: Schlick (plain), film_lut, film_fourier
+(M harmonics) or film_spectral (N wavelengths). Times are GPU timestamps of the render pass
+where the adapter supports them, else wall clock per frame; the median is reported.
+
+Examples:
+  # 1920x1080, 30 frames per pass, default tables (film-dielectric + fourier-srgb)
+  nacre bench-gpu
+  # a quick look on a software rasteriser
+  nacre bench-gpu --width 640 --height 360 --frames 5";
+
+#[derive(Args)]
+struct BenchGpuArgs {
+    /// Target width, pixels.
+    #[arg(long, default_value_t = 1920)]
+    width: u32,
+    /// Target height, pixels.
+    #[arg(long, default_value_t = 1080)]
+    height: u32,
+    /// Frames measured per pass (after 3 discarded warm-up frames).
+    #[arg(long, default_value_t = 30)]
+    frames: u32,
+    /// Harmonics M of film_fourier (0 = automatic).
+    #[arg(long, default_value_t = 3)]
+    harmonics: u32,
+    /// Wavelengths N of film_spectral.
+    #[arg(long, default_value_t = 30)]
+    wavelengths: usize,
+    /// Tables to load (repeatable) [default: film-dielectric + fourier-srgb].
+    #[arg(long = "tables", value_name = "NAME|PATH")]
+    tables: Vec<String>,
 }
 
 const BAKE_EXAMPLES: &str = "\
@@ -694,6 +732,77 @@ fn run_render(args: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
+fn run_bench_gpu(args: &BenchGpuArgs) -> Result<()> {
+    use nacre_runtime::bench::{BenchOptions, BenchPass, run_bench};
+    use nacre_runtime::bindings::TechniqueOptions;
+    use nacre_runtime::{GpuContext, TableSet, Technique};
+    let names: Vec<String> = if args.tables.is_empty() {
+        vec!["film-dielectric".into(), "fourier-srgb".into()]
+    } else {
+        args.tables.clone()
+    };
+    for name in &names {
+        bake::Manifest::read(&bake::resolve_table(name))?;
+    }
+    let mut technique = TechniqueOptions {
+        harmonics: args.harmonics,
+        ..Default::default()
+    };
+    technique.spectral.samples = args.wavelengths;
+    let options = BenchOptions {
+        width: args.width,
+        height: args.height,
+        frames: args.frames,
+        warmup: 3,
+        technique,
+    };
+    let ctx = GpuContext::new_headless().map_err(runtime_error)?;
+    eprintln!("adapter: {}", ctx.describe());
+    let mut tables = TableSet::default();
+    for name in &names {
+        tables
+            .add(&ctx, &bake::resolve_table(name))
+            .map_err(runtime_error)?;
+    }
+    let passes = [
+        BenchPass::Plain,
+        BenchPass::Film(Technique::Lut),
+        BenchPass::Film(Technique::Fourier),
+        BenchPass::Film(Technique::Spectral),
+    ];
+    let results = run_bench(&ctx, &tables, &passes, &options).map_err(runtime_error)?;
+    let plain = results[0].median_ms;
+    let lut = results[1].median_ms;
+    println!(
+        "{}x{}, {} frames per pass, {} (fourier M = {}, spectral N = {})",
+        args.width,
+        args.height,
+        args.frames,
+        if results[0].timestamps {
+            "GPU timestamps"
+        } else {
+            "wall clock (no timestamp queries)"
+        },
+        args.harmonics,
+        args.wavelengths
+    );
+    println!(
+        "{:<22} {:>11} {:>11} {:>10} {:>10}",
+        "pass", "median ms", "min ms", "/ plain", "/ lut"
+    );
+    for r in &results {
+        println!(
+            "{:<22} {:>11.3} {:>11.3} {:>10.2} {:>10.2}",
+            r.pass.name(),
+            r.median_ms,
+            r.min_ms,
+            r.median_ms / plain,
+            r.median_ms / lut
+        );
+    }
+    Ok(())
+}
+
 const CONFORMANCE_EXAMPLES: &str = "\
 Writes DIR/conformance.csv (base_ior,angle_deg,thickness_nm,film_ior,X,Y,Z,R,G,B: exact
 unpolarised reflectance colour of air | film | base, CIE 1931 2 deg, D65, Y = 1 for a perfect
@@ -769,6 +878,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Plot(args) => plot::run(&args),
         Command::Conformance(args) => run_conformance(&args),
         Command::Render(args) => run_render(&args),
+        Command::BenchGpu(args) => run_bench_gpu(&args),
         Command::Info { table } => {
             let path = bake::resolve_table(&table);
             let manifest = bake::Manifest::read(&path)?;

@@ -560,3 +560,56 @@ fn render_bad_input_exits_2_without_output() {
     assert_eq!(o.status.code(), Some(2));
     assert_eq!(std::fs::read(d.join("keep.png")).unwrap(), b"keep");
 }
+
+/// `nacre bench-gpu` times every pass on the adapter it finds (lavapipe in CI) and reports
+/// ratios against the plain pass.
+#[test]
+fn bench_gpu_reports_every_pass() {
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let o = nacre(
+        &[
+            "bench-gpu",
+            "--width",
+            "64",
+            "--height",
+            "32",
+            "--frames",
+            "2",
+        ],
+        &repo,
+    );
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for pass in [
+        "plain GGX + Schlick",
+        "film_lut",
+        "film_fourier",
+        "film_spectral",
+    ] {
+        let line = stdout
+            .lines()
+            .find(|l| l.starts_with(pass))
+            .unwrap_or_else(|| panic!("no `{pass}` line in\n{stdout}"));
+        let ms: f64 = line
+            .split_whitespace()
+            .rev()
+            .nth(3)
+            .unwrap()
+            .parse()
+            .unwrap();
+        assert!(ms.is_finite() && ms >= 0.0, "{line}");
+    }
+    let bad = nacre(
+        &[
+            "bench-gpu",
+            "--frames",
+            "0",
+            "--width",
+            "8",
+            "--height",
+            "8",
+        ],
+        &repo,
+    );
+    assert_eq!(bad.status.code(), Some(2));
+}
