@@ -299,17 +299,27 @@ fn film_colour(raw: FilmInput) -> FilmOutput {
     var rho_p = k_rs;
     var m_r = 1u;
     var m_t = 1u;
+    // A base whose index is the same in every channel (any non-dispersive base) needs its
+    // Fresnel terms once, not three times.
+    var rs: AirySeries;
+    var rp: AirySeries;
+    var ts: AirySeries;
+    var tp: AirySeries;
+    var previous = vec2<f32>(-1.0, -1.0);
     for (var j = 0u; j < 3u; j++) {
         let n3 = vec2<f32>(input.base_ior[j], input.base_kappa[j]);
-        let q3 = normal_component_cos(n3, n1, c);
-        let bottom = fresnel_interface(film, q2c, n3, q3);
-        let rs = airy_series_reflectance(top.r_s, bottom.r_s);
-        let rp = airy_series_reflectance(top.r_p, bottom.r_p);
-        let transmits = input.base_kappa[j] == 0.0;
-        let factor_s = select(0.0, power_factor_s(q1, q3), transmits);
-        let factor_p = select(0.0, power_factor_p(a, q1, n3, q3), transmits);
-        let ts = airy_series_transmittance(top.t_s, bottom.t_s, factor_s, rs.rho);
-        let tp = airy_series_transmittance(top.t_p, bottom.t_p, factor_p, rp.rho);
+        if any(n3 != previous) {
+            previous = n3;
+            let q3 = normal_component_cos(n3, n1, c);
+            let bottom = fresnel_interface(film, q2c, n3, q3);
+            rs = airy_series_reflectance(top.r_s, bottom.r_s);
+            rp = airy_series_reflectance(top.r_p, bottom.r_p);
+            let transmits = input.base_kappa[j] == 0.0;
+            let factor_s = select(0.0, power_factor_s(q1, q3), transmits);
+            let factor_p = select(0.0, power_factor_p(a, q1, n3, q3), transmits);
+            ts = airy_series_transmittance(top.t_s, bottom.t_s, factor_s, rs.rho);
+            tp = airy_series_transmittance(top.t_p, bottom.t_p, factor_p, rp.rho);
+        }
         c0_r[j] = 0.5 * (rs.c0 + rp.c0);
         c0_t[j] = 0.5 * (ts.c0 + tp.c0);
         k_rs.re[j] = rs.k.x;
