@@ -289,3 +289,67 @@ fn film_spectral_matches_samples_n() {
         }
     }
 }
+
+/// Every technique returns finite colours for every input a host engine might send: NaN,
+/// ±∞, negative, zero and huge values in every field, grazing and total internal reflection.
+#[test]
+fn every_technique_is_finite_for_hostile_inputs() {
+    let ctx = ctx();
+    let mut tables = TableSet::load(ctx, &manifest("soap-film")).unwrap();
+    tables.add(ctx, &manifest("fourier-srgb")).unwrap();
+    let colorimeter = tables.colorimeter().unwrap();
+    let values = [
+        f32::NAN,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        -1.0,
+        0.0,
+        1e-30,
+        0.5,
+        1.0,
+        1.33,
+        2.5,
+        1e30,
+        f32::MAX,
+    ];
+    let mut rng = Lcg(99);
+    let mut pick = || values[(rng.next() * values.len() as f64) as usize];
+    let mut inputs = Vec::new();
+    for _ in 0..6000 {
+        inputs.push(FilmInput {
+            cos_theta_i: pick(),
+            thickness_nm: pick() * 500.0,
+            film_ior: pick(),
+            sigma_thickness_nm: pick() * 50.0,
+            ambient_ior: pick(),
+            base_ior: [pick(), pick(), pick()],
+            base_kappa: [pick(), pick(), pick()],
+            ..Default::default()
+        });
+    }
+    // Total internal reflection and evanescent films, exactly grazing.
+    inputs.push(input(0.0, 300.0, 1.0, 0.0, 1.5, C64::new(1.0, 0.0)));
+    inputs.push(input(0.1, 300.0, 1.2, 0.0, 1.5, C64::new(1.33, 0.0)));
+    for technique in Technique::ALL {
+        for harmonics in [0u32, 3] {
+            let options = TechniqueOptions {
+                harmonics,
+                ..Default::default()
+            };
+            let binding =
+                TechniqueBinding::new(ctx, &tables, technique, &options, &colorimeter).unwrap();
+            let out = run_probe(ctx, &binding, &inputs).unwrap();
+            for (i, o) in out.iter().enumerate() {
+                assert!(
+                    o.reflectance
+                        .iter()
+                        .chain(&o.transmittance)
+                        .all(|v| v.is_finite()),
+                    "{} (M = {harmonics}): {o:?} for {:?}",
+                    technique.name(),
+                    inputs[i]
+                );
+            }
+        }
+    }
+}
