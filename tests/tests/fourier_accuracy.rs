@@ -17,18 +17,7 @@ use nacre_optics::fourier::Harmonics;
 use nacre_optics::{C64, Layer, Material, SpectralRule, Stack};
 use std::sync::Arc;
 
-struct Rng(u64);
-
-impl Rng {
-    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        lo + (hi - lo) * ((z >> 11) as f64 / (1u64 << 53) as f64)
-    }
-}
+use nacre_tests::Rng;
 
 const POINTS: usize = 2000;
 

@@ -11,25 +11,10 @@ use nacre_optics::colour::{delta_e_2000, xyz_to_lab};
 use nacre_optics::{C64, Material};
 
 /// SplitMix64: a tiny deterministic generator, so the points are the same on every run.
-struct Rng(u64);
-
-impl Rng {
-    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        lo + (hi - lo) * ((z >> 11) as f64 / (1u64 << 53) as f64)
-    }
-}
+use nacre_tests::{Rng, percentile};
 
 const POINTS: usize = 2000;
 const DEFAULT_TABLES: [&str; 4] = ["soap-film", "film-dielectric", "film-gold", "oil-slick"];
-
-fn percentile(sorted: &[f64], p: f64) -> f64 {
-    sorted[((sorted.len() - 1) as f64 * p).round() as usize]
-}
 
 #[test]
 fn default_tables_meet_the_accuracy_targets() {
