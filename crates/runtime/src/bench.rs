@@ -11,6 +11,7 @@
 use crate::bindings::{TechniqueBinding, TechniqueOptions};
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
+use crate::fullscreen;
 use crate::shaders::{self, Technique};
 use crate::tables::TableSet;
 use std::time::Instant;
@@ -214,31 +215,14 @@ pub fn run_bench(
                 bind_group_layouts: &[Some(&view_layout), Some(table_layout)],
                 immediate_size: 0,
             });
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(pass.name()),
-                layout: Some(&layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("bench_vs"),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: Default::default(),
-                depth_stencil: None,
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some("bench_fs"),
-                    compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState {
-                        format: wgpu::TextureFormat::Rgba8Unorm,
-                        blend: None,
-                        write_mask: wgpu::ColorWrites::ALL,
-                    })],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
+            fullscreen::pipeline(
+                device,
+                pass.name(),
+                &module,
+                &layout,
+                ("bench_vs", "bench_fs"),
+                &[wgpu::TextureFormat::Rgba8Unorm],
+            )
         })?;
         let mut times_ms = Vec::new();
         for frame in 0..options.warmup + options.frames {

@@ -9,6 +9,7 @@ pub mod bench;
 pub mod bindings;
 pub mod context;
 pub mod error;
+pub mod fullscreen;
 pub mod params;
 pub mod probe;
 pub mod readback;

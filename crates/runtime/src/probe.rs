@@ -5,6 +5,7 @@
 use crate::bindings::TechniqueBinding;
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
+use crate::fullscreen;
 use crate::params::{FilmInput, FilmOutput};
 use crate::readback::read_texture;
 use crate::shaders::{self, PROBE};
@@ -81,32 +82,14 @@ pub fn run_probe(
             ],
             immediate_size: 0,
         });
-        let target = Some(wgpu::ColorTargetState {
-            format: wgpu::TextureFormat::Rgba32Float,
-            blend: None,
-            write_mask: wgpu::ColorWrites::ALL,
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("probe"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("probe_vs"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("probe_fs"),
-                compilation_options: Default::default(),
-                targets: &[target.clone(), target],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = fullscreen::pipeline(
+            device,
+            "probe",
+            &module,
+            &layout,
+            ("probe_vs", "probe_fs"),
+            &[wgpu::TextureFormat::Rgba32Float; 2],
+        );
         let storage = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("probe inputs"),
             contents: bytemuck::cast_slice(inputs),
