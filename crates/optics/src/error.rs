@@ -91,6 +91,16 @@ pub enum Error {
         /// Number of films in the stack.
         count: usize,
     },
+    /// A numeric parameter outside its documented range (e.g. a GGX roughness α ≤ 0).
+    #[error("{what} = {value} is out of range: expected {expected}")]
+    OutOfRange {
+        /// The parameter, e.g. `GGX roughness α`.
+        what: &'static str,
+        /// The value given.
+        value: f64,
+        /// The accepted range.
+        expected: &'static str,
+    },
     /// A name (observer, illuminant, colour space) that is not one of the known ones.
     #[error("unknown {what} `{name}`: expected one of {expected}")]
     UnknownName {

@@ -25,6 +25,7 @@ pub mod error;
 pub mod fourier;
 pub mod fresnel;
 pub mod material;
+pub mod microfacet;
 pub mod spectral;
 pub mod stack;
 
