@@ -40,6 +40,12 @@
 // The film term sits where Fresnel sits and is evaluated at the microfacet's incidence v·h;
 // for a metal base the film lies on the metal, and R_f already contains the metal's
 // reflectance (film_lut bakes the base; film_fourier and film_spectral get its complex index).
+// Film weight w (MaterialParams.film_weight; glTF iridescenceFactor, OpenPBR thin_film_weight):
+// a fraction w of the surface is coated, so every film term is blended with the bare base's
+// unpolarised Fresnel reflectance F_base (ambient → base index n + iκ per channel, no film):
+//
+//   R = mix(F_base, R_f, w),   T = mix(1 − F_base, T_f, w)        (w = 1: the film alone, exactly)
+//
 // Diffuse, dielectric base only: a Lambertian base of albedo ρ under the film, weighted by
 // what the film does not reflect: f_d = ρ/π (1 − R_f(v·h)) for the light, ρ (1 − R_f(n·v))
 // for the environment. Metal bases and thin shells have no diffuse term.
@@ -128,7 +134,7 @@ struct ViewParams {
 
 // ─── Group 2: the material (changes per draw) ────────────────────────────────────────────
 //
-// 80 bytes, uniform (mirrored by `MaterialUniform` in crates/runtime/src/render.rs):
+// 96 bytes, uniform (mirrored by `MaterialUniform` in crates/runtime/src/render.rs):
 //
 //   offset size field
 //        0    4 film_ior: f32                 real film index n₂
@@ -145,6 +151,9 @@ struct ViewParams {
 //       60    4 transmission: u32             1: thin transparent shell
 //       64   12 base_colour: vec3<f32>        diffuse albedo ρ (linear RGB, dielectric base)
 //       76    4 thickness_map_scale: f32      s: a map tile spans 2/s units of the scene's map coordinate
+//       80    4 film_weight: f32              w ∈ [0, 1]: F = mix(F_base, R_f, w) (glTF
+//                                             iridescenceFactor, OpenPBR thin_film_weight); 1 = film
+//       84   12 _pad0.._pad2: f32             (96 bytes in all)
 struct MaterialParams {
     film_ior: f32,
     ambient_ior: f32,
@@ -160,6 +169,10 @@ struct MaterialParams {
     transmission: u32,
     base_colour: vec3<f32>,
     thickness_map_scale: f32,
+    film_weight: f32,
+    _pad0: f32,
+    _pad1: f32,
+    _pad2: f32,
 }
 
 @group(2) @binding(0) var<uniform> material_params: MaterialParams;
@@ -334,6 +347,37 @@ fn material_film_input(cos_theta: f32, thickness_nm: f32, sigma_thickness_nm: f3
     return input;
 }
 
+// The bare base's unpolarised Fresnel reflectance per channel at incidence cos θ, seen from
+// the ambient n₁ (fresnel_interface, (|r_s|² + |r_p|²)/2): the film-free part of a partially
+// coated surface (film_weight < 1).
+fn material_base_reflectance(cos_theta: f32) -> vec3<f32> {
+    let p = material_params;
+    let n1 = select(1.0, p.ambient_ior, f32_is_finite(p.ambient_ior) && p.ambient_ior > 0.0);
+    let c = clamp(finite_or(cos_theta, 1.0), 1e-6, 1.0);
+    let q0 = c_real(n1 * c);
+    var r = vec3<f32>(0.0);
+    for (var j = 0; j < 3; j++) {
+        let nk = sanitize_base_index(p.base_ior[j], p.base_kappa[j]);
+        let f = fresnel_interface(c_real(n1), q0, nk, normal_component_cos(nk, n1, c));
+        r[j] = clamp(0.5 * (c_abs2(f.r_s) + c_abs2(f.r_p)), 0.0, 1.0);
+    }
+    return r;
+}
+
+// The film's output blended with the bare base for a film weight w < 1 (see the header);
+// w ≥ 1 (or NaN) returns the film unchanged.
+fn material_weight_film(film: FilmOutput, cos_theta: f32) -> FilmOutput {
+    let w = clamp(finite_or(material_params.film_weight, 1.0), 0.0, 1.0);
+    if w >= 1.0 {
+        return film;
+    }
+    let f_base = material_base_reflectance(cos_theta);
+    var out: FilmOutput;
+    out.reflectance = mix(f_base, film.reflectance, w);
+    out.transmittance = mix(vec3<f32>(1.0) - f_base, film.transmittance, w);
+    return out;
+}
+
 // ─── Shading ─────────────────────────────────────────────────────────────────────────────
 
 // One shading point, as scene.wgsl finds it.
@@ -383,7 +427,7 @@ fn material_shade(s: SurfacePoint) -> ShadeResult {
     let evaluations = select(1u, 2u, n_dot_l > 0.0);
     for (var k = 0u; k < evaluations; k++) {
         let cos_theta = select(n_dot_v, v_dot_h, k == 1u);
-        let film = film_colour(material_film_input(cos_theta, s.thickness_nm, s.sigma_thickness_nm));
+        let film = material_weight_film(film_colour(material_film_input(cos_theta, s.thickness_nm, s.sigma_thickness_nm)), cos_theta);
         if k == 0u {
             film_v = film;
         } else {

@@ -309,7 +309,7 @@ impl LoadedLut {
                 .load_table(path, "reflectance")?
                 .ok_or_else(|| Error::Invalid {
                     context: path.display().to_string(),
-                    message: "the manifest lists no reflectance EXR".into(),
+                    message: "the manifest lists no reflectance EXR or KTX2 file".into(),
                 })?;
         let transmittance = manifest.load_table(path, "transmittance")?;
         let colorimeter = manifest.colorimeter(path)?;

@@ -16,6 +16,7 @@ pub mod error;
 pub mod film_lut;
 pub mod fourier_table;
 pub mod grid;
+pub mod ktx2;
 pub mod materials;
 pub mod output;
 pub mod plot;

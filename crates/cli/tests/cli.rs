@@ -613,3 +613,99 @@ fn bench_gpu_reports_every_pass() {
     );
     assert_eq!(bad.status.code(), Some(2));
 }
+
+/// `nacre render --gltf`: a committed sweep renders; bad glTF files exit 2 with one message
+/// and no output.
+#[test]
+fn render_gltf_writes_a_png_and_refuses_bad_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let sweep = repo.join("tests/golden/gltf/sweep-base-ior.glb");
+    let sweep = sweep.to_str().unwrap();
+    let o = nacre(
+        &[
+            "render", "--gltf", sweep, "--width", "100", "--height", "28", "-o", "s.png",
+        ],
+        d,
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        png_size(&std::fs::read(d.join("s.png")).unwrap()),
+        (100, 28)
+    );
+    // lut with film-dielectric: bases other than 1.5 fall back to fourier, with a note.
+    assert!(
+        stderr(&o).contains("drawn with fourier instead of lut"),
+        "{}",
+        stderr(&o)
+    );
+    let o = nacre(
+        &[
+            "render",
+            "--gltf",
+            sweep,
+            "--technique",
+            "fourier",
+            "--width",
+            "50",
+            "--height",
+            "14",
+            "-o",
+            "f.png",
+        ],
+        d,
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+
+    let good = std::fs::read(repo.join("tests/golden/gltf/sweep-thickness.glb")).unwrap();
+    std::fs::write(d.join("truncated.glb"), &good[..good.len() - 100]).unwrap();
+    std::fs::write(d.join("junk.gltf"), b"{\"asset\": 3}").unwrap();
+    // A line-list primitive: mesh 0's `"material":0` becomes `"material":0,"mode":1` in the
+    // JSON chunk, re-packed as GLB.
+    let json_len = u32::from_le_bytes(good[12..16].try_into().unwrap()) as usize;
+    let json = String::from_utf8(good[20..20 + json_len].to_vec()).unwrap();
+    let json = json.replacen("\"material\":0", "\"material\":0,\"mode\":1", 1);
+    let bin = &good[20 + json_len + 8..];
+    let mut json = json.trim_end().as_bytes().to_vec();
+    while !json.len().is_multiple_of(4) {
+        json.push(b' ');
+    }
+    let total = 12 + 8 + json.len() + 8 + bin.len();
+    let mut lines = Vec::new();
+    lines.extend_from_slice(b"glTF");
+    lines.extend_from_slice(&2u32.to_le_bytes());
+    lines.extend_from_slice(&(total as u32).to_le_bytes());
+    lines.extend_from_slice(&(json.len() as u32).to_le_bytes());
+    lines.extend_from_slice(b"JSON");
+    lines.extend_from_slice(&json);
+    lines.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+    lines.extend_from_slice(b"BIN\0");
+    lines.extend_from_slice(bin);
+    std::fs::write(d.join("lines.glb"), lines).unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        (&["--gltf", "missing.glb"], "missing.glb"),
+        (&["--gltf", "truncated.glb"], "truncated.glb"),
+        (&["--gltf", "junk.gltf"], "junk.gltf"),
+        (&["--gltf", "lines.glb"], "triangle"),
+        (&["--gltf", sweep, "--width", "0"], "width"),
+        (&["--gltf", sweep, "--height", "100000"], "8192"),
+    ];
+    for (extra, expect) in cases {
+        let mut args = vec!["render"];
+        if !extra.iter().any(|a| *a == "--width" || *a == "--height") {
+            args.extend_from_slice(&["--width", "16", "--height", "12"]);
+        }
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&["-o", "out.png"]);
+        let o = nacre(&args, d);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}: {err}");
+        assert!(
+            err.contains(expect),
+            "{extra:?}: expected `{expect}` in: {err}"
+        );
+        assert!(!err.contains("panicked"), "{extra:?}: {err}");
+        assert!(!d.join("out.png").exists(), "{extra:?} wrote an output");
+    }
+}

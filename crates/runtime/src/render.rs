@@ -326,6 +326,10 @@ pub struct MaterialOptions {
     pub roughness_alpha: f32,
     /// A thin transparent shell (the bubble): transmits the film's transmittance.
     pub transmission: bool,
+    /// Film weight w ∈ [0, 1], the coated fraction of the surface: every film term becomes
+    /// mix(F_base, film, w), F_base the bare base's Fresnel reflectance (glTF
+    /// `iridescenceFactor`, OpenPBR `thin_film_weight`; default 1: the film alone).
+    pub film_weight: f32,
 }
 
 impl MaterialOptions {
@@ -358,6 +362,7 @@ impl MaterialOptions {
                 base_colour: [0.02, 0.02, 0.025],
                 roughness_alpha: 0.06,
                 transmission: false,
+                film_weight: 1.0,
             },
             SceneKind::Bubble => MaterialOptions {
                 film_ior: 1.33,
@@ -374,6 +379,7 @@ impl MaterialOptions {
                 base_colour: [0.0; 3],
                 roughness_alpha: 0.001,
                 transmission: true,
+                film_weight: 1.0,
             },
             SceneKind::Plane => MaterialOptions {
                 film_ior: 1.47,
@@ -390,8 +396,67 @@ impl MaterialOptions {
                 base_colour: [0.015, 0.02, 0.025],
                 roughness_alpha: 0.02,
                 transmission: false,
+                film_weight: 1.0,
             },
         }
+    }
+
+    /// Sets the film from OpenPBR's thin-film parameters (OpenPBR Surface 1.1, "Thin-film
+    /// iridescence": `thin_film_weight` ∈ [0, 1], default 0; `thin_film_thickness` in µm,
+    /// default 0.5; `thin_film_ior`, default 1.4 — the OpenPBR specification's parameter table
+    /// and `open_pbr_surface.mtlx`; the glTF iridescence extension's default is 1.3):
+    ///
+    /// * film weight w = `thin_film_weight` (clamped to [0, 1]): OpenPBR's
+    ///   mix(base, film-coated base, w), which nacre applies to the Fresnel term;
+    /// * a constant thickness d = 1000 × `thin_film_thickness_um` nm (OpenPBR has no
+    ///   thickness texture range: [`ThicknessMapping::Gltf`] with min = max = d);
+    /// * film index n₂ = `thin_film_ior`.
+    ///
+    /// The base (OpenPBR's `specular_ior`, `base_metalness`, …) is left as it is.
+    ///
+    /// ```
+    /// use nacre_runtime::render::{MaterialOptions, SceneKind, ThicknessMapping};
+    /// let mut m = MaterialOptions::for_scene(SceneKind::Sphere);
+    /// m.apply_openpbr(0.8, 0.5, 1.5).unwrap();
+    /// assert_eq!(m.film_weight, 0.8);
+    /// assert_eq!(m.thickness, ThicknessMapping::Gltf { min_nm: 500.0, max_nm: 500.0 });
+    /// ```
+    pub fn apply_openpbr(
+        &mut self,
+        thin_film_weight: f32,
+        thin_film_thickness_um: f32,
+        thin_film_ior: f32,
+    ) -> Result<()> {
+        let bad = |message: String| {
+            Err(Error::Invalid {
+                context: "OpenPBR thin film".into(),
+                message,
+            })
+        };
+        if !thin_film_weight.is_finite() {
+            return bad(format!(
+                "thin_film_weight {thin_film_weight} (expected 0 to 1)"
+            ));
+        }
+        if !(thin_film_thickness_um.is_finite() && (0.0..=1000.0).contains(&thin_film_thickness_um))
+        {
+            return bad(format!(
+                "thin_film_thickness {thin_film_thickness_um} µm (expected 0 to 1000)"
+            ));
+        }
+        if !(thin_film_ior.is_finite() && thin_film_ior > 0.0) {
+            return bad(format!(
+                "thin_film_ior {thin_film_ior} (expected a positive number)"
+            ));
+        }
+        let d_nm = thin_film_thickness_um * 1000.0;
+        self.film_weight = thin_film_weight.clamp(0.0, 1.0);
+        self.thickness = ThicknessMapping::Gltf {
+            min_nm: d_nm,
+            max_nm: d_nm,
+        };
+        self.film_ior = thin_film_ior;
+        Ok(())
     }
 
     /// Replaces the base (and its kind, [`BaseKind::of`]).
@@ -405,7 +470,8 @@ impl MaterialOptions {
         self.thickness.max_nm() + self.drain_nm.max(0.0)
     }
 
-    fn validate(&self) -> Result<()> {
+    /// Checks indices, thicknesses, roughness, weight and colour ranges.
+    pub fn validate(&self) -> Result<()> {
         let bad = |message: String| {
             Err(Error::Invalid {
                 context: "material".into(),
@@ -442,6 +508,12 @@ impl MaterialOptions {
         }
         if !(self.thickness_roughness_nm >= 0.0 && self.drain_nm >= 0.0) {
             return bad("thickness roughness and drainage must be non-negative".into());
+        }
+        if !(self.film_weight >= 0.0 && self.film_weight <= 1.0) {
+            return bad(format!(
+                "film weight {} (expected 0 to 1)",
+                self.film_weight
+            ));
         }
         if !(self.roughness_alpha >= 0.0 && self.roughness_alpha <= 1.0) {
             return bad(format!(
@@ -623,7 +695,7 @@ pub struct ViewUniform {
     pub env_lod_max: f32,
 }
 
-/// Mirror of `MaterialParams` (`shaders/material.wgsl`): 80 bytes.
+/// Mirror of `MaterialParams` (`shaders/material.wgsl`): 96 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct MaterialUniform {
@@ -655,6 +727,10 @@ pub struct MaterialUniform {
     pub base_colour: [f32; 3],
     /// Triplanar projection scale (a tile spans 2/scale map units).
     pub thickness_map_scale: f32,
+    /// Film weight w: F = mix(F_base, R_f, w).
+    pub film_weight: f32,
+    /// Padding to 96 bytes.
+    pub _pad: [f32; 3],
 }
 
 impl ViewUniform {
@@ -737,6 +813,8 @@ impl MaterialUniform {
             transmission: u32::from(m.transmission),
             base_colour: m.base_colour,
             thickness_map_scale: m.thickness_map_scale,
+            film_weight: m.film_weight,
+            _pad: [0.0; 3],
         })
     }
 }
@@ -782,7 +860,7 @@ fn mip_chain<const C: usize>(width: usize, height: usize, texels: Vec<[f32; C]>)
     levels
 }
 
-fn check_image_size(path: &Path, what: &str, width: usize, height: usize) -> Result<()> {
+pub(crate) fn check_image_size(path: &Path, what: &str, width: usize, height: usize) -> Result<()> {
     let max = MAX_DIMENSION as usize;
     if width == 0 || height == 0 || width > max || height > max {
         return Err(Error::Invalid {
@@ -1210,7 +1288,7 @@ pub struct Renderer {
     pipeline: wgpu::RenderPipeline,
 }
 
-fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+pub(crate) fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::FRAGMENT,
@@ -1223,7 +1301,7 @@ fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     }
 }
 
-fn texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+pub(crate) fn texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::FRAGMENT,
@@ -1236,7 +1314,7 @@ fn texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     }
 }
 
-fn sampler_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+pub(crate) fn sampler_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::FRAGMENT,
@@ -1246,7 +1324,7 @@ fn sampler_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
 }
 
 /// Group 0 and group 2 share a shape: 0 uniform, 1 filterable 2-D texture, 2 sampler.
-fn group_layout(device: &wgpu::Device, label: &str) -> wgpu::BindGroupLayout {
+pub(crate) fn group_layout(device: &wgpu::Device, label: &str) -> wgpu::BindGroupLayout {
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some(label),
         entries: &[uniform_entry(0), texture_entry(1), sampler_entry(2)],
@@ -1254,7 +1332,7 @@ fn group_layout(device: &wgpu::Device, label: &str) -> wgpu::BindGroupLayout {
 }
 
 /// Uploads a mip chain as a 2-D half-float texture of `format` (C channels of 2 bytes).
-fn upload_mips<const C: usize>(
+pub(crate) fn upload_mips<const C: usize>(
     ctx: &GpuContext,
     label: &str,
     format: wgpu::TextureFormat,
@@ -1316,7 +1394,7 @@ fn upload_mips<const C: usize>(
     })
 }
 
-fn linear_sampler(device: &wgpu::Device, label: &str, repeat_v: bool) -> wgpu::Sampler {
+pub(crate) fn linear_sampler(device: &wgpu::Device, label: &str, repeat_v: bool) -> wgpu::Sampler {
     device.create_sampler(&wgpu::SamplerDescriptor {
         label: Some(label),
         address_mode_u: wgpu::AddressMode::Repeat,
@@ -1594,7 +1672,7 @@ impl Renderer {
 /// Checks that a `film-lut` table can render `material`: the table exists, its ambient is
 /// the material's, the film index and the thicknesses lie inside the table, and a
 /// transmitting material has a table with a transmittance.
-fn check_film_lut(tables: &TableSet, material: &MaterialOptions) -> Result<()> {
+pub(crate) fn check_film_lut(tables: &TableSet, material: &MaterialOptions) -> Result<()> {
     let Some(lut) = &tables.film_lut else {
         return Err(Error::Invalid {
             context: "technique `lut`".into(),
@@ -1662,7 +1740,8 @@ mod tests {
     #[test]
     fn uniform_sizes_match_the_wgsl_layouts() {
         assert_eq!(std::mem::size_of::<ViewUniform>(), 128);
-        assert_eq!(std::mem::size_of::<MaterialUniform>(), 80);
+        assert_eq!(std::mem::size_of::<MaterialUniform>(), 96);
+        assert_eq!(std::mem::offset_of!(MaterialUniform, film_weight), 80);
         assert_eq!(std::mem::offset_of!(MaterialUniform, base_ior), 32);
         assert_eq!(std::mem::offset_of!(MaterialUniform, base_kappa), 48);
         assert_eq!(std::mem::offset_of!(MaterialUniform, base_colour), 64);
@@ -1738,6 +1817,42 @@ mod tests {
             .map(|y| step(y * 64, y * 64 + 1))
             .fold(0.0, f32::max);
         assert!(wrap <= 2.0 * inner + 1e-3, "{wrap} vs {inner}");
+    }
+
+    #[test]
+    fn openpbr_maps_weight_micrometres_and_ior() {
+        let mut m = MaterialOptions::for_scene(SceneKind::Sphere);
+        // OpenPBR's defaults: weight 0 (the base bare), thickness 0.5 µm, index 1.4.
+        m.apply_openpbr(0.0, 0.5, 1.4).unwrap();
+        assert_eq!(m.film_weight, 0.0);
+        assert_eq!(m.film_ior, 1.4);
+        assert_eq!(
+            m.thickness,
+            ThicknessMapping::Gltf {
+                min_nm: 500.0,
+                max_nm: 500.0
+            }
+        );
+        assert_eq!(m.max_thickness_nm(), 500.0);
+        m.apply_openpbr(1.7, 0.25, 1.33).unwrap();
+        assert_eq!(m.film_weight, 1.0, "the weight is clamped to [0, 1]");
+        assert_eq!(m.thickness.max_nm(), 250.0);
+        assert!(m.validate().is_ok());
+        for bad in [
+            (f32::NAN, 0.5, 1.5),
+            (0.5, -1.0, 1.5),
+            (0.5, 0.5, 0.0),
+            (0.5, f32::INFINITY, 1.5),
+        ] {
+            assert!(
+                m.clone().apply_openpbr(bad.0, bad.1, bad.2).is_err(),
+                "{bad:?}"
+            );
+        }
+        // The uniform carries the weight at offset 80.
+        let tables = TableSet::default();
+        let u = MaterialUniform::new(&m, &tables).unwrap();
+        assert_eq!(u.film_weight, 1.0);
     }
 
     #[test]

@@ -27,6 +27,9 @@ pub const PROBE: &str = include_str!("../../../shaders/probe.wgsl");
 pub const MATERIAL: &str = include_str!("../../../shaders/material.wgsl");
 /// Consumer: the ray-cast analytic scenes of `nacre render` (sphere, bubble, plane).
 pub const SCENE: &str = include_str!("../../../shaders/scene.wgsl");
+/// Consumer: rasterised triangle meshes (glTF scenes of `nacre render --gltf`; group 3 holds
+/// the view-projection). Compose it after [`MATERIAL`].
+pub const MESH: &str = include_str!("../../../shaders/mesh.wgsl");
 
 /// How the film colour is computed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

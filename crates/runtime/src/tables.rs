@@ -9,6 +9,11 @@
 //!   is not filterable everywhere, so `film_fourier.wgsl` filters it itself with
 //!   `textureLoad`, exactly as the CPU does.
 //!
+//! The texels come from the OpenEXR files when the manifest lists them, else from the KTX2
+//! files baked beside them (`film-lut`: one 3-D `RGBA16F` texture per quantity; `fourier`:
+//! one 2-D array `RGBA32F` texture with every level; see `nacre_bake::ktx2`), so a
+//! manifest whose `files` list only KTX2 files loads too, into identical textures.
+//!
 //! Every file is checked against its manifest (format, size, SHA-256) before upload, and
 //! every texture against the device's limits, so a mismatch is an [`Error`], not a panic.
 
@@ -192,7 +197,7 @@ fn upload_film_lut(
         .load_table(manifest_path, "reflectance")?
         .ok_or_else(|| Error::Manifest {
             path: manifest_path.to_path_buf(),
-            message: "the manifest lists no reflectance EXR file".into(),
+            message: "the manifest lists no reflectance EXR or KTX2 file".into(),
         })?;
     let transmittance = manifest.load_table(manifest_path, "transmittance")?;
     let has_transmittance = transmittance.is_some();

@@ -175,7 +175,7 @@ fn scene_pipelines_validate_for_every_technique() {
             ),
             (
                 "MaterialParams",
-                80,
+                96,
                 &[
                     ("film_ior", 0),
                     ("ambient_ior", 4),
@@ -191,6 +191,10 @@ fn scene_pipelines_validate_for_every_technique() {
                     ("transmission", 60),
                     ("base_colour", 64),
                     ("thickness_map_scale", 76),
+                    ("film_weight", 80),
+                    ("_pad0", 84),
+                    ("_pad1", 88),
+                    ("_pad2", 92),
                 ][..],
             ),
         ] {
@@ -220,7 +224,7 @@ fn scene_pipelines_validate_for_every_technique() {
     );
     assert_eq!(
         std::mem::size_of::<nacre_runtime::render::MaterialUniform>(),
-        80
+        96
     );
 }
 

@@ -347,11 +347,19 @@ fn every_shader_file_opens_with_a_comment_header() {
     }
 }
 
-/// The consumers the runtime itself composes (probe, bench; the plain baseline).
+/// The consumers the runtime itself composes (the glTF mesh pass, probe, bench; the plain
+/// baseline).
 #[test]
 fn the_runtimes_own_pipelines_validate_and_translate() {
-    use nacre_runtime::shaders::{BENCH, PLAIN, PROBE, compose_source};
+    use nacre_runtime::shaders::{BENCH, MATERIAL, MESH, PLAIN, PROBE, compose_source};
     for technique in Technique::ALL {
+        let (source, map) = composition(
+            technique,
+            &[("material.wgsl", MATERIAL), ("mesh.wgsl", MESH)],
+        );
+        let name = format!("film_{} + material.wgsl + mesh.wgsl", technique.name());
+        let (module, info) = validate(&name, &source, &map);
+        translate(&name, &module, &info);
         for (consumer_name, consumer) in [("probe.wgsl", PROBE), ("bench.wgsl", BENCH)] {
             let (source, map) = composition(technique, &[(consumer_name, consumer)]);
             let name = format!("film_{} + {consumer_name}", technique.name());
