@@ -700,15 +700,19 @@ pub fn bake_recipe(
         }
         let ktx2 = format!("{}.{quantity}.ktx2", recipe.name);
         let ktx2_path = out_dir.join(&ktx2);
+        let (ktx2_format, ktx2_encoding) = match recipe.precision {
+            Precision::Half => (crate::ktx2::Ktx2Format::Rgba16Float, "half"),
+            Precision::Float => (crate::ktx2::Ktx2Format::Rgba32Float, "float"),
+        };
         crate::ktx2::write_ktx2(
             &ktx2_path,
-            &crate::ktx2::film_lut_image(&ktx2_path, table, &embedded)?,
+            &crate::ktx2::film_lut_image_as(&ktx2_path, table, &embedded, ktx2_format)?,
         )?;
         files.push(FileRecord {
             quantity: quantity.into(),
             format: "ktx2".into(),
             path: ktx2,
-            encoding: "half".into(),
+            encoding: ktx2_encoding.into(),
             channels: vec!["R".into(), "G".into(), "B".into(), "A".into()],
             width: table.nx,
             height: table.ny,

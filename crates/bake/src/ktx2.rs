@@ -30,7 +30,8 @@
 //!
 //! # What nacre stores
 //!
-//! * `film-lut` quantity → 3-D texture `VK_FORMAT_R16G16B16A16_SFLOAT` (97), typeSize 2,
+//! * `film-lut` quantity → 3-D texture `VK_FORMAT_R16G16B16A16_SFLOAT` (97), typeSize 2
+//!   (`VK_FORMAT_R32G32B32A32_SFLOAT`, typeSize 4, for a recipe's `precision = "float"`),
 //!   `pixelWidth` = cos θ count, `pixelHeight` = OPD count, `pixelDepth` = film-index count,
 //!   layerCount 0, one level; alpha 1. Texel `(x, y, z)` is [`Table3`] texel `(x, y, z)`,
 //!   so the texel order is exactly the EXR atlas order.
@@ -538,12 +539,27 @@ fn key_values(manifest_json: &str) -> Vec<(String, Vec<u8>)> {
     ]
 }
 
-/// The KTX2 image of a `film-lut` quantity: a 3-D `RGBA16F` texture, alpha 1.
+/// The KTX2 image of a `film-lut` quantity: a 3-D `RGBA16F` texture, alpha 1
+/// ([`film_lut_image_as`] with [`Ktx2Format::Rgba16Float`]).
+///
+/// # Errors
+/// As [`film_lut_image_as`].
+pub fn film_lut_image(path: &Path, table: &Table3, manifest_json: &str) -> Result<Ktx2Image> {
+    film_lut_image_as(path, table, manifest_json, Ktx2Format::Rgba16Float)
+}
+
+/// The KTX2 image of a `film-lut` quantity as a 3-D texture of `format` (`RGBA16F` for a
+/// recipe's `precision = "half"`, `RGBA32F` for `"float"`), alpha 1.
 ///
 /// # Errors
 /// [`Error::Table`] naming `path` for an empty or inconsistent table, a non-finite value,
-/// or a value beyond the half-float range.
-pub fn film_lut_image(path: &Path, table: &Table3, manifest_json: &str) -> Result<Ktx2Image> {
+/// or (half floats) a value beyond the half-float range.
+pub fn film_lut_image_as(
+    path: &Path,
+    table: &Table3,
+    manifest_json: &str,
+    format: Ktx2Format,
+) -> Result<Ktx2Image> {
     let dims = [table.nx, table.ny, table.nz].map(u32::try_from);
     let [Ok(nx), Ok(ny), Ok(nz)] = dims else {
         return Err(table_error(path, "table too large for a KTX2 texture"));
@@ -561,30 +577,44 @@ pub fn film_lut_image(path: &Path, table: &Table3, manifest_json: &str) -> Resul
             ),
         ));
     }
-    let mut level = Vec::with_capacity(table.data.len() / 3 * 8);
+    let mut level = Vec::with_capacity(table.data.len() / 3 * format.texel_bytes());
     for (i, rgb) in table.data.chunks_exact(3).enumerate() {
         for (c, &v) in rgb.iter().enumerate() {
             let h = f16::from_f32(v);
-            if !h.is_finite() {
+            let representable = match format {
+                Ktx2Format::Rgba16Float => h.is_finite(),
+                Ktx2Format::Rgba32Float => v.is_finite(),
+            };
+            if !representable {
                 let (x, y, z) = (
                     i % table.nx,
                     (i / table.nx) % table.ny,
                     i / (table.nx * table.ny),
                 );
+                let range = match format {
+                    Ktx2Format::Rgba16Float => " within the half-float range (±65504)",
+                    Ktx2Format::Rgba32Float => "",
+                };
                 return Err(table_error(
                     path,
                     format!(
-                        "texel (x={x}, y={y}, z={z}) channel {} is {v}: not finite within the half-float range (±65504)",
+                        "texel (x={x}, y={y}, z={z}) channel {} is {v}: not finite{range}",
                         ["R", "G", "B"][c]
                     ),
                 ));
             }
-            level.extend_from_slice(&h.to_le_bytes());
+            match format {
+                Ktx2Format::Rgba16Float => level.extend_from_slice(&h.to_le_bytes()),
+                Ktx2Format::Rgba32Float => level.extend_from_slice(&v.to_le_bytes()),
+            }
         }
-        level.extend_from_slice(&f16::ONE.to_le_bytes());
+        match format {
+            Ktx2Format::Rgba16Float => level.extend_from_slice(&f16::ONE.to_le_bytes()),
+            Ktx2Format::Rgba32Float => level.extend_from_slice(&1f32.to_le_bytes()),
+        }
     }
     Ok(Ktx2Image {
-        format: Ktx2Format::Rgba16Float,
+        format,
         width: nx,
         height: ny,
         depth: nz,

@@ -184,3 +184,80 @@ fn manifest_loads_tables_from_ktx2_when_no_exr_is_listed() {
         }
     }
 }
+
+/// A `precision = "float"` recipe writes its KTX2 files as `RGBA32F` holding the EXR's
+/// full floats bit for bit, and the manifest loads the same table from either file.
+#[test]
+fn float_precision_recipes_write_rgba32f_ktx2() {
+    let out = tempfile::tempdir().unwrap();
+    let recipe_path = out.path().join("small-float.toml");
+    let text = r#"kind = "film-lut"
+[stack]
+ambient = "1.0"
+film = "thin film"
+base = "1.5"
+[axes]
+cos_theta_count = 5
+thickness_nm = [0.0, 800.0]
+opd_count = 7
+film_ior = [1.2, 1.6]
+film_ior_count = 3
+[output]
+precision = "float"
+png = false
+transmittance = "auto"
+"#;
+    std::fs::write(&recipe_path, text).unwrap();
+    let recipe = nacre_bake::bake::Recipe::read(&recipe_path).unwrap();
+    let manifest_path = nacre_bake::bake::bake_recipe(&recipe, out.path(), &|| {}).unwrap();
+    let manifest = Manifest::read(&manifest_path).unwrap();
+    let mut seen = 0;
+    for f in manifest.files.iter().filter(|f| f.format == "ktx2") {
+        assert_eq!(f.encoding, "float", "{}", f.path);
+        let bytes = std::fs::read(out.path().join(&f.path)).unwrap();
+        let reader = open(
+            &bytes,
+            &manifest,
+            ktx2::Format::R32G32B32A32_SFLOAT,
+            &f.path,
+        );
+        let header = reader.header();
+        assert_eq!(
+            (header.pixel_width, header.pixel_height, header.pixel_depth),
+            (5, 7, 3)
+        );
+        let texels: Vec<f32> = reader
+            .levels()
+            .next()
+            .unwrap()
+            .data
+            .chunks_exact(4)
+            .map(|b| f32::from_le_bytes(b.try_into().unwrap()))
+            .collect();
+        let exr = manifest
+            .files
+            .iter()
+            .find(|e| e.format == "exr" && e.quantity == f.quantity)
+            .unwrap();
+        let (table, _) = read_exr_table(&out.path().join(&exr.path), 5, 7, 3).unwrap();
+        assert_eq!(texels.len(), table.data.len() / 3 * 4);
+        for (i, t) in texels.chunks_exact(4).enumerate() {
+            let rgb = &table.data[3 * i..3 * i + 3];
+            assert_eq!(
+                [t[0].to_bits(), t[1].to_bits(), t[2].to_bits()],
+                [rgb[0].to_bits(), rgb[1].to_bits(), rgb[2].to_bits()],
+                "{} texel {i}",
+                f.path
+            );
+            assert_eq!(t[3], 1.0);
+        }
+        let mut only_ktx2 = manifest.clone();
+        only_ktx2.files.retain(|g| g.format == "ktx2");
+        assert_eq!(
+            only_ktx2.load_table(&manifest_path, &f.quantity).unwrap(),
+            Some(table)
+        );
+        seen += 1;
+    }
+    assert_eq!(seen, 2, "reflectance and transmittance");
+}
