@@ -4,8 +4,9 @@
 // (dielectric) or metallic base, lit by one directional light and by an equirectangular HDR
 // environment, with optional transmission through a thin transparent shell (soap bubble),
 // exposure, the Khronos PBR Neutral tone mapper and an sRGB encoding. Composed after
-// common.wgsl, lut_mapping.wgsl and one technique module (which supplies `film_colour`),
-// and before scene.wgsl, which ray-casts the geometry and calls `material_shade`
+// common.wgsl, lut_mapping.wgsl, one technique module (which supplies `film_colour`) and
+// rough_lut_mapping.wgsl (nacre_runtime::shaders::MATERIAL includes it), and before
+// scene.wgsl or mesh.wgsl, which ray-casts the geometry and calls `material_shade`
 // (crates/runtime/src/render.rs; shaders/README.md).
 //
 // Symbols
@@ -21,6 +22,11 @@
 //   R_f(cos θ)    FilmOutput.reflectance       film reflectance colour (replaces Fresnel F)
 //   T_f(cos θ)    FilmOutput.transmittance     film transmittance colour (thin shells)
 //   E_GGX(α)      ggx_albedo_scale             directional albedo of the GGX lobe with F = 1
+//                                              (classic path: Karis's fit, no view dependence)
+//   E₁(μ_o, α)    ggx_albedo                   the same, tabulated exactly over n·v and α
+//   E_f(μ_o, α)   material_rough_film_albedo   directional albedo of the iridescent GGX lobe
+//                                              (rough-film-lut: film and GGX integrated)
+//   L̃(r, α)       env_prefiltered_radiance     GGX-prefiltered environment (split sum)
 //   L_env(ω, k)   env_radiance                 environment radiance towards ω at mip level k
 //   E_l           light_colour × intensity     irradiance of the directional light at normal
 //                                              incidence (linear RGB)
@@ -50,7 +56,7 @@
 // what the film does not reflect: f_d = ρ/π (1 − R_f(v·h)) for the light, ρ (1 − R_f(n·v))
 // for the environment. Metal bases and thin shells have no diffuse term.
 //
-// Image-based lighting (no split-sum table): the environment's mip chain (a 2×2 box filter
+// Classic image-based lighting (no split-sum table): the environment's mip chain (a 2×2 box filter
 // built on the CPU, `render::EnvironmentMap::mip_chain`) stands in for the pre-convolved
 // radiance, and the GGX lobe's directional albedo becomes one scale:
 //
@@ -63,6 +69,36 @@
 // E_GGX is the F = 1 limit (A + B) of B. Karis, "Physically Based Shading on Mobile" (Unreal
 // Engine blog, 2014), EnvBRDFApprox, after D. Lazarov (2013): it ignores the view angle and
 // the multiple scattering between microfacets, and the film is evaluated once, at n·v.
+// That is the classic path (MaterialParams.film_eval = 0, the default; the golden images).
+//
+// Split-sum paths (film_eval = 1 or 2; Karis 2013, "Real Shading in Unreal Engine 4", Eq. 4;
+// Belcour & Barla 2017 §6 and Fig. 16 for why the film matters here):
+//
+//   L_spec ≈ L̃(r, α) · E(μ_o),   μ_o = n·v,  r = reflect(−v, n)
+//   L̃(r, α) = env_prefiltered at level √α (L − 1)   (the GGX convolution with n = v = r)
+//
+//   film_eval = 1, "film at n·v" — the engines' common shortcut: the film colour is evaluated
+//   once per pixel, at n·v, and used for the environment and for every light:
+//       E = R_f(n·v) E₁(n·v, α),   f_s = D G₂ R_f(n·v) / (4 n·v n·l)
+//   film_eval = 2, "exact": the environment takes the film's directional albedo integrated
+//   over the GGX lobe for this view angle (the rough-film-lut table), each light the film at
+//   its own half vector:
+//       E = E_f(n·v, α, d, n₂),               f_s = D G₂ R_f(v·h) / (4 n·v n·l)
+//   and, because the film colour and the environment are correlated across the lobe (a
+//   microfacet's incidence c = v·h fixes the angle 2 acos c between v and the direction it
+//   reflects, so each interference colour sees its own part of the sky), the environment
+//   factor is the film-weighted mean over the lobe's visible normals m_i (a 4 × 4 grid,
+//   MATERIAL_LOBE_SAMPLES, Heitz 2018 visible-normal sampling), per channel:
+//       L_spec ≈ E_f · Σ_i w_i R_f(v·m_i) L̃(l_i, α/2) / Σ_i w_i R_f(v·m_i),
+//       l_i = reflect(−v, m_i),  w_i = G₂(v, l_i)/G₁(v)
+//   (the rough-film-lut supplies the energy, the 16 samples only how it is distributed over
+//   the environment; each sample reads the prefilter at α/2, the width of one stratum). With
+//   a film that does not vary over the lobe this is the split sum for the lobe's true shape.
+//
+// Diffuse (dielectric base) in the split-sum paths: L_env(n, k_max − 2) ρ (1 − R̄) with the
+// lobe's mean reflectance R̄ = R_f(n·v) for the shortcut and R̄ = E_f/E₁ for the exact path;
+// the light's diffuse is as in the classic path with the film at n·v (shortcut) or v·h.
+// A film weight w < 1 blends E_f with the bare base's F_base(n·v) E₁ (exact path).
 //
 // Thin transparent shells (MaterialParams.transmission = 1, the soap bubble): the surface
 // reflects as above and passes T_f(n·v) of the light behind it straight through (no refraction
@@ -131,6 +167,20 @@ struct ViewParams {
 @group(0) @binding(1) var env_map: texture_2d<f32>;
 // Linear min/mag/mip; u repeats, v clamps.
 @group(0) @binding(2) var env_sampler: sampler;
+// The GGX-prefiltered environment of the split sum (Rgba16Float, ENV_PREFILTER_LEVELS array
+// layers of one size, layer k = the convolution with GGX of α_k = (k/(L − 1))², n = v = r;
+// crates/runtime/src/ibl.rs). Same equirectangular layout and sampler as env_map.
+@group(0) @binding(3) var env_prefiltered: texture_2d_array<f32>;
+// E₁(μ_o, α): directional albedo of GGX with F = 1 (Rg16Float, GGX_ALBEDO_SIZE², x = μ_o,
+// y = α, texel i at t = i/(n − 1), sampled at (t (n − 1) + 0.5)/n; r = E₁).
+@group(0) @binding(4) var env_ggx_albedo: texture_2d<f32>;
+// Linear, clamp to edge (env_ggx_albedo and the rough-film-lut).
+@group(0) @binding(5) var env_lut_sampler: sampler;
+// The rough-film-lut's reflected albedo E_r (Rgba16Float; layout and mapping in
+// rough_lut_mapping.wgsl, which this module is composed after) and its axes. A 1×1×1
+// placeholder unless the exact path is drawn.
+@group(0) @binding(6) var env_rough_lut: texture_3d<f32>;
+@group(0) @binding(7) var<uniform> env_rough_lut_params: RoughLutParams;
 
 // ─── Group 2: the material (changes per draw) ────────────────────────────────────────────
 //
@@ -153,7 +203,9 @@ struct ViewParams {
 //       76    4 thickness_map_scale: f32      s: a map tile spans 2/s units of the scene's map coordinate
 //       80    4 film_weight: f32              w ∈ [0, 1]: F = mix(F_base, R_f, w) (glTF
 //                                             iridescenceFactor, OpenPBR thin_film_weight); 1 = film
-//       84   12 _pad0.._pad2: f32             (96 bytes in all)
+//       84    4 film_eval: u32                lighting path: 0 classic, 1 film at n·v (split sum),
+//                                             2 exact (split sum + rough-film-lut, film at v·h)
+//       88    8 _pad1.._pad2: f32             (96 bytes in all)
 struct MaterialParams {
     film_ior: f32,
     ambient_ior: f32,
@@ -170,7 +222,7 @@ struct MaterialParams {
     base_colour: vec3<f32>,
     thickness_map_scale: f32,
     film_weight: f32,
-    _pad0: f32,
+    film_eval: u32,
     _pad1: f32,
     _pad2: f32,
 }
@@ -185,6 +237,15 @@ const MATERIAL_THICKNESS_SVT: u32 = 0u;
 const MATERIAL_THICKNESS_GLTF: u32 = 1u;
 const MATERIAL_BASE_DIELECTRIC: u32 = 0u;
 const MATERIAL_BASE_METAL: u32 = 1u;
+// MaterialParams.film_eval: how the film enters the lighting (see the header).
+const MATERIAL_FILM_EVAL_CLASSIC: u32 = 0u;
+const MATERIAL_FILM_EVAL_NV: u32 = 1u;
+const MATERIAL_FILM_EVAL_EXACT: u32 = 2u;
+// Layers of env_prefiltered (crates/runtime/src/ibl.rs, PREFILTER_LEVELS): layer k holds
+// the environment convolved with GGX of α_k = (k / (L − 1))².
+const ENV_PREFILTER_LEVELS: f32 = 8.0;
+// Texels per side of env_ggx_albedo (ibl.rs, GGX_ALBEDO_SIZE).
+const GGX_ALBEDO_SIZE: f32 = 32.0;
 // Smallest GGX α (a mirror-like α keeps D finite in f32).
 const MATERIAL_ALPHA_MIN: f32 = 1e-3;
 // Smallest |n·v| and |n·l| used in the BRDF (grazing guard).
@@ -301,6 +362,44 @@ fn env_specular_lod(alpha: f32) -> f32 {
     return log2(max(2.0 * alpha * h / PI, 1.0));
 }
 
+// L̃(r, α): the GGX-prefiltered environment towards `dir` for roughness α (level
+// k = √α (L − 1): layers ⌊k⌋ and ⌊k⌋ + 1 sampled bilinearly and mixed), times env_intensity.
+fn env_prefiltered_radiance(dir: vec3<f32>, alpha: f32) -> vec3<f32> {
+    let uv = env_direction_to_uv(dir);
+    let k = clamp(sqrt(clamp(finite_or(alpha, 0.0), 0.0, 1.0)) * (ENV_PREFILTER_LEVELS - 1.0), 0.0, ENV_PREFILTER_LEVELS - 1.0);
+    let k0 = min(u32(floor(k)), u32(ENV_PREFILTER_LEVELS) - 2u);
+    let f = k - f32(k0);
+    let c0 = textureSampleLevel(env_prefiltered, env_sampler, uv, k0, 0.0).rgb;
+    let c1 = textureSampleLevel(env_prefiltered, env_sampler, uv, k0 + 1u, 0.0).rgb;
+    return sanitize_radiance(mix(c0, c1, f) * max(finite_or(view.env_intensity, 0.0), 0.0));
+}
+
+// Visible GGX normals per pixel of the exact path's environment quadrature (a 4 × 4 grid).
+const MATERIAL_LOBE_SAMPLES: u32 = 16u;
+
+// A GGX visible normal for view wo (local frame, n = +z) and u ∈ [0, 1)²: Heitz 2018,
+// "Sampling the GGX Distribution of Visible Normals", JCGT 7(4), Listing 1 (the routine
+// nacre_optics::microfacet::sample_ggx_vndf implements on the CPU).
+fn ggx_sample_vndf(wo: vec3<f32>, alpha: f32, u: vec2<f32>) -> vec3<f32> {
+    let vh = normalize(vec3<f32>(alpha * wo.x, alpha * wo.y, wo.z));
+    let lensq = vh.x * vh.x + vh.y * vh.y;
+    let t1v = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(-vh.y, vh.x, 0.0) * inverseSqrt(max(lensq, 1e-30)), lensq > 0.0);
+    let t2v = cross(vh, t1v);
+    let r = sqrt(u.x);
+    let phi = TWO_PI * u.y;
+    let t1 = r * cos(phi);
+    let s = 0.5 * (1.0 + vh.z);
+    let t2 = (1.0 - s) * sqrt(max(1.0 - t1 * t1, 0.0)) + s * r * sin(phi);
+    let nh = t1 * t1v + t2 * t2v + sqrt(max(1.0 - t1 * t1 - t2 * t2, 0.0)) * vh;
+    return normalize(vec3<f32>(alpha * nh.x, alpha * nh.y, max(nh.z, 0.0)));
+}
+
+// Smith Λ of GGX for a direction of cosine c to the normal: (−1 + √(1 + α² tan²θ)) / 2.
+fn ggx_lambda(c: f32, alpha: f32) -> f32 {
+    let c2 = max(c * c, 1e-8);
+    return 0.5 * (sqrt(1.0 + alpha * alpha * max(1.0 - c2, 0.0) / c2) - 1.0);
+}
+
 // Mip level used for the diffuse (cosine-weighted) lookup.
 fn env_diffuse_lod() -> f32 {
     return max(env_lod_max() - 2.0, 0.0);
@@ -329,6 +428,14 @@ fn ggx_visibility(n_dot_v: f32, n_dot_l: f32, alpha: f32) -> f32 {
 // E_GGX(α) = 1 − 0.55 √α (Karis 2014, EnvBRDFApprox with F = 1).
 fn ggx_albedo_scale(alpha: f32) -> f32 {
     return clamp(1.0 - 0.55 * sqrt(alpha), 0.0, 1.0);
+}
+
+// E₁(μ_o, α): the directional albedo of GGX with F = 1 (height-correlated Smith), from
+// env_ggx_albedo at its texel centres.
+fn ggx_albedo(n_dot_v: f32, alpha: f32) -> f32 {
+    let t = clamp(vec2<f32>(finite_or(n_dot_v, 1.0), finite_or(alpha, 0.0)), vec2<f32>(0.0), vec2<f32>(1.0));
+    let uv = (t * (GGX_ALBEDO_SIZE - 1.0) + 0.5) / GGX_ALBEDO_SIZE;
+    return clamp(textureSampleLevel(env_ggx_albedo, env_lut_sampler, uv, 0.0).r, 0.0, 1.0);
 }
 
 // ─── Film ────────────────────────────────────────────────────────────────────────────────
@@ -378,6 +485,20 @@ fn material_weight_film(film: FilmOutput, cos_theta: f32) -> FilmOutput {
     return out;
 }
 
+// E_f(μ_o, α, d, n₂): the iridescent GGX lobe's directional albedo from the rough-film-lut
+// (two trilinear fetches, rough_lut_sample), blended for a film weight w < 1 with the bare
+// base's F_base(n·v) E₁(n·v, α).
+fn material_rough_film_albedo(n_dot_v: f32, alpha: f32, thickness_nm: f32) -> vec3<f32> {
+    let p = material_params;
+    let e = rough_lut_sample(env_rough_lut, env_lut_sampler, env_rough_lut_params, n_dot_v, alpha, thickness_nm, p.film_ior);
+    let e_film = select(vec3<f32>(0.0), clamp(e, vec3<f32>(0.0), vec3<f32>(1.0)), vec3_is_finite(e));
+    let w = clamp(finite_or(p.film_weight, 1.0), 0.0, 1.0);
+    if w >= 1.0 {
+        return e_film;
+    }
+    return mix(material_base_reflectance(n_dot_v) * ggx_albedo(n_dot_v, alpha), e_film, w);
+}
+
 // ─── Shading ─────────────────────────────────────────────────────────────────────────────
 
 // One shading point, as scene.wgsl finds it.
@@ -419,27 +540,80 @@ fn material_shade(s: SurfacePoint) -> ShadeResult {
     let n_dot_l = dot(n, l);
     let h = safe_normalize(v + l, n);
     let v_dot_h = clamp(dot(v, h), 0.0, 1.0);
+    let mode = select(MATERIAL_FILM_EVAL_CLASSIC, p.film_eval, p.film_eval <= MATERIAL_FILM_EVAL_EXACT);
 
-    // The film at n·v (environment, transmission) and, when the light is above the surface,
-    // at v·h (the light).
+    // The film at n·v (environment, transmission, and every light for the shortcut), when
+    // the light is above the surface and the path evaluates the film per light at v·h, and
+    // for the exact path at each of the lobe's MATERIAL_LOBE_SAMPLES visible normals (see
+    // the header: the environment's distribution over the lobe, weighted by the film).
     var film_v: FilmOutput;
     var film_h: FilmOutput;
-    let evaluations = select(1u, 2u, n_dot_l > 0.0);
+    let light_evaluations = select(0u, 1u, n_dot_l > 0.0 && mode != MATERIAL_FILM_EVAL_NV);
+    let lobe_samples = select(0u, MATERIAL_LOBE_SAMPLES, mode == MATERIAL_FILM_EVAL_EXACT);
+    let evaluations = 1u + light_evaluations + lobe_samples;
+    // The lobe's frame (n = +z) and the view in it.
+    let frame_up = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), abs(n.x) > 0.9);
+    let frame_t = safe_normalize(cross(frame_up, n), vec3<f32>(1.0, 0.0, 0.0));
+    let frame_b = cross(n, frame_t);
+    let wo = normalize(vec3<f32>(dot(v, frame_t), dot(v, frame_b), n_dot_v));
+    let lambda_o = ggx_lambda(wo.z, alpha);
+    var lobe_film_env = vec3<f32>(0.0);
+    var lobe_film = vec3<f32>(0.0);
     for (var k = 0u; k < evaluations; k++) {
-        let cos_theta = select(n_dot_v, v_dot_h, k == 1u);
+        var cos_theta = select(n_dot_v, v_dot_h, k == 1u && light_evaluations == 1u);
+        var lobe_weight = 0.0;
+        var lobe_dir = n;
+        if k > light_evaluations {
+            let i = k - 1u - light_evaluations;
+            let u = vec2<f32>((f32(i % 4u) + 0.5) / 4.0, (f32(i / 4u) + 0.5) / 4.0);
+            let m = ggx_sample_vndf(wo, alpha, u);
+            cos_theta = clamp(dot(wo, m), 0.0, 1.0);
+            let l = 2.0 * cos_theta * m - wo;
+            // G₂/G₁ = (1 + Λ(v)) / (1 + Λ(v) + Λ(l)); 0 below the horizon.
+            lobe_weight = select(0.0, (1.0 + lambda_o) / (1.0 + lambda_o + ggx_lambda(l.z, alpha)), l.z > 0.0);
+            lobe_dir = l.x * frame_t + l.y * frame_b + l.z * n;
+        }
         let film = material_weight_film(film_colour(material_film_input(cos_theta, s.thickness_nm, s.sigma_thickness_nm)), cos_theta);
         if k == 0u {
             film_v = film;
-        } else {
+        } else if k <= light_evaluations {
             film_h = film;
+        } else {
+            let f = lobe_weight * film.reflectance;
+            lobe_film += f;
+            lobe_film_env += f * env_prefiltered_radiance(lobe_dir, 0.5 * alpha);
         }
     }
+    if mode == MATERIAL_FILM_EVAL_NV {
+        film_h = film_v;
+    }
 
-    // Environment: specular at reflect(−v, n) with the film at n·v, diffuse at n.
+    // Environment.
     let one = vec3<f32>(1.0);
     let r = reflect(-v, n);
-    var radiance = env_radiance(r, env_specular_lod(alpha)) * film_v.reflectance * ggx_albedo_scale(alpha);
-    radiance += env_radiance(n, env_diffuse_lod()) * albedo * max(one - film_v.reflectance, vec3<f32>(0.0));
+    var radiance = vec3<f32>(0.0);
+    if mode == MATERIAL_FILM_EVAL_CLASSIC {
+        // Specular at reflect(−v, n) with the film at n·v, diffuse at n.
+        radiance = env_radiance(r, env_specular_lod(alpha)) * film_v.reflectance * ggx_albedo_scale(alpha);
+        radiance += env_radiance(n, env_diffuse_lod()) * albedo * max(one - film_v.reflectance, vec3<f32>(0.0));
+    } else {
+        // Split sum: L̃(r, α) · E.
+        let e_one = ggx_albedo(n_dot_v, alpha);
+        var e_spec = film_v.reflectance * e_one;
+        var mean_reflectance = film_v.reflectance;
+        if mode == MATERIAL_FILM_EVAL_EXACT {
+            e_spec = material_rough_film_albedo(n_dot_v, alpha, s.thickness_nm);
+            mean_reflectance = e_spec / max(e_one, 1e-4);
+        }
+        var env_lobe = env_prefiltered_radiance(r, alpha);
+        if mode == MATERIAL_FILM_EVAL_EXACT {
+            // The film-weighted mean of the environment over the lobe (per channel), where
+            // the lobe reflects anything; the prefiltered value otherwise.
+            env_lobe = select(env_lobe, lobe_film_env / max(lobe_film, vec3<f32>(1e-8)), lobe_film > vec3<f32>(1e-6));
+        }
+        radiance = env_lobe * e_spec;
+        radiance += env_radiance(n, env_diffuse_lod()) * albedo * max(one - mean_reflectance, vec3<f32>(0.0));
+    }
 
     // The directional light.
     if n_dot_l > 0.0 {

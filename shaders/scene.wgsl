@@ -169,9 +169,23 @@ fn scene_sample_thickness(p: vec3<f32>, n: vec3<f32>, dp_dx: vec3<f32>, dp_dy: v
     return vec2<f32>(g, g * g + variance * k);
 }
 
+// Display output: the pixel's radiance exposed, tone-mapped and sRGB-encoded (Rgba8Unorm).
 @fragment
 fn scene_fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
-    let ray = scene_camera_ray(frag.xy);
+    return material_display(scene_radiance(frag.xy));
+}
+
+// Linear output: the pixel's scene radiance before exposure and tone mapping, for an
+// Rgba32Float target (crates/runtime/src/render.rs, RenderOutput::Linear; the Monte Carlo
+// comparisons of issue 6). Non-finite or negative channels are 0.
+@fragment
+fn scene_fs_linear(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+    return vec4<f32>(sanitize_radiance(scene_radiance(frag.xy)), 1.0);
+}
+
+// The linear radiance seen through pixel position `pixel` (see the header).
+fn scene_radiance(pixel: vec2<f32>) -> vec3<f32> {
+    let ray = scene_camera_ray(pixel);
     let hit = scene_intersect(ray);
 
     // Uniform control flow up to the derivatives (no branch on the pixel before them).
@@ -211,5 +225,5 @@ fn scene_fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     if any(throughput > vec3<f32>(0.0)) {
         radiance += throughput * env_radiance(ray.dir, 0.0);
     }
-    return material_display(radiance);
+    return radiance;
 }

@@ -42,6 +42,7 @@ use crate::film_lut::{FilmLut, FilmLutAxes, FilmLutJob, validate_axes};
 use crate::fourier_table::{FourierAxes, FourierTable};
 use crate::materials::resolve;
 use crate::output::write_atomic;
+use crate::rough_lut::{RoughLutAxes, RoughRecipe};
 use crate::stack_spec::{line_of, toml_error};
 use crate::table_io::{self, Precision, Table3};
 use nacre_optics::colour::{Colorimeter, Illuminant, Observer, OutputSpace};
@@ -91,7 +92,7 @@ pub fn resolve_table(name_or_path: &str) -> PathBuf {
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-struct RawColour {
+pub(crate) struct RawColour {
     observer: Option<Spanned<String>>,
     illuminant: Option<Spanned<String>>,
     space: Option<Spanned<String>>,
@@ -99,19 +100,19 @@ struct RawColour {
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-struct RawLayer {
-    material: Spanned<String>,
-    thickness_nm: Spanned<f64>,
+pub(crate) struct RawLayer {
+    pub(crate) material: Spanned<String>,
+    pub(crate) thickness_nm: Spanned<f64>,
 }
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-struct RawStack {
-    ambient: Spanned<String>,
-    film: Option<String>,
-    base: Spanned<String>,
+pub(crate) struct RawStack {
+    pub(crate) ambient: Spanned<String>,
+    pub(crate) film: Option<String>,
+    pub(crate) base: Spanned<String>,
     #[serde(default)]
-    under: Vec<RawLayer>,
+    pub(crate) under: Vec<RawLayer>,
 }
 
 #[derive(Deserialize)]
@@ -126,17 +127,17 @@ struct RawAxes {
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields, untagged)]
-enum Toggle {
+pub(crate) enum Toggle {
     Bool(bool),
     Word(String),
 }
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-struct RawOutput {
-    precision: Option<Precision>,
-    png: Option<bool>,
-    transmittance: Option<Toggle>,
+pub(crate) struct RawOutput {
+    pub(crate) precision: Option<Precision>,
+    pub(crate) png: Option<bool>,
+    pub(crate) transmittance: Option<Toggle>,
 }
 
 #[derive(Deserialize)]
@@ -221,7 +222,7 @@ impl Recipe {
                 path: path.to_path_buf(),
                 line: line_of(&text, kind.kind.span().start),
                 message: format!(
-                    "unknown table kind `{}`: expected `film-lut` or `fourier`",
+                    "unknown table kind `{}`: expected `film-lut`, `rough-film-lut`, `fourier` or `diffraction`",
                     kind.kind.get_ref()
                 ),
             });
@@ -348,7 +349,7 @@ impl Recipe {
 }
 
 /// The real index of a constant, non-absorbing material.
-fn constant_real_index(m: &Material) -> Option<f64> {
+pub(crate) fn constant_real_index(m: &Material) -> Option<f64> {
     if !m.is_constant() {
         return None;
     }
@@ -357,7 +358,7 @@ fn constant_real_index(m: &Material) -> Option<f64> {
 }
 
 /// True when the material is practically transparent (κ ≤ 1e-3) over 360–830 nm.
-fn is_transparent(m: &Material) -> bool {
+pub(crate) fn is_transparent(m: &Material) -> bool {
     (0..=94).all(|i| {
         m.index_at(360.0 + 5.0 * f64::from(i))
             .is_ok_and(|n| n.im <= 1e-3)
@@ -457,6 +458,13 @@ pub struct Manifest {
     /// Machine-readable axes of a `fourier` table.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fourier: Option<FourierAxes>,
+    /// Machine-readable axes of a `rough-film-lut` ([`crate::rough_lut`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rough_film_lut: Option<RoughLutAxes>,
+    /// Sampling, Taylor order and conventions of a `diffraction` table
+    /// ([`crate::diffraction`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub diffraction: Option<crate::diffraction::DiffractionRecord>,
     /// Texel-centre convention.
     pub texel_centres: String,
     /// Atlas layout of the files.
@@ -474,7 +482,12 @@ impl Manifest {
             path: path.to_path_buf(),
             source,
         })?;
-        let m: Manifest = serde_json::from_str(&text).map_err(|e| Error::Recipe {
+        Self::parse(path, &text)
+    }
+
+    /// Parses and validates manifest text; `path` names it in errors.
+    pub fn parse(path: &Path, text: &str) -> Result<Self> {
+        let m: Manifest = serde_json::from_str(text).map_err(|e| Error::Recipe {
             path: path.to_path_buf(),
             line: e.line(),
             message: format!("not a nacre table manifest: {e}"),
@@ -484,6 +497,32 @@ impl Manifest {
                 context: path.display().to_string(),
                 message: format!("manifest format `{}` is not `{MANIFEST_FORMAT}`", m.format),
             });
+        }
+        // Axes a bake could not have written are refused here, before any file is sized
+        // from them.
+        if let Some(a) = &m.film_lut {
+            validate_axes(a, &format!("{}: film_lut", path.display()), MAX_TEXELS)?;
+        }
+        if let Some(f) = &m.fourier {
+            let consistent = f.level_samples.first() == Some(&f.samples)
+                && f.level_samples.len() == f.level_sigma_nm.len()
+                && f.level_samples
+                    .iter()
+                    .all(|n| (1..=MAX_FOURIER_SAMPLES).contains(n))
+                && f.max_opd_nm > 0.0
+                && f.max_opd_nm.is_finite();
+            if !consistent {
+                return Err(Error::Invalid {
+                    context: format!("{}: fourier", path.display()),
+                    message: format!(
+                        "samples = {}, level_samples = {:?}, {} level_sigma_nm, max_opd_nm = {}: expected level 0 of `samples` texels, every level 1 to {MAX_FOURIER_SAMPLES} texels with one sigma each, and a positive finite max_opd_nm",
+                        f.samples,
+                        f.level_samples,
+                        f.level_sigma_nm.len(),
+                        f.max_opd_nm
+                    ),
+                });
+            }
         }
         Ok(m)
     }
@@ -519,6 +558,7 @@ impl Manifest {
             ),
         })?;
         let path = dir.join(&f.path);
+        verify_sha256(manifest_path, &path, f)?;
         let (nx, ny, nz) = (a.cos_theta_count, a.opd_count, a.ior_count);
         if f.format == "ktx2" {
             return crate::ktx2::read_film_lut_ktx2(&path, nx, ny, nz).map(Some);
@@ -541,7 +581,25 @@ impl Manifest {
     }
 }
 
-fn sha256_text(text: &str) -> String {
+/// Checks that the file at `path`, listed in the manifest at `manifest_path` as `f`, has
+/// the SHA-256 the manifest records: a table whose files were replaced or damaged after the
+/// bake is refused rather than read.
+fn verify_sha256(manifest_path: &Path, path: &Path, f: &FileRecord) -> Result<()> {
+    let sha = table_io::sha256_hex(path)?;
+    if sha != f.sha256 {
+        return Err(Error::Table {
+            path: path.to_path_buf(),
+            message: format!(
+                "does not match its manifest {} (SHA-256 {sha}, the manifest says {}): re-bake the table or restore the file",
+                manifest_path.display(),
+                f.sha256
+            ),
+        });
+    }
+    Ok(())
+}
+
+pub(crate) fn sha256_text(text: &str) -> String {
     use sha2::{Digest, Sha256};
     Sha256::digest(text.as_bytes())
         .iter()
@@ -607,10 +665,10 @@ pub fn bake_recipe(
     progress: &(dyn Fn() + Sync),
 ) -> Result<PathBuf> {
     let lut: FilmLut = recipe.job.bake(progress)?;
-    std::fs::create_dir_all(out_dir).map_err(|source| Error::Io {
-        path: out_dir.to_path_buf(),
-        source,
-    })?;
+    // Every file goes to a staging folder first; `commit` moves them in, the manifest last.
+    let stage = crate::output::StagedTable::new(out_dir)?;
+    let dir = stage.path();
+    let mut stale = Vec::new();
     let a = &lut.axes;
     let mut files = Vec::new();
     let channels: Vec<String> = recipe
@@ -652,6 +710,8 @@ pub fn bake_recipe(
         axes: axis_records(a),
         film_lut: Some(a.clone()),
         fourier: None,
+        diffraction: None,
+        rough_film_lut: None,
         texel_centres: "texel i of an axis with count n holds t = i / (n - 1); a sampler reaches t at u = (t * (n - 1) + 0.5) / n; clamp to edge".into(),
         atlas: "width = count(cos_theta); height = count(opd_nm) * count(film_ior); slice k (film_ior index) occupies rows [k * count(opd_nm), (k + 1) * count(opd_nm)), row j of the slice is opd_nm index j, top row first (EXR, PNG); the KTX2 files hold the same texels as a 3-D RGBA16F texture, width = count(cos_theta), height = count(opd_nm), depth = count(film_ior), alpha 1".into(),
         reconstruction: "cos_t = dot(N, V); opd = 2 d sqrt(n_f^2 - n0^2 (1 - cos_t^2)); q(n) = sqrt(n^2 - n0^2 (1 - cos_t^2)); t = (sqrt(cos_t), opd / opd_max, sqrt((q(n_f) - q(ior_min)) / (q(ior_max) - q(ior_min)))); colour = trilinear sample at u = (t (n - 1) + 0.5) / n per axis; specular = colour (replaces the Fresnel term)".into(),
@@ -665,7 +725,7 @@ pub fn bake_recipe(
     for (quantity, table) in quantities {
         let Some(table) = table else { continue };
         let exr = format!("{}.{quantity}.exr", recipe.name);
-        table_io::write_exr(&out_dir.join(&exr), table, recipe.precision)?;
+        table_io::write_exr(&dir.join(&exr), table, recipe.precision)?;
         files.push(FileRecord {
             quantity: quantity.into(),
             format: "exr".into(),
@@ -678,11 +738,11 @@ pub fn bake_recipe(
             channels: vec!["R".into(), "G".into(), "B".into()],
             width: table.nx,
             height: table.ny * table.nz,
-            sha256: table_io::sha256_hex(&out_dir.join(&exr))?,
+            sha256: table_io::sha256_hex(&dir.join(&exr))?,
         });
         if recipe.png {
             let png = format!("{}.{quantity}.png", recipe.name);
-            if table_io::write_png16(&out_dir.join(&png), table)? {
+            if table_io::write_png16(&dir.join(&png), table)? {
                 files.push(FileRecord {
                     quantity: quantity.into(),
                     format: "png16".into(),
@@ -691,15 +751,15 @@ pub fn bake_recipe(
                     channels: vec!["R".into(), "G".into(), "B".into()],
                     width: table.nx,
                     height: table.ny * table.nz,
-                    sha256: table_io::sha256_hex(&out_dir.join(&png))?,
+                    sha256: table_io::sha256_hex(&dir.join(&png))?,
                 });
             } else {
                 // A stale PNG from an earlier bake would contradict the manifest.
-                let _ = std::fs::remove_file(out_dir.join(&png));
+                stale.push(png);
             }
         }
         let ktx2 = format!("{}.{quantity}.ktx2", recipe.name);
-        let ktx2_path = out_dir.join(&ktx2);
+        let ktx2_path = dir.join(&ktx2);
         let (ktx2_format, ktx2_encoding) = match recipe.precision {
             Precision::Half => (crate::ktx2::Ktx2Format::Rgba16Float, "half"),
             Precision::Float => (crate::ktx2::Ktx2Format::Rgba32Float, "float"),
@@ -720,13 +780,13 @@ pub fn bake_recipe(
         });
     }
     manifest.files = files;
-    let path = out_dir.join(format!("{}.json", recipe.name));
+    let name = format!("{}.json", recipe.name);
     let json = serde_json::to_string_pretty(&manifest).expect("manifest serialises");
-    write_atomic(&path, |w| {
+    write_atomic(&dir.join(&name), |w| {
         w.write_all(json.as_bytes())?;
         w.write_all(b"\n")
     })?;
-    Ok(path)
+    stage.commit(&name, &stale)
 }
 
 /// The recipes of the default set, sorted by name.
@@ -745,7 +805,11 @@ pub fn default_recipes() -> Result<Vec<PathBuf>> {
 }
 
 /// Parses the `[colour]` section shared by every kind.
-fn parse_colour(path: &Path, text: &str, colour: Option<RawColour>) -> Result<Colorimeter> {
+pub(crate) fn parse_colour(
+    path: &Path,
+    text: &str,
+    colour: Option<RawColour>,
+) -> Result<Colorimeter> {
     let colour = colour.unwrap_or(RawColour {
         observer: None,
         illuminant: None,
@@ -764,7 +828,7 @@ fn parse_colour(path: &Path, text: &str, colour: Option<RawColour>) -> Result<Co
 }
 
 /// The table name of a recipe: its file stem, restricted to letters, digits, `-` and `_`.
-fn table_name(path: &Path) -> Result<String> {
+pub(crate) fn table_name(path: &Path) -> Result<String> {
     path.file_stem()
         .and_then(|s| s.to_str())
         .filter(|s| {
@@ -856,7 +920,12 @@ impl FourierRecipe {
             ));
         }
         let levels = *f.levels.get_ref();
-        if levels == 0 || samples >> (levels - 1) < 2 {
+        // checked_shr: `levels` of 65 or more must give this error, not a shift overflow.
+        let last_level = u32::try_from(levels.wrapping_sub(1))
+            .ok()
+            .and_then(|shift| samples.checked_shr(shift))
+            .unwrap_or(0);
+        if levels == 0 || last_level < 2 {
             return Err(bad(
                 f.levels.span(),
                 format!(
@@ -877,10 +946,9 @@ impl FourierRecipe {
     /// Bakes and writes the table; returns the manifest path.
     pub fn bake(&self, out_dir: &Path, progress: &(dyn Fn() + Sync)) -> Result<PathBuf> {
         let table = FourierTable::bake(&self.colorimeter, self.axes.clone());
-        std::fs::create_dir_all(out_dir).map_err(|source| Error::Io {
-            path: out_dir.to_path_buf(),
-            source,
-        })?;
+        // Every file goes to a staging folder first; `commit` moves them in, the manifest last.
+        let stage = crate::output::StagedTable::new(out_dir)?;
+        let dir = stage.path();
         let a = &self.axes;
         let c = &self.colorimeter;
         let mut manifest = Manifest {
@@ -921,6 +989,8 @@ impl FourierRecipe {
             }],
             film_lut: None,
             fourier: Some(a.clone()),
+            diffraction: None,
+            rough_film_lut: None,
             texel_centres: "texel i of level k (N_k = level_samples[k] texels) holds μ = (i + 0.5) D_max / N_k: the usual mip-map convention, u = μ / D_max at every level; clamp to edge".into(),
             atlas: "one OpenEXR file per mip level, width N_k, height 2: row 0 holds Re A_j, row 1 holds Im A_j for the channels R, G, B (the output space's channels in order); the KTX2 file holds every level as one 2-D array RGBA32F texture, width N, height 1, layer 0 = Re, layer 1 = Im, mip level k = level k, alpha 0".into(),
             reconstruction: "A = trilinear sample at (u = μ / D_max, lod), lod = σ_μ < σ_1 ? σ_μ / σ_1 : 1 + log2(σ_μ / σ_1); Ŝ_j(μ) = A_j exp(-2πi μ carrier_nu_per_nm[j]); colour_j = white_j [c0 + 2 Σ_m Re(c_m conj Ŝ_j(m D, m τ σ_d))] (Belcour & Barla 2017 Eq. 10; nacre_optics::fourier)".into(),
@@ -930,7 +1000,7 @@ impl FourierRecipe {
         let mut files = Vec::new();
         for k in 0..table.levels.len() {
             let file = format!("{}.level{k}.exr", self.name);
-            let path = out_dir.join(&file);
+            let path = dir.join(&file);
             table.write_level(k, &path)?;
             files.push(FileRecord {
                 quantity: format!("level {k}"),
@@ -945,7 +1015,7 @@ impl FourierRecipe {
             progress();
         }
         let ktx2 = format!("{}.ktx2", self.name);
-        let ktx2_path = out_dir.join(&ktx2);
+        let ktx2_path = dir.join(&ktx2);
         crate::ktx2::write_ktx2(
             &ktx2_path,
             &crate::ktx2::fourier_image(&ktx2_path, &table, &embedded)?,
@@ -961,13 +1031,13 @@ impl FourierRecipe {
             sha256: table_io::sha256_hex(&ktx2_path)?,
         });
         manifest.files = files;
-        let path = out_dir.join(format!("{}.json", self.name));
+        let name = format!("{}.json", self.name);
         let json = serde_json::to_string_pretty(&manifest).expect("manifest serialises");
-        write_atomic(&path, |w| {
+        write_atomic(&dir.join(&name), |w| {
             w.write_all(json.as_bytes())?;
             w.write_all(b"\n")
         })?;
-        Ok(path)
+        stage.commit(&name, &[])
     }
 }
 
@@ -977,6 +1047,10 @@ pub enum AnyRecipe {
     FilmLut(Box<Recipe>),
     /// `fourier`.
     Fourier(Box<FourierRecipe>),
+    /// `rough-film-lut` ([`crate::rough_lut`]).
+    RoughFilmLut(Box<RoughRecipe>),
+    /// `diffraction` ([`crate::diffraction`]).
+    Diffraction(Box<crate::diffraction::DiffractionRecipe>),
 }
 
 impl AnyRecipe {
@@ -986,6 +1060,11 @@ impl AnyRecipe {
             path: path.to_path_buf(),
             source,
         })?;
+        Self::parse(path, text)
+    }
+
+    /// Parses recipe text of any kind; `path` names it and anchors relative material paths.
+    pub fn parse(path: &Path, text: String) -> Result<Self> {
         #[derive(Deserialize)]
         struct KindOnly {
             kind: Spanned<String>,
@@ -995,6 +1074,26 @@ impl AnyRecipe {
             "fourier" => Ok(AnyRecipe::Fourier(Box::new(FourierRecipe::parse(
                 path, text,
             )?))),
+            "rough-film-lut" => Ok(AnyRecipe::RoughFilmLut(Box::new(RoughRecipe::parse(
+                path, text,
+            )?))),
+            "diffraction" => {
+                #[derive(Deserialize)]
+                struct ColourOnly {
+                    colour: Option<RawColour>,
+                }
+                let c: ColourOnly =
+                    toml::from_str(&text).map_err(|e| toml_error(path, &text, &e))?;
+                let colorimeter = parse_colour(path, &text, c.colour)?;
+                Ok(AnyRecipe::Diffraction(Box::new(
+                    crate::diffraction::DiffractionRecipe::parse(
+                        path,
+                        text,
+                        table_name(path)?,
+                        colorimeter,
+                    )?,
+                )))
+            }
             _ => Ok(AnyRecipe::FilmLut(Box::new(Recipe::parse(path, text)?))),
         }
     }
@@ -1004,6 +1103,8 @@ impl AnyRecipe {
         match self {
             AnyRecipe::FilmLut(r) => &r.name,
             AnyRecipe::Fourier(r) => &r.name,
+            AnyRecipe::RoughFilmLut(r) => &r.name,
+            AnyRecipe::Diffraction(r) => &r.name,
         }
     }
 
@@ -1012,6 +1113,8 @@ impl AnyRecipe {
         match self {
             AnyRecipe::FilmLut(r) => (r.job.axes.cos_theta_count * r.job.axes.ior_count) as u64,
             AnyRecipe::Fourier(r) => r.axes.level_samples.len() as u64,
+            AnyRecipe::RoughFilmLut(r) => r.work(),
+            AnyRecipe::Diffraction(_) => 1,
         }
     }
 
@@ -1020,6 +1123,8 @@ impl AnyRecipe {
         match self {
             AnyRecipe::FilmLut(r) => bake_recipe(r, out_dir, progress),
             AnyRecipe::Fourier(r) => r.bake(out_dir, progress),
+            AnyRecipe::RoughFilmLut(r) => r.bake(out_dir, progress),
+            AnyRecipe::Diffraction(r) => r.bake(out_dir, progress),
         }
     }
 }
@@ -1045,16 +1150,19 @@ impl Manifest {
         if (0..levels).any(|k| exr_level(k).is_none())
             && let Some(f) = self.files.iter().find(|f| f.format == "ktx2")
         {
-            return crate::ktx2::read_fourier_ktx2(&dir.join(&f.path), axes);
+            let path = dir.join(&f.path);
+            verify_sha256(manifest_path, &path, f)?;
+            return crate::ktx2::read_fourier_ktx2(&path, axes);
         }
         let paths: Vec<PathBuf> = (0..levels)
             .map(|k| {
-                exr_level(k)
-                    .map(|f| dir.join(&f.path))
-                    .ok_or_else(|| Error::Invalid {
-                        context: manifest_path.display().to_string(),
-                        message: format!("the manifest lists no file for level {k}"),
-                    })
+                let f = exr_level(k).ok_or_else(|| Error::Invalid {
+                    context: manifest_path.display().to_string(),
+                    message: format!("the manifest lists no file for level {k}"),
+                })?;
+                let path = dir.join(&f.path);
+                verify_sha256(manifest_path, &path, f)?;
+                Ok(path)
             })
             .collect::<Result<_>>()?;
         FourierTable::read(axes, &paths)

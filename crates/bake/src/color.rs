@@ -17,6 +17,11 @@
 //!   sensitivities' Fourier transforms evaluated exactly ([`nacre_optics::fourier`]), with M
 //!   harmonics or as many as a 10⁻⁴ tail bound needs, optionally prefiltered for a Gaussian
 //!   thickness distribution of standard deviation SIGMA_NM (one film on a base; reflectance);
+//! * `rough-lut:NAME|PATH` (with a roughness α) — the directional albedo of the rough
+//!   (GGX) iridescent lobe from a baked `rough-film-lut` table, looked up as the shader does
+//!   ([`crate::rough_lut::RoughFilmLut::lookup`]); `rough-mc[:N]` — the Monte Carlo reference
+//!   for the same albedo ([`nacre_optics::microfacet::directional_albedo_with`], N
+//!   visible-normal samples per point, default [`ROUGH_MC_SAMPLES`], seed = the point's index);
 //! * `gaussian` — the Gaussian-fit closed form with Schlick Fresnel and m ≤ 2 of glTF's
 //!   `KHR_materials_iridescence` reference code, for comparison (the base enters through its
 //!   normal-incidence reflectance; the fit ignores `--illuminant`).
@@ -45,6 +50,10 @@ pub const HEADER: &str = "angle_deg,thickness_nm,film_ior,X,Y,Z,R,G,B";
 /// Most points one run may evaluate.
 pub const MAX_POINTS: usize = 10_000_000;
 
+/// Default Monte Carlo samples per point of `rough-mc` (standard error ≈ 1e-5–2e-4 per
+/// channel, see [`nacre_optics::microfacet`]).
+pub const ROUGH_MC_SAMPLES: usize = 1 << 20;
+
 /// The wavelengths of the `rgb3` shortcut, nm (R, G, B).
 pub const RGB3_WAVELENGTHS_NM: [f64; 3] = [650.0, 510.0, 475.0];
 
@@ -66,6 +75,48 @@ pub enum Method {
     Fourier(Harmonics, f64, Option<Arc<FourierTable>>),
     /// The Gaussian-fit closed form of glTF's `KHR_materials_iridescence`.
     GaussianFitBelcour2017,
+    /// Directional albedo of the rough iridescent GGX lobe from a baked `rough-film-lut`
+    /// (manifest path) at roughness `alpha` (NaN until set with [`Method::with_roughness`]),
+    /// the table loaded by the caller.
+    RoughLut {
+        /// Manifest path.
+        path: PathBuf,
+        /// GGX roughness α.
+        alpha: f64,
+        /// The loaded table.
+        table: Option<Arc<RoughTable>>,
+    },
+    /// The Monte Carlo reference of the same albedo: `samples` visible-normal samples per
+    /// point at roughness `alpha` (NaN until set).
+    RoughMonteCarlo {
+        /// GGX roughness α.
+        alpha: f64,
+        /// Samples per point.
+        samples: usize,
+    },
+}
+
+/// A loaded `rough-film-lut` table.
+pub type RoughTable = crate::rough_lut::LoadedRoughLut;
+
+impl Method {
+    /// True for the methods that need a roughness (`rough-lut:`, `rough-mc`).
+    pub fn is_rough(&self) -> bool {
+        matches!(
+            self,
+            Method::RoughLut { .. } | Method::RoughMonteCarlo { .. }
+        )
+    }
+
+    /// The method with GGX roughness `alpha` (for `rough-lut:` and `rough-mc`; others are
+    /// returned unchanged).
+    pub fn with_roughness(self, alpha: f64) -> Self {
+        match self {
+            Method::RoughLut { path, table, .. } => Method::RoughLut { path, alpha, table },
+            Method::RoughMonteCarlo { samples, .. } => Method::RoughMonteCarlo { alpha, samples },
+            m => m,
+        }
+    }
 }
 
 impl Method {
@@ -81,7 +132,34 @@ impl Method {
             "rgb3" => Ok(Method::Rgb3),
             "gaussian" => Ok(Method::GaussianFitBelcour2017),
             t => {
-                if let Some(name) = t.strip_prefix("lut:") {
+                if let Some(name) = t.strip_prefix("rough-lut:") {
+                    if name.is_empty() {
+                        return Err(err(
+                            "expected rough-lut:NAME or rough-lut:PATH/TO/MANIFEST.json",
+                        ));
+                    }
+                    Ok(Method::RoughLut {
+                        path: resolve_table(name),
+                        alpha: f64::NAN,
+                        table: None,
+                    })
+                } else if t == "rough-mc" || t.starts_with("rough-mc:") {
+                    let samples = match t.strip_prefix("rough-mc:") {
+                        None => ROUGH_MC_SAMPLES,
+                        Some(n) => match n.parse::<usize>() {
+                            Ok(n @ 1..=1_073_741_824) => n,
+                            _ => {
+                                return Err(err(
+                                    "rough-mc:N needs a whole number of samples N from 1 to 2^30",
+                                ));
+                            }
+                        },
+                    };
+                    Ok(Method::RoughMonteCarlo {
+                        alpha: f64::NAN,
+                        samples,
+                    })
+                } else if let Some(name) = t.strip_prefix("lut:") {
                     if name.is_empty() {
                         return Err(err("expected lut:NAME or lut:PATH/TO/MANIFEST.json"));
                     }
@@ -120,7 +198,7 @@ impl Method {
                     Ok(Method::Fourier(harmonics, sigma, None))
                 } else {
                     Err(err(
-                        "expected spectral, lut:NAME|PATH, rgb3, samples:N, fourier:M[:SIGMA_NM], fourier:auto[:SIGMA_NM], fourier-exact:… or gaussian",
+                        "expected spectral, lut:NAME|PATH, rgb3, samples:N, fourier:M[:SIGMA_NM], fourier:auto[:SIGMA_NM], fourier-exact:…, gaussian, rough-lut:NAME|PATH or rough-mc[:N]",
                     ))
                 }
             }
@@ -323,54 +401,7 @@ impl LoadedLut {
 
     /// Errors unless `stack` (film first) matches the table's ambient, fixed layers and base.
     pub fn check_stack(&self, path: &Path, stack: &Stack) -> Result<()> {
-        let m = &self.manifest;
-        let context = format!("--method lut:{}", path.display());
-        let mismatch = |what: &str, ours: String, theirs: &str| Error::Invalid {
-            context: context.clone(),
-            message: format!("the table was baked for {what} `{theirs}`, this stack has `{ours}`"),
-        };
-        let base_dir = path.parent();
-        let same = |a: &Material, spec: &str| -> Result<bool> {
-            let b = crate::materials::resolve(spec, &context, base_dir)?;
-            Ok((0..=20).all(|i| {
-                let wl = 380.0 + 20.0 * f64::from(i);
-                match (a.index_at(wl), b.index_at(wl)) {
-                    (Ok(x), Ok(y)) => (x - y).norm() <= 1e-12,
-                    _ => false,
-                }
-            }))
-        };
-        if !same(stack.ambient(), &m.ambient)? {
-            return Err(mismatch(
-                "ambient",
-                stack.ambient().name().into(),
-                &m.ambient,
-            ));
-        }
-        if !same(stack.substrate(), &m.base)? {
-            return Err(mismatch("base", stack.substrate().name().into(), &m.base));
-        }
-        let layers = stack.layers();
-        if layers.len() != 1 + m.under.len() {
-            return Err(Error::Invalid {
-                context,
-                message: format!(
-                    "the table has one film over {} fixed layer(s); this stack has {} layer(s)",
-                    m.under.len(),
-                    layers.len()
-                ),
-            });
-        }
-        for (l, (spec, d)) in layers[1..].iter().zip(&m.under) {
-            if !same(&l.material, spec)? || (l.thickness_nm - d).abs() > 1e-9 {
-                return Err(mismatch(
-                    "fixed layer",
-                    format!("{}@{}", l.material.name(), l.thickness_nm),
-                    &format!("{spec}@{d}"),
-                ));
-            }
-        }
-        Ok(())
+        check_stack_matches(&self.manifest, path, stack, "lut")
     }
 
     /// Colour at a point (output space of the table).
@@ -416,6 +447,148 @@ impl LoadedLut {
     }
 }
 
+/// Errors unless `stack` (film first) matches the ambient, fixed layers and base of the
+/// table `m` at `path`; `method` (`lut`, `rough-lut`) names the flag in messages.
+pub fn check_stack_matches(m: &Manifest, path: &Path, stack: &Stack, method: &str) -> Result<()> {
+    let context = format!("--method {method}:{}", path.display());
+
+    let mismatch = |what: &str, ours: String, theirs: &str| Error::Invalid {
+        context: context.clone(),
+        message: format!("the table was baked for {what} `{theirs}`, this stack has `{ours}`"),
+    };
+    let base_dir = path.parent();
+    let same = |a: &Material, spec: &str| -> Result<bool> {
+        let b = crate::materials::resolve(spec, &context, base_dir)?;
+        Ok((0..=20).all(|i| {
+            let wl = 380.0 + 20.0 * f64::from(i);
+            match (a.index_at(wl), b.index_at(wl)) {
+                (Ok(x), Ok(y)) => (x - y).norm() <= 1e-12,
+                _ => false,
+            }
+        }))
+    };
+    if !same(stack.ambient(), &m.ambient)? {
+        return Err(mismatch(
+            "ambient",
+            stack.ambient().name().into(),
+            &m.ambient,
+        ));
+    }
+    if !same(stack.substrate(), &m.base)? {
+        return Err(mismatch("base", stack.substrate().name().into(), &m.base));
+    }
+    let layers = stack.layers();
+    if layers.len() != 1 + m.under.len() {
+        return Err(Error::Invalid {
+            context,
+            message: format!(
+                "the table has one film over {} fixed layer(s); this stack has {} layer(s)",
+                m.under.len(),
+                layers.len()
+            ),
+        });
+    }
+    for (l, (spec, d)) in layers[1..].iter().zip(&m.under) {
+        if !same(&l.material, spec)? || (l.thickness_nm - d).abs() > 1e-9 {
+            return Err(mismatch(
+                "fixed layer",
+                format!("{}@{}", l.material.name(), l.thickness_nm),
+                &format!("{spec}@{d}"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The first film's thickness (nm) and constant real index at `point` (the point's own
+/// values, else the film's); `context` names the method in errors.
+pub fn film_parameters(stack: &Stack, point: &Point, context: &str) -> Result<(f64, f64)> {
+    let film = stack.layers().first().ok_or_else(|| Error::Invalid {
+        context: context.into(),
+        message: "the method needs a film: give --layer".into(),
+    })?;
+    let n = match point.film_ior {
+        Some(n) => n,
+        None => {
+            let n = film.material.index_at(550.0)?;
+            if !film.material.is_constant() || n.im != 0.0 {
+                return Err(Error::Invalid {
+                    context: context.into(),
+                    message: format!(
+                        "the table takes a constant real film index; `{}` is dispersive or absorbing (give --points with film_ior)",
+                        film.material.name()
+                    ),
+                });
+            }
+            n.re
+        }
+    };
+    Ok((point.thickness_nm.unwrap_or(film.thickness_nm), n))
+}
+
+/// `rough-mc` at every point: the Monte Carlo directional albedo (reflected or
+/// transmitted, per `quantity`) of the GGX lobe with the exact film term of the point's
+/// stack, `samples` samples, seed = the point's index. Returns each point's estimate.
+pub fn rough_monte_carlo(
+    stack: &Stack,
+    points: &[Point],
+    alpha: f64,
+    samples: usize,
+    colorimeter: &Colorimeter,
+    quantity: Quantity,
+) -> Result<Vec<nacre_optics::microfacet::Estimate>> {
+    check_roughness(alpha)?;
+    points
+        .par_iter()
+        .enumerate()
+        .map(|(i, point)| {
+            let s = stack_at(stack, point)?;
+            if quantity == Quantity::Transmittance
+                && s.substrate()
+                    .index_at(nacre_optics::microfacet::REFRACTION_WAVELENGTH_NM)?
+                    .im
+                    != 0.0
+            {
+                return Err(Error::Invalid {
+                    context: "--method rough-mc --quantity t".into(),
+                    message: "transmittance through a rough interface needs a non-absorbing base"
+                        .into(),
+                });
+            }
+            let film = nacre_optics::microfacet::FilmTerm::from_stack(&s, colorimeter)?;
+            let cos_theta_o = point.angle_deg.to_radians().cos();
+            let e = nacre_optics::microfacet::directional_albedo_with(
+                &film,
+                alpha,
+                cos_theta_o,
+                samples,
+                i as u64,
+            )?;
+            Ok(match quantity {
+                Quantity::Reflectance => e.reflection,
+                Quantity::Transmittance => e.transmission,
+            })
+        })
+        .collect()
+}
+
+fn check_roughness(alpha: f64) -> Result<()> {
+    if alpha.is_nan() {
+        return Err(Error::Invalid {
+            context: "--method rough-lut/rough-mc".into(),
+            message: "needs a roughness: give --roughness ALPHA".into(),
+        });
+    }
+    if !(alpha > 0.0 && alpha <= 1.0) {
+        return Err(Error::Flag {
+            flag: "--roughness".into(),
+            value: alpha.to_string(),
+            message: "GGX roughness α must lie in (0, 1]".into(),
+        });
+    }
+    Ok(())
+}
+
 /// Evaluates `points` of `stack` by `method`; returns output-space colours of `colorimeter`
 /// (for `lut:`, of the table's colorimeter).
 pub fn evaluate(
@@ -441,6 +614,43 @@ pub fn evaluate(
                     let lut = lut.expect("lut loaded by the caller");
                     lut.colour(stack, point, quantity)
                 }
+                Method::RoughLut { path, alpha, table } => {
+                    check_roughness(*alpha)?;
+                    let t = match table {
+                        Some(t) => t.clone(),
+                        None => Arc::new(RoughTable::load(path)?),
+                    };
+                    let (d, n) = film_parameters(stack, point, "--method rough-lut")?;
+                    let table = match quantity {
+                        Quantity::Reflectance => &t.lut.reflectance,
+                        Quantity::Transmittance => {
+                            t.lut.transmittance.as_ref().ok_or_else(|| Error::Invalid {
+                                context: "--quantity t".into(),
+                                message: format!(
+                                    "table `{}` has no transmittance",
+                                    t.manifest.name
+                                ),
+                            })?
+                        }
+                    };
+                    Ok(crate::rough_lut::RoughFilmLut::lookup(
+                        &t.lut.axes,
+                        table,
+                        point.angle_deg.to_radians().cos(),
+                        *alpha,
+                        d,
+                        n,
+                    ))
+                }
+                Method::RoughMonteCarlo { alpha, samples } => rough_monte_carlo(
+                    stack,
+                    std::slice::from_ref(point),
+                    *alpha,
+                    *samples,
+                    colorimeter,
+                    quantity,
+                )
+                .map(|e| e[0].colour),
                 Method::Spectral => {
                     let s = stack_at(stack, point)?;
                     if s.layers().is_empty() {

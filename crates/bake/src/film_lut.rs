@@ -329,7 +329,10 @@ pub fn validate_axes(axes: &FilmLutAxes, context: &str, max_texels: u64) -> Resu
             axes.ior_min, axes.ambient_index
         )));
     }
-    let texels = axes.cos_theta_count as u64 * axes.opd_count as u64 * axes.ior_count as u64;
+    // Saturating: absurd counts (up to usize::MAX each) must give this error, not overflow.
+    let texels = (axes.cos_theta_count as u64)
+        .saturating_mul(axes.opd_count as u64)
+        .saturating_mul(axes.ior_count as u64);
     if texels > max_texels {
         return Err(Error::TooLarge {
             what: format!("{context}: texels (cos_theta × opd × film_ior)"),

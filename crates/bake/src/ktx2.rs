@@ -448,6 +448,14 @@ impl Ktx2Image {
                 .ok_or_else(|| bad("a key without its terminating NUL".into()))?;
             let key = std::str::from_utf8(&entry[..nul])
                 .map_err(|_| bad("a key that is not UTF-8".into()))?;
+            // KTX 2.0 §3.11: keys sorted by codepoint, each once (the writer's order).
+            if let Some((last, _)) = image.key_values.last()
+                && last.as_str() >= key
+            {
+                return Err(bad(format!(
+                    "key `{key}` after `{last}`: expected the keys sorted and unique"
+                )));
+            }
             image
                 .key_values
                 .push((key.to_string(), entry[nul + 1..].to_vec()));

@@ -327,9 +327,10 @@ pub fn resolve_with(
             Some(dir) if Path::new(spec).is_relative() => dir.join(spec),
             _ => Path::new(spec).to_path_buf(),
         };
-        let text = std::fs::read_to_string(&path).map_err(|source| Error::Io {
-            path: path.clone(),
-            source,
+        // Named with where the spec came from: a recipe line or a flag.
+        let text = std::fs::read_to_string(&path).map_err(|source| Error::Invalid {
+            context: context.to_string(),
+            message: format!("cannot read the material file {}: {source}", path.display()),
         })?;
         let shown = path.display().to_string();
         return Ok(parse_material_text(spec, &shown, &text)?);
@@ -388,7 +389,10 @@ mod tests {
         let e = resolve("missing.yml", "--layer", None)
             .unwrap_err()
             .to_string();
-        assert!(e.starts_with("missing.yml: "), "{e}");
+        assert!(
+            e.starts_with("--layer: cannot read the material file missing.yml: "),
+            "{e}"
+        );
     }
 
     /// A refractiveindex.info page with constant n and κ over 0.3–1.0 µm.

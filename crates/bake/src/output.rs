@@ -123,9 +123,170 @@ pub fn write_files_atomic(dir: &Path, files: &[(String, Vec<u8>)]) -> Result<()>
     Ok(())
 }
 
+/// The files of one table, written into a hidden staging folder inside the output folder
+/// (`.nacre-stage-*`, same file system) and then moved into place by [`StagedTable::commit`]
+/// so that the table's manifest never describes files that are missing or differ from it,
+/// even when the process is killed half-way:
+///
+/// 1. every file is written completely into the staging folder (and synced);
+/// 2. an existing manifest of the same name that differs from the new one is removed
+///    (from here until step 4 the table has no manifest: it is absent, not inconsistent);
+/// 3. the data files are renamed over their targets, and stale files removed;
+/// 4. the manifest is renamed into place, last.
+///
+/// A run killed before step 2 leaves the previous table untouched; one killed later leaves
+/// no manifest, or the new complete table. Either way the next run succeeds. A staging
+/// folder left by a killed run is hidden and never read.
+pub struct StagedTable {
+    out_dir: std::path::PathBuf,
+    stage: tempfile::TempDir,
+}
+
+impl StagedTable {
+    /// Creates `out_dir` (if needed) and a staging folder inside it.
+    ///
+    /// # Errors
+    /// [`Error::Io`] when either folder cannot be created.
+    pub fn new(out_dir: &Path) -> Result<Self> {
+        let io = |source| Error::Io {
+            path: out_dir.to_path_buf(),
+            source,
+        };
+        if out_dir.exists() && !out_dir.is_dir() {
+            return Err(Error::Invalid {
+                context: out_dir.display().to_string(),
+                message: "exists and is not a folder: expected the output folder".into(),
+            });
+        }
+        std::fs::create_dir_all(out_dir).map_err(io)?;
+        let stage = tempfile::Builder::new()
+            .prefix(".nacre-stage-")
+            .tempdir_in(out_dir)
+            .map_err(io)?;
+        Ok(StagedTable {
+            out_dir: out_dir.to_path_buf(),
+            stage,
+        })
+    }
+
+    /// The staging folder: write every file of the table here.
+    pub fn path(&self) -> &Path {
+        self.stage.path()
+    }
+
+    /// Moves the staged files into the output folder, the manifest `manifest` (a file name
+    /// in the staging folder) last, and removes the files named in `stale` (earlier outputs
+    /// the new manifest no longer lists). Returns the manifest's final path.
+    ///
+    /// # Errors
+    /// [`Error::Io`] when a file cannot be moved or removed.
+    pub fn commit(self, manifest: &str, stale: &[String]) -> Result<std::path::PathBuf> {
+        let io = |path: &Path| {
+            let path = path.to_path_buf();
+            move |source| Error::Io { path, source }
+        };
+        let target = self.out_dir.join(manifest);
+        let staged_manifest = self.stage.path().join(manifest);
+        let new = std::fs::read(&staged_manifest).map_err(io(&staged_manifest))?;
+        match std::fs::read(&target) {
+            Ok(old) if old == new => {}
+            Ok(_) => {
+                std::fs::remove_file(&target).map_err(io(&target))?;
+                sync_dir(&self.out_dir).map_err(io(&self.out_dir))?;
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) => return Err(io(&target)(e)),
+        }
+        let mut names: Vec<std::ffi::OsString> = std::fs::read_dir(self.stage.path())
+            .map_err(io(self.stage.path()))?
+            .map(|e| e.map(|e| e.file_name()))
+            .collect::<std::io::Result<_>>()
+            .map_err(io(self.stage.path()))?;
+        names.sort();
+        for name in names.iter().filter(|n| n.as_os_str() != manifest) {
+            let to = self.out_dir.join(name);
+            std::fs::rename(self.stage.path().join(name), &to).map_err(io(&to))?;
+        }
+        for name in stale {
+            let path = self.out_dir.join(name);
+            match std::fs::remove_file(&path) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(io(&path)(e)),
+                _ => {}
+            }
+        }
+        sync_dir(&self.out_dir).map_err(io(&self.out_dir))?;
+        std::fs::rename(&staged_manifest, &target).map_err(io(&target))?;
+        sync_dir(&self.out_dir).map_err(io(&self.out_dir))?;
+        Ok(target)
+    }
+}
+
+/// Makes renames and removals in `dir` durable (a no-op where folders cannot be synced).
+fn sync_dir(dir: &Path) -> std::io::Result<()> {
+    #[cfg(unix)]
+    std::fs::File::open(dir)?.sync_all()?;
+    #[cfg(not(unix))]
+    let _ = dir;
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A disk that fills up (ENOSPC) or any other write error half-way: the error names
+    /// the target, an existing file is untouched and no temporary file is left.
+    #[test]
+    fn a_failing_writer_leaves_the_existing_file_and_no_temporary() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.csv");
+        std::fs::write(&path, "previous\n").unwrap();
+        let e = write_atomic(&path, |w| {
+            w.write_all(b"half a row,")?;
+            Err(std::io::Error::from_raw_os_error(28)) // ENOSPC
+        })
+        .unwrap_err()
+        .to_string();
+        assert!(e.starts_with(&format!("{}: ", path.display())), "{e}");
+        assert!(e.contains("No space left on device"), "{e}");
+        assert_eq!(std::fs::read(&path).unwrap(), b"previous\n");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    /// A table staged and committed over an older one; staging that fails half-way (the
+    /// stage dropped without a commit) leaves the older table and no staging folder.
+    #[test]
+    fn staged_tables_replace_the_manifest_last() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("t");
+        let stage = StagedTable::new(&out).unwrap();
+        std::fs::write(stage.path().join("a.exr"), "1").unwrap();
+        std::fs::write(stage.path().join("a.png"), "1").unwrap();
+        std::fs::write(stage.path().join("a.json"), "m1").unwrap();
+        assert_eq!(stage.commit("a.json", &[]).unwrap(), out.join("a.json"));
+        let stage = StagedTable::new(&out).unwrap();
+        std::fs::write(stage.path().join("a.exr"), "2").unwrap();
+        drop(stage);
+        assert_eq!(std::fs::read(out.join("a.exr")).unwrap(), b"1");
+        let stage = StagedTable::new(&out).unwrap();
+        std::fs::write(stage.path().join("a.exr"), "2").unwrap();
+        std::fs::write(stage.path().join("a.json"), "m2").unwrap();
+        stage.commit("a.json", &["a.png".into()]).unwrap();
+        assert_eq!(std::fs::read(out.join("a.exr")).unwrap(), b"2");
+        assert_eq!(std::fs::read(out.join("a.json")).unwrap(), b"m2");
+        let mut names: Vec<_> = std::fs::read_dir(&out)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        assert_eq!(names, ["a.exr", "a.json"]);
+        // A file where the folder should be.
+        let e = StagedTable::new(&out.join("a.exr"))
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(e.contains("not a folder"), "{e}");
+    }
 
     #[test]
     fn file_sets_replace_whole_or_not_at_all() {

@@ -305,6 +305,79 @@ fn guarded<T>(path: &Path, format: &str, decode: impl FnOnce() -> Result<T>) -> 
     })
 }
 
+/// Checks, before the decoder sees them, that the offset table of a single-part OpenEXR
+/// file and every chunk it points to lie within the file. The `exr` crate sizes its buffers
+/// from a chunk's byte count as declared, so a 500-byte file declaring a 2 GB chunk would
+/// otherwise cost 2 GB of memory (found by `fuzz/`, target `exr`).
+fn check_exr_chunks(
+    path: &Path,
+    bytes: &[u8],
+    chunk_count: usize,
+    blocks: &exr::meta::BlockDescription,
+) -> Result<()> {
+    let bad = |message: String| table_error(path, format!("not a valid OpenEXR file: {message}"));
+    let i32_at = |at: usize| -> Option<i32> {
+        Some(i32::from_le_bytes(
+            bytes.get(at..at.checked_add(4)?)?.try_into().ok()?,
+        ))
+    };
+    // The header: magic and version, then attributes `name\0type\0size value` up to a NUL.
+    let mut at = 8usize;
+    loop {
+        match bytes.get(at) {
+            None => return Err(bad("the header runs past the end of the file".into())),
+            Some(0) => break,
+            Some(_) => {}
+        }
+        for _ in 0..2 {
+            let nul = bytes[at..]
+                .iter()
+                .position(|&b| b == 0)
+                .ok_or_else(|| bad("an attribute name runs past the end of the file".into()))?;
+            at += nul + 1;
+        }
+        let size = i32_at(at)
+            .and_then(|n| usize::try_from(n).ok())
+            .ok_or_else(|| bad("an attribute size is missing or negative".into()))?;
+        at = at
+            .checked_add(4 + size)
+            .filter(|&end| end <= bytes.len())
+            .ok_or_else(|| bad("an attribute runs past the end of the file".into()))?;
+    }
+    let table = at + 1;
+    let table_end = chunk_count
+        .checked_mul(8)
+        .and_then(|n| n.checked_add(table))
+        .filter(|&end| end <= bytes.len())
+        .ok_or_else(|| {
+            bad(format!(
+                "an offset table of {chunk_count} chunks runs past the end of the file ({} bytes)",
+                bytes.len()
+            ))
+        })?;
+    // A chunk: its coordinates (scan line y, or four tile coordinates), its byte count, data.
+    let coordinates = match blocks {
+        exr::meta::BlockDescription::ScanLines => 4,
+        exr::meta::BlockDescription::Tiles(_) => 16,
+    };
+    for (k, entry) in bytes[table..table_end].chunks_exact(8).enumerate() {
+        let offset = u64::from_le_bytes(entry.try_into().unwrap());
+        let fits = usize::try_from(offset).ok().and_then(|o| {
+            let size = usize::try_from(i32_at(o.checked_add(coordinates)?)?).ok()?;
+            o.checked_add(coordinates + 4)?
+                .checked_add(size)
+                .filter(|&end| end <= bytes.len())
+        });
+        if fits.is_none() {
+            return Err(bad(format!(
+                "chunk {k} of {chunk_count} (at byte {offset}) runs past the end of the file ({} bytes)",
+                bytes.len()
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// Decodes an OpenEXR atlas; with `expected = Some((width, height, what))` the image size
 /// is checked against it before any pixel data is decoded.
 fn decode_exr(
@@ -383,6 +456,21 @@ fn decode_exr(
             )
         })?;
 
+    // The `exr` crate's B44 decoder overflows on malformed blocks (found by `fuzz/`,
+    // target `exr`); nacre writes ZIP, and B44 is lossy: refuse it.
+    if matches!(
+        header.compression,
+        exr::compression::Compression::B44 | exr::compression::Compression::B44A
+    ) {
+        return Err(table_error(
+            path,
+            format!(
+                "OpenEXR file uses {}; expected a lossless compression (none, RLE, ZIP, PIZ)",
+                header.compression
+            ),
+        ));
+    }
+    check_exr_chunks(path, bytes, header.chunk_count, &header.blocks)?;
     // Pedantic: reject duplicate or out-of-range chunk offsets rather than silently leaving
     // blocks of the image unfilled.
     let image = read()
@@ -474,7 +562,15 @@ fn decode_exr(
 /// corrupt, is too large, or holds a non-finite value.
 pub fn read_exr(path: &Path) -> Result<(Table3Atlas, Precision)> {
     let bytes = read_bytes(path)?;
-    guarded(path, "OpenEXR", || decode_exr(path, &bytes, None))
+    decode_exr_bytes(path, &bytes)
+}
+
+/// [`read_exr`] on bytes already in memory; `path` names them in errors.
+///
+/// # Errors
+/// As [`read_exr`], less the I/O errors.
+pub fn decode_exr_bytes(path: &Path, bytes: &[u8]) -> Result<(Table3Atlas, Precision)> {
+    guarded(path, "OpenEXR", || decode_exr(path, bytes, None))
 }
 
 /// Checks requested table dimensions; returns `(height, texels)`.
@@ -602,11 +698,26 @@ fn decode_png16(
 /// [`Error::Io`] when the file cannot be read; [`Error::Table`] when it is not a valid PNG,
 /// is not 16-bit RGB, is not `nx` wide and `ny * nz` high, or is truncated or corrupt.
 pub fn read_png16_table(path: &Path, nx: usize, ny: usize, nz: usize) -> Result<Table3> {
+    table_dims(path, nx, ny, nz)?;
+    let bytes = read_bytes(path)?;
+    decode_png16_table(path, &bytes, nx, ny, nz)
+}
+
+/// [`read_png16_table`] on bytes already in memory; `path` names them in errors.
+///
+/// # Errors
+/// As [`read_png16_table`], less the I/O errors.
+pub fn decode_png16_table(
+    path: &Path,
+    bytes: &[u8],
+    nx: usize,
+    ny: usize,
+    nz: usize,
+) -> Result<Table3> {
     let (height, texels) = table_dims(path, nx, ny, nz)?;
     let what = format!("nx={nx}, ny*nz={ny}*{nz}");
-    let bytes = read_bytes(path)?;
     let data = guarded(path, "PNG", || {
-        decode_png16(path, &bytes, nx, height, texels, &what)
+        decode_png16(path, bytes, nx, height, texels, &what)
     })?;
     Ok(Table3 { nx, ny, nz, data })
 }

@@ -74,9 +74,13 @@ fn every_baked_ktx2_parses_with_the_ktx2_crate_and_matches_its_exr() {
             assert_eq!(sha256_hex(&file).unwrap(), f.sha256, "{what}");
             let bytes = std::fs::read(&file).unwrap();
             match m.kind.as_str() {
-                "film-lut" => {
-                    let a = m.film_lut.as_ref().unwrap();
-                    let (nx, ny, nz) = (a.cos_theta_count, a.opd_count, a.ior_count);
+                // A rough-film-lut is laid out like a film-lut with depth = α blocks × indices.
+                "film-lut" | "rough-film-lut" => {
+                    let (nx, ny, nz) = match (&m.film_lut, &m.rough_film_lut) {
+                        (Some(a), _) => (a.cos_theta_count, a.opd_count, a.ior_count),
+                        (None, Some(a)) => (a.cos_theta_count, a.opd_count, a.depth()),
+                        _ => panic!("{what}: no axes"),
+                    };
                     let reader = open(&bytes, &m, ktx2::Format::R16G16B16A16_SFLOAT, what);
                     let h = reader.header();
                     assert_eq!(
@@ -144,12 +148,58 @@ fn every_baked_ktx2_parses_with_the_ktx2_crate_and_matches_its_exr() {
                         }
                     }
                 }
+                "diffraction" => {
+                    // 2-D array RGBA32F: layer l = (Re T_2l, Im T_2l, Re T_2l+1, Im T_2l+1).
+                    let d = m.diffraction.as_ref().unwrap();
+                    let terms = d.taylor_order + 1;
+                    let reader = open(&bytes, &m, ktx2::Format::R32G32B32A32_SFLOAT, what);
+                    let h = reader.header();
+                    assert_eq!(
+                        (h.pixel_width, h.pixel_height, h.pixel_depth),
+                        (d.nx as u32, d.ny as u32, 0),
+                        "{what}"
+                    );
+                    assert_eq!(h.layer_count as usize, terms.div_ceil(2), "{what}");
+                    assert_eq!(h.level_count, 1, "{what}");
+                    assert_eq!((f.width, f.height), (d.nx, d.ny));
+                    let exr = m
+                        .files
+                        .iter()
+                        .find(|e| e.format == "exr" && e.quantity == "terms")
+                        .unwrap();
+                    let (table, _) =
+                        read_exr_table(&dir.join(&exr.path), d.nx, d.ny, terms).unwrap();
+                    let level = reader.levels().next().unwrap().data;
+                    let v: Vec<f32> = level
+                        .chunks_exact(4)
+                        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+                        .collect();
+                    let bins = d.nx * d.ny;
+                    assert_eq!(v.len(), terms.div_ceil(2) * bins * 4, "{what}");
+                    for n in 0..terms.div_ceil(2) * 2 {
+                        for i in 0..bins {
+                            let at = ((n / 2) * bins + i) * 4 + 2 * (n % 2);
+                            let expect = if n < terms {
+                                let t = table.texel(i % d.nx, i / d.nx, n);
+                                assert_eq!(t[2], 0.0);
+                                [t[0], t[1]]
+                            } else {
+                                [0.0, 0.0]
+                            };
+                            assert_eq!(
+                                [v[at].to_bits(), v[at + 1].to_bits()],
+                                expect.map(f32::to_bits),
+                                "{what}: term {n}, bin {i}"
+                            );
+                        }
+                    }
+                }
                 other => panic!("{}: unexpected kind {other}", m.name),
             }
             seen += 1;
         }
     }
-    assert_eq!(seen, 8, "KTX2 files in the default set");
+    assert_eq!(seen, 11, "KTX2 files in the default set");
 }
 
 /// nacre's own reader agrees with the EXR path through the manifest (EXR entries removed).
@@ -176,6 +226,19 @@ fn manifest_loads_tables_from_ktx2_when_no_exr_is_listed() {
                         m.name
                     );
                 }
+            }
+            "diffraction" => assert_eq!(
+                m.load_diffraction(&copy).unwrap(),
+                full.load_diffraction(&path).unwrap()
+            ),
+            "rough-film-lut" => {
+                use nacre_bake::rough_lut::LoadedRoughLut;
+                assert_eq!(
+                    LoadedRoughLut::load(&copy).unwrap().lut,
+                    LoadedRoughLut::load(&path).unwrap().lut,
+                    "{}",
+                    m.name
+                );
             }
             _ => assert_eq!(
                 m.load_fourier(&copy).unwrap(),

@@ -12,6 +12,7 @@ use nacre_bake::{bake, materials, spectrum};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+mod diffraction;
 mod plot;
 
 #[derive(Parser)]
@@ -44,6 +45,10 @@ enum Command {
     /// Compare the real-time methods with the exact colour over angle × thickness (CSV + PNG).
     #[command(after_help = COMPARE_EXAMPLES)]
     Compare(CompareArgs),
+    /// Diffraction by surface nanostructure (Stam 1999; Dhillon et al. 2014): relative
+    /// reflectance or colour over view angles for a height field or a baked table, as CSV.
+    #[command(after_help = diffraction::EXAMPLES)]
+    Diffraction(diffraction::DiffractionArgs),
     /// Pictures (PNG or SVG): spectra, the chromaticity diagram with film trajectories,
     /// swatch charts of film colours, slices of baked tables.
     Plot(plot::PlotArgs),
@@ -117,7 +122,10 @@ manifest path), rgb3 (650/510/475 nm), samples:N (N wavelengths over 400-700 nm)
 fourier:M | fourier:auto [:SIGMA_NM] (Belcour & Barla 2017 Eq. 10 with exact Fresnel, the
 baked fourier table sampled as a GPU would, optional prefiltering for a thickness standard
 deviation), fourier-exact:… (the same with exact transforms), gaussian (the glTF
-KHR_materials_iridescence Gaussian-fit approximation).
+KHR_materials_iridescence Gaussian-fit approximation), rough-lut:NAME|PATH with --roughness
+ALPHA (the directional albedo of the rough GGX film lobe from a baked rough-film-lut table),
+rough-mc[:N] with --roughness ALPHA (its Monte Carlo reference, N samples per point,
+default 2^20; the largest standard error is printed on stderr).
 
 Examples:
   # colour of a 400 nm soap film over angle, exact
@@ -127,7 +135,10 @@ Examples:
   # points (angle_deg,thickness_nm,film_ior) on the glTF default base, in Rec.2020
   nacre color --ambient 1.0 --layer 1.5@0 --substrate 1.5 --points points.csv --space rec2020
   # transmittance colour, CIE 1964 observer under illuminant A
-  nacre color --layer water@600 --quantity t --observer 1964 --illuminant a";
+  nacre color --layer water@600 --quantity t --observer 1964 --illuminant a
+  # directional albedo of a rough film (GGX alpha 0.3) from the table, and its Monte Carlo reference
+  nacre color --ambient 1.0 --layer 1.33@400 --substrate 1.5 --angles 0:80:10 --method rough-lut:rough-film-dielectric --roughness 0.3
+  nacre color --ambient 1.0 --layer 1.33@400 --substrate 1.5 --angles 0:80:10 --method rough-mc --roughness 0.3";
 
 #[derive(Args)]
 struct ColorArgs {
@@ -156,6 +167,9 @@ struct ColorArgs {
     /// r (reflectance) or t (transmittance into the base).
     #[arg(long, default_value = "r", value_parser = ["r", "t"])]
     quantity: String,
+    /// GGX roughness α (0 < α ≤ 1) of the rough-lut: and rough-mc methods.
+    #[arg(long, value_name = "ALPHA")]
+    roughness: Option<f64>,
     /// CIE observer: 1931 (2°) or 1964 (10°) [default: 1931, or the table's].
     #[arg(long)]
     observer: Option<String>,
@@ -189,10 +203,20 @@ struct CompareArgs {
     #[arg(long, default_value = "fig7")]
     case: String,
     /// Incidence angles, degrees.
-    #[arg(long, value_name = "START:END:STEP", default_value = "0:85:2.5")]
+    #[arg(
+        long,
+        value_name = "START:END:STEP",
+        default_value = "0:85:2.5",
+        allow_hyphen_values = true
+    )]
     angles: String,
     /// Film thicknesses, nm.
-    #[arg(long, value_name = "START:END:STEP", default_value = "0:1000:10")]
+    #[arg(
+        long,
+        value_name = "START:END:STEP",
+        default_value = "0:1000:10",
+        allow_hyphen_values = true
+    )]
     thicknesses: String,
     /// Output folder: compare.csv and compare.png.
     #[arg(short = 'o', long = "output", value_name = "DIR")]
@@ -219,6 +243,10 @@ Examples:
   nacre render --scene plane --technique fourier --harmonics 0 --exposure -0.5 -o plane.png
   # a film on gold, your own environment and thickness map
   nacre render --tables film-gold --tables fourier-srgb --env sky.exr --thickness-map swirl.png -o gold.png
+  # a rough film lit the engines' way (film at n·v) and exactly (film per light, rough-film-lut)
+  nacre render --film-eval nv -o shortcut.png && nacre render --film-eval exact -o exact.png
+  # rough spheres α 0.05 … 0.8: shortcut, exact path and Monte Carlo reference, three rows
+  nacre render --scene rough-row --reference-samples 1024 -o rough-row.png
   # a glTF 2.0 / GLB scene with KHR_materials_iridescence (meshes rasterised, camera fitted)
   nacre render --gltf tests/golden/gltf/sweep-thickness.glb --width 1000 --height 260 -o sweep.png
 
@@ -231,9 +259,20 @@ film-lut table cannot represent is drawn with fourier instead (a note on stderr 
 
 #[derive(Args)]
 struct RenderArgs {
-    /// Scene: sphere, bubble or plane.
-    #[arg(long, default_value = "sphere", value_parser = ["sphere", "bubble", "plane"])]
+    /// Scene: sphere, bubble, plane, or rough-row (spheres of GGX α 0.05 … 0.8 by the
+    /// film-at-n·v shortcut, the exact path and the Monte Carlo reference, three rows).
+    #[arg(long, default_value = "sphere", value_parser = ["sphere", "bubble", "plane", "rough-row"])]
     scene: String,
+    /// How the film enters the lighting: classic (the film at v·h for the light, at n·v for
+    /// a box-filtered environment), nv (the engines' shortcut: the film once at n·v for
+    /// every light and the split-sum environment) or exact (the film at each light's half
+    /// vector; the split-sum environment with the rough-film-lut table's directional
+    /// albedo). nv and exact prefilter the environment with GGX at load.
+    #[arg(long, default_value = "classic", value_parser = ["classic", "nv", "exact"])]
+    film_eval: String,
+    /// Monte Carlo samples per pixel of the rough-row reference (16 to 1048576).
+    #[arg(long, value_name = "N", default_value_t = 1024)]
+    reference_samples: usize,
     /// Render a glTF 2.0 (.gltf / .glb) scene instead of --scene: its triangle meshes and
     /// materials (KHR_materials_iridescence, _ior, _transmission) [default tables:
     /// film-dielectric + fourier-srgb].
@@ -424,7 +463,72 @@ fn run_color(args: &ColorArgs) -> Result<()> {
         }
     };
     let stack = spec.build()?;
+    match (method.is_rough(), args.roughness) {
+        (true, Some(alpha)) => {
+            if !(alpha > 0.0 && alpha <= 1.0) {
+                return Err(Error::Flag {
+                    flag: "--roughness".into(),
+                    value: alpha.to_string(),
+                    message: "GGX roughness α must lie in (0, 1]".into(),
+                });
+            }
+            method = method.with_roughness(alpha);
+        }
+        (true, None) => {
+            return Err(Error::Flag {
+                flag: "--method".into(),
+                value: args.method.clone(),
+                message: "needs --roughness ALPHA (GGX α, 0 < α ≤ 1)".into(),
+            });
+        }
+        (false, Some(alpha)) => {
+            return Err(Error::Flag {
+                flag: "--roughness".into(),
+                value: alpha.to_string(),
+                message: "applies only to --method rough-lut:NAME and rough-mc".into(),
+            });
+        }
+        (false, None) => {}
+    }
     let (lut, colorimeter) = match &method {
+        Method::RoughLut { path, alpha, .. } => {
+            let table = nacre_bake::rough_lut::LoadedRoughLut::load(path)?;
+            color::check_stack_matches(&table.manifest, path, &stack, "rough-lut")?;
+            let m = &table.manifest;
+            for (flag, given, baked) in [
+                ("--observer", &args.observer, &m.observer),
+                ("--illuminant", &args.illuminant, &m.illuminant),
+                ("--space", &args.space, &m.space),
+            ] {
+                if let Some(g) = given
+                    && !g.eq_ignore_ascii_case(baked)
+                {
+                    return Err(Error::Flag {
+                        flag: flag.into(),
+                        value: g.clone(),
+                        message: format!("table `{}` was baked for `{baked}`", m.name),
+                    });
+                }
+            }
+            let a = &table.lut.axes;
+            if !(*alpha >= a.alpha_min && *alpha <= a.alpha_max) {
+                return Err(Error::Flag {
+                    flag: "--roughness".into(),
+                    value: alpha.to_string(),
+                    message: format!(
+                        "table `{}` covers GGX α {} to {}",
+                        m.name, a.alpha_min, a.alpha_max
+                    ),
+                });
+            }
+            let c = table.colorimeter.clone();
+            method = Method::RoughLut {
+                path: path.clone(),
+                alpha: *alpha,
+                table: Some(std::sync::Arc::new(table)),
+            };
+            (None, c)
+        }
         Method::Lut(path) => {
             let lut = LoadedLut::load(path)?;
             lut.check_stack(path, &stack)?;
@@ -480,14 +584,35 @@ fn run_color(args: &ColorArgs) -> Result<()> {
             (None, c)
         }
     };
-    let colours = color::evaluate(
-        &stack,
-        &points,
-        &method,
-        &colorimeter,
-        quantity,
-        lut.as_ref(),
-    )?;
+    let colours = match &method {
+        // The Monte Carlo reference reports its noise: the largest standard error.
+        Method::RoughMonteCarlo { alpha, samples } => {
+            let estimates = color::rough_monte_carlo(
+                &stack,
+                &points,
+                *alpha,
+                *samples,
+                &colorimeter,
+                quantity,
+            )?;
+            let worst = estimates
+                .iter()
+                .flat_map(|e| e.standard_error)
+                .fold(0.0f64, f64::max);
+            eprintln!(
+                "rough-mc: {samples} samples per point (seed = point index); largest standard error per channel {worst:.2e}"
+            );
+            estimates.iter().map(|e| e.colour).collect()
+        }
+        _ => color::evaluate(
+            &stack,
+            &points,
+            &method,
+            &colorimeter,
+            quantity,
+            lut.as_ref(),
+        )?,
+    };
     write_atomic(&args.output, |w| {
         color::write_csv(w, &stack, &points, &colours, &colorimeter)
     })
@@ -678,9 +803,13 @@ fn runtime_error(e: nacre_runtime::Error) -> nacre_bake::error::Error {
 }
 
 fn run_render(args: &RenderArgs) -> Result<()> {
-    use nacre_runtime::render::{SceneKind, SceneOptions, render_scene};
+    use nacre_runtime::render::{FilmEval, SceneKind, SceneOptions, render_scene};
     use nacre_runtime::{GpuContext, TableSet, Technique};
+    if args.scene == "rough-row" {
+        return run_render_rough_row(args);
+    }
     let scene: SceneKind = args.scene.parse().map_err(runtime_error)?;
+    let film_eval: FilmEval = args.film_eval.parse().map_err(runtime_error)?;
     let technique = match args.technique.as_str() {
         "fourier" => Technique::Fourier,
         "spectral" => Technique::Spectral,
@@ -693,7 +822,11 @@ fn run_render(args: &RenderArgs) -> Result<()> {
             SceneKind::Bubble => "soap-film",
             SceneKind::Plane => "oil-slick",
         };
-        vec![lut.into(), "fourier-srgb".into()]
+        let mut names = vec![lut.to_string(), "fourier-srgb".into()];
+        if film_eval == FilmEval::Exact {
+            names.push("rough-film-dielectric".into());
+        }
+        names
     } else {
         args.tables.clone()
     };
@@ -703,6 +836,7 @@ fn run_render(args: &RenderArgs) -> Result<()> {
     options.environment = args.env.clone();
     options.thickness_map = args.thickness_map.clone();
     options.exposure_ev = args.exposure;
+    options.film_eval = film_eval;
     if let Some(m) = args.harmonics {
         options.harmonics = m;
     }
@@ -769,6 +903,67 @@ fn run_render(args: &RenderArgs) -> Result<()> {
         image.height,
         total,
         image.gpu_seconds,
+        args.output.display()
+    );
+    Ok(())
+}
+
+/// `nacre render --scene rough-row`: the shortcut, exact and Monte Carlo rows.
+fn run_render_rough_row(args: &RenderArgs) -> Result<()> {
+    use nacre_runtime::rough_reference::{RoughRowOptions, render_rough_row};
+    use nacre_runtime::{GpuContext, TableSet, Technique};
+    if !(16..=1 << 20).contains(&args.reference_samples) {
+        return Err(nacre_bake::error::Error::Invalid {
+            context: "--reference-samples".into(),
+            message: format!("{} (expected 16 to 1048576)", args.reference_samples),
+        });
+    }
+    let technique = match args.technique.as_str() {
+        "fourier" => Technique::Fourier,
+        "spectral" => Technique::Spectral,
+        _ => Technique::Lut,
+    };
+    let names: Vec<String> = if args.tables.is_empty() {
+        vec![
+            "film-dielectric".into(),
+            "fourier-srgb".into(),
+            "rough-film-dielectric".into(),
+        ]
+    } else {
+        args.tables.clone()
+    };
+    for name in &names {
+        bake::Manifest::read(&bake::resolve_table(name))?;
+    }
+    let options = RoughRowOptions {
+        samples_per_pixel: args.reference_samples,
+        exposure_ev: args.exposure,
+        environment: args.env.clone(),
+        ..RoughRowOptions::default()
+    };
+    let ctx = GpuContext::new_headless().map_err(runtime_error)?;
+    eprintln!("adapter: {}", ctx.describe());
+    let mut tables = TableSet::default();
+    for name in &names {
+        tables
+            .add(&ctx, &bake::resolve_table(name))
+            .map_err(runtime_error)?;
+    }
+    let row = render_rough_row(&ctx, &tables, technique, &options).map_err(runtime_error)?;
+    let png = row.image.encode_png().map_err(runtime_error)?;
+    write_atomic(&args.output, |w| w.write_all(&png))?;
+    eprintln!("alpha   mean dE2000 vs Monte Carlo: film at n.v   exact");
+    for (alpha, nv, exact) in &row.delta_e {
+        eprintln!("{alpha:5.2}   {nv:38.3}   {exact:5.3}");
+    }
+    eprintln!(
+        "rendered rough-row ({}) at {}x{}: GPU {:.2} s, Monte Carlo reference ({} samples per pixel) {:.1} s -> {}",
+        technique.name(),
+        row.image.width,
+        row.image.height,
+        row.gpu_seconds,
+        args.reference_samples,
+        row.reference_seconds,
         args.output.display()
     );
     Ok(())
@@ -917,6 +1112,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Bake(args) => run_bake(&args),
         Command::Color(args) => run_color(&args),
         Command::Compare(args) => run_compare(&args),
+        Command::Diffraction(args) => diffraction::run(&args),
         Command::Plot(args) => plot::run(&args),
         Command::Conformance(args) => run_conformance(&args),
         Command::Render(args) => run_render(&args),

@@ -36,6 +36,10 @@ enum PlotKind {
     /// A baked table as pictures: film-lut slices (cos θ × optical path) or fourier envelopes.
     #[command(after_help = TABLE_EXAMPLES)]
     Table(TableArgs),
+    /// A diffraction map: the colour of a diffracting surface over view directions for a
+    /// fixed light (Stam 1999; see `nacre diffraction`).
+    #[command(after_help = crate::diffraction::MAP_EXAMPLES)]
+    Diffraction(crate::diffraction::MapArgs),
 }
 
 const SPECTRUM_EXAMPLES: &str = "\
@@ -254,6 +258,7 @@ pub fn run(args: &PlotArgs) -> Result<()> {
         PlotKind::Chromaticity(a) => run_chromaticity(a),
         PlotKind::Chart(a) => run_chart(a),
         PlotKind::Table(a) => run_table(a),
+        PlotKind::Diffraction(a) => crate::diffraction::run_map(a),
     }
 }
 

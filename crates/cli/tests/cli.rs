@@ -709,3 +709,124 @@ fn render_gltf_writes_a_png_and_refuses_bad_files() {
         assert!(!d.join("out.png").exists(), "{extra:?} wrote an output");
     }
 }
+
+/// `nacre color --method rough-lut:NAME --roughness A` (issue 6) agrees with the Monte Carlo
+/// reference `rough-mc` at the same points (reflected and transmitted), reports the
+/// reference's noise, and refuses missing, misplaced or out-of-range roughness.
+#[test]
+fn color_rough_methods() {
+    let dir = tempfile::tempdir().unwrap();
+    let stack = [
+        "color",
+        "--ambient",
+        "1.0",
+        "--layer",
+        "1.4@350",
+        "--substrate",
+        "1.5",
+        "--angles",
+        "0:80:40",
+    ];
+    let run = |extra: &[&str]| {
+        let mut args = stack.to_vec();
+        args.extend_from_slice(extra);
+        nacre(&args, dir.path())
+    };
+    let rows = |o: &Output| -> Vec<Vec<f64>> {
+        let text = String::from_utf8(o.stdout.clone()).unwrap();
+        let mut lines = text.lines();
+        assert_eq!(
+            lines.next(),
+            Some("angle_deg,thickness_nm,film_ior,X,Y,Z,R,G,B")
+        );
+        lines
+            .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+            .collect()
+    };
+    for quantity in ["r", "t"] {
+        let lut = run(&[
+            "--method",
+            "rough-lut:rough-film-dielectric",
+            "--roughness",
+            "0.4",
+            "--quantity",
+            quantity,
+        ]);
+        assert!(lut.status.success(), "{}", stderr(&lut));
+        let mc = run(&[
+            "--method",
+            "rough-mc:65536",
+            "--roughness",
+            "0.4",
+            "--quantity",
+            quantity,
+        ]);
+        assert!(mc.status.success(), "{}", stderr(&mc));
+        assert!(
+            stderr(&mc).contains("largest standard error"),
+            "{}",
+            stderr(&mc)
+        );
+        let (a, b) = (rows(&lut), rows(&mc));
+        assert_eq!(a.len(), 3);
+        for (x, y) in a.iter().zip(&b) {
+            assert_eq!(x[..3], y[..3]);
+            for c in 6..9 {
+                // A few per cent reflected, most transmitted: agree within 3 % + 1e-3.
+                assert!(
+                    (x[c] - y[c]).abs() <= 0.03 * y[c] + 1e-3,
+                    "{quantity}: {x:?} vs {y:?}"
+                );
+            }
+        }
+    }
+    for (extra, needle) in [
+        (vec!["--method", "rough-mc"], "--roughness"),
+        (
+            vec!["--method", "spectral", "--roughness", "0.3"],
+            "--roughness",
+        ),
+        (
+            vec![
+                "--method",
+                "rough-lut:rough-film-dielectric",
+                "--roughness",
+                "0.01",
+            ],
+            "covers GGX",
+        ),
+        (vec!["--method", "rough-mc", "--roughness", "1.5"], "(0, 1]"),
+        (
+            vec!["--method", "rough-lut:", "--roughness", "0.3"],
+            "rough-lut:NAME",
+        ),
+        (
+            vec!["--method", "rough-mc:0", "--roughness", "0.3"],
+            "rough-mc:N",
+        ),
+    ] {
+        let o = run(&extra);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(needle), "{extra:?}: {}", stderr(&o));
+        assert!(o.stdout.is_empty());
+    }
+    // A table baked for another base is refused.
+    let o = nacre(
+        &[
+            "color",
+            "--ambient",
+            "1.0",
+            "--layer",
+            "1.4@350",
+            "--substrate",
+            "1.33",
+            "--method",
+            "rough-lut:rough-film-dielectric",
+            "--roughness",
+            "0.3",
+        ],
+        dir.path(),
+    );
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("base"), "{}", stderr(&o));
+}

@@ -111,6 +111,53 @@ pub enum Error {
         /// The accepted names, e.g. `1931, 1964`.
         expected: &'static str,
     },
+    /// A height field holds a NaN or infinite height.
+    #[error("height field sample (x = {x}, y = {y}) is not a finite number")]
+    NonFiniteHeight {
+        /// Column, from 0.
+        x: usize,
+        /// Row, from 0.
+        y: usize,
+    },
+    /// The Taylor expansion of e^{ikwh} would need more terms than the limit: the
+    /// structure is too tall for the wavelength.
+    #[error(
+        "the Taylor expansion of the diffraction phase needs more than {max_order} terms for max |k w h| = {x_max:.3} at tolerance {tolerance:e}: the height field is too tall for the shortest wavelength (lower the height scale or raise the shortest wavelength)"
+    )]
+    TaylorOrder {
+        /// max |k w h| asked for.
+        x_max: f64,
+        /// Tolerance on the remainder bound.
+        tolerance: f64,
+        /// The highest order accepted.
+        max_order: usize,
+    },
+    /// A height-field patch smaller than the coherence window along an axis it varies along.
+    #[error(
+        "the height field spans {patch_um} µm along {axis}, less than the coherence diameter 4σ_s = {coherence_diameter_um} µm: use a larger patch (more samples or a coarser pitch) or a smaller coherence diameter"
+    )]
+    PatchTooSmall {
+        /// `x` or `y`.
+        axis: &'static str,
+        /// Patch size along the axis, µm.
+        patch_um: f64,
+        /// 4σ_s, µm.
+        coherence_diameter_um: f64,
+    },
+    /// A height-field pitch too coarse for the spatial frequencies asked for.
+    #[error(
+        "height-field pitch {pitch_um} µm exceeds the Nyquist limit {max_pitch_um:.6} µm = λ/(2·{max_uv:.4}) for {wavelength_nm} nm at the directions asked for: use a finer pitch, longer wavelengths or directions closer to the specular one"
+    )]
+    NyquistExceeded {
+        /// The pitch, µm.
+        pitch_um: f64,
+        /// The largest acceptable pitch, µm.
+        max_pitch_um: f64,
+        /// The shortest wavelength, nm.
+        wavelength_nm: f64,
+        /// The largest |u| or |v| reached.
+        max_uv: f64,
+    },
 }
 
 /// Shorthand for `Result<T, nacre_optics::Error>`.

@@ -2,7 +2,8 @@
 //!
 //! Pure physics and colorimetry for nacre, in f64: complex refractive indices and
 //! dispersive materials ([`material`]), Snell's law and Fresnel coefficients for absorbing
-//! media ([`fresnel`]), and multilayer thin-film stacks ([`stack`]).
+//! media ([`fresnel`]), multilayer thin-film stacks ([`stack`]), and diffraction by surface
+//! nanostructure from height fields ([`diffraction`]: Stam 1999, Dhillon et al. 2014).
 //!
 //! This crate does no file or GPU I/O: parsers take the text they are handed.
 //!
@@ -21,6 +22,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod colour;
+pub mod diffraction;
 pub mod error;
 pub mod fourier;
 pub mod fresnel;

@@ -572,7 +572,7 @@ fn estimate(sum: &[f64; 3], sum2: &[f64; 3], n: usize) -> Estimate {
 /// normal `h` into a medium of relative index `eta`: ω_t = −ω_o/η + (cos_i/η − cos_t) h,
 /// or None under total internal reflection.
 #[inline]
-fn refract(wo: [f64; 3], h: [f64; 3], cos_i: f64, eta: f64) -> Option<[f64; 3]> {
+pub fn refract(wo: [f64; 3], h: [f64; 3], cos_i: f64, eta: f64) -> Option<[f64; 3]> {
     let sin2_t = (1.0 - cos_i * cos_i).max(0.0) / (eta * eta);
     if sin2_t >= 1.0 {
         return None;

@@ -23,10 +23,32 @@ impl GpuContext {
     pub fn new_headless() -> Result<Self> {
         let instance =
             wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        let adapter = pollster::block_on(wgpu::util::initialize_adapter_from_env_or_default(
-            &instance, None,
-        ))
-        .map_err(|e| Error::NoAdapter(e.to_string()))?;
+        // WGPU_ADAPTER_NAME is matched here rather than by wgpu's helper, which panics when
+        // no adapter matches.
+        let adapter = match std::env::var("WGPU_ADAPTER_NAME") {
+            Ok(wanted) => {
+                let adapters =
+                    pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
+                let names: Vec<String> = adapters.iter().map(|a| a.get_info().name).collect();
+                adapters
+                    .into_iter()
+                    .find(|a| {
+                        a.get_info()
+                            .name
+                            .to_lowercase()
+                            .contains(&wanted.to_lowercase())
+                    })
+                    .ok_or_else(|| {
+                        Error::NoAdapter(format!(
+                            "WGPU_ADAPTER_NAME={wanted} matches none of the adapters found: {names:?}"
+                        ))
+                    })?
+            }
+            Err(_) => pollster::block_on(wgpu::util::initialize_adapter_from_env_or_default(
+                &instance, None,
+            ))
+            .map_err(|e| Error::NoAdapter(e.to_string()))?,
+        };
         let info = adapter.get_info();
         let features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {

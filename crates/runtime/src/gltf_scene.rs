@@ -511,8 +511,41 @@ impl GltfScene {
 
     /// Parses glTF or GLB bytes; `path` names the file in errors and locates external buffers.
     pub fn from_bytes(bytes: &[u8], path: &Path) -> Result<GltfScene> {
-        let gltf = gltf::Gltf::from_slice(bytes)
-            .map_err(|e| invalid(path, format!("not a valid glTF 2.0 / GLB file: {e}")))?;
+        let not_valid =
+            |e: gltf::Error| invalid(path, format!("not a valid glTF 2.0 / GLB file: {e}"));
+        let raw = gltf::Gltf::from_slice_without_validation(bytes).map_err(not_valid)?;
+        let json = raw.document.as_json();
+        let version = &json.asset.version;
+        if !version.starts_with("2.") {
+            return Err(invalid(
+                path,
+                format!("asset version `{version}`: expected a glTF 2.x file"),
+            ));
+        }
+        // gltf-json 1.4 validates a primitive by indexing its POSITION accessor before
+        // checking that it exists (a panic): check every attribute's accessor first.
+        for (m, mesh) in json.meshes.iter().enumerate() {
+            for (p, primitive) in mesh.primitives.iter().enumerate() {
+                if let Some(index) = primitive
+                    .attributes
+                    .values()
+                    .find(|i| i.value() >= json.accessors.len())
+                {
+                    return Err(invalid(
+                        path,
+                        format!(
+                            "meshes[{m}].primitives[{p}].attributes: accessor {} does not exist (the file has {})",
+                            index.value(),
+                            json.accessors.len()
+                        ),
+                    ));
+                }
+            }
+        }
+        let gltf = gltf::Gltf {
+            document: gltf::Document::from_json(raw.document.into_json()).map_err(not_valid)?,
+            blob: raw.blob,
+        };
         let doc = &gltf.document;
         let mut buffers = Vec::new();
         for buffer in doc.buffers() {

@@ -12,11 +12,13 @@ pub mod error;
 pub mod fullscreen;
 pub mod gltf_assets;
 pub mod gltf_scene;
+pub mod ibl;
 pub mod mesh;
 pub mod params;
 pub mod probe;
 pub mod readback;
 pub mod render;
+pub mod rough_reference;
 pub mod shaders;
 pub mod tables;
 

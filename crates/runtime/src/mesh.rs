@@ -357,7 +357,7 @@ pub fn render_gltf(
     };
     let colorimeter = tables.colorimeter()?;
     let device = &ctx.device;
-    let view_layout = group_layout(device, "mesh view");
+    let view_layout = crate::render::view_group_layout(device, "mesh view");
     let material_layout = group_layout(device, "mesh material");
     let mesh_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("mesh pass"),
@@ -391,14 +391,10 @@ pub fn render_gltf(
         pipelines.push((key.clone(), binding, pipeline));
     }
 
-    let env_mips = environment.mip_chain();
-    let view_uniform = ViewUniform::new(&view_options, env_mips.len())?;
-    let env_texture = upload_mips(
-        ctx,
-        "environment",
-        wgpu::TextureFormat::Rgba16Float,
-        &env_mips,
-    )?;
+    crate::render::check_film_eval(tables, options)?;
+    let env =
+        crate::render::EnvironmentTextures::new(ctx, &environment, options.film_eval, tables)?;
+    let view_uniform = ViewUniform::new(&view_options, env.env_levels)?;
     // Per material its thickness texture, or a 1×1 map of g = 1 (d = d_max) without one.
     let flat = ThicknessMap {
         width: 1,
@@ -425,7 +421,9 @@ pub fn render_gltf(
     }
     let mut material_uniforms = Vec::with_capacity(drawn.len());
     for (m, _) in &drawn {
-        material_uniforms.push(MaterialUniform::new(m, tables)?);
+        let mut u = MaterialUniform::new(m, tables)?;
+        u.film_eval = options.film_eval.id();
+        material_uniforms.push(u);
     }
     let mesh_uniform = MeshUniform {
         view_proj: camera.view_proj,
@@ -463,12 +461,11 @@ pub fn render_gltf(
                 ],
             })
         };
-        let view_group = group(
+        let view_group = env.bind_group(
+            device,
             &view_layout,
             "mesh view",
             bytemuck::bytes_of(&view_uniform),
-            &env_texture,
-            false,
         );
         let material_groups: Vec<wgpu::BindGroup> = material_uniforms
             .iter()

@@ -4,8 +4,9 @@
 //! directional light and an equirectangular HDR environment, tone-mapped and read back as
 //! sRGB-encoded RGBA8 pixels.
 //!
-//! Bind groups (`shaders/README.md`): 0 = the view ([`ViewUniform`], the environment and its
-//! sampler), 1 = the technique's tables ([`TechniqueBinding`]), 2 = the material
+//! Bind groups (`shaders/README.md`): 0 = the view ([`ViewUniform`], the environment, its
+//! GGX-prefiltered layers, the E₁ table and the `rough-film-lut` of the split-sum paths:
+//! [`FilmEval`], [`crate::ibl`]), 1 = the technique's tables ([`TechniqueBinding`]), 2 = the material
 //! ([`MaterialUniform`], the thickness map and its sampler). The pipeline's source is
 //! `shaders::compose(technique, &[MATERIAL, SCENE])`.
 //!
@@ -110,6 +111,80 @@ impl FromStr for SceneKind {
             })
     }
 }
+
+/// How the film enters the lighting (`MaterialParams.film_eval` in `shaders/material.wgsl`,
+/// whose header has the equations; `nacre render --film-eval`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum FilmEval {
+    /// The original nacre path: the light sees the film at its half vector v·h; the
+    /// environment is the box-filtered mip chain at a roughness-dependent level times the film
+    /// at n·v times Karis's fit of the GGX albedo, 1 − 0.55√α (no split-sum tables).
+    #[default]
+    Classic,
+    /// The engines' common shortcut (Belcour & Barla 2017, §6, Fig. 16, bottom row): the film
+    /// colour is evaluated once per pixel, at n·v, and used for every light and for the
+    /// split-sum environment: L̃(r, α) R_f(n·v) E₁(n·v, α).
+    NormalView,
+    /// Film per light at its half vector (F(ω_o·h)), and for the environment the split sum
+    /// L̃(r, α) E_f(n·v, α, d, n₂) with E_f the iridescent lobe's directional albedo from a
+    /// `rough-film-lut` table.
+    Exact,
+}
+
+impl FilmEval {
+    /// Every path.
+    pub const ALL: [FilmEval; 3] = [FilmEval::Classic, FilmEval::NormalView, FilmEval::Exact];
+
+    /// The name used on the command line (`classic`, `nv`, `exact`).
+    pub fn name(self) -> &'static str {
+        match self {
+            FilmEval::Classic => "classic",
+            FilmEval::NormalView => "nv",
+            FilmEval::Exact => "exact",
+        }
+    }
+
+    /// `MaterialParams.film_eval`.
+    pub fn id(self) -> u32 {
+        match self {
+            FilmEval::Classic => 0,
+            FilmEval::NormalView => 1,
+            FilmEval::Exact => 2,
+        }
+    }
+
+    /// Whether the path samples the GGX-prefiltered environment (the split sum).
+    pub fn split_sum(self) -> bool {
+        self != FilmEval::Classic
+    }
+}
+
+impl FromStr for FilmEval {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        FilmEval::ALL
+            .into_iter()
+            .find(|k| k.name().eq_ignore_ascii_case(s.trim()))
+            .ok_or_else(|| Error::Invalid {
+                context: format!("film evaluation `{s}`"),
+                message: "expected classic, nv or exact".into(),
+            })
+    }
+}
+
+/// What a [`Renderer`] writes: display pixels or linear radiance.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum RenderOutput {
+    /// Exposed, tone-mapped (PBR Neutral), sRGB-encoded RGBA8 ([`TARGET_FORMAT`]).
+    #[default]
+    Display,
+    /// Linear scene radiance before exposure and tone mapping, `Rgba32Float`
+    /// ([`LINEAR_TARGET_FORMAT`]; `scene_fs_linear`).
+    Linear,
+}
+
+/// The render target format of [`RenderOutput::Linear`].
+pub const LINEAR_TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
 /// A pinhole camera.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -559,6 +634,8 @@ pub struct SceneOptions {
     pub harmonics: u32,
     /// Wavelengths N of `film_spectral` (default 30).
     pub spectral_samples: usize,
+    /// How the film enters the lighting (default [`FilmEval::Classic`]).
+    pub film_eval: FilmEval,
 }
 
 impl SceneOptions {
@@ -578,6 +655,7 @@ impl SceneOptions {
             exposure_ev: 0.0,
             harmonics: technique.harmonics,
             spectral_samples: technique.spectral.samples,
+            film_eval: FilmEval::Classic,
         }
     }
 
@@ -729,8 +807,10 @@ pub struct MaterialUniform {
     pub thickness_map_scale: f32,
     /// Film weight w: F = mix(F_base, R_f, w).
     pub film_weight: f32,
+    /// [`FilmEval::id`]: 0 classic, 1 film at n·v, 2 exact.
+    pub film_eval: u32,
     /// Padding to 96 bytes.
-    pub _pad: [f32; 3],
+    pub _pad: [f32; 2],
 }
 
 impl ViewUniform {
@@ -814,7 +894,8 @@ impl MaterialUniform {
             base_colour: m.base_colour,
             thickness_map_scale: m.thickness_map_scale,
             film_weight: m.film_weight,
-            _pad: [0.0; 3],
+            film_eval: FilmEval::Classic.id(),
+            _pad: [0.0; 2],
         })
     }
 }
@@ -1004,6 +1085,13 @@ fn smoothstep(e0: f64, e1: f64, x: f64) -> f64 {
 /// Every value is finite, non-negative and below the half-float limit. `tables/env/studio.exr`
 /// is this function at 256 × 128 in half floats.
 pub fn procedural_environment(width: usize, height: usize) -> EnvironmentMap {
+    procedural_environment_with(width, height, true)
+}
+
+/// [`procedural_environment`] with or without its sun and glow (`sun = false`: the studio
+/// and sky only, for scenes whose sun is the directional light alone — the rough-sphere
+/// comparisons of `nacre_runtime::rough_reference`).
+pub fn procedural_environment_with(width: usize, height: usize, sun_on: bool) -> EnvironmentMap {
     use std::f64::consts::PI;
     let sun = normalize(SUN_DIRECTION).expect("non-zero");
     // Softboxes: (azimuth from, to; elevation from, to) in degrees, radiance RGB. Azimuth 0
@@ -1044,8 +1132,11 @@ pub fn procedural_environment(width: usize, height: usize) -> EnvironmentMap {
             // Sun and glow.
             let cos_gamma = (dir[0] * sun[0] + dir[1] * sun[1] + dir[2] * sun[2]).clamp(-1.0, 1.0);
             let gamma = cos_gamma.acos();
-            let sun_radiance =
-                60.0 * (-(gamma / 0.035).powi(2)).exp() + 1.5 * (-(gamma / 0.3).powi(2)).exp();
+            let sun_radiance = if sun_on {
+                60.0 * (-(gamma / 0.035).powi(2)).exp() + 1.5 * (-(gamma / 0.3).powi(2)).exp()
+            } else {
+                0.0
+            };
             let sun_colour = [1.0, 0.93, 0.82];
             for k in 0..3 {
                 c[k] += sun_radiance * sun_colour[k];
@@ -1282,6 +1373,7 @@ impl RenderedImage {
 /// A technique's scene pipeline: group-1 tables, group-0/2 layouts, the render pipeline.
 pub struct Renderer {
     technique: Technique,
+    output: RenderOutput,
     binding: TechniqueBinding,
     view_layout: wgpu::BindGroupLayout,
     material_layout: wgpu::BindGroupLayout,
@@ -1323,7 +1415,259 @@ pub(crate) fn sampler_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     }
 }
 
-/// Group 0 and group 2 share a shape: 0 uniform, 1 filterable 2-D texture, 2 sampler.
+/// Group 0, the view and the environment (`shaders/material.wgsl`): 0 the view uniform,
+/// 1 the environment's box mip chain, 2 its sampler (u repeats, v clamps), 3 the
+/// GGX-prefiltered environment, 4 the F = 1 GGX albedo table E₁, 5 a clamp-to-edge sampler,
+/// 6 the `rough-film-lut` reflectance (3-D), 7 its [`RoughLutUniform`].
+pub fn view_group_layout(device: &wgpu::Device, label: &str) -> wgpu::BindGroupLayout {
+    let mut prefiltered = texture_entry(3);
+    prefiltered.ty = wgpu::BindingType::Texture {
+        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+        view_dimension: wgpu::TextureViewDimension::D2Array,
+        multisampled: false,
+    };
+    let mut rough_lut = texture_entry(6);
+    rough_lut.ty = wgpu::BindingType::Texture {
+        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+        view_dimension: wgpu::TextureViewDimension::D3,
+        multisampled: false,
+    };
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries: &[
+            uniform_entry(0),
+            texture_entry(1),
+            sampler_entry(2),
+            prefiltered,
+            texture_entry(4),
+            sampler_entry(5),
+            rough_lut,
+            uniform_entry(7),
+        ],
+    })
+}
+
+/// Mirror of `RoughLutParams` (`shaders/rough_lut_mapping.wgsl`; the axes of
+/// `nacre_bake::rough_lut::RoughLutAxes`): 48 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct RoughLutUniform {
+    /// Texels along cos θ_o.
+    pub cos_theta_count: u32,
+    /// Texels along Δ.
+    pub opd_count: u32,
+    /// Texels along the film index per α block.
+    pub ior_count: u32,
+    /// α blocks.
+    pub alpha_count: u32,
+    /// d_max, nm.
+    pub thickness_max_nm: f32,
+    /// Smallest film index.
+    pub ior_min: f32,
+    /// Largest film index.
+    pub ior_max: f32,
+    /// Smallest α.
+    pub alpha_min: f32,
+    /// Largest α.
+    pub alpha_max: f32,
+    /// Ambient index n₀.
+    pub ambient_index: f32,
+    /// 1 when the table has a transmittance.
+    pub has_transmittance: u32,
+    /// Padding to 48 bytes.
+    pub _pad0: u32,
+}
+
+impl RoughLutUniform {
+    /// The uniform of a loaded table.
+    pub fn new(lut: &crate::tables::RoughFilmLutTextures) -> RoughLutUniform {
+        let a = &lut.axes;
+        RoughLutUniform {
+            cos_theta_count: a.cos_theta_count as u32,
+            opd_count: a.opd_count as u32,
+            ior_count: a.ior_count as u32,
+            alpha_count: a.alpha_count as u32,
+            thickness_max_nm: a.thickness_max_nm as f32,
+            ior_min: a.ior_min as f32,
+            ior_max: a.ior_max as f32,
+            alpha_min: a.alpha_min as f32,
+            alpha_max: a.alpha_max as f32,
+            ambient_index: a.ambient_index as f32,
+            has_transmittance: u32::from(lut.has_transmittance),
+            _pad0: 0,
+        }
+    }
+}
+
+/// The textures of group 0 besides the view uniform: the environment's box mip chain, its
+/// GGX-prefiltered levels ([`crate::ibl::PrefilteredEnvironment`]) and the E₁ table
+/// ([`crate::ibl::ggx_albedo_table`]). The classic path reads neither of the last two: they
+/// are 1 × 1 placeholders unless the path is a split-sum one, and the `rough-film-lut`
+/// a 1 × 1 × 1 placeholder unless the path is [`FilmEval::Exact`].
+pub(crate) struct EnvironmentTextures {
+    /// Mip levels of the environment's box chain.
+    pub env_levels: usize,
+    env: wgpu::Texture,
+    prefiltered: wgpu::Texture,
+    ggx_albedo: wgpu::Texture,
+    rough_lut: wgpu::TextureView,
+    rough_lut_uniform: RoughLutUniform,
+}
+
+impl EnvironmentTextures {
+    /// Uploads `environment` (and, for the split-sum paths, prefilters it and builds E₁).
+    pub(crate) fn new(
+        ctx: &GpuContext,
+        environment: &EnvironmentMap,
+        film_eval: FilmEval,
+        tables: &TableSet,
+    ) -> Result<EnvironmentTextures> {
+        let split_sum = film_eval.split_sum();
+        let (rough_lut, rough_lut_uniform) = match (&tables.rough_film_lut, film_eval) {
+            (Some(lut), FilmEval::Exact) => (
+                lut.reflectance.create_view(&Default::default()),
+                RoughLutUniform::new(lut),
+            ),
+            _ => {
+                let placeholder = ctx.checked("a rough-film-lut placeholder", || {
+                    ctx.device.create_texture(&wgpu::TextureDescriptor {
+                        label: Some("rough-film-lut (unused)"),
+                        size: wgpu::Extent3d {
+                            width: 1,
+                            height: 1,
+                            depth_or_array_layers: 1,
+                        },
+                        mip_level_count: 1,
+                        sample_count: 1,
+                        dimension: wgpu::TextureDimension::D3,
+                        format: wgpu::TextureFormat::Rgba16Float,
+                        usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                        view_formats: &[],
+                    })
+                })?;
+                (
+                    placeholder.create_view(&Default::default()),
+                    RoughLutUniform::default(),
+                )
+            }
+        };
+        let env_mips = environment.mip_chain();
+        let env = upload_mips(
+            ctx,
+            "environment",
+            wgpu::TextureFormat::Rgba16Float,
+            &env_mips,
+        )?;
+        let (prefiltered, ggx_albedo) = if split_sum {
+            let p = crate::ibl::PrefilteredEnvironment::cached(environment);
+            (
+                upload_layers(ctx, "prefiltered environment", &p.levels)?,
+                upload_mips(
+                    ctx,
+                    "GGX albedo",
+                    wgpu::TextureFormat::Rg16Float,
+                    std::slice::from_ref(crate::ibl::ggx_albedo_table()),
+                )?,
+            )
+        } else {
+            (
+                upload_layers(
+                    ctx,
+                    "prefiltered environment (unused)",
+                    &[(1, 1, vec![[0.0f32; 4]])],
+                )?,
+                upload_mips(
+                    ctx,
+                    "GGX albedo (unused)",
+                    wgpu::TextureFormat::Rg16Float,
+                    &[(1, 1, vec![[0.0f32; 2]])],
+                )?,
+            )
+        };
+        Ok(EnvironmentTextures {
+            env,
+            env_levels: env_mips.len(),
+            prefiltered,
+            ggx_albedo,
+            rough_lut,
+            rough_lut_uniform,
+        })
+    }
+
+    /// The group-0 bind group for `layout` ([`view_group_layout`]) with the view uniform
+    /// `uniform` (its bytes).
+    pub(crate) fn bind_group(
+        &self,
+        device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        label: &str,
+        uniform: &[u8],
+    ) -> wgpu::BindGroup {
+        let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: uniform,
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let env_view = self.env.create_view(&Default::default());
+        let prefiltered_view = self.prefiltered.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let albedo_view = self.ggx_albedo.create_view(&Default::default());
+        let rough_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("rough-film-lut axes"),
+            contents: bytemuck::bytes_of(&self.rough_lut_uniform),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let env_sampler = linear_sampler(device, label, false);
+        let clamp_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("lut clamp"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(label),
+            layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&env_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::Sampler(&env_sampler),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(&prefiltered_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: wgpu::BindingResource::TextureView(&albedo_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: wgpu::BindingResource::Sampler(&clamp_sampler),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: wgpu::BindingResource::TextureView(&self.rough_lut),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 7,
+                    resource: rough_buffer.as_entire_binding(),
+                },
+            ],
+        })
+    }
+}
+
+/// Group 2 (and the old group 0) shape: 0 uniform, 1 filterable 2-D texture, 2 sampler.
 pub(crate) fn group_layout(device: &wgpu::Device, label: &str) -> wgpu::BindGroupLayout {
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some(label),
@@ -1394,6 +1738,78 @@ pub(crate) fn upload_mips<const C: usize>(
     })
 }
 
+/// Uploads equal-sized RGBA levels as the layers of a 2-D array `Rgba16Float` texture (one
+/// mip level).
+pub(crate) fn upload_layers(
+    ctx: &GpuContext,
+    label: &str,
+    layers: &[Level<4>],
+) -> Result<wgpu::Texture> {
+    let (width, height, _) = &layers[0];
+    if layers
+        .iter()
+        .any(|l| (l.0, l.1) != (*width, *height) || l.2.len() != l.0 * l.1)
+    {
+        return Err(Error::Invalid {
+            context: label.into(),
+            message: "layers of differing sizes".into(),
+        });
+    }
+    let limit = ctx.device.limits();
+    if (*width.max(height) as u64) > u64::from(limit.max_texture_dimension_2d)
+        || layers.len() as u64 > u64::from(limit.max_texture_array_layers)
+    {
+        return Err(Error::Limit {
+            what: label.to_string(),
+            needed: (*width.max(height)).max(layers.len()) as u64,
+            limit: u64::from(
+                limit
+                    .max_texture_dimension_2d
+                    .min(limit.max_texture_array_layers),
+            ),
+            adapter: ctx.info.name.clone(),
+        });
+    }
+    ctx.checked(&format!("uploading {label}"), || {
+        let size = wgpu::Extent3d {
+            width: *width as u32,
+            height: *height as u32,
+            depth_or_array_layers: layers.len() as u32,
+        };
+        let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba16Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        let halves: Vec<u16> = layers
+            .iter()
+            .flat_map(|l| l.2.iter())
+            .flat_map(|t| t.map(|v| f16::from_f32(v).to_bits()))
+            .collect();
+        ctx.queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            bytemuck::cast_slice(&halves),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some((*width * 8) as u32),
+                rows_per_image: Some(*height as u32),
+            },
+            size,
+        );
+        texture
+    })
+}
+
 pub(crate) fn linear_sampler(device: &wgpu::Device, label: &str, repeat_v: bool) -> wgpu::Sampler {
     device.create_sampler(&wgpu::SamplerDescriptor {
         label: Some(label),
@@ -1420,6 +1836,23 @@ impl Renderer {
         technique: Technique,
         options: &TechniqueOptions,
     ) -> Result<Renderer> {
+        Renderer::new_with_output(ctx, tables, technique, options, RenderOutput::Display)
+    }
+
+    /// [`Renderer::new`] writing `output`: display pixels (`scene_fs`, [`TARGET_FORMAT`]) or
+    /// linear radiance (`scene_fs_linear`, [`LINEAR_TARGET_FORMAT`]; read it with
+    /// [`Renderer::render_linear_with`]).
+    pub fn new_with_output(
+        ctx: &GpuContext,
+        tables: &TableSet,
+        technique: Technique,
+        options: &TechniqueOptions,
+        output: RenderOutput,
+    ) -> Result<Renderer> {
+        let (entry_point, format) = match output {
+            RenderOutput::Display => ("scene_fs", TARGET_FORMAT),
+            RenderOutput::Linear => ("scene_fs_linear", LINEAR_TARGET_FORMAT),
+        };
         let colorimeter = tables.colorimeter()?;
         let binding = TechniqueBinding::new(ctx, tables, technique, options, &colorimeter)?;
         let device = &ctx.device;
@@ -1430,7 +1863,7 @@ impl Renderer {
                     label: Some("scene"),
                     source: wgpu::ShaderSource::Wgsl(source.as_str().into()),
                 });
-                let view_layout = group_layout(device, "scene view");
+                let view_layout = view_group_layout(device, "scene view");
                 let material_layout = group_layout(device, "scene material");
                 let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                     label: Some("scene"),
@@ -1455,10 +1888,10 @@ impl Renderer {
                     multisample: Default::default(),
                     fragment: Some(wgpu::FragmentState {
                         module: &module,
-                        entry_point: Some("scene_fs"),
+                        entry_point: Some(entry_point),
                         compilation_options: Default::default(),
                         targets: &[Some(wgpu::ColorTargetState {
-                            format: TARGET_FORMAT,
+                            format,
                             blend: None,
                             write_mask: wgpu::ColorWrites::ALL,
                         })],
@@ -1470,6 +1903,7 @@ impl Renderer {
             })?;
         Ok(Renderer {
             technique,
+            output,
             binding,
             view_layout,
             material_layout,
@@ -1502,7 +1936,8 @@ impl Renderer {
     }
 
     /// Renders `options` with an environment and a thickness map already in memory
-    /// (`options.environment` and `options.thickness_map` are not read).
+    /// (`options.environment` and `options.thickness_map` are not read). Needs a renderer
+    /// made for [`RenderOutput::Display`].
     pub fn render_with(
         &self,
         ctx: &GpuContext,
@@ -1511,6 +1946,63 @@ impl Renderer {
         environment: &EnvironmentMap,
         thickness: &ThicknessMap,
     ) -> Result<RenderedImage> {
+        if self.output != RenderOutput::Display {
+            return Err(Error::Invalid {
+                context: "render".into(),
+                message: "this renderer writes linear radiance: use render_linear_with".into(),
+            });
+        }
+        let (target, gpu_seconds) = self.draw(ctx, tables, options, environment, thickness)?;
+        let mut pixels = read_texture(ctx, &target, 4)?;
+        for p in pixels.chunks_exact_mut(4) {
+            p[3] = 255;
+        }
+        Ok(RenderedImage {
+            width: options.width,
+            height: options.height,
+            pixels,
+            gpu_seconds,
+        })
+    }
+
+    /// Renders the linear scene radiance of `options` (before exposure and tone mapping)
+    /// with an environment and a thickness map in memory. Needs a renderer made for
+    /// [`RenderOutput::Linear`].
+    pub fn render_linear_with(
+        &self,
+        ctx: &GpuContext,
+        tables: &TableSet,
+        options: &SceneOptions,
+        environment: &EnvironmentMap,
+        thickness: &ThicknessMap,
+    ) -> Result<LinearImage> {
+        if self.output != RenderOutput::Linear {
+            return Err(Error::Invalid {
+                context: "render".into(),
+                message: "this renderer writes display pixels: use render_with".into(),
+            });
+        }
+        let (target, gpu_seconds) = self.draw(ctx, tables, options, environment, thickness)?;
+        let bytes = read_texture(ctx, &target, 16)?;
+        let floats: &[f32] = bytemuck::cast_slice(&bytes);
+        Ok(LinearImage {
+            width: options.width,
+            height: options.height,
+            rgb: floats.chunks_exact(4).map(|p| [p[0], p[1], p[2]]).collect(),
+            gpu_seconds,
+        })
+    }
+
+    /// Draws `options` into a new target of the renderer's output format; returns it and the
+    /// seconds from submission to completion.
+    fn draw(
+        &self,
+        ctx: &GpuContext,
+        tables: &TableSet,
+        options: &SceneOptions,
+        environment: &EnvironmentMap,
+        thickness: &ThicknessMap,
+    ) -> Result<(wgpu::Texture, f64)> {
         options.validate()?;
         for (what, w, h, n) in [
             (
@@ -1537,6 +2029,7 @@ impl Renderer {
         if self.technique == Technique::Lut {
             check_film_lut(tables, &options.material)?;
         }
+        check_film_eval(tables, options)?;
         let (width, height) = (options.width, options.height);
         let limit = ctx.device.limits().max_texture_dimension_2d;
         if width.max(height) > limit {
@@ -1547,15 +2040,10 @@ impl Renderer {
                 adapter: ctx.info.name.clone(),
             });
         }
-        let env_mips = environment.mip_chain();
-        let view_uniform = ViewUniform::new(options, env_mips.len())?;
-        let material_uniform = MaterialUniform::new(&options.material, tables)?;
-        let env_texture = upload_mips(
-            ctx,
-            "environment",
-            wgpu::TextureFormat::Rgba16Float,
-            &env_mips,
-        )?;
+        let env = EnvironmentTextures::new(ctx, environment, options.film_eval, tables)?;
+        let view_uniform = ViewUniform::new(options, env.env_levels)?;
+        let mut material_uniform = MaterialUniform::new(&options.material, tables)?;
+        material_uniform.film_eval = options.film_eval.id();
         let thickness_texture = upload_mips(
             ctx,
             "thickness map",
@@ -1595,12 +2083,11 @@ impl Renderer {
                     ],
                 })
             };
-            let view_group = group(
+            let view_group = env.bind_group(
+                device,
                 &self.view_layout,
                 "scene view",
                 bytemuck::bytes_of(&view_uniform),
-                &env_texture,
-                false,
             );
             let material_group = group(
                 &self.material_layout,
@@ -1619,7 +2106,10 @@ impl Renderer {
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
-                format: TARGET_FORMAT,
+                format: match self.output {
+                    RenderOutput::Display => TARGET_FORMAT,
+                    RenderOutput::Linear => LINEAR_TARGET_FORMAT,
+                },
                 usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
                 view_formats: &[],
             });
@@ -1655,18 +2145,70 @@ impl Renderer {
             (target, submitted)
         })?;
         ctx.wait("rendering the scene")?;
-        let gpu_seconds = submitted.elapsed().as_secs_f64();
-        let mut pixels = read_texture(ctx, &target, 4)?;
-        for p in pixels.chunks_exact_mut(4) {
-            p[3] = 255;
-        }
-        Ok(RenderedImage {
-            width,
-            height,
-            pixels,
-            gpu_seconds,
-        })
+        Ok((target, submitted.elapsed().as_secs_f64()))
     }
+}
+
+/// Linear scene radiance read back from a [`RenderOutput::Linear`] render.
+#[derive(Clone, Debug)]
+pub struct LinearImage {
+    /// Width, pixels.
+    pub width: u32,
+    /// Height, pixels.
+    pub height: u32,
+    /// Linear RGB radiance (the tables' output space), row-major, top row first.
+    pub rgb: Vec<[f32; 3]>,
+    /// As [`RenderedImage::gpu_seconds`].
+    pub gpu_seconds: f64,
+}
+
+/// Checks that the tables can render `options.film_eval`: the exact path needs a
+/// `rough-film-lut` whose ambient matches and whose ranges hold the material.
+pub(crate) fn check_film_eval(tables: &TableSet, options: &SceneOptions) -> Result<()> {
+    if options.film_eval != FilmEval::Exact {
+        return Ok(());
+    }
+    let Some(lut) = &tables.rough_film_lut else {
+        return Err(Error::Invalid {
+            context: "film evaluation `exact`".into(),
+            message: "needs a `rough-film-lut` table in the table set (e.g. rough-film-dielectric)"
+                .into(),
+        });
+    };
+    let axes = &lut.axes;
+    let m = &options.material;
+    let context = format!("rough-film-lut `{}`", lut.name);
+    let tol = 1e-4;
+    if (f64::from(m.ambient_ior) - axes.ambient_index).abs() > tol {
+        return Err(Error::Invalid {
+            context,
+            message: format!(
+                "the table was baked for ambient index {}, the material has {}",
+                axes.ambient_index, m.ambient_ior
+            ),
+        });
+    }
+    let n = f64::from(m.film_ior);
+    if n < axes.ior_min - tol || n > axes.ior_max + tol {
+        return Err(Error::Invalid {
+            context,
+            message: format!(
+                "film index {n} lies outside the table's {}–{}",
+                axes.ior_min, axes.ior_max
+            ),
+        });
+    }
+    let d = f64::from(m.max_thickness_nm());
+    if d > axes.thickness_max_nm * (1.0 + tol) {
+        return Err(Error::Invalid {
+            context,
+            message: format!(
+                "the material reaches {d} nm, beyond the table's {} nm",
+                axes.thickness_max_nm
+            ),
+        });
+    }
+    Ok(())
 }
 
 /// Checks that a `film-lut` table can render `material`: the table exists, its ambient is
@@ -1853,6 +2395,27 @@ mod tests {
         let tables = TableSet::default();
         let u = MaterialUniform::new(&m, &tables).unwrap();
         assert_eq!(u.film_weight, 1.0);
+    }
+
+    #[test]
+    fn film_eval_names_parse_and_uniform_layouts_hold() {
+        for k in FilmEval::ALL {
+            assert_eq!(k.name().parse::<FilmEval>().unwrap(), k);
+        }
+        assert!("fresnel".parse::<FilmEval>().is_err());
+        assert!(!FilmEval::Classic.split_sum() && FilmEval::Exact.split_sum());
+        assert_eq!(std::mem::offset_of!(MaterialUniform, film_eval), 84);
+        assert_eq!(std::mem::size_of::<RoughLutUniform>(), 48);
+        assert_eq!(std::mem::offset_of!(RoughLutUniform, has_transmittance), 40);
+    }
+
+    #[test]
+    fn exact_path_needs_a_rough_table() {
+        let mut o = SceneOptions::new(SceneKind::Sphere);
+        o.film_eval = FilmEval::Exact;
+        assert!(check_film_eval(&TableSet::default(), &o).is_err());
+        o.film_eval = FilmEval::NormalView;
+        assert!(check_film_eval(&TableSet::default(), &o).is_ok());
     }
 
     #[test]

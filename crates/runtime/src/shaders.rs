@@ -22,9 +22,17 @@ pub const PLAIN: &str = include_str!("../../../shaders/plain.wgsl");
 pub const BENCH: &str = include_str!("../../../shaders/bench.wgsl");
 /// Consumer: the GPU = CPU probe pass.
 pub const PROBE: &str = include_str!("../../../shaders/probe.wgsl");
+/// The rough-film-lut coordinate mappings and two-fetch lookup (mirror of
+/// `nacre_bake::rough_lut`; no bindings of its own).
+pub const ROUGH_LUT_MAPPING: &str = include_str!("../../../shaders/rough_lut_mapping.wgsl");
 /// Consumer: the thin-film microfacet material (GGX + film, environment, light, tone
-/// mapping; groups 0 and 2). Compose it before [`SCENE`].
-pub const MATERIAL: &str = include_str!("../../../shaders/material.wgsl");
+/// mapping; groups 0 and 2), preceded by [`ROUGH_LUT_MAPPING`] (its exact split-sum path
+/// samples a `rough-film-lut`). Compose it before [`SCENE`] or [`MESH`].
+pub const MATERIAL: &str = concat!(
+    include_str!("../../../shaders/rough_lut_mapping.wgsl"),
+    "\n",
+    include_str!("../../../shaders/material.wgsl")
+);
 /// Consumer: the ray-cast analytic scenes of `nacre render` (sphere, bubble, plane).
 pub const SCENE: &str = include_str!("../../../shaders/scene.wgsl");
 /// Consumer: rasterised triangle meshes (glTF scenes of `nacre render --gltf`; group 3 holds

@@ -4,6 +4,10 @@
 //!   texture when the base is opaque), x = cos θ, y = Δ, z = film index. The files hold half
 //!   floats (or 16-bit PNG), so the upload is exact, and a linear, clamp-to-edge sampler at
 //!   the texture coordinates of `lut_mapping.wgsl` reproduces the CPU `lut:` method.
+//! * `rough-film-lut` → two 3-D `Rgba16Float` textures (reflectance, transmittance; a 1×1×1
+//!   zero texture when the base is opaque) in the layout of `nacre_bake::rough_lut`: x =
+//!   cos θ_o, y = Δ, z = i_α · count(n_f) + i_n (α-major blocks); `rough_lut_mapping.wgsl`
+//!   samples it (two trilinear fetches, mixed in α).
 //! * `fourier` → one 2-D array texture, `Rgba32Float`, two layers (0: Re A_j, 1: Im A_j),
 //!   width N, height 1, mip level k = the table's level k (N / 2^k texels). Full float
 //!   is not filterable everywhere, so `film_fourier.wgsl` filters it itself with
@@ -23,6 +27,7 @@ use half::f16;
 use nacre_bake::bake::Manifest;
 use nacre_bake::film_lut::FilmLutAxes;
 use nacre_bake::fourier_table::FourierAxes;
+use nacre_bake::rough_lut::RoughLutAxes;
 use nacre_bake::table_io::{self, Table3};
 use nacre_optics::colour::Colorimeter;
 use std::path::{Path, PathBuf};
@@ -40,6 +45,24 @@ pub struct FilmLutTextures {
     /// Reflectance, 3-D `Rgba16Float`.
     pub reflectance: wgpu::Texture,
     /// Transmittance, 3-D `Rgba16Float` (1×1×1 zero when the base is opaque).
+    pub transmittance: wgpu::Texture,
+    /// Whether the table has a transmittance.
+    pub has_transmittance: bool,
+}
+
+/// A `rough-film-lut` table on the GPU (`nacre_bake::rough_lut`).
+pub struct RoughFilmLutTextures {
+    /// Table name (from the manifest).
+    pub name: String,
+    /// The manifest it was loaded from.
+    pub manifest_path: PathBuf,
+    /// The manifest.
+    pub manifest: Manifest,
+    /// Axes (counts, ranges, ambient index).
+    pub axes: RoughLutAxes,
+    /// Directional albedo of the reflected lobe E_r, 3-D `Rgba16Float`.
+    pub reflectance: wgpu::Texture,
+    /// Energy transmitted into the base E_t, 3-D `Rgba16Float` (1×1×1 zero when opaque).
     pub transmittance: wgpu::Texture,
     /// Whether the table has a transmittance.
     pub has_transmittance: bool,
@@ -66,6 +89,8 @@ pub struct TableSet {
     pub film_lut: Option<FilmLutTextures>,
     /// The `fourier` table, if loaded.
     pub fourier: Option<FourierTextures>,
+    /// The `rough-film-lut` table, if loaded (the exact split-sum path).
+    pub rough_film_lut: Option<RoughFilmLutTextures>,
 }
 
 impl TableSet {
@@ -83,11 +108,14 @@ impl TableSet {
         match manifest.kind.as_str() {
             "film-lut" => self.film_lut = Some(upload_film_lut(ctx, manifest, manifest_path)?),
             "fourier" => self.fourier = Some(upload_fourier(ctx, manifest, manifest_path)?),
+            "rough-film-lut" => {
+                self.rough_film_lut = Some(upload_rough_film_lut(ctx, manifest, manifest_path)?)
+            }
             other => {
                 return Err(Error::Manifest {
                     path: manifest_path.to_path_buf(),
                     message: format!(
-                        "table kind `{other}` has no GPU technique (expected `film-lut` or `fourier`)"
+                        "table kind `{other}` has no GPU use (expected `film-lut`, `fourier` or `rough-film-lut`)"
                     ),
                 });
             }
@@ -105,6 +133,11 @@ impl TableSet {
             .map(|t| (&t.manifest, t.manifest_path.as_path()))
             .chain(
                 self.fourier
+                    .iter()
+                    .map(|t| (&t.manifest, t.manifest_path.as_path())),
+            )
+            .chain(
+                self.rough_film_lut
                     .iter()
                     .map(|t| (&t.manifest, t.manifest_path.as_path())),
             )
@@ -218,6 +251,54 @@ fn upload_film_lut(
         reflectance,
         transmittance,
         has_transmittance,
+    })
+}
+
+fn upload_rough_film_lut(
+    ctx: &GpuContext,
+    manifest: Manifest,
+    manifest_path: &Path,
+) -> Result<RoughFilmLutTextures> {
+    let axes = manifest
+        .rough_film_lut
+        .clone()
+        .ok_or_else(|| Error::Manifest {
+            path: manifest_path.to_path_buf(),
+            message: "a rough-film-lut manifest without its `rough_film_lut` axes".into(),
+        })?;
+    let limit = ctx.device.limits().max_texture_dimension_3d;
+    for (name, n) in [
+        ("cos θ axis", axes.cos_theta_count),
+        ("OPD axis", axes.opd_count),
+        ("α × index depth", axes.depth()),
+    ] {
+        check_limit(
+            ctx,
+            &format!("rough-film-lut `{}` {name}", manifest.name),
+            n as u64,
+            limit,
+        )?;
+    }
+    // The loader of nacre-bake reads the EXR (or KTX2) files in the table's layout.
+    let loaded = nacre_bake::rough_lut::LoadedRoughLut::load(manifest_path)?;
+    let label = manifest.name.clone();
+    let lut = &loaded.lut;
+    let (reflectance, transmittance) = ctx.checked("uploading a rough-film-lut table", || {
+        let r = upload_table3(ctx, &format!("{label} reflectance"), &lut.reflectance);
+        let t = match &lut.transmittance {
+            Some(t) => upload_table3(ctx, &format!("{label} transmittance"), t),
+            None => upload_table3(ctx, &format!("{label} (opaque)"), &Table3::new(1, 1, 1)),
+        };
+        (r, t)
+    })?;
+    Ok(RoughFilmLutTextures {
+        name: manifest.name.clone(),
+        manifest_path: manifest_path.to_path_buf(),
+        has_transmittance: lut.transmittance.is_some(),
+        manifest,
+        axes,
+        reflectance,
+        transmittance,
     })
 }
 

@@ -135,7 +135,7 @@ fn scene_pipelines_validate_for_every_technique() {
             &module,
             &info,
         );
-        for entry in ["scene_vs", "scene_fs"] {
+        for entry in ["scene_vs", "scene_fs", "scene_fs_linear"] {
             assert!(
                 module.entry_points.iter().any(|e| e.name == entry),
                 "{entry} missing"
@@ -192,7 +192,7 @@ fn scene_pipelines_validate_for_every_technique() {
                     ("base_colour", 64),
                     ("thickness_map_scale", 76),
                     ("film_weight", 80),
-                    ("_pad0", 84),
+                    ("film_eval", 84),
                     ("_pad1", 88),
                     ("_pad2", 92),
                 ][..],

@@ -351,7 +351,7 @@ fn every_shader_file_opens_with_a_comment_header() {
 /// baseline).
 #[test]
 fn the_runtimes_own_pipelines_validate_and_translate() {
-    use nacre_runtime::shaders::{BENCH, MATERIAL, MESH, PLAIN, PROBE, compose_source};
+    use nacre_runtime::shaders::{BENCH, MATERIAL, MESH, PLAIN, PROBE, SCENE, compose_source};
     for technique in Technique::ALL {
         let (source, map) = composition(
             technique,
@@ -360,6 +360,20 @@ fn the_runtimes_own_pipelines_validate_and_translate() {
         let name = format!("film_{} + material.wgsl + mesh.wgsl", technique.name());
         let (module, info) = validate(&name, &source, &map);
         translate(&name, &module, &info);
+        // The ray-cast scenes: display and linear (split-sum comparison) outputs.
+        let (source, map) = composition(
+            technique,
+            &[("material.wgsl", MATERIAL), ("scene.wgsl", SCENE)],
+        );
+        let name = format!("film_{} + material.wgsl + scene.wgsl", technique.name());
+        let (module, info) = validate(&name, &source, &map);
+        translate(&name, &module, &info);
+        for entry in ["scene_fs", "scene_fs_linear"] {
+            assert!(
+                module.entry_points.iter().any(|e| e.name == entry),
+                "{name}: {entry} missing"
+            );
+        }
         for (consumer_name, consumer) in [("probe.wgsl", PROBE), ("bench.wgsl", BENCH)] {
             let (source, map) = composition(technique, &[(consumer_name, consumer)]);
             let name = format!("film_{} + {consumer_name}", technique.name());

@@ -1,0 +1,1494 @@
+//! Diffraction gratings: height-field sources (files and synthetic specs), the table kind
+//! `diffraction` (layout "terms"), and the CPU evaluation behind `nacre diffraction`.
+//! The physics is [`nacre_optics::diffraction`] (Stam 1999; Dhillon et al. 2014).
+//!
+//! # Height-field sources
+//!
+//! * Synthetic specs ([`SyntheticSpec::parse`]): `sine:PERIOD_UM:AMPLITUDE_UM`,
+//!   `blazed:PERIOD_UM:HEIGHT_UM`, `cd` or `cd:SEED` (tracks 1.6 µm apart, pits 0.1 µm
+//!   deep), `bumps:RADIUS_UM:HEIGHT_UM:FILL` or `bumps:RADIUS_UM:HEIGHT_UM:FILL:SEED`
+//!   (Stam's random bumps). Gratings are one row (invariant along the lines) spanning
+//!   whole periods over at least the coherence diameter; `cd` and `bumps` are square
+//!   patches at least the coherence diameter wide.
+//! * Files ([`read_height_field`]): 8- or 16-bit greyscale PNG (value / full scale ×
+//!   height scale), OpenEXR (one channel `Y`, `Z`, `R` or the only channel, × height
+//!   scale), or CSV (rows of comma-separated numbers, `#` comments, × height scale; row
+//!   0 is y = 0). The pitch (µm per sample) and the height scale (µm) come from the
+//!   recipe or the command line.
+//!
+//! # Table kind `diffraction`, layout "terms"
+//!
+//! ```toml
+//! kind = "diffraction"
+//! description = "CD-like tracks"
+//! [colour]                        # as for film-lut; recorded for the runtime's colour sums
+//! [height_field]
+//! synthetic = "cd"                # or: file = "snake.png" (relative to the recipe)
+//! samples = 256                   # synthetic: samples per axis (along x for gratings)
+//! pitch_um = 0.125                # required with `file`; synthetic: optional
+//! height_scale_um = 0.1           # `file` only: full scale of a PNG, multiplier of EXR/CSV
+//! [diffraction]
+//! layout = "terms"
+//! coherence_diameter_um = 65.0    # 4σ_s; default 65 (Dhillon et al. 2014)
+//! wavelengths = "380:780:5"       # range (and colour step) the table serves
+//! max_angle_deg = 45.0            # light and view polar angles the table serves
+//! taylor_tolerance = 1e-4         # bound on the Taylor remainder |kwh|^{N+1}/(N+1)!
+//! ```
+//!
+//! What every texel holds: layer n of the terms is Tₙ[j] = DFT{(i h)ⁿ}[j] / M (M = Mₓ·M_y
+//! samples, positive exponent e^{+iκ_j·x}), computed in f64 and stored as f32, DC at
+//! texel (⌊Mₓ/2⌋, ⌊M_y/2⌋); texel (s, t) is frequency κ = 2π (s − ⌊Mₓ/2⌋, t − ⌊M_y/2⌋) / L.
+//! The EXR file `NAME.terms.exr` is an atlas Mₓ wide and M_y·(N+1) high (term n in rows
+//! [n·M_y, (n+1)·M_y)), R = Re Tₙ, G = Im Tₙ, B = 0, full float. The KTX2 file
+//! `NAME.terms.ktx2` is a 2-D array `RGBA32F` texture Mₓ × M_y with ⌈(N+1)/2⌉ layers,
+//! layer l = (Re T₂ₗ, Im T₂ₗ, Re T₂ₗ₊₁, Im T₂ₗ₊₁) (zero when 2l + 1 > N).
+//!
+//! How a shader rebuilds the colour: for each wavelength λ of the grid, k = 2π/λ,
+//! (u, v, w) = −ω_i − ω_r, P_j = Σₙ (kw)ⁿ/n! Tₙ[j] at the texels j near (ku, kv)·L/2π,
+//! P̃ = Σ_j P_j exp(−σ_s²|(ku, kv) − κ_j|²/2), ρ = F² · G/w² · |P̃|²
+//! (G/w² = (1 + ω_i·ω_r)²/(cos θ_i cos θ_r (cos θ_i + cos θ_r)²)), then
+//! colour = M · Σ_λ ρ(λ) u(λ) with the CIE weights of the recorded observer and illuminant
+//! ([`nacre_optics::diffraction::SpectralGrid`]). The layout "integrated" of issue 7 (the
+//! wavelength-integrated fast path) is not implemented.
+
+use crate::bake::{AxisRecord, FileRecord, MANIFEST_FORMAT, Manifest};
+use crate::error::{Error, Result};
+use crate::output::write_atomic;
+use crate::spectrum::fmt_sig;
+use crate::stack_spec::{line_of, toml_error};
+use crate::table_io::{self, Precision, Table3};
+use nacre_optics::C64;
+use nacre_optics::colour::Colorimeter;
+use nacre_optics::diffraction::{
+    CD_PIT_DEPTH_UM, CD_TRACK_PITCH_UM, DEFAULT_COHERENCE_DIAMETER_UM, DiffractionSurface,
+    FresnelTerm, HeightField, SpectralGrid, TaylorTerms, in_plane_directions, taylor_order_for,
+};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use toml::Spanned;
+
+/// The sign convention recorded in manifests and printed by the CLI.
+pub const SIGN_CONVENTION: &str = "P(ku, kv) = ∬ exp(+i k (u x + v y + w h(x, y))) dx dy with (u, v, w) = −ω_i − ω_r (ω_i towards the light, ω_r towards the viewer; time dependence exp(−iωt)); T_n[j] = (1/M) Σ_m (i h_m)^n exp(+i κ_j·x_m), κ_j = 2π j / L; P_j = Σ_n (k w)^n / n! T_n[j]; x runs across the grating lines";
+
+/// Largest pitch the automatic sampling of synthetic specs uses, µm: the Nyquist limit of
+/// 380 nm light at |u| = 2 is 0.095 µm.
+pub const AUTO_PITCH_UM: f64 = 0.09;
+
+/// Most samples per axis of a synthetic field or height-field file.
+pub const MAX_AXIS: usize = 4096;
+
+/// A synthetic height field.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SyntheticSpec {
+    /// h = a sin(2πx/d).
+    Sine {
+        /// Period d, µm.
+        period_um: f64,
+        /// Amplitude a, µm.
+        amplitude_um: f64,
+    },
+    /// A sawtooth rising by `height_um` over each period.
+    Blazed {
+        /// Period d, µm.
+        period_um: f64,
+        /// Height, µm.
+        height_um: f64,
+    },
+    /// CD-like tracks of pits.
+    Cd {
+        /// Random seed of the pit sequence.
+        seed: u64,
+    },
+    /// Stam's random bumps.
+    Bumps {
+        /// Bump radius, µm.
+        radius_um: f64,
+        /// Bump height, µm.
+        height_um: f64,
+        /// Covered area fraction (bumps × πr² / patch area).
+        fill: f64,
+        /// Random seed.
+        seed: u64,
+    },
+}
+
+impl SyntheticSpec {
+    /// Parses `sine:PERIOD_UM:AMPLITUDE_UM`, `blazed:PERIOD_UM:HEIGHT_UM`, `cd[:SEED]` or
+    /// `bumps:RADIUS_UM:HEIGHT_UM:FILL[:SEED]`; `None` when `text` names none of these
+    /// kinds (it may be a file). Errors name `context` (a flag or `file:line`).
+    pub fn parse(context: &str, text: &str) -> Result<Option<Self>> {
+        let parts: Vec<&str> = text.trim().split(':').map(str::trim).collect();
+        let err = |message: String| Error::Flag {
+            flag: context.to_string(),
+            value: text.to_string(),
+            message,
+        };
+        let num = |s: &str, what: &str, positive: bool| -> Result<f64> {
+            s.parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite() && if positive { *v > 0.0 } else { *v >= 0.0 })
+                .ok_or_else(|| {
+                    err(format!(
+                        "{what} `{s}` must be a finite {} number",
+                        if positive { "positive" } else { "non-negative" }
+                    ))
+                })
+        };
+        let seed = |s: &str| -> Result<u64> {
+            s.parse::<u64>()
+                .map_err(|_| err(format!("SEED `{s}` must be a non-negative integer")))
+        };
+        let spec = match parts.as_slice() {
+            ["sine", d, a] => SyntheticSpec::Sine {
+                period_um: num(d, "PERIOD_UM", true)?,
+                amplitude_um: num(a, "AMPLITUDE_UM", false)?,
+            },
+            ["blazed", d, h] => SyntheticSpec::Blazed {
+                period_um: num(d, "PERIOD_UM", true)?,
+                height_um: num(h, "HEIGHT_UM", false)?,
+            },
+            ["cd"] => SyntheticSpec::Cd { seed: 1 },
+            ["cd", s] => SyntheticSpec::Cd { seed: seed(s)? },
+            ["bumps", r, h, f] | ["bumps", r, h, f, _] => SyntheticSpec::Bumps {
+                radius_um: num(r, "RADIUS_UM", true)?,
+                height_um: num(h, "HEIGHT_UM", false)?,
+                fill: num(f, "FILL", true)?,
+                seed: parts.get(4).map_or(Ok(1), |s| seed(s))?,
+            },
+            [kind, ..] if ["sine", "blazed", "cd", "bumps"].contains(kind) => {
+                return Err(err(
+                    "expected sine:PERIOD_UM:AMPLITUDE_UM, blazed:PERIOD_UM:HEIGHT_UM, cd[:SEED] or bumps:RADIUS_UM:HEIGHT_UM:FILL[:SEED]".into(),
+                ));
+            }
+            _ => return Ok(None),
+        };
+        Ok(Some(spec))
+    }
+
+    /// Generates the field. The patch spans at least `coherence_diameter_um` (gratings:
+    /// whole periods; `cd`: whole 1.6 µm tracks). `pitch_um` defaults to d/⌈d/0.04⌉ (at
+    /// least 16 samples per period) for gratings and at most [`AUTO_PITCH_UM`] otherwise;
+    /// `samples` (per axis; along x for gratings) overrides the patch size.
+    ///
+    /// # Errors
+    /// [`Error::OpticsIn`] naming `context` for out-of-range parameters;
+    /// [`Error::TooLarge`] beyond [`MAX_AXIS`] samples per axis.
+    pub fn generate(
+        &self,
+        context: &str,
+        coherence_diameter_um: f64,
+        pitch_um: Option<f64>,
+        samples: Option<usize>,
+    ) -> Result<HeightField> {
+        let core = |source| Error::OpticsIn {
+            context: context.to_string(),
+            source,
+        };
+        let too_large = |n: usize| Error::TooLarge {
+            what: format!("{context}: samples per axis"),
+            count: n as u64,
+            limit: MAX_AXIS as u64,
+        };
+        let square = |n: usize| {
+            if n > MAX_AXIS {
+                Err(too_large(n))
+            } else {
+                Ok(n)
+            }
+        };
+        match *self {
+            SyntheticSpec::Sine { period_um, .. } | SyntheticSpec::Blazed { period_um, .. } => {
+                let pitch =
+                    pitch_um.unwrap_or_else(|| period_um / ((period_um / 0.04).ceil().max(16.0)));
+                let periods = (coherence_diameter_um / period_um).ceil().max(1.0);
+                let nx = samples
+                    .unwrap_or_else(|| (periods * period_um / pitch).round().max(1.0) as usize);
+                if nx > MAX_AXIS * MAX_AXIS {
+                    return Err(too_large(nx));
+                }
+                match *self {
+                    SyntheticSpec::Sine {
+                        period_um,
+                        amplitude_um,
+                    } => HeightField::sine_grating(period_um, amplitude_um, pitch, nx),
+                    SyntheticSpec::Blazed {
+                        period_um,
+                        height_um,
+                    } => HeightField::blazed_grating(period_um, height_um, pitch, nx),
+                    _ => unreachable!(),
+                }
+                .map_err(core)
+            }
+            SyntheticSpec::Cd { seed } => {
+                let tracks = (coherence_diameter_um / CD_TRACK_PITCH_UM).ceil().max(1.0);
+                let l = tracks * CD_TRACK_PITCH_UM;
+                let n = square(auto_samples(l, pitch_um, samples))?;
+                let pitch = pitch_um.unwrap_or(l / n as f64);
+                HeightField::cd_tracks(n, n, pitch, CD_PIT_DEPTH_UM, seed).map_err(core)
+            }
+            SyntheticSpec::Bumps {
+                radius_um,
+                height_um,
+                fill,
+                seed,
+            } => {
+                let l = coherence_diameter_um;
+                let n = square(auto_samples(l, pitch_um, samples))?;
+                let pitch = pitch_um.unwrap_or(l / n as f64);
+                HeightField::random_bumps(n, n, pitch, radius_um, height_um, fill, seed)
+                    .map_err(core)
+            }
+        }
+    }
+}
+
+/// Samples per axis covering `l` µm: given, or `l / pitch`, or `l / 0.09` rounded up to a
+/// multiple of 8.
+fn auto_samples(l: f64, pitch_um: Option<f64>, samples: Option<usize>) -> usize {
+    samples.unwrap_or_else(|| match pitch_um {
+        Some(p) => (l / p).ceil().max(1.0) as usize,
+        None => ((l / AUTO_PITCH_UM / 8.0).ceil() as usize).max(1) * 8,
+    })
+}
+
+/// Reads a height-field file (PNG, OpenEXR or CSV by extension; module docs) with
+/// `pitch_um` µm per sample and heights scaled by `height_scale_um`.
+///
+/// # Errors
+/// [`Error::Io`]; [`Error::Table`] (PNG, EXR) or [`Error::Recipe`] (CSV, with the line)
+/// naming the file for malformed content; [`Error::OpticsIn`] for a bad pitch.
+pub fn read_height_field(path: &Path, pitch_um: f64, height_scale_um: f64) -> Result<HeightField> {
+    if !(height_scale_um.is_finite() && height_scale_um >= 0.0) {
+        return Err(Error::Invalid {
+            context: path.display().to_string(),
+            message: format!("height scale {height_scale_um} µm must be finite and non-negative"),
+        });
+    }
+    let bytes = std::fs::read(path).map_err(|source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    let (nx, ny, values) = match ext.as_str() {
+        "png" => decode_png(path, &bytes)?,
+        "exr" => decode_exr(path, &bytes)?,
+        "csv" | "txt" => decode_csv(path, &bytes)?,
+        _ => {
+            return Err(Error::Table {
+                path: path.to_path_buf(),
+                message: "unknown height-field format: expected a .png, .exr or .csv file".into(),
+            });
+        }
+    };
+    if nx > MAX_AXIS || ny > MAX_AXIS {
+        return Err(Error::TooLarge {
+            what: format!("{}: samples per axis", path.display()),
+            count: nx.max(ny) as u64,
+            limit: MAX_AXIS as u64,
+        });
+    }
+    HeightField::new(
+        nx,
+        ny,
+        pitch_um,
+        values.into_iter().map(|v| v * height_scale_um).collect(),
+    )
+    .map_err(|source| Error::OpticsIn {
+        context: path.display().to_string(),
+        source,
+    })
+}
+
+fn table_err(path: &Path, message: String) -> Error {
+    Error::Table {
+        path: path.to_path_buf(),
+        message,
+    }
+}
+
+/// Greyscale PNG, 8 or 16 bits: value / full scale.
+fn decode_png(path: &Path, bytes: &[u8]) -> Result<(usize, usize, Vec<f64>)> {
+    let decode = || -> Result<(usize, usize, Vec<f64>)> {
+        let bad = |e: png::DecodingError| table_err(path, format!("not a valid PNG file: {e}"));
+        let mut decoder = png::Decoder::new_with_limits(
+            std::io::Cursor::new(bytes),
+            png::Limits { bytes: 1 << 29 },
+        );
+        decoder.set_transformations(png::Transformations::EXPAND);
+        let mut reader = decoder.read_info().map_err(bad)?;
+        let (colour, depth) = reader.output_color_type();
+        let channels = match colour {
+            png::ColorType::Grayscale => 1,
+            png::ColorType::GrayscaleAlpha => 2,
+            other => {
+                return Err(table_err(
+                    path,
+                    format!("a {other:?} PNG; a height field must be greyscale (8 or 16 bits)"),
+                ));
+            }
+        };
+        let (bytes_per_sample, full) = match depth {
+            png::BitDepth::Eight => (1, 255.0),
+            png::BitDepth::Sixteen => (2, 65535.0),
+            other => {
+                return Err(table_err(
+                    path,
+                    format!("{} bits per sample; expected 8 or 16", other as u8),
+                ));
+            }
+        };
+        let size = reader
+            .output_buffer_size()
+            .ok_or_else(|| table_err(path, "image too large".into()))?;
+        let mut buf = vec![0u8; size];
+        let frame = reader.next_frame(&mut buf).map_err(bad)?;
+        let (w, h) = (frame.width as usize, frame.height as usize);
+        let stride = channels * bytes_per_sample;
+        let mut values = Vec::with_capacity(w * h);
+        for y in 0..h {
+            let row = &buf[y * frame.line_size..];
+            for x in 0..w {
+                let at = x * stride;
+                let v = if bytes_per_sample == 2 {
+                    f64::from(u16::from_be_bytes([row[at], row[at + 1]]))
+                } else {
+                    f64::from(row[at])
+                };
+                values.push(v / full);
+            }
+        }
+        Ok((w, h, values))
+    };
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(decode)).unwrap_or_else(|_| {
+        Err(table_err(
+            path,
+            "malformed PNG data (the decoder failed)".into(),
+        ))
+    })
+}
+
+/// OpenEXR: the channel `Y`, `Z`, `R` or the only one.
+fn decode_exr(path: &Path, bytes: &[u8]) -> Result<(usize, usize, Vec<f64>)> {
+    use exr::prelude::{FlatSamples, ReadChannels, ReadLayers, read};
+    let decode = || -> Result<(usize, usize, Vec<f64>)> {
+        let image = read()
+            .no_deep_data()
+            .largest_resolution_level()
+            .all_channels()
+            .first_valid_layer()
+            .all_attributes()
+            .non_parallel()
+            .from_buffered(std::io::Cursor::new(bytes))
+            .map_err(|e| table_err(path, format!("not a valid OpenEXR file: {e}")))?;
+        let layer = &image.layer_data;
+        let list = &layer.channel_data.list;
+        let names: Vec<String> = list.iter().map(|c| c.name.to_string()).collect();
+        let channel = ["Y", "Z", "R"]
+            .iter()
+            .find_map(|n| list.iter().find(|c| c.name.eq(n)))
+            .or(if list.len() == 1 { list.first() } else { None })
+            .ok_or_else(|| {
+                table_err(
+                    path,
+                    format!(
+                        "OpenEXR channels {}: expected a channel Y, Z or R, or a single channel",
+                        names.join(", ")
+                    ),
+                )
+            })?;
+        let (w, h) = (layer.size.0, layer.size.1);
+        let values: Vec<f64> = match &channel.sample_data {
+            FlatSamples::F16(v) => v.iter().map(|s| f64::from(s.to_f32())).collect(),
+            FlatSamples::F32(v) => v.iter().map(|s| f64::from(*s)).collect(),
+            FlatSamples::U32(v) => v.iter().map(|s| f64::from(*s)).collect(),
+        };
+        if values.len() != w * h {
+            return Err(table_err(
+                path,
+                "OpenEXR channel size disagrees with the image".into(),
+            ));
+        }
+        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+            return Err(table_err(
+                path,
+                format!("non-finite height at column {}, row {}", i % w, i / w),
+            ));
+        }
+        Ok((w, h, values))
+    };
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(decode)).unwrap_or_else(|_| {
+        Err(table_err(
+            path,
+            "malformed OpenEXR data (the decoder failed)".into(),
+        ))
+    })
+}
+
+/// CSV: rows of comma-separated numbers (row 0 = y = 0), `#` comments, blank lines skipped.
+fn decode_csv(path: &Path, bytes: &[u8]) -> Result<(usize, usize, Vec<f64>)> {
+    let bad = |line: usize, message: String| Error::Recipe {
+        path: path.to_path_buf(),
+        line,
+        message,
+    };
+    let text = std::str::from_utf8(bytes).map_err(|e| bad(1, format!("not UTF-8 text: {e}")))?;
+    let mut values = Vec::new();
+    let (mut nx, mut ny) = (0, 0);
+    for (i, line) in text.lines().enumerate() {
+        let line_no = i + 1;
+        let content = line.split('#').next().unwrap_or("").trim();
+        if content.is_empty() {
+            continue;
+        }
+        let row: Vec<f64> = content
+            .split(',')
+            .map(|c| {
+                let c = c.trim();
+                c.parse::<f64>()
+                    .ok()
+                    .filter(|v| v.is_finite())
+                    .ok_or_else(|| bad(line_no, format!("`{c}` is not a finite number")))
+            })
+            .collect::<Result<_>>()?;
+        if ny == 0 {
+            nx = row.len();
+        } else if row.len() != nx {
+            return Err(bad(
+                line_no,
+                format!("{} values; the first row has {nx}", row.len()),
+            ));
+        }
+        if nx > MAX_AXIS || ny >= MAX_AXIS {
+            return Err(bad(
+                line_no,
+                format!("more than {MAX_AXIS} samples per axis"),
+            ));
+        }
+        values.extend(row);
+        ny += 1;
+    }
+    if ny == 0 {
+        return Err(bad(1, "no height values".into()));
+    }
+    Ok((nx, ny, values))
+}
+
+/// Where a height field comes from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum HeightSource {
+    /// A synthetic spec.
+    Synthetic(SyntheticSpec),
+    /// A file.
+    File(PathBuf),
+}
+
+impl HeightSource {
+    /// A synthetic spec when `text` parses as one, else a file path.
+    pub fn parse(context: &str, text: &str) -> Result<Self> {
+        Ok(match SyntheticSpec::parse(context, text)? {
+            Some(s) => HeightSource::Synthetic(s),
+            None => HeightSource::File(PathBuf::from(text)),
+        })
+    }
+
+    /// Builds the field (see [`SyntheticSpec::generate`], [`read_height_field`]); a file
+    /// needs `pitch_um` (named by `pitch_context` in the error).
+    #[allow(clippy::too_many_arguments)]
+    pub fn load(
+        &self,
+        context: &str,
+        pitch_context: &str,
+        coherence_diameter_um: f64,
+        pitch_um: Option<f64>,
+        samples: Option<usize>,
+        height_scale_um: f64,
+    ) -> Result<HeightField> {
+        match self {
+            HeightSource::Synthetic(s) => {
+                s.generate(context, coherence_diameter_um, pitch_um, samples)
+            }
+            HeightSource::File(path) => {
+                let pitch = pitch_um.ok_or_else(|| Error::Invalid {
+                    context: path.display().to_string(),
+                    message: format!(
+                        "a height-field file needs its sample pitch in µm ({pitch_context})"
+                    ),
+                })?;
+                read_height_field(path, pitch, height_scale_um)
+            }
+        }
+    }
+}
+
+/// Everything a `diffraction` manifest records about the table (beside the common fields).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DiffractionRecord {
+    /// `terms`.
+    pub layout: String,
+    /// The height field: a synthetic spec or the file name as written in the recipe.
+    pub source: String,
+    /// Samples (bins) along x.
+    pub nx: usize,
+    /// Samples (bins) along y.
+    pub ny: usize,
+    /// Sample spacing Δ, µm.
+    pub pitch_um: f64,
+    /// Patch size (Lₓ, L_y), µm.
+    pub patch_um: [f64; 2],
+    /// The mean height removed (a global phase), µm.
+    pub mean_removed_um: f64,
+    /// Largest |h| after removing the mean, µm.
+    pub max_abs_height_um: f64,
+    /// Coherence diameter 4σ_s, µm.
+    pub coherence_diameter_um: f64,
+    /// σ_s, µm.
+    pub sigma_s_um: f64,
+    /// Shortest wavelength served, nm.
+    pub wavelength_min_nm: f64,
+    /// Longest wavelength served, nm.
+    pub wavelength_max_nm: f64,
+    /// Wavelength step of the colour sums, nm.
+    pub wavelength_step_nm: f64,
+    /// Largest polar angle of light and view served, degrees.
+    pub max_angle_deg: f64,
+    /// 2 sin(max_angle): the largest |u|, |v|.
+    pub max_uv: f64,
+    /// Taylor order N (terms T₀ … T_N).
+    pub taylor_order: usize,
+    /// Tolerance asked for on the remainder bound.
+    pub taylor_tolerance: f64,
+    /// max |k w h| at the shortest wavelength with |w| ≤ 2.
+    pub max_phase: f64,
+    /// The remainder bound |kwh|^{N+1}/(N+1)! at max_phase.
+    pub taylor_bound: f64,
+    /// Bound on the error of the Taylor sum from storing Tₙ as f32: 2⁻²⁴ e^{max_phase}.
+    pub f32_rounding_bound: f64,
+    /// Texel of the DC bin, (⌊Mₓ/2⌋, ⌊M_y/2⌋).
+    pub dc_texel: [usize; 2],
+    /// [`SIGN_CONVENTION`].
+    pub sign_convention: String,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawHeightField {
+    synthetic: Option<Spanned<String>>,
+    file: Option<Spanned<String>>,
+    samples: Option<Spanned<usize>>,
+    pitch_um: Option<Spanned<f64>>,
+    height_scale_um: Option<Spanned<f64>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawDiffraction {
+    layout: Option<Spanned<String>>,
+    coherence_diameter_um: Option<Spanned<f64>>,
+    wavelengths: Option<Spanned<String>>,
+    max_angle_deg: Option<Spanned<f64>>,
+    taylor_tolerance: Option<Spanned<f64>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawDiffractionRecipe {
+    #[allow(dead_code)] // checked before the full parse
+    kind: Spanned<String>,
+    description: Option<String>,
+    colour: Option<toml::Value>,
+    height_field: Spanned<RawHeightField>,
+    diffraction: Option<RawDiffraction>,
+}
+
+/// A parsed `diffraction` recipe (module docs).
+pub struct DiffractionRecipe {
+    /// Table name.
+    pub name: String,
+    /// Recipe file.
+    pub path: PathBuf,
+    /// Recipe text.
+    pub text: String,
+    /// Description.
+    pub description: String,
+    /// Colour settings.
+    pub colorimeter: Colorimeter,
+    /// The height field, as written.
+    pub source_text: String,
+    /// The height field (generated or read and checked at parse time).
+    pub field: HeightField,
+    /// The Taylor order, bound and checks, as recorded.
+    pub record: DiffractionRecord,
+}
+
+impl DiffractionRecipe {
+    /// Parses and validates a recipe: reads or generates the height field, chooses N and
+    /// checks the sampling (nothing is transformed yet). `colorimeter` and `name` come from
+    /// the shared `[colour]` parsing of [`crate::bake`].
+    pub fn parse(
+        path: &Path,
+        text: String,
+        name: String,
+        colorimeter: Colorimeter,
+    ) -> Result<Self> {
+        let raw: RawDiffractionRecipe =
+            toml::from_str(&text).map_err(|e| toml_error(path, &text, &e))?;
+        let _ = &raw.colour;
+        let at = |span: std::ops::Range<usize>| {
+            format!("{}:{}", path.display(), line_of(&text, span.start))
+        };
+        let bad = |span: std::ops::Range<usize>, message: String| Error::Recipe {
+            path: path.to_path_buf(),
+            line: line_of(&text, span.start),
+            message,
+        };
+        let d = raw.diffraction.unwrap_or(RawDiffraction {
+            layout: None,
+            coherence_diameter_um: None,
+            wavelengths: None,
+            max_angle_deg: None,
+            taylor_tolerance: None,
+        });
+        if let Some(l) = &d.layout
+            && l.get_ref() != "terms"
+        {
+            return Err(bad(
+                l.span(),
+                format!(
+                    "layout = \"{}\": only \"terms\" is implemented (the \"integrated\" layout is not)",
+                    l.get_ref()
+                ),
+            ));
+        }
+        let positive = |v: &Option<Spanned<f64>>, default: f64, what: &str| -> Result<f64> {
+            match v {
+                None => Ok(default),
+                Some(s) if *s.get_ref() > 0.0 && s.get_ref().is_finite() => Ok(*s.get_ref()),
+                Some(s) => Err(bad(
+                    s.span(),
+                    format!("{what} = {}: must be finite and positive", s.get_ref()),
+                )),
+            }
+        };
+        let coherence = positive(
+            &d.coherence_diameter_um,
+            DEFAULT_COHERENCE_DIAMETER_UM,
+            "coherence_diameter_um",
+        )?;
+        let (wl_context, wl_text) = match &d.wavelengths {
+            Some(s) => (format!("{} wavelengths", at(s.span())), s.get_ref().clone()),
+            None => ("wavelengths".into(), "380:780:5".into()),
+        };
+        let wavelengths = crate::grid::parse_range(&wl_context, &wl_text)?;
+        SpectralGrid::new(&colorimeter, &wavelengths).map_err(|source| Error::OpticsIn {
+            context: wl_context.clone(),
+            source,
+        })?;
+        let max_angle = match &d.max_angle_deg {
+            None => 45.0,
+            Some(s) if *s.get_ref() > 0.0 && *s.get_ref() < 90.0 => *s.get_ref(),
+            Some(s) => {
+                return Err(bad(
+                    s.span(),
+                    format!("max_angle_deg = {}: expected (0, 90)", s.get_ref()),
+                ));
+            }
+        };
+        let tolerance = match &d.taylor_tolerance {
+            None => 1e-4,
+            Some(s) if *s.get_ref() > 0.0 && *s.get_ref() < 1.0 => *s.get_ref(),
+            Some(s) => {
+                return Err(bad(
+                    s.span(),
+                    format!("taylor_tolerance = {}: expected (0, 1)", s.get_ref()),
+                ));
+            }
+        };
+        let hf = raw.height_field.get_ref();
+        let (source_span, source_text, source) = match (&hf.synthetic, &hf.file) {
+            (Some(s), None) => {
+                let spec = SyntheticSpec::parse(&format!("{} synthetic", at(s.span())), s.get_ref())?
+                    .ok_or_else(|| bad(s.span(), format!("synthetic = \"{}\": expected sine:PERIOD_UM:AMPLITUDE_UM, blazed:PERIOD_UM:HEIGHT_UM, cd[:SEED] or bumps:RADIUS_UM:HEIGHT_UM:FILL[:SEED]", s.get_ref())))?;
+                (s.span(), s.get_ref().clone(), HeightSource::Synthetic(spec))
+            }
+            (None, Some(f)) => {
+                let p = Path::new(f.get_ref());
+                let full = match path.parent() {
+                    Some(dir) if p.is_relative() => dir.join(p),
+                    _ => p.to_path_buf(),
+                };
+                (f.span(), f.get_ref().clone(), HeightSource::File(full))
+            }
+            _ => {
+                return Err(bad(
+                    raw.height_field.span(),
+                    "[height_field] needs exactly one of `synthetic` and `file`".into(),
+                ));
+            }
+        };
+        let pitch = match &hf.pitch_um {
+            None => None,
+            Some(s) if *s.get_ref() > 0.0 && s.get_ref().is_finite() => Some(*s.get_ref()),
+            Some(s) => {
+                return Err(bad(
+                    s.span(),
+                    format!("pitch_um = {}: must be finite and positive", s.get_ref()),
+                ));
+            }
+        };
+        let samples = match &hf.samples {
+            None => None,
+            Some(s) if (1..=MAX_AXIS).contains(s.get_ref()) => Some(*s.get_ref()),
+            Some(s) => {
+                return Err(bad(
+                    s.span(),
+                    format!("samples = {}: expected 1 to {MAX_AXIS}", s.get_ref()),
+                ));
+            }
+        };
+        let scale = positive(&hf.height_scale_um, 1.0, "height_scale_um")?;
+        if matches!(source, HeightSource::Synthetic(_)) && hf.height_scale_um.is_some() {
+            return Err(bad(
+                raw.height_field.span(),
+                "height_scale_um applies to `file` only".into(),
+            ));
+        }
+        let field = source.load(
+            &at(source_span.clone()),
+            &format!("{} pitch_um", at(raw.height_field.span())),
+            coherence,
+            pitch,
+            samples,
+            scale,
+        )?;
+        let record = plan(
+            &field,
+            &source_text,
+            coherence,
+            &wavelengths,
+            max_angle,
+            tolerance,
+        )
+        .map_err(|source| Error::OpticsIn {
+            context: at(source_span),
+            source,
+        })?;
+        if record.f32_rounding_bound > tolerance {
+            return Err(Error::Invalid {
+                context: path.display().to_string(),
+                message: format!(
+                    "max |k w h| = {:.3}: the Taylor sum of f32 terms could err by {:.2e} (2^-24 e^{{|kwh|}}), above taylor_tolerance {tolerance:e}; the structure is too tall for a terms table at {} nm",
+                    record.max_phase, record.f32_rounding_bound, record.wavelength_min_nm
+                ),
+            });
+        }
+        Ok(DiffractionRecipe {
+            name,
+            path: path.to_path_buf(),
+            description: raw.description.unwrap_or_default(),
+            colorimeter,
+            source_text,
+            field,
+            record,
+            text,
+        })
+    }
+
+    /// Computes the terms and writes `NAME.terms.exr`, `NAME.terms.ktx2` and `NAME.json`;
+    /// returns the manifest path.
+    pub fn bake(&self, out_dir: &Path, progress: &(dyn Fn() + Sync)) -> Result<PathBuf> {
+        let terms = TaylorTerms::compute(&self.field, self.record.taylor_order);
+        progress();
+        // Every file goes to a staging folder first; `commit` moves them into `out_dir`,
+        // the manifest last (crate::output::StagedTable).
+        let stage = crate::output::StagedTable::new(out_dir)?;
+        let out_dir = stage.path();
+        let r = &self.record;
+        let c = &self.colorimeter;
+        let file_name = self
+            .path
+            .file_name()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let layers = r.taylor_order + 1;
+        let mut manifest = Manifest {
+            format: MANIFEST_FORMAT.into(),
+            generated_by: format!(
+                "generated by `nacre bake` from the recipe {file_name} (in tables/recipes/ for the default set, which `nacre bake` with no arguments regenerates); do not edit"
+            ),
+            name: self.name.clone(),
+            kind: "diffraction".into(),
+            description: self.description.clone(),
+            nacre_version: env!("CARGO_PKG_VERSION").into(),
+            recipe_file: file_name,
+            recipe_sha256: crate::bake::sha256_text(&self.text),
+            recipe: self.text.clone(),
+            observer: c.observer().to_string(),
+            illuminant: c.illuminant().to_string(),
+            space: c.space().to_string(),
+            colour_convention: format!(
+                "relative reflectance rho = F^2 G/w^2 |P~|^2 (1 for a flat perfect mirror in its specular direction); colour = M * sum over the wavelength grid {}:{}:{} nm of rho(lambda) u(lambda), u the CIE XYZ weights of observer {} under illuminant {} rescaled so that rho = 1 gives the illuminant white, M the matrix to linear {} (Bradford adapted; rho = 1 is (1, 1, 1))",
+                r.wavelength_min_nm, r.wavelength_max_nm, r.wavelength_step_nm, c.observer(), c.illuminant(), c.space()
+            ),
+            ambient: String::new(),
+            film: String::new(),
+            under: Vec::new(),
+            base: String::new(),
+            axes: vec![
+                AxisRecord {
+                    name: "kappa_x".into(),
+                    unit: "rad/um".into(),
+                    count: r.nx,
+                    min: -2.0 * std::f64::consts::PI * (r.nx / 2) as f64 / r.patch_um[0],
+                    max: 2.0 * std::f64::consts::PI * (r.nx as f64 - 1.0 - (r.nx / 2) as f64) / r.patch_um[0],
+                    mapping: "DFT bins, DC centred".into(),
+                    forward: format!("s = round(kappa_x * {} / (2 pi)) + {}", r.patch_um[0], r.nx / 2),
+                    inverse: format!("kappa_x = 2 pi (s - {}) / {}", r.nx / 2, r.patch_um[0]),
+                },
+                AxisRecord {
+                    name: "kappa_y".into(),
+                    unit: "rad/um".into(),
+                    count: r.ny,
+                    min: -2.0 * std::f64::consts::PI * (r.ny / 2) as f64 / r.patch_um[1],
+                    max: 2.0 * std::f64::consts::PI * (r.ny as f64 - 1.0 - (r.ny / 2) as f64) / r.patch_um[1],
+                    mapping: "DFT bins, DC centred".into(),
+                    forward: format!("t = round(kappa_y * {} / (2 pi)) + {}", r.patch_um[1], r.ny / 2),
+                    inverse: format!("kappa_y = 2 pi (t - {}) / {}", r.ny / 2, r.patch_um[1]),
+                },
+                AxisRecord {
+                    name: "taylor_term".into(),
+                    unit: "1".into(),
+                    count: layers,
+                    min: 0.0,
+                    max: r.taylor_order as f64,
+                    mapping: "term index n".into(),
+                    forward: "n".into(),
+                    inverse: "n".into(),
+                },
+            ],
+            film_lut: None,
+            fourier: None,
+            rough_film_lut: None,
+            diffraction: Some(r.clone()),
+            texel_centres: "texel (s, t) holds the DFT bin of frequency kappa = 2 pi (s - floor(nx/2), t - floor(ny/2)) / L exactly (integer texel loads; no filtering)".into(),
+            atlas: format!(
+                "EXR: width nx = {}, height ny * (N + 1) = {} * {}; term n occupies rows [n ny, (n + 1) ny), R = Re T_n, G = Im T_n, B = 0, full float. KTX2: 2-D array RGBA32F texture nx x ny with ceil((N + 1) / 2) = {} layers, layer l = (Re T_2l, Im T_2l, Re T_2l+1, Im T_2l+1), zero beyond T_N",
+                r.nx, r.ny, layers, layers.div_ceil(2)
+            ),
+            reconstruction: format!(
+                "k = 2 pi / lambda; (u, v, w) = -omega_i - omega_r; P_j = sum_n (k w)^n / n! T_n[j]; P~ = sum over bins j near (k u, k v) L / (2 pi) of P_j exp(-sigma_s^2 |(k u, k v) - kappa_j|^2 / 2), sigma_s = {} um; rho = F^2 (1 + omega_i.omega_r)^2 / (cos_i cos_r (cos_i + cos_r)^2) |P~|^2 (Stam 1999; Dhillon et al. 2014); colour as colour_convention",
+                r.sigma_s_um
+            ),
+            files: Vec::new(),
+        };
+        let embedded = manifest.embedded_json();
+        let mut table = Table3::new(r.nx, r.ny, layers);
+        let layer_data: Vec<Vec<C64>> = (0..layers).map(|n| terms.layer(n)).collect();
+        for (n, layer) in layer_data.iter().enumerate() {
+            for (i, v) in layer.iter().enumerate() {
+                table.set(i % r.nx, i / r.nx, n, [v.re as f32, v.im as f32, 0.0]);
+            }
+        }
+        let exr = format!("{}.terms.exr", self.name);
+        table_io::write_exr(&out_dir.join(&exr), &table, Precision::Float)?;
+        let mut files = vec![FileRecord {
+            quantity: "terms".into(),
+            format: "exr".into(),
+            path: exr.clone(),
+            encoding: "float".into(),
+            channels: vec!["R".into(), "G".into(), "B".into()],
+            width: r.nx,
+            height: r.ny * layers,
+            sha256: table_io::sha256_hex(&out_dir.join(&exr))?,
+        }];
+        let ktx2 = format!("{}.terms.ktx2", self.name);
+        let ktx2_path = out_dir.join(&ktx2);
+        crate::ktx2::write_ktx2(&ktx2_path, &terms_image(&layer_data, r.nx, r.ny, &embedded))?;
+        files.push(FileRecord {
+            quantity: "terms".into(),
+            format: "ktx2".into(),
+            path: ktx2,
+            encoding: "float".into(),
+            channels: vec!["R".into(), "G".into(), "B".into(), "A".into()],
+            width: r.nx,
+            height: r.ny,
+            sha256: table_io::sha256_hex(&ktx2_path)?,
+        });
+        manifest.files = files;
+        let name = format!("{}.json", self.name);
+        let json = serde_json::to_string_pretty(&manifest).expect("manifest serialises");
+        write_atomic(&out_dir.join(&name), |w| {
+            w.write_all(json.as_bytes())?;
+            w.write_all(b"\n")
+        })?;
+        stage.commit(&name, &[])
+    }
+}
+
+/// The KTX2 image of the terms (module docs).
+fn terms_image(
+    layers: &[Vec<C64>],
+    nx: usize,
+    ny: usize,
+    manifest_json: &str,
+) -> crate::ktx2::Ktx2Image {
+    let pairs = layers.len().div_ceil(2);
+    let mut level = Vec::with_capacity(pairs * nx * ny * 16);
+    for l in 0..pairs {
+        for i in 0..nx * ny {
+            let a = layers[2 * l][i];
+            let b = layers.get(2 * l + 1).map_or(C64::new(0.0, 0.0), |t| t[i]);
+            for v in [a.re, a.im, b.re, b.im] {
+                level.extend_from_slice(&(v as f32).to_le_bytes());
+            }
+        }
+    }
+    let nul = |s: &str| {
+        let mut v = s.as_bytes().to_vec();
+        v.push(0);
+        v
+    };
+    crate::ktx2::Ktx2Image {
+        format: crate::ktx2::Ktx2Format::Rgba32Float,
+        width: nx as u32,
+        height: ny as u32,
+        depth: 0,
+        layers: pairs as u32,
+        levels: vec![level],
+        key_values: vec![
+            (
+                crate::ktx2::WRITER_KEY.into(),
+                nul(&format!("nacre {}", env!("CARGO_PKG_VERSION"))),
+            ),
+            (crate::ktx2::MANIFEST_KEY.into(), nul(manifest_json)),
+        ],
+    }
+}
+
+/// Chooses N and checks the sampling for a field; the record of a terms table.
+///
+/// # Errors
+/// The core's [`nacre_optics::Error::TaylorOrder`], `PatchTooSmall` or `NyquistExceeded`.
+pub fn plan(
+    field: &HeightField,
+    source: &str,
+    coherence_diameter_um: f64,
+    wavelengths_nm: &[f64],
+    max_angle_deg: f64,
+    tolerance: f64,
+) -> nacre_optics::Result<DiffractionRecord> {
+    let wl_min = wavelengths_nm.iter().copied().fold(f64::INFINITY, f64::min);
+    let wl_max = wavelengths_nm
+        .iter()
+        .copied()
+        .fold(f64::NEG_INFINITY, f64::max);
+    let max_phase = nacre_optics::diffraction::max_phase(field, wl_min, 2.0);
+    let (order, bound) = taylor_order_for(max_phase, tolerance)?;
+    let sigma_s_um = coherence_diameter_um / 4.0;
+    let max_uv = 2.0 * max_angle_deg.to_radians().sin();
+    // The checks need only the geometry: a one-term surface suffices.
+    let probe = DiffractionSurface::new(
+        TaylorTerms::from_terms(
+            field.nx(),
+            field.ny(),
+            field.pitch_um(),
+            &[vec![C64::new(0.0, 0.0); field.nx() * field.ny()]],
+        )?,
+        sigma_s_um,
+    )?;
+    probe.check_sampling(wl_min, max_uv)?;
+    let (lx, ly) = field.patch_um();
+    Ok(DiffractionRecord {
+        layout: "terms".into(),
+        source: source.to_string(),
+        nx: field.nx(),
+        ny: field.ny(),
+        pitch_um: field.pitch_um(),
+        patch_um: [lx, ly],
+        mean_removed_um: field.mean_removed_um(),
+        max_abs_height_um: field.max_abs_height_um(),
+        coherence_diameter_um,
+        sigma_s_um,
+        wavelength_min_nm: wl_min,
+        wavelength_max_nm: wl_max,
+        wavelength_step_nm: if wavelengths_nm.len() > 1 {
+            wavelengths_nm[1] - wavelengths_nm[0]
+        } else {
+            0.0
+        },
+        max_angle_deg,
+        max_uv,
+        taylor_order: order,
+        taylor_tolerance: tolerance,
+        max_phase,
+        taylor_bound: bound,
+        f32_rounding_bound: f64::from(f32::EPSILON) * 0.5 * max_phase.exp(),
+        dc_texel: [field.nx() / 2, field.ny() / 2],
+        sign_convention: SIGN_CONVENTION.into(),
+    })
+}
+
+impl Manifest {
+    /// Loads the Taylor terms of a `diffraction` table (from its EXR file, else its KTX2
+    /// file) as stored (f32 values).
+    pub fn load_diffraction(
+        &self,
+        manifest_path: &Path,
+    ) -> Result<(DiffractionRecord, TaylorTerms)> {
+        let r = self.diffraction.clone().ok_or_else(|| Error::Invalid {
+            context: manifest_path.display().to_string(),
+            message: format!(
+                "table `{}` is a `{}` table, not a diffraction table",
+                self.name, self.kind
+            ),
+        })?;
+        let dir = manifest_path.parent().unwrap_or(Path::new("."));
+        let layers = r.taylor_order + 1;
+        let find = |format: &str| {
+            self.files
+                .iter()
+                .find(|f| f.quantity == "terms" && f.format == format)
+        };
+        let mut terms = vec![vec![C64::new(0.0, 0.0); r.nx * r.ny]; layers];
+        if let Some(f) = find("exr") {
+            let (t, _) = table_io::read_exr_table(&dir.join(&f.path), r.nx, r.ny, layers)?;
+            for (n, layer) in terms.iter_mut().enumerate() {
+                for (i, v) in layer.iter_mut().enumerate() {
+                    let [re, im, _] = t.texel(i % r.nx, i / r.nx, n);
+                    *v = C64::new(f64::from(re), f64::from(im));
+                }
+            }
+        } else if let Some(f) = find("ktx2") {
+            let path = dir.join(&f.path);
+            let image = crate::ktx2::read_ktx2(&path)?;
+            if image.format != crate::ktx2::Ktx2Format::Rgba32Float
+                || (
+                    image.width as usize,
+                    image.height as usize,
+                    image.layers as usize,
+                ) != (r.nx, r.ny, layers.div_ceil(2))
+                || image.levels.len() != 1
+            {
+                return Err(Error::Table {
+                    path,
+                    message: format!(
+                        "texture is {:?} {}x{} with {} layers; expected Rgba32Float {}x{} with {} layers",
+                        image.format,
+                        image.width,
+                        image.height,
+                        image.layers,
+                        r.nx,
+                        r.ny,
+                        layers.div_ceil(2)
+                    ),
+                });
+            }
+            let data = image.level_f32(0);
+            for (n, layer) in terms.iter_mut().enumerate() {
+                for (i, v) in layer.iter_mut().enumerate() {
+                    let at = ((n / 2) * r.nx * r.ny + i) * 4 + 2 * (n % 2);
+                    *v = C64::new(f64::from(data[at]), f64::from(data[at + 1]));
+                }
+            }
+        } else {
+            return Err(Error::Invalid {
+                context: manifest_path.display().to_string(),
+                message: "the manifest lists no terms file".into(),
+            });
+        }
+        let t = TaylorTerms::from_terms(r.nx, r.ny, r.pitch_um, &terms).map_err(|source| {
+            Error::OpticsIn {
+                context: manifest_path.display().to_string(),
+                source,
+            }
+        })?;
+        Ok((r, t))
+    }
+}
+
+/// A `nacre diffraction` evaluation: one incidence, a list of in-plane view angles.
+pub struct ViewSweep<'a> {
+    /// The surface.
+    pub surface: &'a DiffractionSurface,
+    /// Incidence angle θ_i, degrees (light on the −x side when positive).
+    pub incidence_deg: f64,
+    /// View angles θ_r, degrees (viewer on the +x side when positive).
+    pub views_deg: &'a [f64],
+    /// Wavelengths, nm.
+    pub wavelengths_nm: &'a [f64],
+    /// Fresnel factor.
+    pub fresnel: FresnelTerm,
+}
+
+impl ViewSweep<'_> {
+    /// ρ for every (view, wavelength), view-major; views in parallel (each value
+    /// independent: the same result whatever the thread count).
+    pub fn reflectance(&self) -> Vec<f64> {
+        self.views_deg
+            .par_iter()
+            .flat_map_iter(|&view| {
+                let (wi, wr) = in_plane_directions(self.incidence_deg, view);
+                self.wavelengths_nm
+                    .iter()
+                    .map(move |&wl| self.surface.relative_reflectance(wi, wr, wl, self.fresnel))
+            })
+            .collect()
+    }
+
+    /// Writes `view_deg,wavelength_nm,reflectance`.
+    pub fn write_reflectance_csv(&self, w: &mut dyn Write, rho: &[f64]) -> std::io::Result<()> {
+        writeln!(w, "view_deg,wavelength_nm,reflectance")?;
+        let mut cells = rho.iter();
+        for &v in self.views_deg {
+            for &wl in self.wavelengths_nm {
+                writeln!(
+                    w,
+                    "{v},{wl},{}",
+                    fmt_sig(*cells.next().expect("one value per cell"))
+                )?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Colours (XYZ, output space) per view from ρ on the wavelength grid.
+    pub fn colours(
+        &self,
+        rho: &[f64],
+        grid: &SpectralGrid,
+        colorimeter: &Colorimeter,
+    ) -> Vec<([f64; 3], [f64; 3])> {
+        rho.chunks(self.wavelengths_nm.len())
+            .map(|values| {
+                let xyz = grid.xyz(values);
+                (xyz, colorimeter.output_from_xyz(xyz))
+            })
+            .collect()
+    }
+
+    /// Writes `view_deg,X,Y,Z,R,G,B`.
+    pub fn write_colour_csv(
+        &self,
+        w: &mut dyn Write,
+        colours: &[([f64; 3], [f64; 3])],
+    ) -> std::io::Result<()> {
+        writeln!(w, "view_deg,X,Y,Z,R,G,B")?;
+        for (&v, (xyz, rgb)) in self.views_deg.iter().zip(colours) {
+            writeln!(
+                w,
+                "{v},{},{},{},{},{},{}",
+                fmt_sig(xyz[0]),
+                fmt_sig(xyz[1]),
+                fmt_sig(xyz[2]),
+                fmt_sig(rgb[0]),
+                fmt_sig(rgb[1]),
+                fmt_sig(rgb[2])
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// A diffraction map (`nacre plot diffraction`): the colour of ρ over view directions for
+/// a fixed light, on the projected hemisphere (x = sin θ_r cos φ_r across the grating
+/// lines, y = sin θ_r sin φ_r along them; the light at θ_i in the x–z plane on the −x
+/// side), as sRGB: linear sRGB × exposure, clipped per channel (the `nacre plot`
+/// conventions).
+#[derive(Clone, Debug)]
+pub struct DiffractionMap {
+    /// Title.
+    pub title: String,
+    /// Cells per side.
+    pub cells: usize,
+    /// sin of the largest view angle drawn: the disc's radius.
+    pub radius: f64,
+    /// Linear sRGB per cell (row-major from y = −radius), `None` outside the disc.
+    pub colours: Vec<Option<[f64; 3]>>,
+    /// Factor applied before clipping.
+    pub exposure: f64,
+    /// (x, y) of the specular direction.
+    pub specular: [f64; 2],
+}
+
+/// The view direction of map cell (ix, iy), or `None` outside the disc.
+fn map_direction(ix: usize, iy: usize, cells: usize, radius: f64) -> Option<[f64; 3]> {
+    let at = |i: usize| radius * (2.0 * (i as f64 + 0.5) / cells as f64 - 1.0);
+    let (x, y) = (at(ix), at(iy));
+    let r2 = x * x + y * y;
+    (r2 <= radius * radius).then(|| [x, y, (1.0 - r2).sqrt()])
+}
+
+impl DiffractionMap {
+    /// Evaluates ρ over `grid`'s wavelengths at every cell (rows in parallel, each cell
+    /// independent) and converts to linear sRGB. With `exposure` `None` the exposure puts
+    /// the 98th percentile of the cells' largest channel at 1 (the specular highlight
+    /// saturates; the orders show).
+    #[allow(clippy::too_many_arguments)]
+    pub fn compute(
+        title: String,
+        surface: &DiffractionSurface,
+        incidence_deg: f64,
+        max_view_deg: f64,
+        cells: usize,
+        grid: &SpectralGrid,
+        colorimeter: &Colorimeter,
+        fresnel: FresnelTerm,
+        exposure: Option<f64>,
+    ) -> Self {
+        let radius = max_view_deg.to_radians().sin();
+        let (omega_i, _) = in_plane_directions(incidence_deg, 0.0);
+        let display = crate::plot::DisplayConverter::new(colorimeter);
+        let colours: Vec<Option<[f64; 3]>> = (0..cells)
+            .into_par_iter()
+            .flat_map_iter(|iy| {
+                let display = &display;
+                (0..cells).map(move |ix| {
+                    let omega_r = map_direction(ix, iy, cells, radius)?;
+                    let rho: Vec<f64> = grid
+                        .wavelengths_nm()
+                        .iter()
+                        .map(|&wl| surface.relative_reflectance(omega_i, omega_r, wl, fresnel))
+                        .collect();
+                    let xyz = grid.xyz(&rho);
+                    Some(display.linear_srgb(colorimeter.output_from_xyz(xyz)))
+                })
+            })
+            .collect();
+        let exposure = exposure.unwrap_or_else(|| {
+            let mut peaks: Vec<f64> = colours
+                .iter()
+                .flatten()
+                .map(|c| c.iter().fold(0.0f64, |m, v| m.max(*v)))
+                .collect();
+            peaks.sort_by(f64::total_cmp);
+            let p = peaks.get(peaks.len() * 98 / 100).copied().unwrap_or(0.0);
+            if p > 0.0 { 1.0 / p } else { 1.0 }
+        });
+        DiffractionMap {
+            title,
+            cells,
+            radius,
+            colours,
+            exposure,
+            specular: [incidence_deg.to_radians().sin(), 0.0],
+        }
+    }
+}
+
+impl crate::plot::Figure for DiffractionMap {
+    fn size(&self) -> (u32, u32) {
+        (760, 800)
+    }
+
+    fn draw<DB: plotters::prelude::DrawingBackend>(
+        &self,
+        root: &plotters::prelude::DrawingArea<DB, plotters::coord::Shift>,
+        format: crate::plot::ImageFormat,
+    ) -> crate::plot::DrawResult<DB> {
+        use plotters::prelude::*;
+        let area = root.titled(&self.title, ("sans-serif", 17))?;
+        let r = self.radius;
+        let mut chart = ChartBuilder::on(&area)
+            .margin(16)
+            .x_label_area_size(48)
+            .y_label_area_size(60)
+            .build_cartesian_2d(-r..r, -r..r)?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .x_desc("sin θ_r cos φ_r (across the grating lines)")
+            .y_desc("sin θ_r sin φ_r (along the lines)")
+            .label_style(("sans-serif", 14))
+            .axis_desc_style(("sans-serif", 16))
+            .draw()?;
+        chart.draw_series(std::iter::once(Rectangle::new(
+            [(-r, -r), (r, r)],
+            BLACK.filled(),
+        )))?;
+        // SVG: coarser cells (every other one) to keep files small.
+        let stride = if format == crate::plot::ImageFormat::Png {
+            1
+        } else {
+            2
+        };
+        let step = 2.0 * r / self.cells as f64;
+        let mut rects = Vec::new();
+        for iy in (0..self.cells).step_by(stride) {
+            for ix in (0..self.cells).step_by(stride) {
+                if let Some(c) = self.colours[iy * self.cells + ix] {
+                    let (x0, y0) = (-r + ix as f64 * step, -r + iy as f64 * step);
+                    let span = step * stride as f64;
+                    rects.push(Rectangle::new(
+                        [(x0, y0), (x0 + span, y0 + span)],
+                        crate::plot::srgb8(c.map(|v| v * self.exposure)).filled(),
+                    ));
+                }
+            }
+        }
+        chart.draw_series(rects)?;
+        chart.draw_series(std::iter::once(Cross::new(
+            (self.specular[0], self.specular[1]),
+            6,
+            WHITE.stroke_width(1),
+        )))?;
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn specs_parse_and_name_the_flag() {
+        assert_eq!(
+            SyntheticSpec::parse("--x", "sine:1.6:0.05").unwrap(),
+            Some(SyntheticSpec::Sine {
+                period_um: 1.6,
+                amplitude_um: 0.05
+            })
+        );
+        assert_eq!(
+            SyntheticSpec::parse("--x", "cd").unwrap(),
+            Some(SyntheticSpec::Cd { seed: 1 })
+        );
+        assert_eq!(
+            SyntheticSpec::parse("--x", "bumps:0.5:0.1:0.3:9").unwrap(),
+            Some(SyntheticSpec::Bumps {
+                radius_um: 0.5,
+                height_um: 0.1,
+                fill: 0.3,
+                seed: 9
+            })
+        );
+        assert_eq!(SyntheticSpec::parse("--x", "snake.png").unwrap(), None);
+        for bad in [
+            "sine:0:0.1",
+            "sine:1.6",
+            "blazed:a:1",
+            "cd:-1",
+            "bumps:1:1",
+            "sine:1:-0.1",
+        ] {
+            let e = SyntheticSpec::parse("--surface", bad)
+                .unwrap_err()
+                .to_string();
+            assert!(e.starts_with("--surface `"), "{bad}: {e}");
+        }
+    }
+
+    fn recipe(dir: &Path, name: &str, text: &str) -> Result<crate::bake::AnyRecipe> {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        crate::bake::AnyRecipe::read(&path)
+    }
+
+    #[test]
+    fn recipes_bake_terms_and_refuse_bad_sampling() {
+        let dir = tempfile::tempdir().unwrap();
+        let good = "kind = \"diffraction\"\n[height_field]\nsynthetic = \"sine:1.6:0.05\"\n[diffraction]\ncoherence_diameter_um = 16.0\nmax_angle_deg = 60.0\n";
+        let r = recipe(dir.path(), "sine.toml", good).unwrap();
+        let out = dir.path().join("out");
+        let manifest_path = r.bake(&out, &|| {}).unwrap();
+        let m = Manifest::read(&manifest_path).unwrap();
+        assert_eq!(m.kind, "diffraction");
+        let (record, terms) = m.load_diffraction(&manifest_path).unwrap();
+        assert_eq!((record.nx, record.ny), (terms.size().0, 1));
+        assert!(record.taylor_bound <= 1e-4);
+        assert_eq!(record.patch_um[0], 16.0);
+        // The stored terms are the f64 terms rounded to f32.
+        let field = HeightField::sine_grating(1.6, 0.05, 0.04, 400).unwrap();
+        let exact = TaylorTerms::compute(&field, record.taylor_order);
+        for n in 0..=record.taylor_order {
+            for (a, b) in terms.layer(n).iter().zip(exact.layer(n)) {
+                assert_eq!((a.re as f32, a.im as f32), (b.re as f32, b.im as f32));
+            }
+        }
+        assert_eq!(terms.bin(0, 0, 0), Some(C64::new(1.0, 0.0)));
+        // Bad sampling: clear errors naming the recipe.
+        let e = recipe(
+            dir.path(),
+            "coarse.toml",
+            &good.replace("[diffraction]", "pitch_um = 0.2\n[diffraction]"),
+        )
+        .err()
+        .unwrap()
+        .to_string();
+        assert!(e.contains("coarse.toml:3") && e.contains("Nyquist"), "{e}");
+        let e = recipe(
+            dir.path(),
+            "small.toml",
+            "kind = \"diffraction\"\n[height_field]\nsynthetic = \"cd\"\nsamples = 64\npitch_um = 0.1\n",
+        )
+        .err()
+        .unwrap()
+        .to_string();
+        assert!(
+            e.contains("small.toml:3") && e.contains("coherence diameter"),
+            "{e}"
+        );
+        let e = recipe(
+            dir.path(),
+            "layout.toml",
+            &good.replace("[diffraction]", "[diffraction]\nlayout = \"integrated\""),
+        )
+        .err()
+        .unwrap()
+        .to_string();
+        assert!(e.contains("layout.toml:5") && e.contains("not"), "{e}");
+        let e = recipe(
+            dir.path(),
+            "file.toml",
+            "kind = \"diffraction\"\n[height_field]\nfile = \"h.csv\"\n",
+        )
+        .err()
+        .unwrap()
+        .to_string();
+        assert!(e.contains("pitch_um"), "{e}");
+    }
+
+    #[test]
+    fn csv_height_fields_name_the_line() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("h.csv");
+        std::fs::write(&p, "# heights\n0,1,2\n3,4,5\n").unwrap();
+        let f = read_height_field(&p, 0.1, 2.0).unwrap();
+        assert_eq!((f.nx(), f.ny()), (3, 2));
+        assert_eq!(f.mean_removed_um(), 5.0);
+        std::fs::write(&p, "0,1,2\n3,4\n").unwrap();
+        let e = read_height_field(&p, 0.1, 1.0).unwrap_err().to_string();
+        assert!(e.contains("h.csv:2:"), "{e}");
+        std::fs::write(&p, "0,x\n").unwrap();
+        let e = read_height_field(&p, 0.1, 1.0).unwrap_err().to_string();
+        assert!(e.contains("h.csv:1:") && e.contains("`x`"), "{e}");
+    }
+
+    #[test]
+    fn png_height_fields_scale_to_full_range() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("h.png");
+        let mut bytes = Vec::new();
+        {
+            let mut enc = png::Encoder::new(&mut bytes, 2, 1);
+            enc.set_color(png::ColorType::Grayscale);
+            enc.set_depth(png::BitDepth::Sixteen);
+            let mut w = enc.write_header().unwrap();
+            w.write_image_data(&[0, 0, 255, 255]).unwrap();
+        }
+        std::fs::write(&p, &bytes).unwrap();
+        let f = read_height_field(&p, 0.1, 0.2).unwrap();
+        assert_eq!(f.heights_um(), &[-0.1, 0.1]);
+        std::fs::write(&p, b"not a png").unwrap();
+        assert!(
+            read_height_field(&p, 0.1, 0.2)
+                .unwrap_err()
+                .to_string()
+                .contains("h.png")
+        );
+    }
+}

@@ -1,0 +1,1520 @@
+//! Table kind `rough-film-lut`: the directional albedo of the iridescent GGX lobe,
+//! pre-integrated over wavelength and over the microfacet distribution — the split-sum
+//! "second factor" for rough thin-film surfaces (issue 6).
+//!
+//! # What the table holds
+//!
+//! For a view direction ω_o at cos θ_o = ω_o·n, GGX roughness α, and a film of thickness d
+//! and real index n_f over the recipe's fixed layers and base, in the recipe's ambient:
+//!
+//! ```text
+//! E_r(cos θ_o, α, d, n_f) = ∫ f_r(ω_o, ω_i) cos θ_i dω_i            (reflectance table)
+//! E_t(cos θ_o, α, d, n_f) = ∫ f_t(ω_o, ω_t) |cos θ_t| dω_t          (transmittance table)
+//! ```
+//!
+//! with f_r the GGX BRDF of Belcour & Barla 2017, Eq. 1 (height-correlated Smith G₂, the
+//! film's spectral Airy reflectance R(ω_o·h; λ) in place of Fresnel) and f_t the energy it
+//! transmits into a dielectric base, exactly as [`nacre_optics::microfacet`] defines them,
+//! each as a colour of the recipe's colorimeter (RGB in the output space, a perfect
+//! reflector = (1, 1, 1); XYZ with Y = 1 for `space = "xyz"`). Light that single scattering
+//! masks is lost, so E_r + E_t ≤ 1 for a lossless stack (white-furnace test).
+//!
+//! # The bake is a matrix product (not Monte Carlo)
+//!
+//! f_r is linear in the film term, which depends on the microfacet only through
+//! c = cos θ_d = ω_o·h. With microfacet normals drawn from the distribution of visible
+//! normals D_ωo(h) (Heitz 2018) the albedo is (microfacet.rs, "Estimator")
+//!
+//! ```text
+//! E_r = ∫ D_ωo(h) F_R(ω_o·h) G₂(ω_o, ω_i)/G₁(ω_o) χ⁺(ω_i·n) dh = ∫₀¹ K_r(c; cos θ_o, α) F_R(c) dc
+//! E_t = ∫ D_ωo(h) F_T(ω_o·h) G₂(ω_o, ω_t)/G₁(ω_o) χ⁻(ω_t·n) dh = ∫₀¹ K_t(c; cos θ_o, α, η) F_T(c) dc
+//! ```
+//!
+//! where F_R(c), F_T(c) are the colours of the film stack's unpolarised reflectance and
+//! transmittance at incidence cosine c (the exact spectral integral of film-lut,
+//! [`nacre_optics::SpectralRule`]), ω_i = 2(ω_o·h)h − ω_o, ω_t = refract(ω_o, h, η) with
+//! η = n_base/n_ambient at 560 nm, and K_r, K_t are *kernels*: the distribution of c under
+//! the visible normals, weighted by G₂/G₁. The kernels do not depend on the film, so the
+//! bake computes them once per (cos θ_o, α) and the film colours once per (c, d, n_f):
+//!
+//! 1. **Kernels** ([`kernels`]). The visible-normal domain is Heitz's unit disk (Heitz,
+//!    "Sampling the GGX Distribution of Visible Normals", JCGT 7(4), 2018, Listing 1: the map
+//!    (u₁, u₂) ∈ [0, 1]² → h of [`sample_ggx_vndf`] has constant density on the disk), so
+//!    E = ∫∫ F(ω_o·h(u₁, u₂)) g(u₁, u₂) du₁ du₂ with g = G₂/G₁ (0 below the horizon). The
+//!    integral is taken by a deterministic product rule: [`KERNEL_RADIAL_NODES`]-point
+//!    Gauss–Legendre in v, u₁ = r² = 1 − (1 − v)² (nodes crowd the rim, where GGX's tail
+//!    lives), and the [`KERNEL_AZIMUTH_NODES`]-point midpoint rule in
+//!    u₂ = φ/2π (the trapezoid rule of a periodic function). Each node's weight is spread
+//!    onto a uniform grid of [`KERNEL_COS_NODES`] cosines c_j = j/(N_c − 1) with the
+//!    4-point (cubic) Lagrange weights of its c, so that Σ_j K_j F(c_j) = ∫ K F̃ with F̃ the
+//!    cubic interpolant of F through the grid nodes.
+//! 2. **Film colours**. For every film index n_k of the table and every c_j, one thickness
+//!    sweep ([`Stack::colours_over_thickness`]) gives F_R and F_T on a uniform fine grid of
+//!    thicknesses d_m = m δd over [0, [`THICKNESS_EXTENSION`] · d_max] with δd chosen so
+//!    that the optical path advances by at most [`FINE_OPD_STEP_NM`] per node
+//!    (2 δd n_max ≤ 24 nm), resolving the interference fringes.
+//! 3. **Product**. Texel (x, y, n_k, α_a) at cos θ_o, Δ and d = Δ / (2 q(n_k, c_ref(cos θ_o,
+//!    α_a))) holds Σ_j K[x, a, j] F̃(c_j, d, n_k), with F̃ cubic Lagrange interpolation in d on
+//!    the fine grid. Thicknesses beyond the fine grid (texels outside the physical range that only
+//!    grazing views of films nearly index-matched to the ambient reach) take its last node.
+//!
+//! Every sum runs in a fixed order and every parallel task writes its own texels, so the
+//! output is byte-identical whatever the thread count (tested by the default-set test).
+//!
+//! ## Accuracy of the quadrature
+//!
+//! Cubic Lagrange interpolation of a fringe of phase step k h per node errs by at most
+//! (k h)⁴ · 9/16 / 24: the fine thickness grid (24 nm of optical path per node, k h ≤ 0.4
+//! rad at 380 nm) and the c grid (128 nodes: at most 2 d_max dc = 19 nm of path per node
+//! inside the thickness range, |dΔ/dc| = 2 d c/q ≤ 2 d) keep it below 6·10⁻⁴ of the fringe
+//! amplitude (a film reflects a few per cent: ≲ 3·10⁻⁵ absolute). With F ≡ 1 the
+//! reflection kernel's mass is GGX's single-scattering albedo; it matches the Monte Carlo
+//! reference of [`nacre_optics::microfacet`] at 2²² samples within its noise (test
+//! `furnace_kernel_matches_monte_carlo`). The table's own interpolation error dominates:
+//! the default `rough-film-dielectric` (16 × 256 × 12 α × 24 n) is off by ΔE2000 0.112 /
+//! 0.297 / 0.66 (mean / p95 / max) in reflection and 0.055 / 0.119 / 0.30 in transmission
+//! against the Monte Carlo reference at 1000 random points (`tests/tests/rough_lut_accuracy.rs`
+//! with `NACRE_ROUGH_POINTS=1000`); the film-index axis is the one that matters most (at 160
+//! points, 16 indices gave p95 0.51 and 24 give 0.27; 24 view angles or 16 roughnesses with
+//! 16 indices instead did not lower it).
+//!
+//! # Axes and mappings (forward and inverse: [`RoughLutAxes`])
+//!
+//! | axis | count | t from the physical value | inverse |
+//! |---|---|---|---|
+//! | x: cos θ_o | `cos_theta_count` | t = √cos θ_o | cos θ_o = t² |
+//! | y: Δ, nm | `opd_count` | t = Δ / Δ_max, Δ = 2 d q(n_f, c_ref(cos θ_o, α)), Δ_max = 2 d_max n_max | Δ = t Δ_max |
+//! | film index | `film_ior_count` | t = √((n_f − n_min)/(n_max − n_min)) | n_f = n_min + t² (n_max − n_min) |
+//! | roughness α | `alpha_count` | t = ln(α/α_min) / ln(α_max/α_min) | α = α_min (α_max/α_min)^t |
+//!
+//! q(n, cos θ) = √(n² − n₀² sin²θ) is the film's normal wave-vector component (as in
+//! film-lut). Δ is the optical path difference at the kernel's mean microfacet cosine,
+//! c_ref(cos θ_o, α) = cos θ_o + (2α − α²)(0.7 − 0.8 cos θ_o) ([`RoughLutAxes::reference_cos`],
+//! a fit within ±0.05 of the kernel mean): the specular path (c_ref = cos θ_o) for smooth
+//! films, where film-lut showed that at fixed Δ the colour varies slowly with index and
+//! angle, moving to c ≈ 0.7–0.9 at α = 1 whatever the view. Referring Δ to the view cosine at
+//! every α instead left errors of ΔE2000 1.7 at α ≈ 1 (neighbouring view-angle texels at the
+//! same Δ then hold films of different thickness as the normal microfacets see them). Each α
+//! block refers Δ to its own α, so a lookup computes t_y per block. Unlike film-lut's index axis,
+//! this one does not depend on θ_o, so the film colours of step 2 are shared by every view
+//! angle. The square root crowds texels near n_min, where a film nearly index-matched to the
+//! ambient changes fastest; the logarithm in α spreads them over 0.02–0.3, where roughness
+//! washes the fringes out (the spread of microfacet optical paths grows linearly with α).
+//! Values outside the ranges clamp to them.
+//!
+//! # Texture layout and texel centres
+//!
+//! Per quantity one 3-D texture: width = count(cos θ_o), height = count(Δ), depth =
+//! count(α) × count(n_f) in α-major blocks, slice z = i_α · count(n_f) + i_n. On every axis
+//! texel i of `count` holds t = i / (count − 1), reached at texture coordinate
+//! u = (t (count − 1) + 0.5) / count. Within one α block a linear sampler filters x, y and
+//! the film index (the index coordinate w = (i_α count(n_f) + t_n (count(n_f) − 1) + 0.5) /
+//! depth stays between the block's first and last texel centres, so filtering never mixes
+//! blocks); the two α blocks around t_α are fetched separately and mixed:
+//!
+//! ```text
+//! t  = forward(cos θ_o, α, d, n_f)                  // (t_x, t_y, t_n, t_α)
+//! s  = t_α (count(α) − 1);  a₀ = min(⌊s⌋, count(α) − 2);  f = s − a₀
+//! E  = mix(sample(a₀), sample(a₀ + 1), f)           // sample(a): trilinear within block a
+//! environment specular = prefiltered_env(R, α) × E_r;  transmitted = … × E_t
+//! ```
+//!
+//! `shaders/rough_lut_mapping.wgsl` mirrors this and [`RoughFilmLut::lookup`] does the same
+//! on the CPU. The files: OpenEXR atlas (width = count(cos θ_o), height = count(Δ) × depth,
+//! slice z at rows [z count(Δ), (z + 1) count(Δ)), [`crate::table_io`]) and KTX 2.0 3-D
+//! `RGBA16F` textures with alpha 1 ([`crate::ktx2::film_lut_image`]).
+
+use crate::bake::{
+    AxisRecord, FileRecord, MANIFEST_FORMAT, MAX_TEXELS, Manifest, RawColour, RawOutput, RawStack,
+    Toggle, constant_real_index, is_transparent, parse_colour, sha256_text, table_name,
+};
+use crate::error::{Error, Result};
+use crate::film_lut::MIN_COS_THETA;
+use crate::materials::resolve;
+use crate::output::write_atomic;
+use crate::stack_spec::{line_of, toml_error};
+use crate::table_io::{self, Precision, Table3};
+use nacre_optics::colour::Colorimeter;
+use nacre_optics::microfacet::{REFRACTION_WAVELENGTH_NM, refract, sample_ggx_vndf, smith_lambda};
+use nacre_optics::{C64, Layer, Material, SpectralRule, Stack};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use toml::Spanned;
+
+/// Nodes of the uniform grid of microfacet cosines c = ω_o·h on which the kernels are
+/// tabulated and the film colours evaluated.
+pub const KERNEL_COS_NODES: usize = 128;
+
+/// Gauss–Legendre nodes in v, u₁ = 1 − (1 − v)² (u₁ the squared radius on Heitz's
+/// visible-normal disk).
+pub const KERNEL_RADIAL_NODES: usize = 128;
+
+/// Midpoint nodes in u₂ (the azimuth on the disk).
+pub const KERNEL_AZIMUTH_NODES: usize = 384;
+
+/// Largest optical path advance between nodes of the fine thickness grid, nm.
+pub const FINE_OPD_STEP_NM: f64 = 24.0;
+
+/// The fine thickness grid covers [0, THICKNESS_EXTENSION · d_max]: texels near the top of
+/// the Δ axis at grazing views of low-index films hold thicker films than d_max, and the
+/// interpolation near the physical range's edge reads them.
+pub const THICKNESS_EXTENSION: f64 = 1.5;
+
+/// Axes of a rough-film LUT, with the forward (physical → t ∈ [0, 1]) and inverse mappings.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RoughLutAxes {
+    /// Texels along cos θ_o (x, the texture width).
+    pub cos_theta_count: usize,
+    /// Texels along the optical path difference Δ at the reference cosine (y, the height).
+    pub opd_count: usize,
+    /// Texels along the film index within one α block.
+    pub ior_count: usize,
+    /// α blocks (the texture depth is `alpha_count * ior_count`).
+    pub alpha_count: usize,
+    /// Smallest film thickness, nm (the table covers Δ from 0).
+    pub thickness_min_nm: f64,
+    /// Largest film thickness d_max, nm.
+    pub thickness_max_nm: f64,
+    /// Smallest film index.
+    pub ior_min: f64,
+    /// Largest film index.
+    pub ior_max: f64,
+    /// Smallest GGX roughness α.
+    pub alpha_min: f64,
+    /// Largest GGX roughness α.
+    pub alpha_max: f64,
+    /// The (real, constant) ambient index n₀.
+    pub ambient_index: f64,
+    /// Relative index η = n_base / n₀ at 560 nm used to refract into the base, when the
+    /// transmittance table is baked.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub base_eta: Option<f64>,
+}
+
+impl RoughLutAxes {
+    /// Δ_max = 2 d_max n_max, nm.
+    pub fn opd_max_nm(&self) -> f64 {
+        2.0 * self.thickness_max_nm * self.ior_max
+    }
+
+    /// Normal component q = √(n² − n₀² sin²θ) of a film of index `film_ior` seen at
+    /// `cos_theta`.
+    pub fn film_q(&self, cos_theta: f64, film_ior: f64) -> f64 {
+        let sin2 = (1.0 - cos_theta * cos_theta).max(0.0);
+        (film_ior * film_ior - self.ambient_index * self.ambient_index * sin2)
+            .max(0.0)
+            .sqrt()
+    }
+
+    /// The microfacet cosine the Δ axis of an α block refers to:
+    /// c_ref(cos θ_o, α) = cos θ_o + (2α − α²)(0.7 − 0.8 cos θ_o), a fit (within ±0.05)
+    /// of the mean of c = ω_o·h under the reflection kernel (c_ref → cos θ_o as α → 0, the
+    /// specular direction; 0.7–0.9 at α = 1 whatever the view). Clamped to [0, 1].
+    pub fn reference_cos(cos_theta_o: f64, alpha: f64) -> f64 {
+        let c = cos_theta_o.clamp(0.0, 1.0);
+        let s = alpha.clamp(0.0, 1.0) * (2.0 - alpha.clamp(0.0, 1.0));
+        (c + s * (0.7 - 0.8 * c)).clamp(0.0, 1.0)
+    }
+
+    /// Optical path difference of the Δ axis, Δ = 2 d q(n, c_ref(cos θ_o, α)), nm: the film's
+    /// path at the kernel's mean microfacet, so that at fixed Δ the albedo varies slowly
+    /// with view angle and index at every roughness.
+    pub fn opd_nm(&self, cos_theta: f64, alpha: f64, thickness_nm: f64, film_ior: f64) -> f64 {
+        2.0 * thickness_nm * self.film_q(Self::reference_cos(cos_theta, alpha), film_ior)
+    }
+
+    /// t of roughness α: ln(α/α_min) / ln(α_max/α_min) (0 when the range is one value).
+    pub fn alpha_t(&self, alpha: f64) -> f64 {
+        let span = (self.alpha_max / self.alpha_min).ln();
+        if span > 0.0 {
+            (alpha / self.alpha_min).ln() / span
+        } else {
+            0.0
+        }
+    }
+
+    /// Forward mapping: physical (cos θ_o, α, d nm, n_f) → (t_x, t_y, t_n, t_α), each clamped
+    /// to [0, 1]; non-finite values become 0.
+    pub fn forward(
+        &self,
+        cos_theta: f64,
+        alpha: f64,
+        thickness_nm: f64,
+        film_ior: f64,
+    ) -> [f64; 4] {
+        let c = cos_theta.clamp(0.0, 1.0);
+        let tx = c.sqrt();
+        let ty =
+            self.opd_nm(c, alpha.max(self.alpha_min), thickness_nm, film_ior) / self.opd_max_nm();
+        let span = self.ior_max - self.ior_min;
+        let tn = if span > 0.0 {
+            ((film_ior - self.ior_min) / span).max(0.0).sqrt()
+        } else {
+            0.0
+        };
+        let ta = self.alpha_t(alpha.max(self.alpha_min));
+        [tx, ty, tn, ta].map(|t| {
+            if t.is_finite() {
+                t.clamp(0.0, 1.0)
+            } else {
+                0.0
+            }
+        })
+    }
+
+    /// Inverse mapping: t → (cos θ_o, Δ nm, n_f, α).
+    pub fn inverse(&self, t: [f64; 4]) -> (f64, f64, f64, f64) {
+        (
+            t[0] * t[0],
+            t[1] * self.opd_max_nm(),
+            self.ior_min + t[2] * t[2] * (self.ior_max - self.ior_min),
+            self.alpha_min * (self.alpha_max / self.alpha_min).powf(t[3]),
+        )
+    }
+
+    /// t of texel `i` on an axis of `count` texels: i / (count − 1) (0 when count = 1).
+    pub fn texel_t(i: usize, count: usize) -> f64 {
+        crate::film_lut::FilmLutAxes::texel_t(i, count)
+    }
+
+    /// Texture depth: `alpha_count * ior_count`.
+    pub fn depth(&self) -> usize {
+        self.alpha_count * self.ior_count
+    }
+
+    /// cos θ_o of texel column `x` (at least [`MIN_COS_THETA`]).
+    pub fn texel_cos_theta(&self, x: usize) -> f64 {
+        let t = Self::texel_t(x, self.cos_theta_count);
+        (t * t).max(MIN_COS_THETA)
+    }
+
+    /// Film index of index texel `k`.
+    pub fn texel_ior(&self, k: usize) -> f64 {
+        self.inverse([0.0, 0.0, Self::texel_t(k, self.ior_count), 0.0])
+            .2
+    }
+
+    /// Roughness of α block `a`.
+    pub fn texel_alpha(&self, a: usize) -> f64 {
+        self.inverse([0.0, 0.0, 0.0, Self::texel_t(a, self.alpha_count)])
+            .3
+    }
+
+    /// Film thickness (nm) of texel (x, y, k) of α block `a`:
+    /// d = Δ_y / (2 q(n_k, c_ref(cos θ_x, α_a))) (0 at Δ = 0).
+    pub fn texel_thickness_nm(&self, x: usize, y: usize, k: usize, a: usize) -> f64 {
+        let opd = Self::texel_t(y, self.opd_count) * self.opd_max_nm();
+        let c_ref = Self::reference_cos(self.texel_cos_theta(x), self.texel_alpha(a));
+        let q = self.film_q(c_ref, self.texel_ior(k));
+        if opd > 0.0 { opd / (2.0 * q) } else { 0.0 }
+    }
+}
+
+/// One kernel pair: K_r and K_t on the c grid of [`KERNEL_COS_NODES`] nodes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Kernel {
+    /// Reflection kernel weights K_r(c_j).
+    pub reflection: Vec<f64>,
+    /// Transmission kernel weights K_t(c_j) (all 0 without a base index).
+    pub transmission: Vec<f64>,
+}
+
+impl Kernel {
+    /// First and one-past-last node with a nonzero weight in either kernel.
+    fn support(&self) -> (usize, usize) {
+        let nz = |v: &f64| *v != 0.0;
+        let lo = self
+            .reflection
+            .iter()
+            .position(nz)
+            .into_iter()
+            .chain(self.transmission.iter().position(nz))
+            .min()
+            .unwrap_or(0);
+        let hi = self
+            .reflection
+            .iter()
+            .rposition(nz)
+            .into_iter()
+            .chain(self.transmission.iter().rposition(nz))
+            .max()
+            .map_or(0, |i| i + 1);
+        (lo, hi.max(lo))
+    }
+}
+
+/// The cosine of node j of an `n`-node c grid: j / (n − 1).
+pub fn kernel_cos(j: usize, n: usize) -> f64 {
+    j as f64 / (n - 1) as f64
+}
+
+/// Gauss–Legendre nodes and weights on [0, 1] (Newton iteration on P_n from the
+/// Chebyshev-like initial guesses cos(π(i + 3/4)/(n + 1/2)); Abramowitz & Stegun 25.4.29).
+pub fn gauss_legendre_01(n: usize) -> (Vec<f64>, Vec<f64>) {
+    let mut nodes = vec![0.0; n];
+    let mut weights = vec![0.0; n];
+    for i in 0..n {
+        let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+        let mut dp = 1.0;
+        for _ in 0..100 {
+            // P_n(x) and P_n'(x) by the three-term recurrence.
+            let (mut p0, mut p1) = (1.0, x);
+            for k in 2..=n {
+                let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
+                p0 = p1;
+                p1 = p2;
+            }
+            let p = if n == 0 { 1.0 } else { p1 };
+            let pm1 = if n <= 1 { 1.0 } else { p0 };
+            dp = n as f64 * (x * p - pm1) / (x * x - 1.0);
+            let dx = p / dp;
+            x -= dx;
+            if dx.abs() < 1e-16 {
+                break;
+            }
+        }
+        nodes[i] = 0.5 * (1.0 - x);
+        weights[i] = 1.0 / ((1.0 - x * x) * dp * dp);
+    }
+    (nodes, weights)
+}
+
+/// 4-point Lagrange (cubic) interpolation stencil at fractional position `pos` on a grid of
+/// `n` ≥ 4 uniform nodes: the first node and the weights, exact for cubics; the stencil is
+/// shifted inwards at the ends. `pos` is clamped to [0, n − 1].
+#[inline]
+pub fn cubic_stencil(pos: f64, n: usize) -> (usize, [f64; 4]) {
+    let pos = pos.clamp(0.0, (n - 1) as f64);
+    let start = ((pos.floor() as isize) - 1).clamp(0, n as isize - 4) as usize;
+    let x = pos - start as f64 - 1.0;
+    (
+        start,
+        [
+            -x * (x - 1.0) * (x - 2.0) / 6.0,
+            (x + 1.0) * (x - 1.0) * (x - 2.0) / 2.0,
+            -(x + 1.0) * x * (x - 2.0) / 2.0,
+            (x + 1.0) * x * (x - 1.0) / 6.0,
+        ],
+    )
+}
+
+/// The reflection and transmission kernels of view cosine `cos_theta_o` and roughness
+/// `alpha` on an `n_c`-node c grid (see the module docs), with relative base index `eta`
+/// for transmission. Deterministic: the nodes are summed in a fixed order.
+pub fn kernels(cos_theta_o: f64, alpha: f64, eta: Option<f64>, n_c: usize) -> Kernel {
+    kernels_with(
+        cos_theta_o,
+        alpha,
+        eta,
+        n_c,
+        KERNEL_RADIAL_NODES,
+        KERNEL_AZIMUTH_NODES,
+    )
+}
+
+/// [`kernels`] with explicit quadrature orders (radial Gauss–Legendre nodes, azimuthal
+/// midpoint nodes).
+pub fn kernels_with(
+    cos_theta_o: f64,
+    alpha: f64,
+    eta: Option<f64>,
+    n_c: usize,
+    radial: usize,
+    azimuth: usize,
+) -> Kernel {
+    let c_o = cos_theta_o.clamp(MIN_COS_THETA, 1.0);
+    let wo = [(1.0 - c_o * c_o).max(0.0).sqrt(), 0.0, c_o];
+    let lambda_o = smith_lambda(wo, alpha);
+    let g1_o = 1.0 / (1.0 + lambda_o);
+    // Gauss–Legendre in v with u₁ = 1 − (1 − v)² (du₁ = 2(1 − v) dv): nodes crowd the disk's
+    // rim, where GGX's long tail lives (a mass ≈ α² beyond 45° at normal view) and where
+    // N_z = √(1 − r²) has its square-root edge, which the substitution makes linear in v.
+    let (vs, wvs) = gauss_legendre_01(radial);
+    let (u1s, w1s): (Vec<f64>, Vec<f64>) = vs
+        .iter()
+        .zip(&wvs)
+        .map(|(&v, &w)| (1.0 - (1.0 - v) * (1.0 - v), 2.0 * (1.0 - v) * w))
+        .unzip();
+    let mut k = Kernel {
+        reflection: vec![0.0; n_c],
+        transmission: vec![0.0; n_c],
+    };
+    let scale = (n_c - 1) as f64;
+    for (&u1, &w1) in u1s.iter().zip(&w1s) {
+        let w = w1 / azimuth as f64;
+        for i in 0..azimuth {
+            let u2 = (i as f64 + 0.5) / azimuth as f64;
+            let h = sample_ggx_vndf(wo, alpha, u1, u2);
+            let cos_d = wo[0] * h[0] + wo[1] * h[1] + wo[2] * h[2];
+            if cos_d <= 0.0 {
+                continue;
+            }
+            let (start, lw) = cubic_stencil(cos_d * scale, n_c);
+            let wi = std::array::from_fn(|c| 2.0 * cos_d * h[c] - wo[c]);
+            if wi[2] > 0.0 {
+                let g = w / (1.0 + lambda_o + smith_lambda(wi, alpha)) / g1_o;
+                for (slot, w) in k.reflection[start..start + 4].iter_mut().zip(lw) {
+                    *slot += g * w;
+                }
+            }
+            if let Some(eta) = eta
+                && let Some(wt) = refract(wo, h, cos_d, eta)
+                && wt[2] < 0.0
+            {
+                let g = w / (1.0 + lambda_o + smith_lambda(wt, alpha)) / g1_o;
+                for (slot, w) in k.transmission[start..start + 4].iter_mut().zip(lw) {
+                    *slot += g * w;
+                }
+            }
+        }
+    }
+    k
+}
+
+/// A rough-film LUT in memory.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RoughFilmLut {
+    /// The axes.
+    pub axes: RoughLutAxes,
+    /// Reflected albedo E_r per texel (width × height × depth, see the module docs).
+    pub reflectance: Table3,
+    /// Transmitted albedo E_t per texel, when the base transmits.
+    pub transmittance: Option<Table3>,
+}
+
+impl RoughFilmLut {
+    /// The albedo colour at physical (cos θ_o, α, d nm, n_f) from `table` (one quantity),
+    /// exactly as the shader samples it: trilinear within the two α blocks around α, mixed
+    /// linearly (module docs).
+    pub fn lookup(
+        axes: &RoughLutAxes,
+        table: &Table3,
+        cos_theta: f64,
+        alpha: f64,
+        thickness_nm: f64,
+        film_ior: f64,
+    ) -> [f64; 3] {
+        let t = axes.forward(cos_theta, alpha, thickness_nm, film_ior);
+        let (a0, f) = lerp_index(t[3], axes.alpha_count);
+        // Each block's Δ axis refers to its own α (texel_alpha), as it was baked.
+        let block = |a: usize| {
+            let t_block = axes.forward(cos_theta, axes.texel_alpha(a), thickness_nm, film_ior);
+            trilinear(
+                table,
+                [t[0], t_block[1], t[2]],
+                a * axes.ior_count,
+                axes.ior_count,
+            )
+        };
+        let lo = block(a0);
+        if f == 0.0 {
+            return lo;
+        }
+        let hi = block(a0 + 1);
+        std::array::from_fn(|c| lo[c] + f * (hi[c] - lo[c]))
+    }
+}
+
+/// Lower texel and fraction of linear interpolation at t on `count` texels.
+fn lerp_index(t: f64, count: usize) -> (usize, f64) {
+    if count <= 1 {
+        return (0, 0.0);
+    }
+    let pos = t.clamp(0.0, 1.0) * (count - 1) as f64;
+    let i = (pos.floor() as usize).min(count - 2);
+    (i, pos - i as f64)
+}
+
+/// Trilinear interpolation at normalised t (x, y, index) inside the block of `block_count`
+/// slices starting at slice `z0`.
+fn trilinear(table: &Table3, t: [f64; 3], z0: usize, block_count: usize) -> [f64; 3] {
+    let (x0, fx) = lerp_index(t[0], table.nx);
+    let (y0, fy) = lerp_index(t[1], table.ny);
+    let (k0, fk) = lerp_index(t[2], block_count);
+    let mut out = [0.0; 3];
+    for corner in 0..8 {
+        let (ux, uy, uk) = (corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
+        let w = [(1.0 - fx, fx), (1.0 - fy, fy), (1.0 - fk, fk)];
+        let weight = [ux, uy, uk]
+            .iter()
+            .zip(w)
+            .map(|(&u, (a, b))| if u == 1 { b } else { a })
+            .product::<f64>();
+        if weight == 0.0 {
+            continue;
+        }
+        let v = table.texel(x0 + ux, y0 + uy, z0 + k0 + uk);
+        for c in 0..3 {
+            out[c] += weight * f64::from(v[c]);
+        }
+    }
+    out
+}
+
+/// Everything needed to bake one rough-film LUT.
+pub struct RoughLutJob {
+    /// Axes.
+    pub axes: RoughLutAxes,
+    /// Ambient (constant real index).
+    pub ambient: Material,
+    /// Fixed layers under the film, top first.
+    pub under: Vec<Layer>,
+    /// Base.
+    pub base: Material,
+    /// Colour conversion.
+    pub colorimeter: Colorimeter,
+    /// Whether to bake the transmitted albedo.
+    pub transmittance: bool,
+}
+
+impl RoughLutJob {
+    /// Nodes of the fine thickness grid and its step, nm.
+    pub fn thickness_grid(&self) -> (usize, f64) {
+        let a = &self.axes;
+        let top = THICKNESS_EXTENSION * a.thickness_max_nm;
+        let nodes = ((top * 2.0 * a.ior_max / FINE_OPD_STEP_NM).ceil() as usize + 1).max(4);
+        (nodes, top / (nodes - 1) as f64)
+    }
+
+    /// Bakes the table (module docs); `progress` is called once per film index.
+    pub fn bake(&self, progress: &(dyn Fn() + Sync)) -> Result<RoughFilmLut> {
+        let a = &self.axes;
+        let n_c = KERNEL_COS_NODES;
+        let eta = if self.transmittance { a.base_eta } else { None };
+        let pairs: Vec<(usize, usize)> = (0..a.cos_theta_count)
+            .flat_map(|x| (0..a.alpha_count).map(move |al| (x, al)))
+            .collect();
+        let kernels: Vec<Kernel> = pairs
+            .par_iter()
+            .map(|&(x, al)| kernels(a.texel_cos_theta(x), a.texel_alpha(al), eta, n_c))
+            .collect();
+        let supports: Vec<(usize, usize)> = kernels.iter().map(Kernel::support).collect();
+        let (d_nodes, d_step) = self.thickness_grid();
+        let d_grid: Vec<f64> = (0..d_nodes).map(|m| m as f64 * d_step).collect();
+        let under_opd = Stack::new(self.ambient.clone(), self.under.clone(), self.base.clone())?
+            .max_opd_nm(None);
+        let rule = SpectralRule::new(
+            &self.colorimeter,
+            2.0 * d_grid[d_nodes - 1] * a.ior_max + under_opd,
+        );
+        let depth = a.depth();
+        let mut reflectance = Table3::new(a.cos_theta_count, a.opd_count, depth);
+        let mut transmittance = self
+            .transmittance
+            .then(|| Table3::new(a.cos_theta_count, a.opd_count, depth));
+        for k in 0..a.ior_count {
+            let n = a.texel_ior(k);
+            let film = Material::constant(format!("{n}"), C64::new(n, 0.0))?;
+            let mut layers = vec![Layer {
+                material: film,
+                thickness_nm: 0.0,
+            }];
+            layers.extend(self.under.iter().cloned());
+            let stack = Stack::new(self.ambient.clone(), layers, self.base.clone())?;
+            // Film colours F_R, F_T at every (c_j, d_m).
+            let colours: Vec<nacre_optics::FilmColours> = (0..n_c)
+                .into_par_iter()
+                .map(|j| {
+                    let c = kernel_cos(j, n_c).max(MIN_COS_THETA);
+                    Ok(stack.colours_over_thickness(1, c.acos().to_degrees(), &rule, &d_grid)?)
+                })
+                .collect::<Result<_>>()?;
+            // The product, one column x at a time: texel (x, y, k, a) =
+            // Σ_m w_m Σ_j K[x, a, j] F(c_j, d_m), w the cubic weights of its thickness.
+            let columns: Vec<Vec<[f64; 6]>> = (0..a.cos_theta_count)
+                .into_par_iter()
+                .map(|x| {
+                    let mut out = Vec::with_capacity(a.opd_count * a.alpha_count);
+                    for y in 0..a.opd_count {
+                        for al in 0..a.alpha_count {
+                            let kern = &kernels[x * a.alpha_count + al];
+                            let (lo, hi) = supports[x * a.alpha_count + al];
+                            let d = a.texel_thickness_nm(x, y, k, al);
+                            let (m0, w) = cubic_stencil(d / d_step, d_nodes);
+                            let mut e = [0.0; 6];
+                            for (s, ws) in w.iter().enumerate() {
+                                let mut v = [0.0; 6];
+                                let rows = kern.reflection[lo..hi]
+                                    .iter()
+                                    .zip(&kern.transmission[lo..hi])
+                                    .zip(&colours[lo..hi]);
+                                for ((&kr, &kt), f) in rows {
+                                    let (r, t) = (f.reflectance[m0 + s], f.transmittance[m0 + s]);
+                                    for c in 0..3 {
+                                        v[c] += kr * r[c];
+                                        v[3 + c] += kt * t[c];
+                                    }
+                                }
+                                for c in 0..6 {
+                                    e[c] += ws * v[c];
+                                }
+                            }
+                            out.push(e);
+                        }
+                    }
+                    out
+                })
+                .collect();
+            for (x, column) in columns.iter().enumerate() {
+                for y in 0..a.opd_count {
+                    for al in 0..a.alpha_count {
+                        let e = column[y * a.alpha_count + al];
+                        let z = al * a.ior_count + k;
+                        reflectance.set(x, y, z, [e[0], e[1], e[2]].map(|v| v as f32));
+                        if let Some(t) = transmittance.as_mut() {
+                            t.set(x, y, z, [e[3], e[4], e[5]].map(|v| v as f32));
+                        }
+                    }
+                }
+            }
+            progress();
+        }
+        Ok(RoughFilmLut {
+            axes: a.clone(),
+            reflectance,
+            transmittance,
+        })
+    }
+}
+
+/// Checks the axes of a recipe; `context` names the recipe's `[axes]` table.
+pub fn validate_axes(axes: &RoughLutAxes, context: &str, max_texels: u64) -> Result<()> {
+    let err = |message: String| Error::Invalid {
+        context: context.to_string(),
+        message,
+    };
+    for (name, count, least) in [
+        ("cos_theta_count", axes.cos_theta_count, 2),
+        ("opd_count", axes.opd_count, 2),
+        ("film_ior_count", axes.ior_count, 1),
+        ("alpha_count", axes.alpha_count, 1),
+    ] {
+        if count < least {
+            return Err(err(format!(
+                "{name} = {count}: needs at least {least} texel(s)"
+            )));
+        }
+    }
+    if !(axes.thickness_max_nm > 0.0 && axes.thickness_max_nm <= 1e5) {
+        return Err(err(format!(
+            "thickness_nm maximum {} must be positive and at most 100000 nm",
+            axes.thickness_max_nm
+        )));
+    }
+    if !(axes.thickness_min_nm >= 0.0 && axes.thickness_min_nm < axes.thickness_max_nm) {
+        return Err(err(format!(
+            "thickness_nm range [{}, {}] must satisfy 0 ≤ min < max",
+            axes.thickness_min_nm, axes.thickness_max_nm
+        )));
+    }
+    if !(axes.ior_min > 0.0 && axes.ior_max >= axes.ior_min && axes.ior_max <= 10.0) {
+        return Err(err(format!(
+            "film_ior range [{}, {}] must satisfy 0 < min ≤ max ≤ 10",
+            axes.ior_min, axes.ior_max
+        )));
+    }
+    if axes.ior_min < axes.ambient_index {
+        return Err(err(format!(
+            "film_ior minimum {} is below the ambient index {}: the film would be evanescent at grazing angles",
+            axes.ior_min, axes.ambient_index
+        )));
+    }
+    if (axes.ior_max > axes.ior_min) != (axes.ior_count > 1) {
+        return Err(err(format!(
+            "film_ior = [{}, {}] with film_ior_count = {}: a range needs at least 2 texels, a single index exactly 1",
+            axes.ior_min, axes.ior_max, axes.ior_count
+        )));
+    }
+    if !(axes.alpha_min >= 1e-3 && axes.alpha_max >= axes.alpha_min && axes.alpha_max <= 1.0) {
+        return Err(err(format!(
+            "alpha range [{}, {}] must satisfy 0.001 ≤ min ≤ max ≤ 1",
+            axes.alpha_min, axes.alpha_max
+        )));
+    }
+    if (axes.alpha_max > axes.alpha_min) != (axes.alpha_count > 1) {
+        return Err(err(format!(
+            "alpha = [{}, {}] with alpha_count = {}: a range needs at least 2 texels, a single roughness exactly 1",
+            axes.alpha_min, axes.alpha_max, axes.alpha_count
+        )));
+    }
+    let texels = axes.cos_theta_count as u64
+        * axes.opd_count as u64
+        * axes.ior_count as u64
+        * axes.alpha_count as u64;
+    if texels > max_texels {
+        return Err(Error::TooLarge {
+            what: format!("{context}: texels (cos_theta × opd × film_ior × alpha)"),
+            count: texels,
+            limit: max_texels,
+        });
+    }
+    Ok(())
+}
+
+// ---------------------------------------------------------------------------------------
+// Recipes
+// ---------------------------------------------------------------------------------------
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawRoughAxes {
+    cos_theta_count: usize,
+    thickness_nm: [f64; 2],
+    opd_count: usize,
+    film_ior: [f64; 2],
+    film_ior_count: usize,
+    alpha: [f64; 2],
+    alpha_count: usize,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawRoughRecipe {
+    #[allow(dead_code)] // checked before the full parse
+    kind: Spanned<String>,
+    description: Option<String>,
+    colour: Option<RawColour>,
+    stack: RawStack,
+    axes: Spanned<RawRoughAxes>,
+    output: Option<RawOutput>,
+}
+
+/// A parsed `rough-film-lut` recipe.
+///
+/// ```toml
+/// kind = "rough-film-lut"
+/// description = "..."
+/// [colour]                      # as for film-lut
+/// [stack]                       # as for film-lut: ambient (constant), film label, base, under
+/// ambient = "1.0"
+/// base = "1.5"
+/// [axes]
+/// cos_theta_count = 16          # texels along cos θ_o (√ mapping)
+/// thickness_nm = [0.0, 1200.0]  # film thickness range
+/// opd_count = 256               # texels along the optical path difference (at c_ref)
+/// film_ior = [1.0, 2.5]         # film index range (≥ ambient), √ mapping
+/// film_ior_count = 24
+/// alpha = [0.02, 1.0]           # GGX roughness range (0.001 ≤ min ≤ max ≤ 1), log mapping
+/// alpha_count = 12
+/// [output]                      # optional
+/// precision = "half"            # OpenEXR: half | float
+/// png = false                   # default false for this kind
+/// transmittance = "auto"        # auto (when the base is transparent) | true | false
+/// ```
+pub struct RoughRecipe {
+    /// Table name (file stem).
+    pub name: String,
+    /// Recipe file.
+    pub path: PathBuf,
+    /// Recipe text.
+    pub text: String,
+    /// Description.
+    pub description: String,
+    /// Ambient spec.
+    pub ambient_spec: String,
+    /// Film label.
+    pub film_label: String,
+    /// Base spec.
+    pub base_spec: String,
+    /// Fixed layers under the film (spec, thickness nm).
+    pub under_specs: Vec<(String, f64)>,
+    /// The job.
+    pub job: RoughLutJob,
+    /// OpenEXR precision.
+    pub precision: Precision,
+    /// Also write 16-bit PNGs (when every value is in [0, 1]).
+    pub png: bool,
+}
+
+impl RoughRecipe {
+    /// Parses recipe text; `path` names it in errors and anchors relative material paths.
+    pub fn parse(path: &Path, text: String) -> Result<Self> {
+        let raw: RawRoughRecipe = toml::from_str(&text).map_err(|e| toml_error(path, &text, &e))?;
+        let at = |span: std::ops::Range<usize>| {
+            format!("{}:{}", path.display(), line_of(&text, span.start))
+        };
+        let colorimeter = parse_colour(path, &text, raw.colour)?;
+        let base_dir = path.parent();
+        let ambient = resolve(
+            raw.stack.ambient.get_ref(),
+            &at(raw.stack.ambient.span()),
+            base_dir,
+        )?;
+        let ambient_index = constant_real_index(&ambient).ok_or_else(|| Error::Invalid {
+            context: at(raw.stack.ambient.span()),
+            message: format!(
+                "the ambient of a rough-film-lut must have a constant real index (e.g. \"1.0\"), not `{}`",
+                raw.stack.ambient.get_ref()
+            ),
+        })?;
+        let base = resolve(
+            raw.stack.base.get_ref(),
+            &at(raw.stack.base.span()),
+            base_dir,
+        )?;
+        let mut under = Vec::new();
+        let mut under_specs = Vec::new();
+        for l in &raw.stack.under {
+            let d = *l.thickness_nm.get_ref();
+            if !(d >= 0.0 && d.is_finite()) {
+                return Err(Error::Recipe {
+                    path: path.to_path_buf(),
+                    line: line_of(&text, l.thickness_nm.span().start),
+                    message: format!("thickness_nm = {d}: must be finite and non-negative"),
+                });
+            }
+            under.push(Layer {
+                material: resolve(l.material.get_ref(), &at(l.material.span()), base_dir)?,
+                thickness_nm: d,
+            });
+            under_specs.push((l.material.get_ref().clone(), d));
+        }
+        let output = raw.output.unwrap_or(RawOutput {
+            precision: None,
+            png: None,
+            transmittance: None,
+        });
+        let transmits = under
+            .iter()
+            .map(|l| &l.material)
+            .chain(std::iter::once(&base))
+            .all(is_transparent);
+        let transmittance = match output.transmittance {
+            None => transmits,
+            Some(Toggle::Bool(b)) => b,
+            Some(Toggle::Word(w)) if w == "auto" => transmits,
+            Some(Toggle::Word(w)) => {
+                return Err(Error::Invalid {
+                    context: path.display().to_string(),
+                    message: format!(
+                        "[output] transmittance = \"{w}\": expected \"auto\", true or false"
+                    ),
+                });
+            }
+        };
+        let base_eta = if transmittance {
+            let nb = base.index_at(REFRACTION_WAVELENGTH_NM)?;
+            if nb.im != 0.0 || !(nb.re > 0.0) {
+                return Err(Error::Invalid {
+                    context: at(raw.stack.base.span()),
+                    message: format!(
+                        "transmittance through a rough interface needs a non-absorbing base; `{}` has index {nb} at {REFRACTION_WAVELENGTH_NM} nm (set [output] transmittance = false)",
+                        raw.stack.base.get_ref()
+                    ),
+                });
+            }
+            Some(nb.re / ambient_index)
+        } else {
+            None
+        };
+        let ax = raw.axes.get_ref();
+        let axes = RoughLutAxes {
+            cos_theta_count: ax.cos_theta_count,
+            opd_count: ax.opd_count,
+            ior_count: ax.film_ior_count,
+            alpha_count: ax.alpha_count,
+            thickness_min_nm: ax.thickness_nm[0],
+            thickness_max_nm: ax.thickness_nm[1],
+            ior_min: ax.film_ior[0],
+            ior_max: ax.film_ior[1],
+            alpha_min: ax.alpha[0],
+            alpha_max: ax.alpha[1],
+            ambient_index,
+            base_eta,
+        };
+        validate_axes(&axes, &at(raw.axes.span()), MAX_TEXELS)?;
+        Ok(RoughRecipe {
+            name: table_name(path)?,
+            path: path.to_path_buf(),
+            description: raw.description.unwrap_or_default(),
+            ambient_spec: raw.stack.ambient.get_ref().clone(),
+            film_label: raw.stack.film.unwrap_or_else(|| "film".into()),
+            base_spec: raw.stack.base.get_ref().clone(),
+            under_specs,
+            job: RoughLutJob {
+                axes,
+                ambient,
+                under,
+                base,
+                colorimeter,
+                transmittance,
+            },
+            precision: output.precision.unwrap_or(Precision::Half),
+            png: output.png.unwrap_or(false),
+            text,
+        })
+    }
+
+    /// Units of work for progress bars: one per film index.
+    pub fn work(&self) -> u64 {
+        self.job.axes.ior_count as u64
+    }
+
+    /// Bakes and writes the table into `out_dir`; returns the manifest path.
+    pub fn bake(&self, out_dir: &Path, progress: &(dyn Fn() + Sync)) -> Result<PathBuf> {
+        let lut = self.job.bake(progress)?;
+        // Every file goes to a staging folder first; `commit` moves them into `out_dir`,
+        // the manifest last (crate::output::StagedTable).
+        let stage = crate::output::StagedTable::new(out_dir)?;
+        let out_dir = stage.path();
+        let a = &lut.axes;
+        let c = &self.job.colorimeter;
+        let channels: Vec<String> = c
+            .space()
+            .channel_names()
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        let file_name = self
+            .path
+            .file_name()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let (d_nodes, d_step) = self.job.thickness_grid();
+        let mut manifest = Manifest {
+            format: MANIFEST_FORMAT.into(),
+            generated_by: format!(
+                "generated by `nacre bake` from the recipe {file_name} (in tables/recipes/ for the default set, which `nacre bake` with no arguments regenerates); do not edit"
+            ),
+            name: self.name.clone(),
+            kind: "rough-film-lut".into(),
+            description: self.description.clone(),
+            nacre_version: env!("CARGO_PKG_VERSION").into(),
+            recipe_file: file_name,
+            recipe_sha256: sha256_text(&self.text),
+            recipe: self.text.clone(),
+            observer: c.observer().to_string(),
+            illuminant: c.illuminant().to_string(),
+            space: c.space().to_string(),
+            colour_convention: format!(
+                "linear {} (channels {:?}); reflectance: directional albedo E_r = integral of f_r cos(theta_i) over the hemisphere of the GGX microfacet BRDF with height-correlated Smith G2 and the film's unpolarised spectral reflectance in place of Fresnel (Belcour & Barla 2017 Eq. 1), as the colour of R(lambda) x illuminant x CMF over 360-830 nm normalised so that a perfect reflector has Y = 1 (RGB (1,1,1)); transmittance: energy E_t transmitted into the base through the rough film-coated interface (refraction at eta = {}); single scattering: E_r + E_t <= 1 for a lossless stack. Baked by kernel quadrature (no Monte Carlo): {} c nodes (cubic), {}x{} visible-normal nodes (Gauss-Legendre x midpoint), fine thickness grid {} nodes of {:.6} nm (cubic)",
+                c.space(),
+                channels,
+                a.base_eta.map_or("none".to_string(), |e| e.to_string()),
+                KERNEL_COS_NODES,
+                KERNEL_RADIAL_NODES,
+                KERNEL_AZIMUTH_NODES,
+                d_nodes,
+                d_step
+            ),
+            ambient: self.ambient_spec.clone(),
+            film: self.film_label.clone(),
+            under: self.under_specs.clone(),
+            base: self.base_spec.clone(),
+            axes: axis_records(a),
+            film_lut: None,
+            fourier: None,
+            diffraction: None,
+            rough_film_lut: Some(a.clone()),
+            texel_centres: "texel i of an axis with count n holds t = i / (n - 1); a sampler reaches t at u = (t * (n - 1) + 0.5) / n; clamp to edge. The film_ior coordinate of alpha block a is w = (a * count(film_ior) + t_ior * (count(film_ior) - 1) + 0.5) / (count(alpha) * count(film_ior)), which stays inside the block".into(),
+            atlas: "per quantity one 3-D texture: width = count(cos_theta_o), height = count(opd_nm), depth = count(alpha) * count(film_ior) in alpha-major blocks, slice z = i_alpha * count(film_ior) + i_ior. EXR: an atlas of width = count(cos_theta_o), height = count(opd_nm) * depth, slice z at rows [z * count(opd_nm), (z + 1) * count(opd_nm)), row j of the slice is opd_nm index j, top row first; KTX2: the same texels as a 3-D RGBA16F texture, alpha 1".into(),
+            reconstruction: "cos_o = dot(N, V); q(n) = sqrt(n^2 - n0^2 (1 - cos_o^2)); c_ref(alpha) = clamp(cos_o + (2 alpha - alpha^2) (0.7 - 0.8 cos_o), 0, 1); t = (sqrt(cos_o), t_y, sqrt((n_f - ior_min) / (ior_max - ior_min)), ln(alpha / alpha_min) / ln(alpha_max / alpha_min)), each clamped to [0, 1]; s = t_alpha (count(alpha) - 1), a0 = min(floor(s), count(alpha) - 2), f = s - a0; alpha_a = alpha_min (alpha_max / alpha_min)^(a / (count(alpha) - 1)) is block a's roughness and t_y(a) = 2 d q(n_f, c_ref(alpha_a)) / opd_max; E = mix(trilinear(block a0), trilinear(block a0 + 1), f) with trilinear(block a) = linear sample at (u(t_x), u(t_y(a)), (a count(ior) + t_ior (count(ior) - 1) + 0.5) / depth); environment specular = prefiltered_env(R, alpha) * E_reflectance, transmitted energy = E_transmittance (shaders/rough_lut_mapping.wgsl)".into(),
+            files: Vec::new(),
+        };
+        let embedded = manifest.embedded_json();
+        let mut files = Vec::new();
+        for (quantity, table) in [
+            ("reflectance", Some(&lut.reflectance)),
+            ("transmittance", lut.transmittance.as_ref()),
+        ] {
+            let Some(table) = table else { continue };
+            files.extend(self.write_quantity(out_dir, quantity, table, &embedded)?);
+        }
+        manifest.files = files;
+        let name = format!("{}.json", self.name);
+        let json = serde_json::to_string_pretty(&manifest).expect("manifest serialises");
+        write_atomic(&out_dir.join(&name), |w| {
+            w.write_all(json.as_bytes())?;
+            w.write_all(b"\n")
+        })?;
+        stage.commit(&name, &[])
+    }
+}
+
+impl RoughRecipe {
+    /// Writes one quantity's files — `NAME.QUANTITY.exr` (atlas), `.png` when asked for
+    /// and every value is in [0, 1], and `.ktx2` (3-D `RGBA16F`, alpha 1) — each atomically,
+    /// and returns their records.
+    fn write_quantity(
+        &self,
+        out_dir: &Path,
+        quantity: &str,
+        table: &Table3,
+        embedded_manifest: &str,
+    ) -> Result<Vec<FileRecord>> {
+        let rgb: Vec<String> = vec!["R".into(), "G".into(), "B".into()];
+        let mut files = Vec::new();
+        let exr = format!("{}.{quantity}.exr", self.name);
+        table_io::write_exr(&out_dir.join(&exr), table, self.precision)?;
+        files.push(FileRecord {
+            quantity: quantity.into(),
+            format: "exr".into(),
+            encoding: match self.precision {
+                Precision::Half => "half",
+                Precision::Float => "float",
+            }
+            .into(),
+            channels: rgb.clone(),
+            width: table.nx,
+            height: table.ny * table.nz,
+            sha256: table_io::sha256_hex(&out_dir.join(&exr))?,
+            path: exr,
+        });
+        let png = format!("{}.{quantity}.png", self.name);
+        if self.png && table_io::write_png16(&out_dir.join(&png), table)? {
+            files.push(FileRecord {
+                quantity: quantity.into(),
+                format: "png16".into(),
+                encoding: "unorm16".into(),
+                channels: rgb,
+                width: table.nx,
+                height: table.ny * table.nz,
+                sha256: table_io::sha256_hex(&out_dir.join(&png))?,
+                path: png,
+            });
+        } else {
+            // A stale PNG from an earlier bake would contradict the manifest.
+            let _ = std::fs::remove_file(out_dir.join(&png));
+        }
+        let ktx2 = format!("{}.{quantity}.ktx2", self.name);
+        let ktx2_path = out_dir.join(&ktx2);
+        crate::ktx2::write_ktx2(
+            &ktx2_path,
+            &crate::ktx2::film_lut_image(&ktx2_path, table, embedded_manifest)?,
+        )?;
+        files.push(FileRecord {
+            quantity: quantity.into(),
+            format: "ktx2".into(),
+            path: ktx2,
+            encoding: "half".into(),
+            channels: vec!["R".into(), "G".into(), "B".into(), "A".into()],
+            width: table.nx,
+            height: table.ny,
+            sha256: table_io::sha256_hex(&ktx2_path)?,
+        });
+        Ok(files)
+    }
+}
+
+fn axis_records(a: &RoughLutAxes) -> Vec<AxisRecord> {
+    vec![
+        AxisRecord {
+            name: "cos_theta_o".into(),
+            unit: "1".into(),
+            count: a.cos_theta_count,
+            min: 0.0,
+            max: 1.0,
+            mapping: "square".into(),
+            forward: "t = sqrt(cos_theta_o)".into(),
+            inverse: "cos_theta_o = t * t".into(),
+        },
+        AxisRecord {
+            name: "opd_nm".into(),
+            unit: "nm".into(),
+            count: a.opd_count,
+            min: 0.0,
+            max: a.opd_max_nm(),
+            mapping: "linear in the optical path difference at the reference microfacet cosine c_ref = cos_theta_o + (2 alpha - alpha^2) (0.7 - 0.8 cos_theta_o) (clamped to [0, 1]); alpha is the alpha block's own roughness".into(),
+            forward: format!(
+                "t = 2 * thickness_nm * sqrt(film_ior^2 - {}^2 * (1 - c_ref^2)) / {}",
+                a.ambient_index,
+                a.opd_max_nm()
+            ),
+            inverse: format!(
+                "opd_nm = t * {}; thickness_nm = opd_nm / (2 sqrt(film_ior^2 - {}^2 (1 - c_ref^2)))",
+                a.opd_max_nm(),
+                a.ambient_index
+            ),
+        },
+        AxisRecord {
+            name: "film_ior".into(),
+            unit: "1".into(),
+            count: a.ior_count,
+            min: a.ior_min,
+            max: a.ior_max,
+            mapping: "square root".into(),
+            forward: format!(
+                "t = sqrt((film_ior - {lo}) / ({hi} - {lo}))",
+                lo = a.ior_min,
+                hi = a.ior_max
+            ),
+            inverse: format!(
+                "film_ior = {lo} + t^2 ({hi} - {lo})",
+                lo = a.ior_min,
+                hi = a.ior_max
+            ),
+        },
+        AxisRecord {
+            name: "alpha".into(),
+            unit: "1".into(),
+            count: a.alpha_count,
+            min: a.alpha_min,
+            max: a.alpha_max,
+            mapping: "logarithmic; alpha-major blocks of the depth axis, mixed by the shader"
+                .into(),
+            forward: format!(
+                "t = ln(alpha / {lo}) / ln({hi} / {lo})",
+                lo = a.alpha_min,
+                hi = a.alpha_max
+            ),
+            inverse: format!(
+                "alpha = {lo} * ({hi} / {lo})^t",
+                lo = a.alpha_min,
+                hi = a.alpha_max
+            ),
+        },
+    ]
+}
+
+/// A rough-film LUT loaded through its manifest, for CPU lookups (`nacre color --method
+/// rough-lut:`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoadedRoughLut {
+    /// The manifest.
+    pub manifest: Manifest,
+    /// The table.
+    pub lut: RoughFilmLut,
+    /// The table's colorimeter.
+    pub colorimeter: Colorimeter,
+}
+
+impl LoadedRoughLut {
+    /// Loads the table at `path` (a manifest), from its EXR files or else its KTX2 files.
+    pub fn load(path: &Path) -> Result<Self> {
+        let manifest = Manifest::read(path)?;
+        let axes = manifest
+            .rough_film_lut
+            .clone()
+            .ok_or_else(|| Error::Invalid {
+                context: path.display().to_string(),
+                message: format!(
+                    "table `{}` is a `{}` table, not a rough-film-lut",
+                    manifest.name, manifest.kind
+                ),
+            })?;
+        let dir = path.parent().unwrap_or(Path::new("."));
+        let (nx, ny, nz) = (axes.cos_theta_count, axes.opd_count, axes.depth());
+        let load = |quantity: &str| -> Result<Option<Table3>> {
+            let find = |format: &str| {
+                manifest
+                    .files
+                    .iter()
+                    .find(|f| f.quantity == quantity && f.format == format)
+            };
+            match (find("exr"), find("ktx2")) {
+                (Some(f), _) => Ok(Some(
+                    table_io::read_exr_table(&dir.join(&f.path), nx, ny, nz)?.0,
+                )),
+                (None, Some(f)) => Ok(Some(crate::ktx2::read_film_lut_ktx2(
+                    &dir.join(&f.path),
+                    nx,
+                    ny,
+                    nz,
+                )?)),
+                (None, None) => Ok(None),
+            }
+        };
+        let reflectance = load("reflectance")?.ok_or_else(|| Error::Invalid {
+            context: path.display().to_string(),
+            message: "the manifest lists no reflectance EXR or KTX2 file".into(),
+        })?;
+        let transmittance = load("transmittance")?;
+        let colorimeter = manifest.colorimeter(path)?;
+        Ok(LoadedRoughLut {
+            lut: RoughFilmLut {
+                axes,
+                reflectance,
+                transmittance,
+            },
+            manifest,
+            colorimeter,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn axes() -> RoughLutAxes {
+        RoughLutAxes {
+            cos_theta_count: 9,
+            opd_count: 17,
+            ior_count: 5,
+            alpha_count: 4,
+            thickness_min_nm: 0.0,
+            thickness_max_nm: 1200.0,
+            ior_min: 1.0,
+            ior_max: 2.5,
+            alpha_min: 0.02,
+            alpha_max: 1.0,
+            ambient_index: 1.0,
+            base_eta: Some(1.5),
+        }
+    }
+
+    #[test]
+    fn forward_and_inverse_round_trip() {
+        let a = axes();
+        for &(c, al, d, n) in &[
+            (1.0, 0.02, 0.0, 1.0),
+            (0.5, 0.3, 300.0, 1.7),
+            (0.01, 1.0, 1200.0, 2.5),
+            (0.9, 0.05, 17.0, 1.2),
+        ] {
+            let t = a.forward(c, al, d, n);
+            let (c2, opd, n2, al2) = a.inverse(t);
+            assert!((c2 - c).abs() < 1e-12 && (n2 - n).abs() < 1e-12, "{t:?}");
+            assert!((al2 - al).abs() < 1e-12 * al, "{al} {al2}");
+            assert!((opd - a.opd_nm(c, al, d, n)).abs() < 1e-9);
+        }
+        // Texel parameters map back to their own t.
+        for (x, y, k, al) in [(1, 0, 0, 0), (8, 16, 4, 3), (3, 7, 2, 1)] {
+            let (c, n, alpha) = (a.texel_cos_theta(x), a.texel_ior(k), a.texel_alpha(al));
+            let d = a.texel_thickness_nm(x, y, k, al);
+            let t = a.forward(c, alpha, d, n);
+            let want = [
+                RoughLutAxes::texel_t(x, 9),
+                RoughLutAxes::texel_t(y, 17),
+                RoughLutAxes::texel_t(k, 5),
+                RoughLutAxes::texel_t(al, 4),
+            ];
+            for i in 0..4 {
+                assert!((t[i] - want[i]).abs() < 1e-12, "{t:?} vs {want:?}");
+            }
+        }
+        // Out of range and non-finite inputs clamp.
+        assert_eq!(a.forward(f64::NAN, 0.001, -1.0, 0.5), [0.0; 4]);
+        assert_eq!(a.forward(2.0, 5.0, 1e9, 9.0), [1.0; 4]);
+    }
+
+    #[test]
+    fn gauss_legendre_integrates_polynomials_exactly() {
+        let (x, w) = gauss_legendre_01(12);
+        assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-14);
+        for p in 0..24 {
+            let got: f64 = x.iter().zip(&w).map(|(x, w)| w * x.powi(p)).sum();
+            assert!((got - 1.0 / (p as f64 + 1.0)).abs() < 1e-14, "x^{p}: {got}");
+        }
+    }
+
+    #[test]
+    fn cubic_stencil_reproduces_cubics() {
+        let f = |x: f64| 2.0 - x + 0.3 * x * x - 0.05 * x * x * x;
+        for &pos in &[0.0, 0.3, 1.0, 2.5, 7.9, 9.0] {
+            let (s, w) = cubic_stencil(pos, 10);
+            let v: f64 = (0..4).map(|m| w[m] * f((s + m) as f64)).sum();
+            assert!((v - f(pos)).abs() < 1e-12, "{pos}: {v}");
+        }
+    }
+
+    #[test]
+    fn lookup_is_exact_at_texels_and_linear_between_alpha_blocks() {
+        let a = axes();
+        let mut table = Table3::new(9, 17, a.depth());
+        for z in 0..a.depth() {
+            for y in 0..17 {
+                for x in 0..9 {
+                    let v = (x + 100 * y + 10_000 * z) as f32;
+                    table.set(x, y, z, [v, 2.0 * v, -v]);
+                }
+            }
+        }
+        // Texel (4, 8, k = 2, α block 1): z = 1 * 5 + 2.
+        let (c, n, al) = (a.texel_cos_theta(4), a.texel_ior(2), a.texel_alpha(1));
+        let d = a.texel_thickness_nm(4, 8, 2, 1);
+        let v = RoughFilmLut::lookup(&a, &table, c, al, d, n);
+        assert!((v[0] - (4.0 + 800.0 + 70_000.0)).abs() < 1e-6, "{v:?}");
+        // Half-way (in t) between α blocks 1 and 2: the mean of the two blocks' values.
+        let (_, _, _, al_mid) = a.inverse([0.0, 0.0, 0.0, 1.5 / 3.0]);
+        let v = RoughFilmLut::lookup(&a, &table, c, al_mid, d, n);
+        // Each block reads Δ referred to its own α: y is 8 in block 1, y₂ in block 2.
+        let y2 = a.forward(c, a.texel_alpha(2), d, n)[1] * 16.0;
+        assert!((y2 - 8.0).abs() > 0.01 && y2 < 16.0, "{y2}");
+        let want = 0.5 * (4.0 + 800.0 + 70_000.0) + 0.5 * (4.0 + 100.0 * y2 + 120_000.0);
+        assert!((v[0] - want).abs() < 1e-6, "{v:?} vs {want}");
+    }
+
+    #[test]
+    fn kernel_of_a_smooth_surface_is_a_spike_at_the_view_cosine() {
+        // α → 0: every visible normal is n, c = cos θ_o, G₂/G₁ → 1.
+        let k = kernels_with(0.6, 1e-4, None, 256, 16, 16);
+        let mass: f64 = k.reflection.iter().sum();
+        assert!((mass - 1.0).abs() < 1e-6, "{mass}");
+        let mean: f64 = k
+            .reflection
+            .iter()
+            .enumerate()
+            .map(|(j, w)| w * kernel_cos(j, 256))
+            .sum();
+        assert!((mean - 0.6).abs() < 1e-4, "{mean}");
+    }
+
+    fn srgb() -> Colorimeter {
+        use nacre_optics::colour::{Illuminant, Observer, OutputSpace, RgbSpace};
+        Colorimeter::new(
+            Observer::Cie1931_2Deg,
+            Illuminant::D65,
+            OutputSpace::Rgb(RgbSpace::Srgb),
+        )
+    }
+
+    /// (c) With F ≡ 1 the reflection kernel's mass is GGX's single-scattering albedo: the
+    /// deterministic quadrature against the Monte Carlo reference at 2²² samples.
+    #[test]
+    fn furnace_kernel_matches_monte_carlo() {
+        use nacre_optics::microfacet::{FilmTerm, directional_albedo_with};
+        let mirror = FilmTerm::perfect_mirror(&srgb());
+        for &(cos_o, alpha) in &[(1.0, 0.02), (0.9, 0.5), (0.3, 0.5), (0.9, 1.0), (0.1, 1.0)] {
+            let mass: f64 = kernels(cos_o, alpha, None, KERNEL_COS_NODES)
+                .reflection
+                .iter()
+                .sum();
+            let mc = directional_albedo_with(&mirror, alpha, cos_o, 1 << 22, 11).unwrap();
+            let (e, se) = (mc.reflection.colour[1], mc.reflection.standard_error[1]);
+            eprintln!(
+                "cos θ_o {cos_o} α {alpha}: quadrature {mass:.6}, Monte Carlo {e:.6} ± {se:.1e}"
+            );
+            assert!(
+                (mass - e).abs() <= 4.0 * se + 1e-4,
+                "{cos_o} {alpha}: {mass} vs {e} ± {se}"
+            );
+            assert!(mass <= 1.0 + 1e-9);
+        }
+    }
+
+    fn tiny_job(base: &str) -> RoughLutJob {
+        let m = |s: &str| Material::parse_index(s).unwrap();
+        let axes = RoughLutAxes {
+            cos_theta_count: 5,
+            opd_count: 9,
+            ior_count: 3,
+            alpha_count: 3,
+            thickness_min_nm: 0.0,
+            thickness_max_nm: 600.0,
+            ior_min: 1.0,
+            ior_max: 2.0,
+            alpha_min: 0.05,
+            alpha_max: 1.0,
+            ambient_index: 1.0,
+            base_eta: Some(1.5),
+        };
+        RoughLutJob {
+            axes,
+            ambient: m("1.0"),
+            under: vec![],
+            base: m(base),
+            colorimeter: srgb(),
+            transmittance: true,
+        }
+    }
+
+    /// (b) White furnace on every entry of a lossless stack's table, and the bake at a
+    /// texel against the kernel product with the exact film colour at that thickness.
+    #[test]
+    fn lossless_bake_passes_the_white_furnace_and_matches_the_exact_product() {
+        let job = tiny_job("1.5");
+        let lut = job.bake(&|| {}).unwrap();
+        let t = lut.transmittance.as_ref().unwrap();
+        for (x, y, k, al) in [(3, 6, 1, 2), (4, 3, 1, 0)] {
+            check_texel(&lut, x, y, k, al);
+        }
+        // Linear sRGB channels of saturated film colours may be negative (a violet
+        // residual reflection), so the law is on the sum, channel by channel: R + T ≤ 1.
+        for (i, (r, t)) in lut.reflectance.data.iter().zip(&t.data).enumerate() {
+            assert!(r + t <= 1.0 + 1e-6, "value {i}: {r} + {t}");
+        }
+    }
+
+    fn check_texel(lut: &RoughFilmLut, x: usize, y: usize, k: usize, al: usize) {
+        let a = &lut.axes;
+        let (cos_o, n, alpha) = (a.texel_cos_theta(x), a.texel_ior(k), a.texel_alpha(al));
+        let d = a.texel_thickness_nm(x, y, k, al);
+        let m = |s: &str| Material::parse_index(s).unwrap();
+        let stack = Stack::new(
+            m("1.0"),
+            vec![Layer {
+                material: m(&format!("{n}")),
+                thickness_nm: d,
+            }],
+            m("1.5"),
+        )
+        .unwrap();
+        let kern = kernels(cos_o, alpha, Some(1.5), KERNEL_COS_NODES);
+        let rule = SpectralRule::new(&srgb(), stack.max_opd_nm(None));
+        let mut e = [0.0; 6];
+        for j in 0..KERNEL_COS_NODES {
+            let c = kernel_cos(j, KERNEL_COS_NODES).max(MIN_COS_THETA);
+            let f = stack
+                .colours_over_thickness(1, c.acos().to_degrees(), &rule, &[d])
+                .unwrap();
+            for ch in 0..3 {
+                e[ch] += kern.reflection[j] * f.reflectance[0][ch];
+                e[3 + ch] += kern.transmission[j] * f.transmittance[0][ch];
+            }
+        }
+        let got = lut.reflectance.texel(x, y, al * a.ior_count + k);
+        for ch in 0..3 {
+            assert!(
+                (f64::from(got[ch]) - e[ch]).abs() < 1e-5,
+                "{got:?} vs {e:?}"
+            );
+        }
+    }
+
+    /// (d) Bad recipes: errors name the file and the line.
+    #[test]
+    fn bad_recipes_name_file_and_line() {
+        let good = "kind = \"rough-film-lut\"\n[stack]\nambient = \"1.0\"\nbase = \"1.5\"\n[axes]\ncos_theta_count = 4\nthickness_nm = [0.0, 500.0]\nopd_count = 8\nfilm_ior = [1.0, 2.0]\nfilm_ior_count = 3\nalpha = [0.05, 1.0]\nalpha_count = 3\n";
+        let path = Path::new("dir/rough.toml");
+        let parsed = RoughRecipe::parse(path, good.to_string()).unwrap();
+        assert_eq!(parsed.name, "rough");
+        assert_eq!(parsed.job.axes.base_eta, Some(1.5));
+        for (from, to, want) in [
+            (
+                "alpha = [0.05, 1.0]",
+                "alpha = [0.0, 1.0]",
+                "dir/rough.toml:5",
+            ),
+            ("alpha_count = 3", "alpha_count = 1", "dir/rough.toml:5"),
+            ("opd_count = 8", "opd_count = 1", "dir/rough.toml:5"),
+            (
+                "film_ior = [1.0, 2.0]",
+                "film_ior = [0.5, 2.0]",
+                "dir/rough.toml:5",
+            ),
+            (
+                "alpha_count = 3",
+                "alpha_count = 3\nbogus = 1",
+                "dir/rough.toml:13",
+            ),
+            (
+                "base = \"1.5\"",
+                "base = \"unobtainium\"",
+                "dir/rough.toml:4",
+            ),
+            ("ambient = \"1.0\"", "ambient = \"au\"", "dir/rough.toml:3"),
+            (
+                "alpha_count = 3",
+                "alpha_count = 100000000",
+                "dir/rough.toml:5",
+            ),
+        ] {
+            let text = good.replace(from, to);
+            let e = RoughRecipe::parse(path, text).err().expect(to).to_string();
+            assert!(e.contains(want), "{to}: {e}");
+        }
+        // Transmittance through an absorbing base is refused at the base's line.
+        let text = good.replace("base = \"1.5\"", "base = \"0.2+3i\"")
+            + "[output]\ntransmittance = true\n";
+        let e = RoughRecipe::parse(path, text).err().unwrap().to_string();
+        assert!(
+            e.contains("dir/rough.toml:4") && e.contains("non-absorbing"),
+            "{e}"
+        );
+        // The kind dispatch reaches this parser.
+        let any = crate::bake::AnyRecipe::parse(path, good.to_string()).unwrap();
+        assert_eq!(any.name(), "rough");
+    }
+}

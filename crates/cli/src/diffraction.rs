@@ -1,0 +1,548 @@
+//! `nacre diffraction`: relative reflectance and colour of a diffracting surface over view
+//! angles in the plane of incidence (Stam 1999; Dhillon et al. 2014), from a height field
+//! (file or synthetic spec) or a baked `diffraction` table. The physics is
+//! [`nacre_optics::diffraction`], the sources and CSV writers [`nacre_bake::diffraction`].
+
+use clap::Args;
+use nacre_bake::bake;
+use nacre_bake::diffraction::{HeightSource, ViewSweep};
+use nacre_bake::error::{Error, Result};
+use nacre_bake::grid::parse_range;
+use nacre_bake::output::write_atomic;
+use nacre_optics::C64;
+use nacre_optics::colour::Colorimeter;
+use nacre_optics::diffraction::{
+    DEFAULT_COHERENCE_DIAMETER_UM, DiffractionSurface, FresnelTerm, SpectralGrid, TaylorTerms,
+    max_phase, taylor_order_for,
+};
+use std::path::PathBuf;
+
+/// Tolerance on the Taylor remainder bound for fields evaluated directly (f64 terms).
+pub const TAYLOR_TOLERANCE: f64 = 1e-6;
+
+pub const EXAMPLES: &str = "\
+Geometry: x runs across the grating lines and the plane of incidence is x-z. --incidence
+θ_i > 0 puts the light on the -x side; a view angle θ_r > 0 puts the viewer on the +x side,
+so the specular direction is θ_r = θ_i and a grating of period d sends order m to
+sin θ_m = sin θ_i + m λ / d. Output: `view_deg,wavelength_nm,reflectance` (relative
+reflectance: Stam's BRDF over that of a flat perfect mirror in its specular direction, so a
+mirror gives 1 there), or with --color `view_deg,X,Y,Z,R,G,B` (XYZ under the illuminant,
+perfect reflector Y = 1; R, G, B linear in --space) summed over the --wavelengths grid.
+
+Height fields: sine:PERIOD_UM:AMPLITUDE_UM, blazed:PERIOD_UM:HEIGHT_UM (one row, whole
+periods over the coherence diameter), cd[:SEED] (tracks 1.6 µm apart, pits 0.1 µm deep),
+bumps:RADIUS_UM:HEIGHT_UM:FILL[:SEED] (Stam's random bumps), or a greyscale PNG (8/16 bit,
+full scale = --height-scale), OpenEXR (channel Y, Z or R) or CSV file (× --height-scale)
+with --pitch.
+
+Examples:
+  # first and second orders of a 1.6 µm sinusoidal grating lit at 30 degrees
+  nacre diffraction sine:1.6:0.05 --incidence 30 --views -80:80:0.1 -o sine.csv
+  # the colours of a CD-like surface seen across the tracks
+  nacre diffraction cd --incidence 20 --views -60:60:0.5 --color -o cd.csv
+  # a measured height map, 0.1 µm per pixel, white = 0.15 µm
+  nacre diffraction snake.png --pitch 0.1 --height-scale 0.15 --color
+  # from the baked default table
+  nacre diffraction --table cd-tracks --incidence 20 --views -40:40:0.5 --color";
+
+#[derive(Args)]
+pub struct DiffractionArgs {
+    /// Height field: a .png/.exr/.csv file or a synthetic spec (see below).
+    #[arg(
+        value_name = "FILE|SPEC",
+        required_unless_present = "table",
+        conflicts_with = "table"
+    )]
+    surface: Option<String>,
+    /// Evaluate a baked `diffraction` table (default-set name or manifest path) instead.
+    #[arg(long, value_name = "NAME|PATH")]
+    table: Option<String>,
+    /// Incidence angle θ_i, degrees, in (-90, 90).
+    #[arg(
+        long,
+        value_name = "DEG",
+        default_value = "0",
+        allow_hyphen_values = true
+    )]
+    incidence: String,
+    /// View angles θ_r, degrees, signed (see below).
+    #[arg(
+        long,
+        value_name = "START:END:STEP",
+        default_value = "-80:80:0.25",
+        allow_hyphen_values = true
+    )]
+    views: String,
+    /// Vacuum wavelengths, nm (the colour grid with --color; within 360-830).
+    #[arg(
+        long,
+        value_name = "START:END:STEP",
+        default_value = "380:780:5",
+        allow_hyphen_values = true
+    )]
+    wavelengths: String,
+    /// Write colours (view_deg,X,Y,Z,R,G,B) instead of spectra.
+    #[arg(long)]
+    color: bool,
+    /// Sample pitch of the height field, µm (required for files; synthetic: automatic).
+    #[arg(long, value_name = "UM")]
+    pitch: Option<String>,
+    /// Samples per axis of a synthetic field (along x for gratings) [default: automatic].
+    #[arg(long, value_name = "N")]
+    samples: Option<usize>,
+    /// Height of a file's full scale (PNG) or multiplier (EXR, CSV), µm.
+    #[arg(long, value_name = "UM", default_value = "1")]
+    height_scale: String,
+    /// Coherence diameter 4σ_s of the light, µm [default: 65].
+    #[arg(long, value_name = "UM")]
+    coherence: Option<String>,
+    /// Fresnel factor: the refractive index (n or n+κi) of the bulk material, evaluated at
+    /// the half-vector angle [default: F = 1, a perfect reflector].
+    #[arg(long, value_name = "INDEX")]
+    fresnel: Option<String>,
+    /// CIE observer: 1931 or 1964 [default: 1931, or the table's].
+    #[arg(long)]
+    observer: Option<String>,
+    /// Illuminant: d65, d50, a or e [default: d65, or the table's].
+    #[arg(long)]
+    illuminant: Option<String>,
+    /// Output space: xyz, srgb, rec2020, p3 or acescg (linear) [default: srgb, or the table's].
+    #[arg(long)]
+    space: Option<String>,
+    /// Output CSV file, or `-` for standard output.
+    #[arg(
+        short = 'o',
+        long = "output",
+        value_name = "FILE.csv",
+        default_value = "-"
+    )]
+    output: PathBuf,
+}
+
+fn flag(flag: &str, value: &str, message: impl Into<String>) -> Error {
+    Error::Flag {
+        flag: flag.into(),
+        value: value.into(),
+        message: message.into(),
+    }
+}
+
+fn positive(name: &str, text: &str) -> Result<f64> {
+    text.trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .ok_or_else(|| {
+            flag(
+                name,
+                text,
+                "expected a finite positive number of micrometres",
+            )
+        })
+}
+
+fn angles(name: &str, text: &str) -> Result<Vec<f64>> {
+    let v = parse_range(name, text)?;
+    if let Some(a) = v.iter().find(|a| !(a.abs() < 90.0)) {
+        return Err(flag(
+            name,
+            text,
+            format!("angle {a} must lie strictly between -90 and 90 degrees"),
+        ));
+    }
+    Ok(v)
+}
+
+/// Everything `nacre diffraction` and `nacre plot diffraction` share: the surface, its
+/// colorimeter and the wavelength grid.
+pub struct Loaded {
+    pub surface: DiffractionSurface,
+    pub colorimeter: Colorimeter,
+    pub wavelengths: Vec<f64>,
+    pub fresnel: FresnelTerm,
+}
+
+/// Loads the surface of `args` for `incidences` × `views` (degrees), checking the sampling.
+#[allow(clippy::too_many_arguments)]
+pub fn load(
+    surface: Option<&str>,
+    table: Option<&str>,
+    wavelengths_text: &str,
+    pitch: Option<&str>,
+    samples: Option<usize>,
+    height_scale: &str,
+    coherence: Option<&str>,
+    fresnel: Option<&str>,
+    colour: [Option<&str>; 3],
+    directions: &[([f64; 3], [f64; 3])],
+) -> Result<Loaded> {
+    let wavelengths = parse_range("--wavelengths", wavelengths_text)?;
+    if let Some(l) = wavelengths.iter().find(|l| !(**l >= 360.0 && **l <= 830.0)) {
+        return Err(flag(
+            "--wavelengths",
+            wavelengths_text,
+            format!("wavelength {l} nm is outside 360-830 nm"),
+        ));
+    }
+    let wl_min = wavelengths.iter().copied().fold(f64::INFINITY, f64::min);
+    let wl_max = wavelengths.iter().copied().fold(0.0, f64::max);
+    let fresnel = match fresnel {
+        None => FresnelTerm::Unity,
+        Some(text) => {
+            let m = nacre_optics::Material::parse_index(text)
+                .map_err(|e| flag("--fresnel", text, e.to_string()))?;
+            let n: C64 = m
+                .index_at(550.0)
+                .map_err(|e| flag("--fresnel", text, e.to_string()))?;
+            FresnelTerm::Index(n)
+        }
+    };
+    // |u|, |v| and |w| reached by the directions asked for.
+    let max_uv = directions
+        .iter()
+        .map(|(i, r)| (i[0] + r[0]).abs().max((i[1] + r[1]).abs()))
+        .fold(0.0, f64::max);
+    let w_max = directions
+        .iter()
+        .map(|(i, r)| i[2] + r[2])
+        .fold(0.0, f64::max);
+    let (terms, sigma_s, table_colour, context) = match (surface, table) {
+        (_, Some(name)) => {
+            let path = bake::resolve_table(name);
+            let manifest = bake::Manifest::read(&path)?;
+            let (record, terms) = manifest.load_diffraction(&path)?;
+            if wl_min < record.wavelength_min_nm - 1e-9 || wl_max > record.wavelength_max_nm + 1e-9
+            {
+                return Err(flag(
+                    "--wavelengths",
+                    wavelengths_text,
+                    format!(
+                        "table `{name}` serves {}-{} nm",
+                        record.wavelength_min_nm, record.wavelength_max_nm
+                    ),
+                ));
+            }
+            let max_polar_deg = directions
+                .iter()
+                .map(|(i, r)| i[2].min(r[2]).clamp(-1.0, 1.0).acos().to_degrees())
+                .fold(0.0, f64::max);
+            if max_polar_deg > record.max_angle_deg + 1e-9 || max_uv > record.max_uv * (1.0 + 1e-9)
+            {
+                return Err(Error::Invalid {
+                    context: "--incidence/--views".into(),
+                    message: format!(
+                        "light or view reaches {max_polar_deg:.2}° from the normal; table `{name}` serves light and view within {}° (|u|, |v| ≤ {:.4})",
+                        record.max_angle_deg, record.max_uv
+                    ),
+                });
+            }
+            if coherence.is_some() || pitch.is_some() || samples.is_some() {
+                return Err(flag(
+                    "--table",
+                    name,
+                    "--coherence, --pitch and --samples come from the table",
+                ));
+            }
+            let c = [
+                Some(manifest.observer.clone()),
+                Some(manifest.illuminant.clone()),
+                Some(manifest.space.clone()),
+            ];
+            (terms, record.sigma_s_um, c, format!("--table {name}"))
+        }
+        (Some(text), None) => {
+            let coherence_um = match coherence {
+                Some(t) => positive("--coherence", t)?,
+                None => DEFAULT_COHERENCE_DIAMETER_UM,
+            };
+            let pitch_um = pitch.map(|t| positive("--pitch", t)).transpose()?;
+            let scale = height_scale
+                .trim()
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite() && *v >= 0.0)
+                .ok_or_else(|| {
+                    flag(
+                        "--height-scale",
+                        height_scale,
+                        "expected a finite non-negative number of micrometres",
+                    )
+                })?;
+            if samples == Some(0) {
+                return Err(flag("--samples", "0", "expected at least 1"));
+            }
+            let source = HeightSource::parse("FILE|SPEC", text)?;
+            let field = source.load(text, "--pitch", coherence_um, pitch_um, samples, scale)?;
+            let x = max_phase(&field, wl_min, w_max);
+            let (order, bound) =
+                taylor_order_for(x, TAYLOR_TOLERANCE).map_err(|source| Error::OpticsIn {
+                    context: text.to_string(),
+                    source,
+                })?;
+            eprintln!(
+                "nacre: {}x{} samples at {} µm, Taylor order N = {order} (remainder bound {bound:.1e} at max |k w h| = {x:.3}), 4σ_s = {coherence_um} µm",
+                field.nx(),
+                field.ny(),
+                field.pitch_um()
+            );
+            (
+                TaylorTerms::compute(&field, order),
+                coherence_um / 4.0,
+                [None, None, None],
+                text.to_string(),
+            )
+        }
+        (None, None) => unreachable!("clap requires FILE|SPEC or --table"),
+    };
+    let surface = DiffractionSurface::new(terms, sigma_s).map_err(|source| Error::OpticsIn {
+        context: context.clone(),
+        source,
+    })?;
+    surface
+        .check_sampling(wl_min, max_uv)
+        .map_err(|source| Error::OpticsIn {
+            context: format!("{context} with --views/--incidence and --wavelengths"),
+            source,
+        })?;
+    let pick = |given: Option<&str>, table: &Option<String>, default: &str| {
+        given
+            .map(str::to_string)
+            .or_else(|| table.clone())
+            .unwrap_or_else(|| default.to_string())
+    };
+    let o = pick(colour[0], &table_colour[0], "1931");
+    let i = pick(colour[1], &table_colour[1], "d65");
+    let s = pick(colour[2], &table_colour[2], "srgb");
+    let colorimeter = Colorimeter::new(
+        o.parse()
+            .map_err(|e: nacre_optics::Error| flag("--observer", &o, e.to_string()))?,
+        i.parse()
+            .map_err(|e: nacre_optics::Error| flag("--illuminant", &i, e.to_string()))?,
+        s.parse()
+            .map_err(|e: nacre_optics::Error| flag("--space", &s, e.to_string()))?,
+    );
+    Ok(Loaded {
+        surface,
+        colorimeter,
+        wavelengths,
+        fresnel,
+    })
+}
+
+pub fn run(args: &DiffractionArgs) -> Result<()> {
+    let incidence = args
+        .incidence
+        .trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|a| a.abs() < 90.0)
+        .ok_or_else(|| {
+            flag(
+                "--incidence",
+                &args.incidence,
+                "expected an angle in degrees strictly between -90 and 90",
+            )
+        })?;
+    let views = angles("--views", &args.views)?;
+    let directions: Vec<_> = views
+        .iter()
+        .map(|&v| nacre_optics::diffraction::in_plane_directions(incidence, v))
+        .collect();
+    let loaded = load(
+        args.surface.as_deref(),
+        args.table.as_deref(),
+        &args.wavelengths,
+        args.pitch.as_deref(),
+        args.samples,
+        &args.height_scale,
+        args.coherence.as_deref(),
+        args.fresnel.as_deref(),
+        [
+            args.observer.as_deref(),
+            args.illuminant.as_deref(),
+            args.space.as_deref(),
+        ],
+        &directions,
+    )?;
+    let sweep = ViewSweep {
+        surface: &loaded.surface,
+        incidence_deg: incidence,
+        views_deg: &views,
+        wavelengths_nm: &loaded.wavelengths,
+        fresnel: loaded.fresnel,
+    };
+    let rho = sweep.reflectance();
+    if args.color {
+        let grid =
+            SpectralGrid::new(&loaded.colorimeter, &loaded.wavelengths).map_err(|source| {
+                Error::OpticsIn {
+                    context: "--wavelengths".into(),
+                    source,
+                }
+            })?;
+        let colours = sweep.colours(&rho, &grid, &loaded.colorimeter);
+        write_atomic(&args.output, |w| sweep.write_colour_csv(w, &colours))
+    } else {
+        write_atomic(&args.output, |w| sweep.write_reflectance_csv(w, &rho))
+    }
+}
+
+pub const MAP_EXAMPLES: &str = "\
+The map shows the colour of the relative reflectance over view directions for a fixed
+light (as `nacre diffraction --color`), on the projected hemisphere: x = sin θ_r cos φ_r
+across the grating lines, y = sin θ_r sin φ_r along them, the light at --incidence on the
+-x side (the white cross marks the specular direction). Colours are linear sRGB × exposure,
+clipped; by default the exposure puts the 98th percentile at 1.
+
+Examples:
+  nacre plot diffraction cd --incidence 20 -o cd-map.png
+  nacre plot diffraction sine:1.6:0.05 --incidence 30 --max-view 80 -o sine-map.png
+  nacre plot diffraction --table cd-tracks --incidence 10 --max-view 35 -o table-map.png";
+
+#[derive(Args)]
+pub struct MapArgs {
+    /// Height field: a .png/.exr/.csv file or a synthetic spec (as `nacre diffraction`).
+    #[arg(
+        value_name = "FILE|SPEC",
+        required_unless_present = "table",
+        conflicts_with = "table"
+    )]
+    surface: Option<String>,
+    /// A baked `diffraction` table instead (default-set name or manifest path).
+    #[arg(long, value_name = "NAME|PATH")]
+    table: Option<String>,
+    /// Incidence angle θ_i, degrees, in (-90, 90); the light is on the -x side.
+    #[arg(
+        long,
+        value_name = "DEG",
+        default_value = "20",
+        allow_hyphen_values = true
+    )]
+    incidence: String,
+    /// Largest view angle drawn, degrees, in (0, 90).
+    #[arg(long, value_name = "DEG", default_value = "60")]
+    max_view: String,
+    /// Cells per side of the map (16 to 1024).
+    #[arg(long, default_value_t = 161)]
+    cells: usize,
+    /// Wavelength grid of the colour sums, nm.
+    #[arg(long, value_name = "START:END:STEP", default_value = "380:780:10")]
+    wavelengths: String,
+    /// Exposure: a positive factor, or `auto`.
+    #[arg(long, default_value = "auto")]
+    exposure: String,
+    /// Sample pitch of the height field, µm (required for files).
+    #[arg(long, value_name = "UM")]
+    pitch: Option<String>,
+    /// Samples per axis of a synthetic field.
+    #[arg(long, value_name = "N")]
+    samples: Option<usize>,
+    /// Height of a file's full scale (PNG) or multiplier (EXR, CSV), µm.
+    #[arg(long, value_name = "UM", default_value = "1")]
+    height_scale: String,
+    /// Coherence diameter 4σ_s, µm [default: 65].
+    #[arg(long, value_name = "UM")]
+    coherence: Option<String>,
+    /// Output image (.png or .svg).
+    #[arg(
+        short = 'o',
+        long = "output",
+        value_name = "FILE",
+        default_value = "diffraction.png"
+    )]
+    output: PathBuf,
+}
+
+pub fn run_map(args: &MapArgs) -> Result<()> {
+    nacre_bake::plot::ImageFormat::from_path(&args.output)?;
+    let incidence = args
+        .incidence
+        .trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|a| a.abs() < 90.0)
+        .ok_or_else(|| {
+            flag(
+                "--incidence",
+                &args.incidence,
+                "expected an angle in degrees strictly between -90 and 90",
+            )
+        })?;
+    let max_view = args
+        .max_view
+        .trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|a| *a > 0.0 && *a < 90.0)
+        .ok_or_else(|| {
+            flag(
+                "--max-view",
+                &args.max_view,
+                "expected an angle in degrees strictly between 0 and 90",
+            )
+        })?;
+    if !(16..=1024).contains(&args.cells) {
+        return Err(flag(
+            "--cells",
+            &args.cells.to_string(),
+            "expected 16 to 1024",
+        ));
+    }
+    let exposure = match args.exposure.trim() {
+        "auto" => None,
+        t => Some(
+            t.parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite() && *v > 0.0)
+                .ok_or_else(|| flag("--exposure", t, "expected a positive number or `auto`"))?,
+        ),
+    };
+    // The extreme view directions: the rim of the disc.
+    let (wi, _) = nacre_optics::diffraction::in_plane_directions(incidence, 0.0);
+    let s = max_view.to_radians().sin();
+    let c = max_view.to_radians().cos();
+    let directions: Vec<_> = [[s, 0.0, c], [-s, 0.0, c], [0.0, s, c], [0.0, -s, c]]
+        .into_iter()
+        .map(|r| (wi, r))
+        .collect();
+    let loaded = load(
+        args.surface.as_deref(),
+        args.table.as_deref(),
+        &args.wavelengths,
+        args.pitch.as_deref(),
+        args.samples,
+        &args.height_scale,
+        args.coherence.as_deref(),
+        None,
+        [None, None, None],
+        &directions,
+    )?;
+    let grid = SpectralGrid::new(&loaded.colorimeter, &loaded.wavelengths).map_err(|source| {
+        Error::OpticsIn {
+            context: "--wavelengths".into(),
+            source,
+        }
+    })?;
+    let name = args
+        .surface
+        .clone()
+        .or_else(|| args.table.clone())
+        .unwrap_or_default();
+    let map = nacre_bake::diffraction::DiffractionMap::compute(
+        String::new(),
+        &loaded.surface,
+        incidence,
+        max_view,
+        args.cells,
+        &grid,
+        &loaded.colorimeter,
+        loaded.fresnel,
+        exposure,
+    );
+    let title = format!(
+        "diffraction map of {name}: light at {incidence}°, views to {max_view}°, exposure {:.3}",
+        map.exposure
+    );
+    let map = nacre_bake::diffraction::DiffractionMap { title, ..map };
+    nacre_bake::plot::write_figure(&args.output, &map)
+}

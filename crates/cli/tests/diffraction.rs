@@ -1,0 +1,247 @@
+//! End-to-end tests of `nacre diffraction`: output columns and values, the baked default
+//! table, and bad input (exit status 2, a message naming the flag, no output written).
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn nacre(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_nacre"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("run nacre")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn rows(o: &Output) -> (String, Vec<Vec<f64>>) {
+    let text = String::from_utf8(o.stdout.clone()).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().to_string();
+    let rows = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    (header, rows)
+}
+
+#[test]
+fn spectra_of_a_sinusoidal_grating() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = nacre(
+        &[
+            "diffraction",
+            "sine:1.6:0.05",
+            "--incidence",
+            "30",
+            "--views",
+            "-10:40:0.05",
+            "--wavelengths",
+            "500:600:50",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (header, rows) = rows(&o);
+    assert_eq!(header, "view_deg,wavelength_nm,reflectance");
+    assert_eq!(rows.len(), 1001 * 3);
+    assert_eq!((rows[0][0], rows[0][1]), (-10.0, 500.0));
+    assert_eq!((rows[1][0], rows[1][1]), (-10.0, 550.0));
+    // Specular: G/w² = 1 and |P_0|² = J_0(k w a)² (0.592752 at 550 nm, w = −2 cos 30°).
+    let spec = rows.iter().find(|r| r[0] == 30.0 && r[1] == 550.0).unwrap();
+    assert!((spec[2] - 0.592_752).abs() < 1e-4, "{spec:?}");
+    // The first order on the −x side of the specular: sin θ = sin 30° − 0.55/1.6.
+    let theory = (0.5f64 - 0.55 / 1.6).asin().to_degrees();
+    let peak = rows
+        .iter()
+        .filter(|r| r[1] == 550.0 && r[0] < 20.0)
+        .max_by(|a, b| a[2].total_cmp(&b[2]))
+        .unwrap();
+    assert!((peak[0] - theory).abs() < 0.1, "{peak:?} vs {theory}");
+}
+
+#[test]
+fn colours_and_files() {
+    let dir = tempfile::tempdir().unwrap();
+    // A flat CSV height field (any constant: the mean is removed) is a mirror; one row is
+    // a surface invariant along y.
+    let line = vec!["0.2"; 512].join(",");
+    std::fs::write(dir.path().join("flat.csv"), format!("# flat\n{line}\n")).unwrap();
+    let o = nacre(
+        &[
+            "diffraction",
+            "flat.csv",
+            "--pitch",
+            "0.25",
+            "--incidence",
+            "-20",
+            "--views",
+            "-25:-15:5",
+            "--wavelengths",
+            "400:700:10",
+            "--color",
+            "-o",
+            "c.csv",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(dir.path().join("c.csv")).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("view_deg,X,Y,Z,R,G,B"));
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 3);
+    // The specular row is the illuminant white: Y = 1, RGB = (1, 1, 1).
+    let spec = &rows[1];
+    assert_eq!(spec[0], -20.0);
+    for v in &spec[4..7] {
+        assert!((v - 1.0).abs() < 1e-9, "{spec:?}");
+    }
+    assert!((spec[2] - 1.0).abs() < 1e-9);
+    assert!(rows[0][2] < 1e-6 && rows[2][2] < 1e-6, "{rows:?}");
+}
+
+#[test]
+fn the_default_table_evaluates_like_its_height_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let common = [
+        "--incidence",
+        "10",
+        "--views",
+        "-40:40:2",
+        "--wavelengths",
+        "380:780:20",
+    ];
+    let mut a = vec!["diffraction", "--table", "cd-tracks"];
+    a.extend(common);
+    let from_table = nacre(&a, dir.path());
+    assert!(from_table.status.success(), "{}", stderr(&from_table));
+    let mut b = vec![
+        "diffraction",
+        "cd",
+        "--samples",
+        "256",
+        "--pitch",
+        "0.125",
+        "--coherence",
+        "32",
+    ];
+    b.extend(common);
+    let direct = nacre(&b, dir.path());
+    assert!(direct.status.success(), "{}", stderr(&direct));
+    let (h1, r1) = rows(&from_table);
+    let (h2, r2) = rows(&direct);
+    assert_eq!(h1, h2);
+    assert_eq!(r1.len(), 41 * 21);
+    // f32 terms and the table's Taylor order (bound 4.5e-4 at the worst point) against f64
+    // terms at order N for 1e-6: 4.8e-5 at most when recorded, against a peak ρ of 0.76.
+    let worst = r1
+        .iter()
+        .zip(&r2)
+        .map(|(a, b)| (a[2] - b[2]).abs())
+        .fold(0.0, f64::max);
+    assert!(worst < 2e-4, "{worst}");
+    assert!(r1.iter().any(|r| r[2] > 1e-3));
+}
+
+#[test]
+fn bad_input_exits_2_naming_the_flag() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("keep.csv"), "old").unwrap();
+    std::fs::write(dir.path().join("h.csv"), "0,1\n2\n").unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        (&["sine:1.6:0.05", "--incidence", "95"], "--incidence"),
+        (&["sine:1.6:0.05", "--incidence", "abc"], "--incidence"),
+        (&["sine:1.6:0.05", "--views", "10:0:1"], "--views"),
+        (&["sine:1.6:0.05", "--views", "0:90:1"], "--views"),
+        (
+            &["sine:1.6:0.05", "--wavelengths", "300:400:5"],
+            "--wavelengths",
+        ),
+        (&["sine:0:0.05"], "sine:0:0.05"),
+        (&["blazed:2"], "blazed:2"),
+        (&["sine:1.6:0.05", "--pitch", "0.3"], "Nyquist"),
+        (&["sine:1.6:0.05", "--pitch", "0"], "--pitch"),
+        (&["cd", "--coherence", "0"], "--coherence"),
+        (&["h.csv", "--pitch", "0.1"], "h.csv:2"),
+        (&["h.csv"], "--pitch"),
+        (&["missing.png", "--pitch", "0.1"], "missing.png"),
+        (&["sine:1.6:0.05", "--space", "cmyk"], "--space"),
+        (&["sine:1.6:0.05", "--fresnel", "x"], "--fresnel"),
+        (&["--table", "cd-tracks", "--views", "-80:80:1"], "45"),
+        (
+            &["--table", "cd-tracks", "--wavelengths", "360:700:5"],
+            "--wavelengths",
+        ),
+        (&["--table", "no-such-table"], "no-such-table"),
+    ];
+    for (args, needle) in cases {
+        let mut a = vec!["diffraction"];
+        a.extend_from_slice(args);
+        a.extend(["-o", "keep.csv"]);
+        let o = nacre(&a, dir.path());
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {e}");
+        assert!(e.contains(needle), "{args:?}: {e}");
+        assert!(!e.contains("panicked"), "{args:?}: {e}");
+        assert_eq!(
+            std::fs::read_to_string(dir.path().join("keep.csv")).unwrap(),
+            "old"
+        );
+    }
+    let o = nacre(&["diffraction"], dir.path());
+    assert_eq!(o.status.code(), Some(2));
+}
+
+#[test]
+fn diffraction_map_png() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = nacre(
+        &[
+            "plot",
+            "diffraction",
+            "sine:1.6:0.05",
+            "--incidence",
+            "30",
+            "--max-view",
+            "70",
+            "--cells",
+            "40",
+            "--wavelengths",
+            "400:700:50",
+            "-o",
+            "map.png",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let bytes = std::fs::read(dir.path().join("map.png")).unwrap();
+    let decoder = png::Decoder::new(std::io::Cursor::new(bytes));
+    let reader = decoder.read_info().unwrap();
+    assert_eq!((reader.info().width, reader.info().height), (760, 800));
+    for (args, needle) in [
+        (&["sine:1.6:0.05", "-o", "map.jpg"][..], "-o/--output"),
+        (
+            &["sine:1.6:0.05", "--cells", "4", "-o", "m.png"][..],
+            "--cells",
+        ),
+        (
+            &["sine:1.6:0.05", "--max-view", "90", "-o", "m.png"][..],
+            "--max-view",
+        ),
+        (
+            &["sine:1.6:0.05", "--exposure", "0", "-o", "m.png"][..],
+            "--exposure",
+        ),
+    ] {
+        let mut a = vec!["plot", "diffraction"];
+        a.extend_from_slice(args);
+        let o = nacre(&a, dir.path());
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        assert!(stderr(&o).contains(needle), "{args:?}: {}", stderr(&o));
+    }
+    assert!(!dir.path().join("m.png").exists());
+}

@@ -1,0 +1,400 @@
+//! Validation of the diffraction model against physics laws and closed forms: the grating
+//! equation, Bessel-function order intensities of a sinusoidal grating (Jacobi–Anger),
+//! Parseval, and the flat mirror.
+
+use super::*;
+use crate::colour::{Illuminant, Observer, OutputSpace, RgbSpace};
+
+/// σ_s of the thesis' 65 µm coherence diameter.
+const SIGMA_S_UM: f64 = DEFAULT_COHERENCE_DIAMETER_UM / 4.0;
+
+/// Bessel function of the first kind J_m(x) by its power series
+/// Σ_k (−1)^k (x/2)^{2k+|m|} / (k! (k+|m|)!), with J_{−m} = (−1)^m J_m. Accurate to ~1e-14
+/// for |x| ≤ 10 (terms peak near (x/2)^{x}/Γ(x/2)² and the series is summed to 60 terms).
+fn bessel_j(m: i32, x: f64) -> f64 {
+    let ma = m.unsigned_abs() as i32;
+    let half = 0.5 * x;
+    let mut term = half.powi(ma) / (1..=ma).map(f64::from).product::<f64>();
+    let mut sum = term;
+    for k in 1..60 {
+        term *= -half * half / (f64::from(k) * f64::from(k + ma));
+        sum += term;
+    }
+    if m < 0 && ma % 2 == 1 { -sum } else { sum }
+}
+
+#[test]
+fn bessel_series_matches_reference_values() {
+    // Abramowitz & Stegun Table 9.1.
+    assert!((bessel_j(0, 1.0) - 0.765_197_686_557_966_6).abs() < 1e-14);
+    assert!((bessel_j(1, 1.0) - 0.440_050_585_744_933_5).abs() < 1e-14);
+    assert!((bessel_j(2, 5.0) - 0.046_565_116_277_752_21).abs() < 1e-13);
+    assert!((bessel_j(-1, 2.0) + 0.576_724_807_756_873_4).abs() < 1e-14);
+}
+
+/// A 1-D grating sampled with `per_period` samples per period over enough whole periods to
+/// cover the coherence diameter.
+fn grating(kind: &str, period_um: f64, height_um: f64) -> HeightField {
+    let per_period = ((period_um / 0.04).ceil() as usize).max(16);
+    let pitch = period_um / per_period as f64;
+    let periods = (DEFAULT_COHERENCE_DIAMETER_UM / period_um).ceil() as usize;
+    let nx = periods * per_period;
+    match kind {
+        "sine" => HeightField::sine_grating(period_um, height_um, pitch, nx).unwrap(),
+        _ => HeightField::blazed_grating(period_um, height_um, pitch, nx).unwrap(),
+    }
+}
+
+fn surface(field: &HeightField, wavelength_min_nm: f64, tolerance: f64) -> DiffractionSurface {
+    let (order, _) = taylor_order_for(max_phase(field, wavelength_min_nm, 2.0), tolerance).unwrap();
+    DiffractionSurface::new(TaylorTerms::compute(field, order), SIGMA_S_UM).unwrap()
+}
+
+/// Local maxima of ρ over view angles −89°…89° (step 0.02°) above `floor`, each refined by
+/// the parabola through log ρ at the three samples around it (exact for a Gaussian lobe).
+fn peaks(s: &DiffractionSurface, incidence_deg: f64, wavelength_nm: f64, floor: f64) -> Vec<f64> {
+    let step = 0.02;
+    let views: Vec<f64> = (0..=8900).map(|i| -89.0 + step * i as f64).collect();
+    let rho: Vec<f64> = views
+        .iter()
+        .map(|&v| {
+            let (wi, wr) = in_plane_directions(incidence_deg, v);
+            s.relative_reflectance(wi, wr, wavelength_nm, FresnelTerm::Unity)
+        })
+        .collect();
+    let mut out = Vec::new();
+    for i in 1..views.len() - 1 {
+        if rho[i] > floor && rho[i] >= rho[i - 1] && rho[i] > rho[i + 1] {
+            let (a, b, c) = (rho[i - 1].ln(), rho[i].ln(), rho[i + 1].ln());
+            let offset = 0.5 * (a - c) / (a - 2.0 * b + c);
+            out.push(views[i] + offset * step);
+        }
+    }
+    out
+}
+
+/// θ_m from sin θ_m = sin θ_i + mλ/d, degrees, when it is a propagating order.
+fn order_angle_deg(incidence_deg: f64, m: i32, wavelength_nm: f64, period_um: f64) -> Option<f64> {
+    let s = incidence_deg.to_radians().sin() + f64::from(m) * wavelength_nm * 1e-3 / period_um;
+    (s.abs() < 0.97).then(|| s.asin().to_degrees())
+}
+
+#[test]
+fn peaks_follow_the_grating_equation() {
+    let mut worst: f64 = 0.0;
+    let mut checked = 0;
+    for (kind, d, h) in [
+        ("sine", 1.6, 0.06),
+        ("sine", 0.74, 0.05),
+        ("blazed", 2.5, 0.25),
+        ("blazed", 1.6, 0.15),
+    ] {
+        let field = grating(kind, d, h);
+        let s = surface(&field, 400.0, 1e-8);
+        s.check_sampling(400.0, 2.0).unwrap();
+        for incidence in [0.0, 20.0, 45.0] {
+            for wavelength in [450.0, 550.0, 650.0] {
+                let found = peaks(&s, incidence, wavelength, 1e-6);
+                for m in [-2, -1, 1, 2] {
+                    let Some(theory) = order_angle_deg(incidence, m, wavelength, d) else {
+                        continue;
+                    };
+                    let nearest = found
+                        .iter()
+                        .map(|p| (p - theory).abs())
+                        .fold(f64::INFINITY, f64::min);
+                    assert!(
+                        nearest < 0.2,
+                        "{kind} d={d} θi={incidence} λ={wavelength} m={m}: theory {theory:.4}°, peaks {found:?}"
+                    );
+                    worst = worst.max(nearest);
+                    checked += 1;
+                }
+            }
+        }
+    }
+    assert!(checked > 60, "{checked}");
+    eprintln!("grating equation: {checked} orders, max peak-angle error {worst:.2e}°");
+}
+
+#[test]
+fn period_is_recovered_from_peak_angles() {
+    // The thesis' blazed 2.5 µm grating, first orders on both sides, 400–700 nm.
+    let d = 2.5;
+    let field = grating("blazed", d, 0.3);
+    let s = surface(&field, 400.0, 1e-8);
+    let incidence: f64 = 15.0;
+    let (mut sxx, mut sxy) = (0.0, 0.0);
+    for i in 0..=12 {
+        let wavelength = 400.0 + 25.0 * f64::from(i);
+        let found = peaks(&s, incidence, wavelength, 1e-6);
+        for m in [-1, 1] {
+            let theory = order_angle_deg(incidence, m, wavelength, d).unwrap();
+            let p = found
+                .iter()
+                .copied()
+                .min_by(|a, b| (a - theory).abs().total_cmp(&(b - theory).abs()))
+                .unwrap();
+            // sin θ_m − sin θ_i = (mλ) / d: slope 1/d through the origin.
+            let x = f64::from(m) * wavelength * 1e-3;
+            let y = p.to_radians().sin() - incidence.to_radians().sin();
+            sxx += x * x;
+            sxy += x * y;
+        }
+    }
+    let recovered = sxx / sxy;
+    let error = (recovered - d).abs() / d;
+    eprintln!("recovered period {recovered:.6} µm, relative error {error:.2e}");
+    assert!(error < 0.005, "{recovered}");
+}
+
+#[test]
+fn sinusoidal_grating_orders_are_bessel_functions() {
+    let d = 1.6;
+    let mut worst: f64 = 0.0;
+    for a in [0.02, 0.05, 0.1] {
+        let field = grating("sine", d, a);
+        let s = surface(&field, 400.0, 1e-9);
+        for wavelength in [400.0, 550.0, 700.0] {
+            for incidence in [0.0, 10.0, 30.0] {
+                for m in -3..=3 {
+                    let Some(theta_m) = order_angle_deg(incidence, m, wavelength, d) else {
+                        continue;
+                    };
+                    let (wi, wr) = in_plane_directions(incidence, theta_m);
+                    let [u, v, w] = [-wi[0] - wr[0], -wi[1] - wr[1], -wi[2] - wr[2]];
+                    let p2 = s.transform(wavelength, u, v, w).norm_sqr();
+                    let j = bessel_j(m, k_per_um(wavelength) * w * a);
+                    let err = (p2 - j * j).abs();
+                    assert!(
+                        err < 1e-3,
+                        "a={a} λ={wavelength} θi={incidence} m={m}: {p2} vs {}",
+                        j * j
+                    );
+                    worst = worst.max(err);
+                }
+            }
+        }
+    }
+    eprintln!("sinusoidal grating: max | |P_m|² − J_m(kwa)² | = {worst:.2e}");
+}
+
+#[test]
+fn taylor_sum_carries_unit_energy_up_to_the_bound() {
+    // Parseval for the DFT: Σ_j |P_j|² = mean |Σ_n (ikwh)ⁿ/n!|², within 2ε + ε² of 1 where
+    // ε is the remainder bound, for every order N.
+    let field = HeightField::cd_tracks(128, 128, 0.125, CD_PIT_DEPTH_UM, 7).unwrap();
+    let kw = -2.0 * k_per_um(380.0);
+    let x_max = kw.abs() * field.max_abs_height_um();
+    let (n_tol, _) = taylor_order_for(x_max, 1e-10).unwrap();
+    let terms = TaylorTerms::compute(&field, n_tol);
+    for order in [2, 4, 6, 8, n_tol] {
+        let sub: Vec<Vec<C64>> = (0..=order).map(|n| terms.layer(n)).collect();
+        let t = TaylorTerms::from_terms(128, 128, 0.125, &sub).unwrap();
+        let energy: f64 = t.series(kw).iter().map(|p| p.norm_sqr()).sum();
+        let eps = taylor_remainder_bound(x_max, order);
+        assert!(
+            (energy - 1.0).abs() <= 2.0 * eps + eps * eps + 1e-12,
+            "N={order}: energy {energy}, bound {eps}"
+        );
+        if order == n_tol {
+            eprintln!(
+                "DFT Parseval at N={order}: |Σ|P_j|² − 1| = {:.2e}",
+                (energy - 1.0).abs()
+            );
+            assert!((energy - 1.0).abs() < 1e-9);
+        }
+    }
+}
+
+#[test]
+fn windowed_transform_carries_unit_energy() {
+    // ∫|P̃(q)|² dq / ∫ exp(−σ²q²) dq = 1 for a unit-modulus phase screen: the flat mirror's
+    // energy is spread over the orders, not created or lost by the window. 1-D surfaces
+    // (ny = 1), so the y factor is the same for both and cancels.
+    let mut worst: f64 = 0.0;
+    let profiles = [
+        grating("blazed", 2.5, 0.3),
+        grating("sine", 0.74, 0.08),
+        // A smooth random profile: the bins lie closer than the window's width here.
+        {
+            let nx = 1024;
+            let pitch = 0.0625;
+            let mut rng = SplitMix64::stream(3, 0);
+            let waves: Vec<(f64, f64, f64)> = (0..12)
+                .map(|_| {
+                    let j = 1 + (rng.next_u64() % 40) as usize;
+                    (j as f64, 0.02 * rng.next_f64(), 2.0 * PI * rng.next_f64())
+                })
+                .collect();
+            let h = (0..nx)
+                .map(|i| {
+                    let x = i as f64 / nx as f64;
+                    waves
+                        .iter()
+                        .map(|(j, a, p)| a * (2.0 * PI * j * x + p).sin())
+                        .sum()
+                })
+                .collect();
+            HeightField::new(nx, 1, pitch, h).unwrap()
+        },
+    ];
+    for field in &profiles {
+        let s = surface(field, 400.0, 1e-10);
+        for (wavelength, w) in [(400.0, -2.0), (550.0, -1.7), (700.0, -1.2)] {
+            let k = k_per_um(wavelength);
+            let q_max = PI / field.pitch_um();
+            let dq = 0.05 / SIGMA_S_UM;
+            let steps = (2.0 * q_max / dq) as usize;
+            let integral: f64 = (0..=steps)
+                .map(|i| {
+                    let q = -q_max + i as f64 * dq;
+                    s.transform(wavelength, q / k, 0.0, w).norm_sqr() * dq
+                })
+                .sum();
+            let flat = PI.sqrt() / SIGMA_S_UM;
+            let ratio = integral / flat;
+            worst = worst.max((ratio - 1.0).abs());
+            assert!((ratio - 1.0).abs() < 1e-3, "λ={wavelength}: {ratio}");
+        }
+    }
+    eprintln!("windowed Parseval: max |E − 1| = {worst:.2e}");
+}
+
+#[test]
+fn flat_mirror_reflects_one_in_the_specular_direction() {
+    let field = HeightField::new(256, 256, 0.25, vec![0.37; 256 * 256]).unwrap();
+    assert_eq!(field.mean_removed_um(), 0.37);
+    assert_eq!(field.max_abs_height_um(), 0.0);
+    let s = DiffractionSurface::new(TaylorTerms::compute(&field, 3), 16.0).unwrap();
+    for incidence in [0.0, 25.0, 60.0, -40.0] {
+        for wavelength in [380.0, 550.0, 780.0] {
+            let (wi, wr) = in_plane_directions(incidence, incidence);
+            let rho = s.relative_reflectance(wi, wr, wavelength, FresnelTerm::Unity);
+            assert!((rho - 1.0).abs() < 1e-12, "{incidence} {wavelength}: {rho}");
+            // Three degrees off the specular direction the window has fallen away.
+            let (wi, wr) = in_plane_directions(incidence, incidence + 3.0);
+            let off = s.relative_reflectance(wi, wr, wavelength, FresnelTerm::Unity);
+            assert!(off < 1e-3, "{incidence} {wavelength}: {off}");
+        }
+    }
+    // With a Fresnel term the specular value is the bulk reflectance at θ_i.
+    let glass = FresnelTerm::Index(C64::new(1.5, 0.0));
+    let (wi, wr) = in_plane_directions(0.0, 0.0);
+    let rho = s.relative_reflectance(wi, wr, 550.0, glass);
+    assert!((rho - 0.04).abs() < 1e-12, "{rho}");
+}
+
+#[test]
+fn taylor_bound_and_order() {
+    assert_eq!(taylor_remainder_bound(1.0, 0), 1.0);
+    assert!((taylor_remainder_bound(2.0, 2) - 8.0 / 6.0).abs() < 1e-15);
+    let (n, b) = taylor_order_for(2.3, 1e-4).unwrap();
+    assert!(b <= 1e-4 && taylor_remainder_bound(2.3, n - 1) > 1e-4);
+    // The bound is a true bound of the phase-factor error.
+    for x in [0.3, 1.0, 2.5, 6.0] {
+        for order in 0..20 {
+            let c = taylor_coefficients(x, order);
+            let s: C64 = c
+                .iter()
+                .enumerate()
+                .map(|(n, c)| c * C64::new(0.0, 1.0).powi(n as i32))
+                .sum();
+            let err = (C64::from_polar(1.0, x) - s).norm();
+            assert!(err <= taylor_remainder_bound(x, order) * (1.0 + 1e-12) + 1e-15);
+        }
+    }
+    assert!(matches!(
+        taylor_order_for(200.0, 1e-6),
+        Err(Error::TaylorOrder { .. })
+    ));
+    assert!(taylor_order_for(1.0, 0.0).is_err());
+}
+
+#[test]
+fn dft_terms_match_direct_sums_and_are_dc_centred() {
+    let field = HeightField::random_bumps(12, 10, 0.3, 0.5, 0.05, 0.4, 9).unwrap();
+    let terms = TaylorTerms::compute(&field, 3);
+    assert_eq!(terms.bin(0, 0, 0), Some(C64::new(1.0, 0.0)));
+    assert!(terms.bin(1, 0, 0).unwrap().norm() < 1e-15); // mean removed
+    let h = field.heights_um();
+    for n in 0..=3usize {
+        for (jx, jy) in [(1i64, 0i64), (-3, 2), (5, -5), (-6, 4)] {
+            let mut direct = C64::new(0.0, 0.0);
+            for y in 0..10 {
+                for x in 0..12 {
+                    let phase =
+                        2.0 * PI * (jx as f64 * x as f64 / 12.0 + jy as f64 * y as f64 / 10.0);
+                    direct +=
+                        C64::new(0.0, h[y * 12 + x]).powi(n as i32) * C64::from_polar(1.0, phase);
+                }
+            }
+            direct /= 120.0;
+            let t = terms.bin(n, jx, jy).unwrap();
+            assert!(
+                (t - direct).norm() < 1e-15,
+                "n={n} ({jx},{jy}): {t} vs {direct}"
+            );
+        }
+    }
+    assert_eq!(terms.bin(0, 6, 0), None);
+    assert_eq!(terms.bin(0, 0, -6), None);
+}
+
+#[test]
+fn generators_are_deterministic_and_shaped() {
+    let a = HeightField::cd_tracks(256, 256, 0.125, CD_PIT_DEPTH_UM, 1).unwrap();
+    let b = HeightField::cd_tracks(256, 256, 0.125, CD_PIT_DEPTH_UM, 1).unwrap();
+    let c = HeightField::cd_tracks(256, 256, 0.125, CD_PIT_DEPTH_UM, 2).unwrap();
+    assert_eq!(a, b);
+    assert_ne!(a, c);
+    // Pits go down by at most the depth; lands sit at the top.
+    let max = a.heights_um().iter().fold(f64::MIN, |m, h| m.max(*h));
+    let min = a.heights_um().iter().fold(f64::MAX, |m, h| m.min(*h));
+    assert!((max - min - CD_PIT_DEPTH_UM).abs() < 1e-12, "{max} {min}");
+    // The tracks are 1.6 µm apart: the x power spectrum peaks at j = L/1.6 = 20.
+    let t = TaylorTerms::compute(&a, 1);
+    let power = |j: i64| t.bin(1, j, 0).unwrap().norm_sqr();
+    assert!((1..40).filter(|&j| j != 20).all(|j| power(j) < power(20)));
+    let blazed = HeightField::blazed_grating(2.0, 0.2, 0.1, 40).unwrap();
+    let h = blazed.heights_um();
+    assert!((h[1] - h[0] - 0.01).abs() < 1e-12 && h[20] < h[19]);
+    let sine = HeightField::sine_grating(1.0, 0.1, 0.05, 40).unwrap();
+    assert!((sine.max_abs_height_um() - 0.1).abs() < 1e-12);
+    assert!(HeightField::sine_grating(0.0, 0.1, 0.05, 40).is_err());
+    assert!(HeightField::new(2, 2, 0.1, vec![0.0, f64::NAN, 0.0, 0.0]).is_err());
+    assert!(HeightField::new(2, 2, 0.1, vec![0.0; 3]).is_err());
+}
+
+#[test]
+fn sampling_checks_name_the_limits() {
+    let field = HeightField::cd_tracks(256, 256, 0.125, CD_PIT_DEPTH_UM, 1).unwrap();
+    let s = DiffractionSurface::new(TaylorTerms::compute(&field, 2), 8.0).unwrap();
+    s.check_sampling(380.0, 1.5).unwrap();
+    assert!(matches!(
+        s.check_sampling(380.0, 2.0),
+        Err(Error::NyquistExceeded { .. })
+    ));
+    let s = DiffractionSurface::new(TaylorTerms::compute(&field, 2), SIGMA_S_UM).unwrap();
+    assert!(matches!(
+        s.check_sampling(380.0, 1.0),
+        Err(Error::PatchTooSmall { .. })
+    ));
+}
+
+#[test]
+fn white_spectrum_is_white() {
+    let c = Colorimeter::new(
+        Observer::Cie1931_2Deg,
+        Illuminant::D65,
+        OutputSpace::Rgb(RgbSpace::Srgb),
+    );
+    let wl: Vec<f64> = (0..=80).map(|i| 380.0 + 5.0 * f64::from(i)).collect();
+    let grid = SpectralGrid::new(&c, &wl).unwrap();
+    let xyz = grid.xyz(&vec![1.0; wl.len()]);
+    let rgb = c.output_from_xyz(xyz);
+    for v in rgb {
+        assert!((v - 1.0).abs() < 1e-12, "{rgb:?}");
+    }
+    assert!(SpectralGrid::new(&c, &[300.0, 400.0]).is_err());
+}
