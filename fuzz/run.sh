@@ -16,13 +16,15 @@ if [ ${#targets[@]} -eq 0 ]; then
     targets=(recipe material manifest flags exr ktx2 png)
 fi
 triple=$(rustc -vV | sed -n 's/^host: //p')
+# cargo puts the binaries under CARGO_TARGET_DIR when it is set (relative to this folder).
+target_dir=${CARGO_TARGET_DIR:-target}
 # -a: debug assertions (integer overflow checks) in the instrumented build.
 cargo fuzz build -s none -O -a
 for t in "${targets[@]}"; do
     mkdir -p "corpus/$t" "artifacts/$t"
     echo "fuzz/run.sh: $t for ${seconds} s" >&2
     # shellcheck disable=SC2086
-    "target/$triple/release/$t" "corpus/$t" "seeds/$t" \
+    "$target_dir/$triple/release/$t" "corpus/$t" "seeds/$t" \
         -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=20 \
         -artifact_prefix="artifacts/$t/" -print_final_stats=1 ${FUZZ_FLAGS:-} \
         2>"artifacts/$t/log.txt" || {
