@@ -91,7 +91,12 @@ pub struct DiffractionArgs {
     #[arg(long, value_name = "N")]
     samples: Option<usize>,
     /// Height of a file's full scale (PNG) or multiplier (EXR, CSV), µm.
-    #[arg(long, value_name = "UM", default_value = "1")]
+    #[arg(
+        long,
+        value_name = "UM",
+        default_value = "1",
+        allow_hyphen_values = true
+    )]
     height_scale: String,
     /// Coherence diameter 4σ_s of the light, µm [default: 65].
     #[arg(long, value_name = "UM")]

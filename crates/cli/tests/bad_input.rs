@@ -454,6 +454,10 @@ fn fixtures(d: &Path) -> Vec<Case> {
     }
     write(&d.join("g/truncated16.png"), &png[..png.len() - 20]);
     write(&d.join("g/truncated.exr"), &exr[..exr.len() - 40]);
+    // Height fields for `nacre diffraction` (CSV rows of heights; line 2 is bad).
+    write(&d.join("h/nan.csv"), "0,0.1,0\n0.1,NaN,0.1\n0,0.1,0\n");
+    write(&d.join("h/text.csv"), "0,0.1,0\n0.1,deep,0.1\n0,0.1,0\n");
+    write(&d.join("h/empty.csv"), "");
     write(&d.join("g/tri.bin"), triangle());
     write(
         &d.join("g/missing-buffer.gltf"),
@@ -895,6 +899,81 @@ fn fixtures(d: &Path) -> Vec<Case> {
             "gltf: asset version 1.0",
             render(&["--gltf", "g/version1.gltf"]),
             &["version1.gltf", "2.x"],
+        ),
+        // --- height fields (`nacre diffraction`) ---
+        case(
+            "height field: truncated PNG",
+            &[
+                "diffraction",
+                "g/truncated16.png",
+                "--pitch",
+                "0.1",
+                "-o",
+                "out.csv",
+            ],
+            &["truncated16.png"],
+        ),
+        case(
+            "height field: truncated EXR",
+            &[
+                "diffraction",
+                "g/truncated.exr",
+                "--pitch",
+                "0.1",
+                "-o",
+                "out.csv",
+            ],
+            &["truncated.exr"],
+        ),
+        case(
+            "height field: NaN height in a CSV",
+            &[
+                "diffraction",
+                "h/nan.csv",
+                "--pitch",
+                "0.1",
+                "-o",
+                "out.csv",
+            ],
+            &["nan.csv:2"],
+        ),
+        case(
+            "height field: text in a CSV",
+            &[
+                "diffraction",
+                "h/text.csv",
+                "--pitch",
+                "0.1",
+                "-o",
+                "out.csv",
+            ],
+            &["text.csv:2"],
+        ),
+        case(
+            "height field: empty CSV",
+            &[
+                "diffraction",
+                "h/empty.csv",
+                "--pitch",
+                "0.1",
+                "-o",
+                "out.csv",
+            ],
+            &["empty.csv"],
+        ),
+        case(
+            "height field: negative height scale",
+            &[
+                "diffraction",
+                "h/nan.csv",
+                "--pitch",
+                "0.1",
+                "--height-scale",
+                "-1",
+                "-o",
+                "out.csv",
+            ],
+            &["--height-scale"],
         ),
         // --- the GPU runtime ---
         case_env(
