@@ -254,41 +254,13 @@ impl Recipe {
             &colour.space,
             OutputSpace::Rgb(nacre_optics::colour::RgbSpace::Srgb),
         )?;
-        let base_dir = path.parent();
-        let ambient = resolve(
-            raw.stack.ambient.get_ref(),
-            &at(raw.stack.ambient.span()),
-            base_dir,
-        )?;
-        let ambient_index = constant_real_index(&ambient).ok_or_else(|| Error::Invalid {
-            context: at(raw.stack.ambient.span()),
-            message: format!(
-                "the ambient of a film-lut must have a constant real index (e.g. \"1.0\"), not `{}`",
-                raw.stack.ambient.get_ref()
-            ),
-        })?;
-        let base = resolve(
-            raw.stack.base.get_ref(),
-            &at(raw.stack.base.span()),
-            base_dir,
-        )?;
-        let mut under = Vec::new();
-        let mut under_specs = Vec::new();
-        for l in &raw.stack.under {
-            let d = *l.thickness_nm.get_ref();
-            if !(d >= 0.0 && d.is_finite()) {
-                return Err(Error::Recipe {
-                    path: path.to_path_buf(),
-                    line: line_of(&text, l.thickness_nm.span().start),
-                    message: format!("thickness_nm = {d}: must be finite and non-negative"),
-                });
-            }
-            under.push(Layer {
-                material: resolve(l.material.get_ref(), &at(l.material.span()), base_dir)?,
-                thickness_nm: d,
-            });
-            under_specs.push((l.material.get_ref().clone(), d));
-        }
+        let RecipeStack {
+            ambient,
+            ambient_index,
+            base,
+            under,
+            under_specs,
+        } = RecipeStack::parse(path, &text, &raw.stack, "film-lut")?;
         let ax = raw.axes.get_ref();
         let axes = FilmLutAxes {
             cos_theta_count: ax.cos_theta_count,
@@ -344,6 +316,66 @@ impl Recipe {
             precision: output.precision.unwrap_or(Precision::Half),
             png: output.png.unwrap_or(true),
             text,
+        })
+    }
+}
+
+/// The materials of a table recipe's `[stack]` (shared by the `film-lut` and
+/// `rough-film-lut` kinds): ambient, base and the layers under the film, resolved.
+pub(crate) struct RecipeStack {
+    pub(crate) ambient: Material,
+    /// The ambient's constant real index n₀.
+    pub(crate) ambient_index: f64,
+    pub(crate) base: Material,
+    pub(crate) under: Vec<Layer>,
+    /// `(material spec, thickness_nm)` of each layer under the film, as written.
+    pub(crate) under_specs: Vec<(String, f64)>,
+}
+
+impl RecipeStack {
+    /// Resolves `stack` of the recipe `path` (text `text`) for a table of `kind`.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] naming the file and line of an ambient without a constant real
+    /// index or a material that cannot be resolved; [`Error::Recipe`] for a negative or
+    /// non-finite layer thickness.
+    pub(crate) fn parse(path: &Path, text: &str, stack: &RawStack, kind: &str) -> Result<Self> {
+        let at = |span: std::ops::Range<usize>| {
+            format!("{}:{}", path.display(), line_of(text, span.start))
+        };
+        let base_dir = path.parent();
+        let ambient = resolve(stack.ambient.get_ref(), &at(stack.ambient.span()), base_dir)?;
+        let ambient_index = constant_real_index(&ambient).ok_or_else(|| Error::Invalid {
+            context: at(stack.ambient.span()),
+            message: format!(
+                "the ambient of a {kind} must have a constant real index (e.g. \"1.0\"), not `{}`",
+                stack.ambient.get_ref()
+            ),
+        })?;
+        let base = resolve(stack.base.get_ref(), &at(stack.base.span()), base_dir)?;
+        let mut under = Vec::new();
+        let mut under_specs = Vec::new();
+        for l in &stack.under {
+            let d = *l.thickness_nm.get_ref();
+            if !(d >= 0.0 && d.is_finite()) {
+                return Err(Error::Recipe {
+                    path: path.to_path_buf(),
+                    line: line_of(text, l.thickness_nm.span().start),
+                    message: format!("thickness_nm = {d}: must be finite and non-negative"),
+                });
+            }
+            under.push(Layer {
+                material: resolve(l.material.get_ref(), &at(l.material.span()), base_dir)?,
+                thickness_nm: d,
+            });
+            under_specs.push((l.material.get_ref().clone(), d));
+        }
+        Ok(RecipeStack {
+            ambient,
+            ambient_index,
+            base,
+            under,
+            under_specs,
         })
     }
 }

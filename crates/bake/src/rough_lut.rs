@@ -126,11 +126,10 @@
 
 use crate::bake::{
     AxisRecord, FileRecord, MANIFEST_FORMAT, MAX_TEXELS, Manifest, RawColour, RawOutput, RawStack,
-    Toggle, constant_real_index, is_transparent, parse_colour, sha256_text, table_name,
+    RecipeStack, Toggle, is_transparent, parse_colour, sha256_text, table_name,
 };
 use crate::error::{Error, Result};
 use crate::film_lut::MIN_COS_THETA;
-use crate::materials::resolve;
 use crate::output::write_atomic;
 use crate::stack_spec::{line_of, toml_error};
 use crate::table_io::{self, Precision, Table3};
@@ -835,41 +834,13 @@ impl RoughRecipe {
             format!("{}:{}", path.display(), line_of(&text, span.start))
         };
         let colorimeter = parse_colour(path, &text, raw.colour)?;
-        let base_dir = path.parent();
-        let ambient = resolve(
-            raw.stack.ambient.get_ref(),
-            &at(raw.stack.ambient.span()),
-            base_dir,
-        )?;
-        let ambient_index = constant_real_index(&ambient).ok_or_else(|| Error::Invalid {
-            context: at(raw.stack.ambient.span()),
-            message: format!(
-                "the ambient of a rough-film-lut must have a constant real index (e.g. \"1.0\"), not `{}`",
-                raw.stack.ambient.get_ref()
-            ),
-        })?;
-        let base = resolve(
-            raw.stack.base.get_ref(),
-            &at(raw.stack.base.span()),
-            base_dir,
-        )?;
-        let mut under = Vec::new();
-        let mut under_specs = Vec::new();
-        for l in &raw.stack.under {
-            let d = *l.thickness_nm.get_ref();
-            if !(d >= 0.0 && d.is_finite()) {
-                return Err(Error::Recipe {
-                    path: path.to_path_buf(),
-                    line: line_of(&text, l.thickness_nm.span().start),
-                    message: format!("thickness_nm = {d}: must be finite and non-negative"),
-                });
-            }
-            under.push(Layer {
-                material: resolve(l.material.get_ref(), &at(l.material.span()), base_dir)?,
-                thickness_nm: d,
-            });
-            under_specs.push((l.material.get_ref().clone(), d));
-        }
+        let RecipeStack {
+            ambient,
+            ambient_index,
+            base,
+            under,
+            under_specs,
+        } = RecipeStack::parse(path, &text, &raw.stack, "rough-film-lut")?;
         let output = raw.output.unwrap_or(RawOutput {
             precision: None,
             png: None,
