@@ -21,7 +21,7 @@ use crate::gltf_scene::{GltfScene, is_gold_like};
 use crate::readback::read_texture;
 use crate::render::{
     BaseKind, EnvironmentMap, MaterialOptions, MaterialUniform, RenderedImage, SceneOptions,
-    TARGET_FORMAT, ThicknessMap, ViewUniform, check_film_lut, group_layout, linear_sampler,
+    TARGET_FORMAT, ThicknessMap, ViewUniform, check_film_lut, group_layout, uniform_texture_group,
     upload_mips,
 };
 use crate::shaders::{self, MATERIAL, MESH, Technique};
@@ -435,31 +435,7 @@ pub fn render_gltf(
                      contents: &[u8],
                      texture: &wgpu::Texture,
                      repeat_v: bool| {
-            let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage: wgpu::BufferUsages::UNIFORM,
-            });
-            let view = texture.create_view(&Default::default());
-            let sampler = linear_sampler(device, label, repeat_v);
-            device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some(label),
-                layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: uniform.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: wgpu::BindingResource::TextureView(&view),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: wgpu::BindingResource::Sampler(&sampler),
-                    },
-                ],
-            })
+            uniform_texture_group(device, layout, label, contents, texture, repeat_v)
         };
         let view_group = env.bind_group(
             device,

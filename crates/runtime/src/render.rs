@@ -1810,6 +1810,44 @@ pub(crate) fn upload_layers(
     })
 }
 
+/// A bind group of the layout shared by the view and material groups: binding 0 a uniform
+/// buffer holding `contents`, 1 `texture`'s default view, 2 a linear sampler
+/// ([`linear_sampler`]; `repeat_v` repeats v instead of clamping).
+pub(crate) fn uniform_texture_group(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    label: &str,
+    contents: &[u8],
+    texture: &wgpu::Texture,
+    repeat_v: bool,
+) -> wgpu::BindGroup {
+    let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents,
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let view = texture.create_view(&Default::default());
+    let sampler = linear_sampler(device, label, repeat_v);
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: uniform.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: wgpu::BindingResource::TextureView(&view),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: wgpu::BindingResource::Sampler(&sampler),
+            },
+        ],
+    })
+}
+
 pub(crate) fn linear_sampler(device: &wgpu::Device, label: &str, repeat_v: bool) -> wgpu::Sampler {
     device.create_sampler(&wgpu::SamplerDescriptor {
         label: Some(label),
@@ -2057,31 +2095,7 @@ impl Renderer {
                          contents: &[u8],
                          texture: &wgpu::Texture,
                          repeat_v: bool| {
-                let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some(label),
-                    contents,
-                    usage: wgpu::BufferUsages::UNIFORM,
-                });
-                let view = texture.create_view(&Default::default());
-                let sampler = linear_sampler(device, label, repeat_v);
-                device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some(label),
-                    layout,
-                    entries: &[
-                        wgpu::BindGroupEntry {
-                            binding: 0,
-                            resource: uniform.as_entire_binding(),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 1,
-                            resource: wgpu::BindingResource::TextureView(&view),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 2,
-                            resource: wgpu::BindingResource::Sampler(&sampler),
-                        },
-                    ],
-                })
+                uniform_texture_group(device, layout, label, contents, texture, repeat_v)
             };
             let view_group = env.bind_group(
                 device,
