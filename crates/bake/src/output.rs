@@ -29,8 +29,9 @@ pub fn write_atomic(
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
+    remove_stale(dir);
     let tmp = tempfile::Builder::new()
-        .prefix(".nacre-")
+        .prefix(&temp_prefix())
         .suffix(".tmp")
         .tempfile_in(dir)
         .map_err(io)?;
@@ -81,12 +82,13 @@ pub fn write_files_atomic(dir: &Path, files: &[(String, Vec<u8>)]) -> Result<()>
         probe = p.parent();
     }
     std::fs::create_dir_all(dir).map_err(io(dir))?;
+    remove_stale(dir);
     let staged = files
         .iter()
         .map(|(name, bytes)| {
             let target = dir.join(name);
             let tmp = tempfile::Builder::new()
-                .prefix(".nacre-")
+                .prefix(&temp_prefix())
                 .suffix(".tmp")
                 .tempfile_in(dir)
                 .map_err(io(&target))?;
@@ -136,7 +138,8 @@ pub fn write_files_atomic(dir: &Path, files: &[(String, Vec<u8>)]) -> Result<()>
 ///
 /// A run killed before step 2 leaves the previous table untouched; one killed later leaves
 /// no manifest, or the new complete table. Either way the next run succeeds. A staging
-/// folder left by a killed run is hidden and never read.
+/// folder left by a killed run is hidden, never read, and removed by the next write into
+/// the same folder ([`remove_stale`]).
 pub struct StagedTable {
     out_dir: std::path::PathBuf,
     stage: tempfile::TempDir,
@@ -159,8 +162,9 @@ impl StagedTable {
             });
         }
         std::fs::create_dir_all(out_dir).map_err(io)?;
+        remove_stale(out_dir);
         let stage = tempfile::Builder::new()
-            .prefix(".nacre-stage-")
+            .prefix(&format!("{STAGE_PREFIX}{}-", std::process::id()))
             .tempdir_in(out_dir)
             .map_err(io)?;
         Ok(StagedTable {
@@ -221,6 +225,66 @@ impl StagedTable {
     }
 }
 
+/// Name prefix of temporary files: `.nacre-PID-` (then random characters and `.tmp`).
+const TEMP_PREFIX: &str = ".nacre-";
+/// Name prefix of staging folders: `.nacre-stage-PID-` (then random characters).
+const STAGE_PREFIX: &str = ".nacre-stage-";
+
+fn temp_prefix() -> String {
+    format!("{TEMP_PREFIX}{}-", std::process::id())
+}
+
+/// The process id in a leftover's name: `.nacre-stage-PID-…` or `.nacre-PID-….tmp`.
+fn owner_pid(name: &str) -> Option<u32> {
+    let rest = match name.strip_prefix(STAGE_PREFIX) {
+        Some(rest) => rest,
+        None => name.strip_prefix(TEMP_PREFIX)?.strip_suffix(".tmp")?,
+    };
+    rest.split_once('-')?.0.parse().ok()
+}
+
+/// Whether process `pid` is running, where the system says (Linux's `/proc`); `None` where
+/// it cannot be told.
+fn process_alive(pid: u32) -> Option<bool> {
+    let proc = Path::new("/proc");
+    proc.join("self")
+        .exists()
+        .then(|| proc.join(pid.to_string()).exists())
+}
+
+/// Removes the temporary files and staging folders that killed runs left in `dir`: those
+/// whose name carries the id of a process that is no longer running. Leftovers of running
+/// processes (concurrent bakes into the same folder) are kept, as is everything where
+/// liveness cannot be told (no `/proc`), and everything whose name nacre did not make.
+/// Best effort: a leftover that cannot be removed stays hidden and unread. (A folder
+/// shared between PID namespaces, e.g. containers, could hold a live bake's staging folder
+/// under a pid this process cannot see; bake into such a folder from one namespace.)
+pub fn remove_stale(dir: &Path) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    let own = std::process::id();
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let Some(pid) = name.to_str().and_then(owner_pid) else {
+            continue;
+        };
+        if pid == own || process_alive(pid) != Some(false) {
+            continue;
+        }
+        let path = entry.path();
+        match entry.file_type() {
+            Ok(t) if t.is_dir() => {
+                let _ = std::fs::remove_dir_all(&path);
+            }
+            Ok(_) => {
+                let _ = std::fs::remove_file(&path);
+            }
+            Err(_) => {}
+        }
+    }
+}
+
 /// Makes renames and removals in `dir` durable (a no-op where folders cannot be synced).
 fn sync_dir(dir: &Path) -> std::io::Result<()> {
     #[cfg(unix)]
@@ -233,6 +297,45 @@ fn sync_dir(dir: &Path) -> std::io::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Leftovers of dead processes go; those of running ones (this one, pid 1), foreign
+    /// hidden files and unparsable names stay.
+    #[test]
+    fn stale_leftovers_of_dead_processes_are_removed() {
+        if process_alive(1).is_none() {
+            eprintln!("skipped: no /proc here, so nothing is removed (documented)");
+            return;
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        let dead = 4_000_000_000u32; // above any pid_max (2^22)
+        let own = std::process::id();
+        let stage = |pid: u32| d.join(format!(".nacre-stage-{pid}-Ab3xYz"));
+        let tmp = |pid: u32| d.join(format!(".nacre-{pid}-Qw9e.tmp"));
+        for pid in [dead, own, 1] {
+            std::fs::create_dir(stage(pid)).unwrap();
+            std::fs::write(stage(pid).join("table.exr"), "x").unwrap();
+            std::fs::write(tmp(pid), "x").unwrap();
+        }
+        let keep = [".nacre-stage-Ab3xYz", ".nacre-x-1.tmp", ".other", "t.json"];
+        for name in keep {
+            std::fs::write(d.join(name), "x").unwrap();
+        }
+        assert_eq!(
+            owner_pid(&format!(".nacre-stage-{dead}-Ab3xYz")),
+            Some(dead)
+        );
+        assert_eq!(owner_pid(&format!(".nacre-{own}-Qw9e.tmp")), Some(own));
+        assert_eq!(owner_pid(".nacre-stage-Ab3xYz"), None);
+        remove_stale(d);
+        assert!(!stage(dead).exists() && !tmp(dead).exists());
+        for pid in [own, 1] {
+            assert!(stage(pid).join("table.exr").exists() && tmp(pid).exists());
+        }
+        for name in keep {
+            assert!(d.join(name).exists(), "{name}");
+        }
+    }
 
     /// A disk that fills up (ENOSPC) or any other write error half-way: the error names
     /// the target, an existing file is untouched and no temporary file is left.

@@ -164,6 +164,16 @@ fn bake_killed_at_random_moments_leaves_complete_tables_or_none() {
     assert!(bake(d, 1, &out).status().unwrap().success());
     assert_eq!(check(&out, &reference), vec![Some(1), Some(1)]);
     assert_eq!(files(&out), reference[1]);
+    // …and removes what the killed bakes left behind (their processes are gone).
+    let left: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with(".nacre-"))
+        .collect();
+    assert!(
+        left.is_empty(),
+        "leftovers of killed bakes remain: {left:?}"
+    );
 }
 
 /// Whether `dir` can be written to by this process (root ignores permission bits).

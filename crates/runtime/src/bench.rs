@@ -9,13 +9,13 @@
 //! measured frames is reported, after warm-up frames that are discarded.
 
 use crate::bindings::{TechniqueBinding, TechniqueOptions};
+use crate::context::BufferInitExt;
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
 use crate::fullscreen;
 use crate::shaders::{self, Technique};
 use crate::tables::TableSet;
 use std::time::Instant;
-use wgpu::util::DeviceExt;
 
 /// What one bench pass shades.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

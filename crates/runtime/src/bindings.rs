@@ -2,6 +2,7 @@
 //! that fill them. Groups are ordered by how often they change: 0 view, 1 tables,
 //! 2 material (`shaders/README.md`).
 
+use crate::context::BufferInitExt;
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
 use crate::params;
@@ -9,7 +10,6 @@ use crate::shaders::Technique;
 use crate::tables::TableSet;
 use nacre_optics::Material;
 use nacre_optics::colour::Colorimeter;
-use wgpu::util::DeviceExt;
 
 const STAGES: wgpu::ShaderStages = wgpu::ShaderStages::FRAGMENT.union(wgpu::ShaderStages::COMPUTE);
 

@@ -50,6 +50,19 @@ pub enum Error {
         /// wgpu's message.
         message: String,
     },
+    /// The device was lost (driver reset, GPU removed, or `wgpu::Device::destroy`): nothing
+    /// more can run on it; create a new [`crate::GpuContext`].
+    #[error(
+        "the GPU device on {adapter} was lost while {context} ({reason}): create a new device and reload the tables"
+    )]
+    DeviceLost {
+        /// Adapter name.
+        adapter: String,
+        /// What the runtime was doing.
+        context: String,
+        /// wgpu's reason and message.
+        reason: String,
+    },
     /// A request the runtime refuses (bad sizes, missing tables for a technique, …).
     #[error("{context}: {message}")]
     Invalid {

@@ -23,7 +23,7 @@ pub mod shaders;
 pub mod tables;
 
 pub use bindings::{TechniqueBinding, TechniqueOptions};
-pub use context::GpuContext;
+pub use context::{BufferInitExt, GpuContext};
 pub use error::{Error, Result};
 pub use params::{FilmInput, FilmOutput};
 pub use render::{RenderedImage, Renderer, SceneKind, SceneOptions, render_scene};

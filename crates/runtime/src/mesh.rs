@@ -15,6 +15,7 @@
 //! (`MeshUniform`: view-projection).
 
 use crate::bindings::TechniqueBinding;
+use crate::context::BufferInitExt;
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
 use crate::gltf_scene::{GltfScene, is_gold_like};
@@ -27,7 +28,6 @@ use crate::render::{
 use crate::shaders::{self, MATERIAL, MESH, Technique};
 use crate::tables::TableSet;
 use bytemuck::{Pod, Zeroable};
-use wgpu::util::DeviceExt;
 
 /// Depth buffer format.
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;

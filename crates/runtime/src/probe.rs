@@ -3,13 +3,13 @@
 //! of the GPU = CPU tests (`shaders/probe.wgsl`).
 
 use crate::bindings::TechniqueBinding;
+use crate::context::BufferInitExt;
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
 use crate::fullscreen;
 use crate::params::{FilmInput, FilmOutput};
 use crate::readback::read_texture;
 use crate::shaders::{self, PROBE};
-use wgpu::util::DeviceExt;
 
 /// Pixels per row of the probe target (64 × 16 bytes: rows already 256-byte aligned).
 const WIDTH: u32 = 64;

@@ -36,6 +36,7 @@
 //! ```
 
 use crate::bindings::{SpectralSetup, TechniqueBinding, TechniqueOptions};
+use crate::context::BufferInitExt;
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
 use crate::readback::read_texture;
@@ -47,7 +48,6 @@ use nacre_optics::{C64, Material};
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
-use wgpu::util::DeviceExt;
 
 /// Largest width or height of a rendered image, an environment map or a thickness map.
 pub const MAX_DIMENSION: u32 = 8192;

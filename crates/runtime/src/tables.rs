@@ -120,6 +120,8 @@ impl TableSet {
                 });
             }
         }
+        // Finishes the uploads: a device lost meanwhile is reported here, not at first use.
+        ctx.wait(&format!("uploading {}", manifest_path.display()))?;
         Ok(())
     }
 
