@@ -1,5 +1,6 @@
 //! Diffraction gratings: height-field sources (files and synthetic specs), the table kind
-//! `diffraction` (layout "terms"), and the CPU evaluation behind `nacre diffraction`.
+//! `diffraction` (layout "terms" here, layout "integrated" in
+//! [`crate::diffraction_integrated`]), and the CPU evaluation behind `nacre diffraction`.
 //! The physics is [`nacre_optics::diffraction`] (Stam 1999; Dhillon et al. 2014).
 //!
 //! # Height-field sources
@@ -28,7 +29,7 @@
 //! pitch_um = 0.125                # required with `file`; synthetic: optional
 //! height_scale_um = 0.1           # `file` only: full scale of a PNG, multiplier of EXR/CSV
 //! [diffraction]
-//! layout = "terms"
+//! layout = "terms"                # or "integrated" (crate::diffraction_integrated)
 //! coherence_diameter_um = 65.0    # 4σ_s; default 65 (Dhillon et al. 2014)
 //! wavelengths = "380:780:5"       # range (and colour step) the table serves
 //! max_angle_deg = 45.0            # light and view polar angles the table serves
@@ -48,8 +49,10 @@
 //! P̃ = Σ_j P_j exp(−σ_s²|(ku, kv) − κ_j|²/2), ρ = F² · G/w² · |P̃|²
 //! (G/w² = (1 + ω_i·ω_r)²/(cos θ_i cos θ_r (cos θ_i + cos θ_r)²)), then
 //! colour = M · Σ_λ ρ(λ) u(λ) with the CIE weights of the recorded observer and illuminant
-//! ([`nacre_optics::diffraction::SpectralGrid`]). The layout "integrated" of issue 7 (the
-//! wavelength-integrated fast path) is not implemented.
+//! ([`nacre_optics::diffraction::SpectralGrid`]). The layout "integrated" (the
+//! wavelength-integrated fast path, `layout = "integrated"` with the keys
+//! `integrated_samples`, `integrated_gamma`, `integrated_tolerance`) is documented in
+//! [`crate::diffraction_integrated`].
 
 use crate::bake::{AxisRecord, FileRecord, MANIFEST_FORMAT, Manifest};
 use crate::error::{Error, Result};
@@ -529,7 +532,7 @@ impl HeightSource {
 /// Everything a `diffraction` manifest records about the table (beside the common fields).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct DiffractionRecord {
-    /// `terms`.
+    /// `terms` or `integrated`.
     pub layout: String,
     /// The height field: a synthetic spec or the file name as written in the recipe.
     pub source: String,
@@ -573,6 +576,10 @@ pub struct DiffractionRecord {
     pub dc_texel: [usize; 2],
     /// [`SIGN_CONVENTION`].
     pub sign_convention: String,
+    /// Layout "integrated" only: its axes, settings and measured reconstruction error
+    /// ([`crate::diffraction_integrated`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub integrated: Option<crate::diffraction_integrated::IntegratedRecord>,
 }
 
 #[derive(Deserialize)]
@@ -593,6 +600,9 @@ struct RawDiffraction {
     wavelengths: Option<Spanned<String>>,
     max_angle_deg: Option<Spanned<f64>>,
     taylor_tolerance: Option<Spanned<f64>>,
+    integrated_samples: Option<Spanned<i64>>,
+    integrated_gamma: Option<Spanned<f64>>,
+    integrated_tolerance: Option<Spanned<f64>>,
 }
 
 #[derive(Deserialize)]
@@ -622,8 +632,11 @@ pub struct DiffractionRecipe {
     pub source_text: String,
     /// The height field (generated or read and checked at parse time).
     pub field: HeightField,
-    /// The Taylor order, bound and checks, as recorded.
+    /// The Taylor order, bound and checks, as recorded (layout "integrated": the
+    /// measured error is filled in by the bake).
     pub record: DiffractionRecord,
+    /// The wavelength grid of the colour sums, nm.
+    pub wavelengths_nm: Vec<f64>,
 }
 
 impl DiffractionRecipe {
@@ -653,17 +666,42 @@ impl DiffractionRecipe {
             wavelengths: None,
             max_angle_deg: None,
             taylor_tolerance: None,
+            integrated_samples: None,
+            integrated_gamma: None,
+            integrated_tolerance: None,
         });
-        if let Some(l) = &d.layout
-            && l.get_ref() != "terms"
-        {
-            return Err(bad(
-                l.span(),
-                format!(
-                    "layout = \"{}\": only \"terms\" is implemented (the \"integrated\" layout is not)",
-                    l.get_ref()
+        let integrated_layout = match d.layout.as_ref().map(|l| (l, l.get_ref().as_str())) {
+            None | Some((_, "terms")) => false,
+            Some((_, "integrated")) => true,
+            Some((l, other)) => {
+                return Err(bad(
+                    l.span(),
+                    format!("layout = \"{other}\": expected \"terms\" or \"integrated\""),
+                ));
+            }
+        };
+        if !integrated_layout {
+            for (key, span) in [
+                (
+                    "integrated_samples",
+                    d.integrated_samples.as_ref().map(Spanned::span),
                 ),
-            ));
+                (
+                    "integrated_gamma",
+                    d.integrated_gamma.as_ref().map(Spanned::span),
+                ),
+                (
+                    "integrated_tolerance",
+                    d.integrated_tolerance.as_ref().map(Spanned::span),
+                ),
+            ] {
+                if let Some(span) = span {
+                    return Err(bad(
+                        span,
+                        format!("{key} applies to layout = \"integrated\" only"),
+                    ));
+                }
+            }
         }
         let positive = |v: &Option<Spanned<f64>>, default: f64, what: &str| -> Result<f64> {
             match v {
@@ -766,7 +804,7 @@ impl DiffractionRecipe {
             samples,
             scale,
         )?;
-        let record = plan(
+        let mut record = plan(
             &field,
             &source_text,
             coherence,
@@ -778,7 +816,17 @@ impl DiffractionRecipe {
             context: at(source_span),
             source,
         })?;
-        if record.f32_rounding_bound > tolerance {
+        if integrated_layout {
+            let settings = crate::diffraction_integrated::IntegratedSettings::parse(
+                &bad,
+                d.integrated_samples.as_ref(),
+                d.integrated_gamma.as_ref(),
+                d.integrated_tolerance.as_ref(),
+                record.taylor_order,
+            )?;
+            record.layout = "integrated".into();
+            record.integrated = Some(settings.record(&record));
+        } else if record.f32_rounding_bound > tolerance {
             return Err(Error::Invalid {
                 context: path.display().to_string(),
                 message: format!(
@@ -795,13 +843,18 @@ impl DiffractionRecipe {
             source_text,
             field,
             record,
+            wavelengths_nm: wavelengths,
             text,
         })
     }
 
-    /// Computes the terms and writes `NAME.terms.exr`, `NAME.terms.ktx2` and `NAME.json`;
-    /// returns the manifest path.
+    /// Computes the terms and writes `NAME.terms.exr`, `NAME.terms.ktx2` and `NAME.json`
+    /// (layout "integrated": [`crate::diffraction_integrated::bake`]); returns the
+    /// manifest path.
     pub fn bake(&self, out_dir: &Path, progress: &(dyn Fn() + Sync)) -> Result<PathBuf> {
+        if self.record.integrated.is_some() {
+            return crate::diffraction_integrated::bake(self, out_dir, progress);
+        }
         let terms = TaylorTerms::compute(&self.field, self.record.taylor_order);
         progress();
         // Every file goes to a staging folder first; `commit` moves them into `out_dir`,
@@ -1030,6 +1083,7 @@ pub fn plan(
         f32_rounding_bound: f64::from(f32::EPSILON) * 0.5 * max_phase.exp(),
         dc_texel: [field.nx() / 2, field.ny() / 2],
         sign_convention: SIGN_CONVENTION.into(),
+        integrated: None,
     })
 }
 
@@ -1047,6 +1101,15 @@ impl Manifest {
                 self.name, self.kind
             ),
         })?;
+        if r.layout != "terms" {
+            return Err(Error::Invalid {
+                context: manifest_path.display().to_string(),
+                message: format!(
+                    "diffraction table `{}` has the layout \"{}\", which stores colours summed over wavelengths, not the Taylor terms",
+                    self.name, r.layout
+                ),
+            });
+        }
         let dir = manifest_path.parent().unwrap_or(Path::new("."));
         let layers = r.taylor_order + 1;
         let find = |format: &str| {
@@ -1177,21 +1240,40 @@ impl ViewSweep<'_> {
         w: &mut dyn Write,
         colours: &[([f64; 3], [f64; 3])],
     ) -> std::io::Result<()> {
-        writeln!(w, "view_deg,X,Y,Z,R,G,B")?;
-        for (&v, (xyz, rgb)) in self.views_deg.iter().zip(colours) {
-            writeln!(
-                w,
-                "{v},{},{},{},{},{},{}",
-                fmt_sig(xyz[0]),
-                fmt_sig(xyz[1]),
-                fmt_sig(xyz[2]),
-                fmt_sig(rgb[0]),
-                fmt_sig(rgb[1]),
-                fmt_sig(rgb[2])
-            )?;
-        }
-        Ok(())
+        write_colour_csv(w, self.views_deg, colours)
     }
+}
+
+/// `f` of every light/view pair, in parallel (each value independent, the order kept: the
+/// same result whatever the thread count).
+pub fn par_map_pairs<T: Send>(
+    pairs: &[([f64; 3], [f64; 3])],
+    f: &(dyn Fn([f64; 3], [f64; 3]) -> T + Sync),
+) -> Vec<T> {
+    pairs.par_iter().map(|&(wi, wr)| f(wi, wr)).collect()
+}
+
+/// Writes `view_deg,X,Y,Z,R,G,B`, one row per view angle (degrees) with its (XYZ,
+/// output-space) colour.
+pub fn write_colour_csv(
+    w: &mut dyn Write,
+    views_deg: &[f64],
+    colours: &[([f64; 3], [f64; 3])],
+) -> std::io::Result<()> {
+    writeln!(w, "view_deg,X,Y,Z,R,G,B")?;
+    for (&v, (xyz, rgb)) in views_deg.iter().zip(colours) {
+        writeln!(
+            w,
+            "{v},{},{},{},{},{},{}",
+            fmt_sig(xyz[0]),
+            fmt_sig(xyz[1]),
+            fmt_sig(xyz[2]),
+            fmt_sig(rgb[0]),
+            fmt_sig(rgb[1]),
+            fmt_sig(rgb[2])
+        )?;
+    }
+    Ok(())
 }
 
 /// A diffraction map (`nacre plot diffraction`): the colour of ρ over view directions for
@@ -1240,6 +1322,37 @@ impl DiffractionMap {
         fresnel: FresnelTerm,
         exposure: Option<f64>,
     ) -> Self {
+        let colour = |omega_i: [f64; 3], omega_r: [f64; 3]| {
+            let rho: Vec<f64> = grid
+                .wavelengths_nm()
+                .iter()
+                .map(|&wl| surface.relative_reflectance(omega_i, omega_r, wl, fresnel))
+                .collect();
+            colorimeter.output_from_xyz(grid.xyz(&rho))
+        };
+        Self::compute_with(
+            title,
+            &colour,
+            incidence_deg,
+            max_view_deg,
+            cells,
+            colorimeter,
+            exposure,
+        )
+    }
+
+    /// As [`DiffractionMap::compute`] for any evaluation `colour(ω_i, ω_r)` giving the
+    /// colour in `colorimeter`'s output space (e.g. an integrated table's,
+    /// [`nacre_optics::diffraction::integrated::IntegratedTable::colour`]).
+    pub fn compute_with(
+        title: String,
+        colour: &(dyn Fn([f64; 3], [f64; 3]) -> [f64; 3] + Sync),
+        incidence_deg: f64,
+        max_view_deg: f64,
+        cells: usize,
+        colorimeter: &Colorimeter,
+        exposure: Option<f64>,
+    ) -> Self {
         let radius = max_view_deg.to_radians().sin();
         let (omega_i, _) = in_plane_directions(incidence_deg, 0.0);
         let display = crate::plot::DisplayConverter::new(colorimeter);
@@ -1249,13 +1362,7 @@ impl DiffractionMap {
                 let display = &display;
                 (0..cells).map(move |ix| {
                     let omega_r = map_direction(ix, iy, cells, radius)?;
-                    let rho: Vec<f64> = grid
-                        .wavelengths_nm()
-                        .iter()
-                        .map(|&wl| surface.relative_reflectance(omega_i, omega_r, wl, fresnel))
-                        .collect();
-                    let xyz = grid.xyz(&rho);
-                    Some(display.linear_srgb(colorimeter.output_from_xyz(xyz)))
+                    Some(display.linear_srgb(colour(omega_i, omega_r)))
                 })
             })
             .collect();
@@ -1435,12 +1542,33 @@ mod tests {
         let e = recipe(
             dir.path(),
             "layout.toml",
-            &good.replace("[diffraction]", "[diffraction]\nlayout = \"integrated\""),
+            &good.replace("[diffraction]", "[diffraction]\nlayout = \"spectral\""),
         )
         .err()
         .unwrap()
         .to_string();
-        assert!(e.contains("layout.toml:5") && e.contains("not"), "{e}");
+        assert!(
+            e.contains("layout.toml:5") && e.contains("\"integrated\""),
+            "{e}"
+        );
+        let e = recipe(
+            dir.path(),
+            "keys.toml",
+            &good.replace("[diffraction]", "[diffraction]\nintegrated_samples = 64"),
+        )
+        .err()
+        .unwrap()
+        .to_string();
+        assert!(
+            e.contains("keys.toml:5") && e.contains("integrated_samples"),
+            "{e}"
+        );
+        assert!(
+            m.load_diffraction_integrated(&manifest_path)
+                .unwrap_err()
+                .to_string()
+                .contains("\"terms\"")
+        );
         let e = recipe(
             dir.path(),
             "file.toml",

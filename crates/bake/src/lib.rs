@@ -13,6 +13,7 @@ pub mod color;
 pub mod compare;
 pub mod conformance;
 pub mod diffraction;
+pub mod diffraction_integrated;
 pub mod error;
 pub mod film_lut;
 pub mod fourier_table;

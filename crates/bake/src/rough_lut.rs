@@ -17,7 +17,10 @@
 //! transmits into a dielectric base, exactly as [`nacre_optics::microfacet`] defines them,
 //! each as a colour of the recipe's colorimeter (RGB in the output space, a perfect
 //! reflector = (1, 1, 1); XYZ with Y = 1 for `space = "xyz"`). Light that single scattering
-//! masks is lost, so E_r + E_t ≤ 1 for a lossless stack (white-furnace test).
+//! masks is lost, so E_r + E_t ≤ 1 for a lossless stack (white-furnace test). The stored
+//! values keep the law exactly, channel by channel: [`store_albedo_pair`] renormalises a
+//! pair whose quadrature sum exceeds 1 and rounds a pair down instead of to the nearest
+//! `f32` or half float where rounding to the nearest would push the sum above 1.
 //!
 //! # The bake is a matrix product (not Monte Carlo)
 //!
@@ -515,6 +518,32 @@ impl RoughFilmLut {
     }
 }
 
+impl RoughFilmLut {
+    /// The tables as the half-float files store them: each (E_r, E_t) pair rounded by
+    /// [`store_albedo_pair`] (so that E_r + E_t ≤ 1 holds for the stored halves), E_r alone
+    /// rounded to the nearest half where nothing is transmitted. Values are `f32`s that are
+    /// exactly half floats.
+    pub fn rounded_to_half(&self) -> (Table3, Option<Table3>) {
+        let Some(t) = &self.transmittance else {
+            let mut r = self.reflectance.clone();
+            for v in &mut r.data {
+                *v = half::f16::from_f32(*v).to_f32();
+            }
+            return (r, None);
+        };
+        let (mut r_out, mut t_out) = (self.reflectance.clone(), t.clone());
+        for ((r, t), (r_in, t_in)) in r_out
+            .data
+            .iter_mut()
+            .zip(t_out.data.iter_mut())
+            .zip(self.reflectance.data.iter().zip(&t.data))
+        {
+            (*r, *t) = store_albedo_pair(f64::from(*r_in), f64::from(*t_in), Precision::Half);
+        }
+        (r_out, Some(t_out))
+    }
+}
+
 /// Lower texel and fraction of linear interpolation at t on `count` texels.
 fn lerp_index(t: f64, count: usize) -> (usize, f64) {
     if count <= 1 {
@@ -660,9 +689,14 @@ impl RoughLutJob {
                     for al in 0..a.alpha_count {
                         let e = column[y * a.alpha_count + al];
                         let z = al * a.ior_count + k;
-                        reflectance.set(x, y, z, [e[0], e[1], e[2]].map(|v| v as f32));
                         if let Some(t) = transmittance.as_mut() {
-                            t.set(x, y, z, [e[3], e[4], e[5]].map(|v| v as f32));
+                            let pairs: [(f32, f32); 3] = std::array::from_fn(|c| {
+                                store_albedo_pair(e[c], e[3 + c], Precision::Float)
+                            });
+                            reflectance.set(x, y, z, pairs.map(|p| p.0));
+                            t.set(x, y, z, pairs.map(|p| p.1));
+                        } else {
+                            reflectance.set(x, y, z, [e[0], e[1], e[2]].map(|v| v as f32));
                         }
                     }
                 }
@@ -674,6 +708,85 @@ impl RoughLutJob {
             reflectance,
             transmittance,
         })
+    }
+}
+
+/// One channel of a texel's reflected and transmitted albedo (E_r, E_t), rounded to
+/// `precision` so that the stored pair keeps the white-furnace law E_r + E_t ≤ 1 exactly
+/// (the sum taken of the stored values; `Precision::Half` for the half-float files).
+///
+/// 1. Energy-conserving renormalisation: a pair whose sum exceeds 1 (only the quadrature's
+///    own error could do that — the reflection and transmission kernels each carry at most
+///    GGX's single-scattering mass ≤ 1 and F_R + F_T = 1 at every node — and the default
+///    table's largest sum is 0.999997) is scaled by 1/(E_r + E_t), which keeps its split.
+/// 2. Each value is rounded to the nearest representable one, as the file writers do
+///    (`f16::from_f32`, round to nearest even). Two values rounded up may together exceed 1
+///    by up to an ulp (2⁻¹¹ at 1 in half floats, more where a linear-RGB channel of a
+///    saturated film colour is slightly negative and the other slightly above 1).
+/// 3. Where they do, the transmitted value, then also the reflected one, is rounded down
+///    instead (towards −∞: towards zero for the non-negative values that make up nearly
+///    every texel): the rounded-down values are ≤ the exact ones, so their sum is ≤ 1.
+///    Each stored value then errs by less than one ulp (≤ 4.9·10⁻⁴ in half floats below 1).
+pub fn store_albedo_pair(reflected: f64, transmitted: f64, precision: Precision) -> (f32, f32) {
+    let (mut r, mut t) = (reflected, transmitted);
+    let sum = r + t;
+    if sum > 1.0 {
+        (r, t) = (r / sum, t / sum);
+        if r + t > 1.0 {
+            t = 1.0 - r;
+        }
+    }
+    let round = |v: f64, down: bool| -> f32 {
+        match (precision, down) {
+            (Precision::Half, false) => half::f16::from_f64(v).to_f32(),
+            (Precision::Half, true) => f16_round_down(v).to_f32(),
+            (Precision::Float, false) => v as f32,
+            (Precision::Float, true) => f32_round_down(v),
+        }
+    };
+    let nearest = |v: f64| round(v, false);
+    let down = |v: f64| round(v, true);
+    let fits = |a: f32, b: f32| f64::from(a) + f64::from(b) <= 1.0;
+    let (qr, qt) = (nearest(r), nearest(t));
+    if fits(qr, qt) {
+        return (qr, qt);
+    }
+    let qt = down(t);
+    if fits(qr, qt) {
+        return (qr, qt);
+    }
+    (down(r), qt)
+}
+
+/// The largest `f32` not above `v` (finite `v`).
+fn f32_round_down(v: f64) -> f32 {
+    let q = v as f32;
+    if f64::from(q) <= v {
+        return q;
+    }
+    // q > v: step one ulp towards −∞.
+    if q > 0.0 {
+        f32::from_bits(q.to_bits() - 1)
+    } else if q == 0.0 {
+        -f32::from_bits(1)
+    } else {
+        f32::from_bits(q.to_bits() + 1)
+    }
+}
+
+/// The largest `f16` not above `v` (|v| within the `f16` range).
+fn f16_round_down(v: f64) -> half::f16 {
+    let q = half::f16::from_f64(v);
+    if q.to_f64() <= v {
+        return q;
+    }
+    let bits = q.to_bits();
+    if q > half::f16::ZERO {
+        half::f16::from_bits(bits - 1)
+    } else if q == half::f16::ZERO {
+        half::f16::from_bits(0x8001)
+    } else {
+        half::f16::from_bits(bits + 1)
     }
 }
 
@@ -985,12 +1098,21 @@ impl RoughRecipe {
         };
         let embedded = manifest.embedded_json();
         let mut files = Vec::new();
-        for (quantity, table) in [
-            ("reflectance", Some(&lut.reflectance)),
-            ("transmittance", lut.transmittance.as_ref()),
+        // The half-float files (the KTX2 textures always, the EXR atlases at
+        // `precision = "half"`) hold the pairs rounded by `store_albedo_pair`.
+        let (half_r, half_t) = lut.rounded_to_half();
+        for (quantity, table, halves) in [
+            ("reflectance", Some(&lut.reflectance), Some(&half_r)),
+            ("transmittance", lut.transmittance.as_ref(), half_t.as_ref()),
         ] {
-            let Some(table) = table else { continue };
-            files.extend(self.write_quantity(out_dir, quantity, table, &embedded)?);
+            let (Some(table), Some(halves)) = (table, halves) else {
+                continue;
+            };
+            let exr = match self.precision {
+                Precision::Half => halves,
+                Precision::Float => table,
+            };
+            files.extend(self.write_quantity(out_dir, quantity, exr, halves, &embedded)?);
         }
         manifest.files = files;
         let name = format!("{}.json", self.name);
@@ -1004,14 +1126,16 @@ impl RoughRecipe {
 }
 
 impl RoughRecipe {
-    /// Writes one quantity's files — `NAME.QUANTITY.exr` (atlas), `.png` when asked for
-    /// and every value is in [0, 1], and `.ktx2` (3-D `RGBA16F`, alpha 1) — each atomically,
-    /// and returns their records.
+    /// Writes one quantity's files — `NAME.QUANTITY.exr` (atlas, from `table`), `.png` when
+    /// asked for and every value is in [0, 1], and `.ktx2` (3-D `RGBA16F`, alpha 1, from
+    /// `halves`, values that are already half floats) — each atomically, and returns their
+    /// records.
     fn write_quantity(
         &self,
         out_dir: &Path,
         quantity: &str,
         table: &Table3,
+        halves: &Table3,
         embedded_manifest: &str,
     ) -> Result<Vec<FileRecord>> {
         let rgb: Vec<String> = vec!["R".into(), "G".into(), "B".into()];
@@ -1052,7 +1176,7 @@ impl RoughRecipe {
         let ktx2_path = out_dir.join(&ktx2);
         crate::ktx2::write_ktx2(
             &ktx2_path,
-            &crate::ktx2::film_lut_image(&ktx2_path, table, embedded_manifest)?,
+            &crate::ktx2::film_lut_image(&ktx2_path, halves, embedded_manifest)?,
         )?;
         files.push(FileRecord {
             quantity: quantity.into(),
@@ -1393,9 +1517,66 @@ mod tests {
         }
         // Linear sRGB channels of saturated film colours may be negative (a violet
         // residual reflection), so the law is on the sum, channel by channel: R + T ≤ 1.
-        for (i, (r, t)) in lut.reflectance.data.iter().zip(&t.data).enumerate() {
-            assert!(r + t <= 1.0 + 1e-6, "value {i}: {r} + {t}");
+        let (half_r, half_t) = lut.rounded_to_half();
+        let half_t = half_t.unwrap();
+        for (r_table, t_table) in [(&lut.reflectance, t), (&half_r, &half_t)] {
+            for (i, (r, t)) in r_table.data.iter().zip(&t_table.data).enumerate() {
+                assert!(f64::from(*r) + f64::from(*t) <= 1.0, "value {i}: {r} + {t}");
+            }
         }
+        for (h, f) in half_r.data.iter().zip(&lut.reflectance.data) {
+            assert_eq!(half::f16::from_f32(*h).to_f32(), *h);
+            assert!((h - f).abs() <= 4.9e-4, "{h} vs {f}");
+        }
+    }
+
+    /// (e) Storage rounding keeps E_r + E_t ≤ 1 where rounding to the nearest would not,
+    /// errs by less than one ulp, and leaves pairs that fit untouched.
+    #[test]
+    fn stored_pairs_keep_the_white_furnace_law() {
+        use half::f16;
+        let sum = |(a, b): (f32, f32)| f64::from(a) + f64::from(b);
+        // The first two round up to a sum of 1 + 2⁻¹² and 1 + 3.3·10⁻⁴ at the nearest
+        // halves (the second: a negative channel and one above 1, where the ulp is 2⁻¹⁰).
+        for &(r, t) in &[
+            (0.449_95, 0.550_05),
+            (-0.000_65, 1.000_63),
+            (0.04, 0.959_9),
+            (0.5, 0.5),
+            (0.123_456, 0.876_543_9),
+        ] {
+            assert!(r + t <= 1.0);
+            let nearest =
+                f64::from(f16::from_f64(r).to_f32()) + f64::from(f16::from_f64(t).to_f32());
+            let (qr, qt) = store_albedo_pair(r, t, Precision::Half);
+            assert!(
+                sum((qr, qt)) <= 1.0,
+                "{r} {t}: {qr} {qt} (nearest {nearest})"
+            );
+            assert_eq!(f16::from_f32(qr).to_f32(), qr);
+            assert_eq!(f16::from_f32(qt).to_f32(), qt);
+            for (q, v) in [(qr, r), (qt, t)] {
+                let ulp = f16::from_f64(v.abs()).to_f64() * 2f64.powi(-10) + 1e-7;
+                assert!((f64::from(q) - v).abs() <= ulp, "{q} vs {v}");
+            }
+            if nearest <= 1.0 {
+                assert_eq!(
+                    (qr, qt),
+                    (f16::from_f64(r).to_f32(), f16::from_f64(t).to_f32())
+                );
+            }
+            let (fr, ft) = store_albedo_pair(r, t, Precision::Float);
+            assert!(sum((fr, ft)) <= 1.0);
+            assert!((f64::from(fr) - r).abs() < 1e-7 && (f64::from(ft) - t).abs() < 1e-7);
+        }
+        // At least one of the cases needed the rounding down.
+        let needs = |(r, t): (f64, f64)| {
+            f64::from(f16::from_f64(r).to_f32()) + f64::from(f16::from_f64(t).to_f32()) > 1.0
+        };
+        assert!(needs((0.449_95, 0.550_05)) && needs((-0.000_65, 1.000_63)));
+        // A quadrature sum above 1 is renormalised, keeping the split.
+        let (qr, qt) = store_albedo_pair(0.25, 0.7503, Precision::Float);
+        assert!(sum((qr, qt)) <= 1.0 && (f64::from(qr) - 0.25 / 1.0003).abs() < 1e-7);
     }
 
     fn check_texel(lut: &RoughFilmLut, x: usize, y: usize, k: usize, al: usize) {

@@ -5,12 +5,14 @@
 
 use clap::Args;
 use nacre_bake::bake;
-use nacre_bake::diffraction::{HeightSource, ViewSweep};
+use nacre_bake::diffraction::{HeightSource, ViewSweep, par_map_pairs, write_colour_csv};
+use nacre_bake::diffraction_integrated::DEFAULT_INTEGRATED_SAMPLES;
 use nacre_bake::error::{Error, Result};
 use nacre_bake::grid::parse_range;
 use nacre_bake::output::write_atomic;
 use nacre_optics::C64;
 use nacre_optics::colour::Colorimeter;
+use nacre_optics::diffraction::integrated::{IntegratedTable, WarpedAxis};
 use nacre_optics::diffraction::{
     DEFAULT_COHERENCE_DIAMETER_UM, DiffractionSurface, FresnelTerm, SpectralGrid, TaylorTerms,
     max_phase, taylor_order_for,
@@ -29,6 +31,14 @@ reflectance: Stam's BRDF over that of a flat perfect mirror in its specular dire
 mirror gives 1 there), or with --color `view_deg,X,Y,Z,R,G,B` (XYZ under the illuminant,
 perfect reflector Y = 1; R, G, B linear in --space) summed over the --wavelengths grid.
 
+Layouts: a baked table (--table) is evaluated in its own layout. `terms` tables (and height
+fields, by default) sum the Taylor terms per wavelength; `integrated` tables (the fast
+path: wavelength-integrated colour tables I_p(u, v), colour = C * sum_p w^p I_p, bilinear
+in warped (u, v) as a shader samples them) give colours only (--color), on the grid and
+in the colour space they were baked for. `--layout integrated` builds such a table in
+memory from a height field (--integrated-samples texels along v, gamma = 3, covering the
+directions asked for) and evaluates from it.
+
 Height fields: sine:PERIOD_UM:AMPLITUDE_UM, blazed:PERIOD_UM:HEIGHT_UM (one row, whole
 periods over the coherence diameter), cd[:SEED] (tracks 1.6 µm apart, pits 0.1 µm deep),
 bumps:RADIUS_UM:HEIGHT_UM:FILL[:SEED] (Stam's random bumps), or a greyscale PNG (8/16 bit,
@@ -43,7 +53,11 @@ Examples:
   # a measured height map, 0.1 µm per pixel, white = 0.15 µm
   nacre diffraction snake.png --pitch 0.1 --height-scale 0.15 --color
   # from the baked default table
-  nacre diffraction --table cd-tracks --incidence 20 --views -40:40:0.5 --color";
+  nacre diffraction --table cd-tracks --incidence 20 --views -40:40:0.5 --color
+  # from the baked integrated (fast path) table, as a shader would
+  nacre diffraction --table cd-tracks-fast --incidence 20 --views -40:40:0.5 --color
+  # a height field through an integrated table built in memory
+  nacre diffraction sine:1.6:0.05 --coherence 16 --layout integrated --color --views -40:40:1";
 
 #[derive(Args)]
 pub struct DiffractionArgs {
@@ -73,17 +87,20 @@ pub struct DiffractionArgs {
         allow_hyphen_values = true
     )]
     views: String,
-    /// Vacuum wavelengths, nm (the colour grid with --color; within 360-830).
-    #[arg(
-        long,
-        value_name = "START:END:STEP",
-        default_value = "380:780:5",
-        allow_hyphen_values = true
-    )]
-    wavelengths: String,
+    /// Vacuum wavelengths, nm (the colour grid with --color; within 360-830) [default:
+    /// 380:780:5, or an integrated table's grid].
+    #[arg(long, value_name = "START:END:STEP", allow_hyphen_values = true)]
+    wavelengths: Option<String>,
     /// Write colours (view_deg,X,Y,Z,R,G,B) instead of spectra.
     #[arg(long)]
     color: bool,
+    /// Layout to evaluate a height field through: terms or integrated (needs --color)
+    /// [default: terms; a --table uses its own].
+    #[arg(long, value_name = "terms|integrated")]
+    layout: Option<String>,
+    /// Texels along v of an in-memory integrated table (even, 4-4096; u gets half).
+    #[arg(long, value_name = "N")]
+    integrated_samples: Option<usize>,
     /// Sample pitch of the height field, µm (required for files; synthetic: automatic).
     #[arg(long, value_name = "UM")]
     pitch: Option<String>,
@@ -158,40 +175,106 @@ fn angles(name: &str, text: &str) -> Result<Vec<f64>> {
     Ok(v)
 }
 
-/// Everything `nacre diffraction` and `nacre plot diffraction` share: the surface, its
+/// How the colour (and, for terms, the spectrum) is evaluated.
+pub enum Evaluator {
+    /// The Taylor terms, per wavelength.
+    Terms(DiffractionSurface),
+    /// An integrated table (colours only).
+    Integrated(IntegratedTable),
+}
+
+/// Everything `nacre diffraction` and `nacre plot diffraction` share: the evaluator, its
 /// colorimeter and the wavelength grid.
 pub struct Loaded {
-    pub surface: DiffractionSurface,
+    pub evaluator: Evaluator,
     pub colorimeter: Colorimeter,
     pub wavelengths: Vec<f64>,
     pub fresnel: FresnelTerm,
+    /// What the evaluator came from (`--table NAME`, `--layout integrated`), for messages.
+    pub context: String,
 }
 
-/// Loads the surface of `args` for `incidences` × `views` (degrees), checking the sampling.
-#[allow(clippy::too_many_arguments)]
-pub fn load(
-    surface: Option<&str>,
-    table: Option<&str>,
-    wavelengths_text: &str,
-    pitch: Option<&str>,
-    samples: Option<usize>,
-    height_scale: &str,
-    coherence: Option<&str>,
-    fresnel: Option<&str>,
-    colour: [Option<&str>; 3],
-    directions: &[([f64; 3], [f64; 3])],
-) -> Result<Loaded> {
-    let wavelengths = parse_range("--wavelengths", wavelengths_text)?;
+impl Loaded {
+    /// (XYZ, output-space colour) for each light/view pair.
+    pub fn colours(
+        &self,
+        directions: &[([f64; 3], [f64; 3])],
+    ) -> Result<Vec<([f64; 3], [f64; 3])>> {
+        let c = &self.colorimeter;
+        match &self.evaluator {
+            Evaluator::Terms(surface) => {
+                let grid =
+                    SpectralGrid::new(c, &self.wavelengths).map_err(|source| Error::OpticsIn {
+                        context: "--wavelengths".into(),
+                        source,
+                    })?;
+                Ok(par_map_pairs(directions, &|wi, wr| {
+                    let rho: Vec<f64> = self
+                        .wavelengths
+                        .iter()
+                        .map(|&l| surface.relative_reflectance(wi, wr, l, self.fresnel))
+                        .collect();
+                    let xyz = grid.xyz(&rho);
+                    (xyz, c.output_from_xyz(xyz))
+                }))
+            }
+            Evaluator::Integrated(table) => Ok(par_map_pairs(directions, &|wi, wr| {
+                let out = table.colour(wi, wr, self.fresnel);
+                (c.xyz_from_output(out), out)
+            })),
+        }
+    }
+}
+
+/// The sources and options `load` reads.
+pub struct Source<'a> {
+    pub surface: Option<&'a str>,
+    pub table: Option<&'a str>,
+    /// `--wavelengths` as given.
+    pub wavelengths: Option<&'a str>,
+    /// The grid when `--wavelengths` is not given (terms layout).
+    pub default_wavelengths: &'a str,
+    pub pitch: Option<&'a str>,
+    pub samples: Option<usize>,
+    pub height_scale: &'a str,
+    pub coherence: Option<&'a str>,
+    pub fresnel: Option<&'a str>,
+    /// --observer, --illuminant, --space.
+    pub colour: [Option<&'a str>; 3],
+    pub layout: Option<&'a str>,
+    pub integrated_samples: Option<usize>,
+}
+
+fn parse_wavelengths(text: &str) -> Result<Vec<f64>> {
+    let wavelengths = parse_range("--wavelengths", text)?;
     if let Some(l) = wavelengths.iter().find(|l| !(**l >= 360.0 && **l <= 830.0)) {
         return Err(flag(
             "--wavelengths",
-            wavelengths_text,
+            text,
             format!("wavelength {l} nm is outside 360-830 nm"),
         ));
     }
-    let wl_min = wavelengths.iter().copied().fold(f64::INFINITY, f64::min);
-    let wl_max = wavelengths.iter().copied().fold(0.0, f64::max);
-    let fresnel = match fresnel {
+    Ok(wavelengths)
+}
+
+/// Loads the surface or table of `src` for the light/view pairs `directions`, checking
+/// the sampling and the table's range.
+pub fn load(src: &Source, directions: &[([f64; 3], [f64; 3])]) -> Result<Loaded> {
+    let integrated_wanted = match src.layout.map(str::trim) {
+        None | Some("terms") => false,
+        Some("integrated") => true,
+        Some(other) => {
+            return Err(flag("--layout", other, "expected `terms` or `integrated`"));
+        }
+    };
+    if src.integrated_samples.is_some() && !integrated_wanted {
+        return Err(flag(
+            "--integrated-samples",
+            &src.integrated_samples.unwrap_or(0).to_string(),
+            "applies to --layout integrated only",
+        ));
+    }
+    let fresnel = match src.fresnel {
         None => FresnelTerm::Unity,
         Some(text) => {
             let m = nacre_optics::Material::parse_index(text)
@@ -211,16 +294,75 @@ pub fn load(
         .iter()
         .map(|(i, r)| i[2] + r[2])
         .fold(0.0, f64::max);
-    let (terms, sigma_s, table_colour, context) = match (surface, table) {
+    let pick = |given: Option<&str>, table: &Option<String>, default: &str| {
+        given
+            .map(str::to_string)
+            .or_else(|| table.clone())
+            .unwrap_or_else(|| default.to_string())
+    };
+    let colorimeter_of = |table_colour: [Option<String>; 3]| -> Result<Colorimeter> {
+        let o = pick(src.colour[0], &table_colour[0], "1931");
+        let i = pick(src.colour[1], &table_colour[1], "d65");
+        let s = pick(src.colour[2], &table_colour[2], "srgb");
+        Ok(Colorimeter::new(
+            o.parse()
+                .map_err(|e: nacre_optics::Error| flag("--observer", &o, e.to_string()))?,
+            i.parse()
+                .map_err(|e: nacre_optics::Error| flag("--illuminant", &i, e.to_string()))?,
+            s.parse()
+                .map_err(|e: nacre_optics::Error| flag("--space", &s, e.to_string()))?,
+        ))
+    };
+    let (terms, sigma_s, table_colour, context, wavelengths) = match (src.surface, src.table) {
         (_, Some(name)) => {
             let path = bake::resolve_table(name);
             let manifest = bake::Manifest::read(&path)?;
-            let (record, terms) = manifest.load_diffraction(&path)?;
+            let record = manifest.diffraction.clone().ok_or_else(|| Error::Invalid {
+                context: path.display().to_string(),
+                message: format!(
+                    "table `{}` is a `{}` table, not a diffraction table",
+                    manifest.name, manifest.kind
+                ),
+            })?;
+            if let Some(l) = src.layout {
+                return Err(flag(
+                    "--layout",
+                    l,
+                    format!(
+                        "applies to height fields; table `{name}` has the layout \"{}\"",
+                        record.layout
+                    ),
+                ));
+            }
+            let integrated = record.layout == "integrated";
+            let table_grid = format!(
+                "{}:{}:{}",
+                record.wavelength_min_nm, record.wavelength_max_nm, record.wavelength_step_nm
+            );
+            let wavelengths = match (src.wavelengths, integrated) {
+                (Some(text), true) => {
+                    let w = parse_wavelengths(text)?;
+                    if w != parse_range("--wavelengths", &table_grid)? {
+                        return Err(flag(
+                            "--wavelengths",
+                            text,
+                            format!(
+                                "table `{name}` has the integrated layout: its colours are summed over {table_grid} nm (leave --wavelengths out)"
+                            ),
+                        ));
+                    }
+                    w
+                }
+                (None, true) => parse_range("--wavelengths", &table_grid)?,
+                (text, false) => parse_wavelengths(text.unwrap_or(src.default_wavelengths))?,
+            };
+            let wl_min = wavelengths.iter().copied().fold(f64::INFINITY, f64::min);
+            let wl_max = wavelengths.iter().copied().fold(0.0, f64::max);
             if wl_min < record.wavelength_min_nm - 1e-9 || wl_max > record.wavelength_max_nm + 1e-9
             {
                 return Err(flag(
                     "--wavelengths",
-                    wavelengths_text,
+                    src.wavelengths.unwrap_or(src.default_wavelengths),
                     format!(
                         "table `{name}` serves {}-{} nm",
                         record.wavelength_min_nm, record.wavelength_max_nm
@@ -241,7 +383,7 @@ pub fn load(
                     ),
                 });
             }
-            if coherence.is_some() || pitch.is_some() || samples.is_some() {
+            if src.coherence.is_some() || src.pitch.is_some() || src.samples.is_some() {
                 return Err(flag(
                     "--table",
                     name,
@@ -253,15 +395,68 @@ pub fn load(
                 Some(manifest.illuminant.clone()),
                 Some(manifest.space.clone()),
             ];
-            (terms, record.sigma_s_um, c, format!("--table {name}"))
+            if integrated {
+                let colorimeter = colorimeter_of(c.clone())?;
+                let baked = manifest.colorimeter(&path)?;
+                for (given, flag_name, same) in [
+                    (
+                        src.colour[0],
+                        "--observer",
+                        colorimeter.observer() == baked.observer(),
+                    ),
+                    (
+                        src.colour[1],
+                        "--illuminant",
+                        colorimeter.illuminant() == baked.illuminant(),
+                    ),
+                    (
+                        src.colour[2],
+                        "--space",
+                        colorimeter.space() == baked.space(),
+                    ),
+                ] {
+                    if let (Some(v), false) = (given, same) {
+                        return Err(flag(
+                            flag_name,
+                            v,
+                            format!(
+                                "table `{name}` has the integrated layout, baked for observer {}, illuminant {} and space {}",
+                                baked.observer(),
+                                baked.illuminant(),
+                                baked.space()
+                            ),
+                        ));
+                    }
+                }
+                let (_, table) = manifest.load_diffraction_integrated(&path)?;
+                return Ok(Loaded {
+                    evaluator: Evaluator::Integrated(table),
+                    colorimeter,
+                    wavelengths,
+                    fresnel,
+                    context: format!("--table {name}"),
+                });
+            }
+            let (record, terms) = manifest.load_diffraction(&path)?;
+            (
+                terms,
+                record.sigma_s_um,
+                c,
+                format!("--table {name}"),
+                wavelengths,
+            )
         }
         (Some(text), None) => {
-            let coherence_um = match coherence {
+            let wavelengths =
+                parse_wavelengths(src.wavelengths.unwrap_or(src.default_wavelengths))?;
+            let wl_min = wavelengths.iter().copied().fold(f64::INFINITY, f64::min);
+            let coherence_um = match src.coherence {
                 Some(t) => positive("--coherence", t)?,
                 None => DEFAULT_COHERENCE_DIAMETER_UM,
             };
-            let pitch_um = pitch.map(|t| positive("--pitch", t)).transpose()?;
-            let scale = height_scale
+            let pitch_um = src.pitch.map(|t| positive("--pitch", t)).transpose()?;
+            let scale = src
+                .height_scale
                 .trim()
                 .parse::<f64>()
                 .ok()
@@ -269,15 +464,15 @@ pub fn load(
                 .ok_or_else(|| {
                     flag(
                         "--height-scale",
-                        height_scale,
+                        src.height_scale,
                         "expected a finite non-negative number of micrometres",
                     )
                 })?;
-            if samples == Some(0) {
+            if src.samples == Some(0) {
                 return Err(flag("--samples", "0", "expected at least 1"));
             }
             let source = HeightSource::parse("FILE|SPEC", text)?;
-            let field = source.load(text, "--pitch", coherence_um, pitch_um, samples, scale)?;
+            let field = source.load(text, "--pitch", coherence_um, pitch_um, src.samples, scale)?;
             let x = max_phase(&field, wl_min, w_max);
             let (order, bound) =
                 taylor_order_for(x, TAYLOR_TOLERANCE).map_err(|source| Error::OpticsIn {
@@ -295,10 +490,12 @@ pub fn load(
                 coherence_um / 4.0,
                 [None, None, None],
                 text.to_string(),
+                wavelengths,
             )
         }
         (None, None) => unreachable!("clap requires FILE|SPEC or --table"),
     };
+    let wl_min = wavelengths.iter().copied().fold(f64::INFINITY, f64::min);
     let surface = DiffractionSurface::new(terms, sigma_s).map_err(|source| Error::OpticsIn {
         context: context.clone(),
         source,
@@ -309,28 +506,44 @@ pub fn load(
             context: format!("{context} with --views/--incidence and --wavelengths"),
             source,
         })?;
-    let pick = |given: Option<&str>, table: &Option<String>, default: &str| {
-        given
-            .map(str::to_string)
-            .or_else(|| table.clone())
-            .unwrap_or_else(|| default.to_string())
+    let colorimeter = colorimeter_of(table_colour)?;
+    let evaluator = if integrated_wanted {
+        let n = src.integrated_samples.unwrap_or(DEFAULT_INTEGRATED_SAMPLES);
+        let axis =
+            WarpedAxis::new(max_uv.clamp(1e-3, 2.0), 3.0, n).map_err(|source| Error::OpticsIn {
+                context: "--integrated-samples".into(),
+                source,
+            })?;
+        let grid =
+            SpectralGrid::new(&colorimeter, &wavelengths).map_err(|source| Error::OpticsIn {
+                context: "--wavelengths".into(),
+                source,
+            })?;
+        eprintln!(
+            "nacre: integrated table of {} x {n} texels x {} layers over |u|, |v| <= {:.4}",
+            n / 2,
+            2 * surface.terms().order() + 1,
+            axis.max_uv
+        );
+        Evaluator::Integrated(IntegratedTable::compute(
+            &surface,
+            &grid,
+            &colorimeter,
+            axis,
+        ))
+    } else {
+        Evaluator::Terms(surface)
     };
-    let o = pick(colour[0], &table_colour[0], "1931");
-    let i = pick(colour[1], &table_colour[1], "d65");
-    let s = pick(colour[2], &table_colour[2], "srgb");
-    let colorimeter = Colorimeter::new(
-        o.parse()
-            .map_err(|e: nacre_optics::Error| flag("--observer", &o, e.to_string()))?,
-        i.parse()
-            .map_err(|e: nacre_optics::Error| flag("--illuminant", &i, e.to_string()))?,
-        s.parse()
-            .map_err(|e: nacre_optics::Error| flag("--space", &s, e.to_string()))?,
-    );
     Ok(Loaded {
-        surface,
+        evaluator,
         colorimeter,
         wavelengths,
         fresnel,
+        context: if integrated_wanted {
+            "--layout integrated".into()
+        } else {
+            context
+        },
     })
 }
 
@@ -353,43 +566,53 @@ pub fn run(args: &DiffractionArgs) -> Result<()> {
         .iter()
         .map(|&v| nacre_optics::diffraction::in_plane_directions(incidence, v))
         .collect();
+    if args.layout.as_deref().map(str::trim) == Some("integrated") && !args.color {
+        return Err(flag(
+            "--layout",
+            "integrated",
+            "the integrated layout holds colours summed over wavelengths: add --color, or use the terms layout for per-wavelength reflectance",
+        ));
+    }
     let loaded = load(
-        args.surface.as_deref(),
-        args.table.as_deref(),
-        &args.wavelengths,
-        args.pitch.as_deref(),
-        args.samples,
-        &args.height_scale,
-        args.coherence.as_deref(),
-        args.fresnel.as_deref(),
-        [
-            args.observer.as_deref(),
-            args.illuminant.as_deref(),
-            args.space.as_deref(),
-        ],
+        &Source {
+            surface: args.surface.as_deref(),
+            table: args.table.as_deref(),
+            wavelengths: args.wavelengths.as_deref(),
+            default_wavelengths: "380:780:5",
+            pitch: args.pitch.as_deref(),
+            samples: args.samples,
+            height_scale: &args.height_scale,
+            coherence: args.coherence.as_deref(),
+            fresnel: args.fresnel.as_deref(),
+            colour: [
+                args.observer.as_deref(),
+                args.illuminant.as_deref(),
+                args.space.as_deref(),
+            ],
+            layout: args.layout.as_deref(),
+            integrated_samples: args.integrated_samples,
+        },
         &directions,
     )?;
+    if args.color {
+        let colours = loaded.colours(&directions)?;
+        return write_atomic(&args.output, |w| write_colour_csv(w, &views, &colours));
+    }
+    let Evaluator::Terms(surface) = &loaded.evaluator else {
+        return Err(Error::Invalid {
+            context: loaded.context.clone(),
+            message: "the integrated layout holds colours summed over wavelengths, not spectra: add --color, or use a terms table for per-wavelength reflectance".into(),
+        });
+    };
     let sweep = ViewSweep {
-        surface: &loaded.surface,
+        surface,
         incidence_deg: incidence,
         views_deg: &views,
         wavelengths_nm: &loaded.wavelengths,
         fresnel: loaded.fresnel,
     };
     let rho = sweep.reflectance();
-    if args.color {
-        let grid =
-            SpectralGrid::new(&loaded.colorimeter, &loaded.wavelengths).map_err(|source| {
-                Error::OpticsIn {
-                    context: "--wavelengths".into(),
-                    source,
-                }
-            })?;
-        let colours = sweep.colours(&rho, &grid, &loaded.colorimeter);
-        write_atomic(&args.output, |w| sweep.write_colour_csv(w, &colours))
-    } else {
-        write_atomic(&args.output, |w| sweep.write_reflectance_csv(w, &rho))
-    }
+    write_atomic(&args.output, |w| sweep.write_reflectance_csv(w, &rho))
 }
 
 pub const MAP_EXAMPLES: &str = "\
@@ -430,9 +653,17 @@ pub struct MapArgs {
     /// Cells per side of the map (16 to 1024).
     #[arg(long, default_value_t = 161)]
     cells: usize,
-    /// Wavelength grid of the colour sums, nm.
-    #[arg(long, value_name = "START:END:STEP", default_value = "380:780:10")]
-    wavelengths: String,
+    /// Wavelength grid of the colour sums, nm [default: 380:780:10, or an integrated
+    /// table's grid].
+    #[arg(long, value_name = "START:END:STEP")]
+    wavelengths: Option<String>,
+    /// Layout to evaluate a height field through: terms or integrated [default: terms; a
+    /// --table uses its own].
+    #[arg(long, value_name = "terms|integrated")]
+    layout: Option<String>,
+    /// Texels along v of an in-memory integrated table (even, 4-4096; u gets half).
+    #[arg(long, value_name = "N")]
+    integrated_samples: Option<usize>,
     /// Exposure: a positive factor, or `auto`.
     #[arg(long, default_value = "auto")]
     exposure: String,
@@ -511,39 +742,58 @@ pub fn run_map(args: &MapArgs) -> Result<()> {
         .map(|r| (wi, r))
         .collect();
     let loaded = load(
-        args.surface.as_deref(),
-        args.table.as_deref(),
-        &args.wavelengths,
-        args.pitch.as_deref(),
-        args.samples,
-        &args.height_scale,
-        args.coherence.as_deref(),
-        None,
-        [None, None, None],
+        &Source {
+            surface: args.surface.as_deref(),
+            table: args.table.as_deref(),
+            wavelengths: args.wavelengths.as_deref(),
+            default_wavelengths: "380:780:10",
+            pitch: args.pitch.as_deref(),
+            samples: args.samples,
+            height_scale: &args.height_scale,
+            coherence: args.coherence.as_deref(),
+            fresnel: None,
+            colour: [None, None, None],
+            layout: args.layout.as_deref(),
+            integrated_samples: args.integrated_samples,
+        },
         &directions,
     )?;
-    let grid = SpectralGrid::new(&loaded.colorimeter, &loaded.wavelengths).map_err(|source| {
-        Error::OpticsIn {
-            context: "--wavelengths".into(),
-            source,
-        }
-    })?;
     let name = args
         .surface
         .clone()
         .or_else(|| args.table.clone())
         .unwrap_or_default();
-    let map = nacre_bake::diffraction::DiffractionMap::compute(
-        String::new(),
-        &loaded.surface,
-        incidence,
-        max_view,
-        args.cells,
-        &grid,
-        &loaded.colorimeter,
-        loaded.fresnel,
-        exposure,
-    );
+    let map = match &loaded.evaluator {
+        Evaluator::Terms(surface) => {
+            let grid =
+                SpectralGrid::new(&loaded.colorimeter, &loaded.wavelengths).map_err(|source| {
+                    Error::OpticsIn {
+                        context: "--wavelengths".into(),
+                        source,
+                    }
+                })?;
+            nacre_bake::diffraction::DiffractionMap::compute(
+                String::new(),
+                surface,
+                incidence,
+                max_view,
+                args.cells,
+                &grid,
+                &loaded.colorimeter,
+                loaded.fresnel,
+                exposure,
+            )
+        }
+        Evaluator::Integrated(table) => nacre_bake::diffraction::DiffractionMap::compute_with(
+            String::new(),
+            &|wi, wr| table.colour(wi, wr, loaded.fresnel),
+            incidence,
+            max_view,
+            args.cells,
+            &loaded.colorimeter,
+            exposure,
+        ),
+    };
     let title = format!(
         "diffraction map of {name}: light at {incidence}°, views to {max_view}°, exposure {:.3}",
         map.exposure

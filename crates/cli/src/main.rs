@@ -77,8 +77,10 @@ enum Command {
 const BENCH_GPU_EXAMPLES: &str = "\
 Every pass shades each pixel of a WIDTHxHEIGHT target with the same GGX microfacet material
 (shaders/bench.wgsl); only the Fresnel term differs: Schlick (plain), film_lut, film_fourier
-(M harmonics) or film_spectral (N wavelengths). Times are GPU timestamps of the render pass
-where the adapter supports them, else wall clock per frame; the median is reported.
+(M harmonics) or film_spectral (N wavelengths). A last pass times the diffraction technique
+at the same resolution (one directional light per pixel, the --diffraction table, Sigma over
+the --diffraction-step grid). Times are GPU timestamps of the render pass where the adapter
+supports them, else wall clock per frame; the median is reported.
 
 Examples:
   # 1920x1080, 30 frames per pass, default tables (film-dielectric + fourier-srgb)
@@ -106,6 +108,12 @@ struct BenchGpuArgs {
     /// Tables to load (repeatable) [default: film-dielectric + fourier-srgb].
     #[arg(long = "tables", value_name = "NAME|PATH")]
     tables: Vec<String>,
+    /// The diffraction table of the `diffraction` pass (default-set name or manifest path).
+    #[arg(long, value_name = "NAME|PATH", default_value = "cd-tracks")]
+    diffraction: String,
+    /// Wavelength step of the `diffraction` pass's colour sum, nm (as `nacre render`).
+    #[arg(long, value_name = "NM", default_value_t = 10.0)]
+    diffraction_step: f64,
 }
 
 const BAKE_EXAMPLES: &str = "\
@@ -249,6 +257,8 @@ Examples:
   nacre render --scene rough-row --reference-samples 1024 -o rough-row.png
   # a glTF 2.0 / GLB scene with KHR_materials_iridescence (meshes rasterised, camera fitted)
   nacre render --gltf tests/golden/gltf/sweep-thickness.glb --width 1000 --height 260 -o sweep.png
+  # diffraction (technique `diffraction`, tables cd-tracks / snake-ridges): a CD and snake scales
+  nacre render --scene cd-disc -o cd.png && nacre render --scene snake-skin -o snake.png
 
 With --gltf, each material maps onto nacre's: iridescenceIor → film index, d = mix(thickness
 minimum, maximum, g) with g the thickness texture's green channel (PNG; g = 1 without one),
@@ -259,9 +269,11 @@ film-lut table cannot represent is drawn with fourier instead (a note on stderr 
 
 #[derive(Args)]
 struct RenderArgs {
-    /// Scene: sphere, bubble, plane, or rough-row (spheres of GGX α 0.05 … 0.8 by the
-    /// film-at-n·v shortcut, the exact path and the Monte Carlo reference, three rows).
-    #[arg(long, default_value = "sphere", value_parser = ["sphere", "bubble", "plane", "rough-row"])]
+    /// Scene: sphere, bubble, plane, rough-row (spheres of GGX α 0.05 … 0.8 by the
+    /// film-at-n·v shortcut, the exact path and the Monte Carlo reference, three rows), or a
+    /// diffraction scene: cd-disc (a CD-like disc with circular tracks; table cd-tracks) or
+    /// snake-skin (a curved patch of scales with fanned ridges; table snake-ridges).
+    #[arg(long, default_value = "sphere", value_parser = ["sphere", "bubble", "plane", "rough-row", "cd-disc", "snake-skin"])]
     scene: String,
     /// How the film enters the lighting: classic (the film at v·h for the light, at n·v for
     /// a box-filtered environment), nv (the engines' shortcut: the film once at n·v for
@@ -279,7 +291,8 @@ struct RenderArgs {
     #[arg(long, value_name = "FILE.glb", conflicts_with_all = ["scene", "thickness_map"])]
     gltf: Option<PathBuf>,
     /// A table to load (repeatable): default-set name or manifest path [default: the scene's
-    /// film-lut (sphere film-dielectric, bubble soap-film, plane oil-slick) + fourier-srgb].
+    /// film-lut (sphere film-dielectric, bubble soap-film, plane oil-slick) + fourier-srgb;
+    /// cd-disc and snake-skin take one diffraction table: cd-tracks, snake-ridges].
     #[arg(long = "tables", value_name = "NAME|PATH")]
     tables: Vec<String>,
     /// Technique: lut, fourier or spectral.
@@ -307,6 +320,13 @@ struct RenderArgs {
     /// Wavelengths N of the spectral technique (1 to 4096) [default: 30].
     #[arg(long, value_name = "N")]
     wavelengths: Option<usize>,
+    /// Diffraction scenes: wavelength step of the colour sum, nm, over the table's range (the
+    /// table's own step, 5 nm for the default set, is the CPU's grid).
+    #[arg(long, value_name = "NM", default_value_t = 10.0)]
+    wavelength_step: f64,
+    /// Diffraction scenes: brightest environment directions diffracted like the light (0 to 8).
+    #[arg(long, value_name = "K", default_value_t = 4)]
+    env_samples: usize,
     /// Output PNG file.
     #[arg(short = 'o', long = "output", value_name = "FILE.png")]
     output: PathBuf,
@@ -808,6 +828,12 @@ fn run_render(args: &RenderArgs) -> Result<()> {
     if args.scene == "rough-row" {
         return run_render_rough_row(args);
     }
+    if let Ok(scene) = args
+        .scene
+        .parse::<nacre_runtime::diffraction::DiffractionScene>()
+    {
+        return run_render_diffraction(args, scene);
+    }
     let scene: SceneKind = args.scene.parse().map_err(runtime_error)?;
     let film_eval: FilmEval = args.film_eval.parse().map_err(runtime_error)?;
     let technique = match args.technique.as_str() {
@@ -908,6 +934,82 @@ fn run_render(args: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
+/// `nacre render --scene cd-disc | snake-skin`: the `diffraction` technique.
+fn run_render_diffraction(
+    args: &RenderArgs,
+    scene: nacre_runtime::diffraction::DiffractionScene,
+) -> Result<()> {
+    use nacre_runtime::GpuContext;
+    use nacre_runtime::diffraction::{
+        DiffractionSceneOptions, DiffractionTable, render_diffraction_scene, wavelength_grid,
+    };
+    let name = match args.tables.as_slice() {
+        [] => scene.default_table().to_string(),
+        [one] => one.clone(),
+        _ => {
+            return Err(nacre_bake::error::Error::Invalid {
+                context: "--tables".into(),
+                message: format!("the {} scene takes one diffraction table", scene.name()),
+            });
+        }
+    };
+    let mut options = DiffractionSceneOptions::new(scene);
+    options.width = args.width;
+    options.height = args.height;
+    options.environment = args.env.clone();
+    options.exposure_ev = args.exposure;
+    options.env_samples = args.env_samples;
+    options.technique.wavelength_step_nm = Some(args.wavelength_step);
+    // Check the settings and read every input before starting the GPU: bad input fails fast.
+    options.validate().map_err(runtime_error)?;
+    let path = bake::resolve_table(&name);
+    let manifest = bake::Manifest::read(&path)?;
+    let record = manifest
+        .diffraction
+        .clone()
+        .ok_or_else(|| nacre_bake::error::Error::Invalid {
+            context: path.display().to_string(),
+            message: format!(
+                "table `{}` is a `{}` table; the {} scene needs a diffraction table",
+                manifest.name,
+                manifest.kind,
+                scene.name()
+            ),
+        })?;
+    wavelength_grid(&record, Some(args.wavelength_step)).map_err(|_| {
+        nacre_bake::error::Error::Invalid {
+            context: "--wavelength-step".into(),
+            message: format!(
+                "{} nm over {}–{} nm (expected 2 to 4096 wavelengths)",
+                args.wavelength_step, record.wavelength_min_nm, record.wavelength_max_nm
+            ),
+        }
+    })?;
+    if let Some(path) = &options.environment {
+        nacre_runtime::render::EnvironmentMap::load(path).map_err(runtime_error)?;
+    }
+    let ctx = GpuContext::new_headless().map_err(runtime_error)?;
+    eprintln!("adapter: {}", ctx.describe());
+    let table = DiffractionTable::load(&ctx, &path).map_err(runtime_error)?;
+    let start = std::time::Instant::now();
+    let image = render_diffraction_scene(&ctx, &table, &options).map_err(runtime_error)?;
+    let total = start.elapsed().as_secs_f64();
+    let png = image.encode_png().map_err(runtime_error)?;
+    write_atomic(&args.output, |w| w.write_all(&png))?;
+    eprintln!(
+        "rendered {} (diffraction, {}, {} nm step) at {}x{} in {:.2} s (render pass {:.2} s) -> {}",
+        scene.name(),
+        table.name,
+        args.wavelength_step,
+        image.width,
+        image.height,
+        total,
+        image.gpu_seconds,
+        args.output.display()
+    );
+    Ok(())
+}
+
 /// `nacre render --scene rough-row`: the shortcut, exact and Monte Carlo rows.
 fn run_render_rough_row(args: &RenderArgs) -> Result<()> {
     use nacre_runtime::rough_reference::{RoughRowOptions, render_rough_row};
@@ -970,8 +1072,9 @@ fn run_render_rough_row(args: &RenderArgs) -> Result<()> {
 }
 
 fn run_bench_gpu(args: &BenchGpuArgs) -> Result<()> {
-    use nacre_runtime::bench::{BenchOptions, BenchPass, run_bench};
+    use nacre_runtime::bench::{BenchOptions, BenchPass, run_bench_with_diffraction};
     use nacre_runtime::bindings::TechniqueOptions;
+    use nacre_runtime::diffraction::{DiffractionOptions, DiffractionTable};
     use nacre_runtime::{GpuContext, TableSet, Technique};
     let names: Vec<String> = if args.tables.is_empty() {
         vec!["film-dielectric".into(), "fourier-srgb".into()]
@@ -981,6 +1084,12 @@ fn run_bench_gpu(args: &BenchGpuArgs) -> Result<()> {
     for name in &names {
         bake::Manifest::read(&bake::resolve_table(name))?;
     }
+    let diffraction_path = bake::resolve_table(&args.diffraction);
+    bake::Manifest::read(&diffraction_path)?;
+    let diffraction_options = DiffractionOptions {
+        wavelength_step_nm: Some(args.diffraction_step),
+        ..DiffractionOptions::default()
+    };
     let mut technique = TechniqueOptions {
         harmonics: args.harmonics,
         ..Default::default()
@@ -1001,17 +1110,26 @@ fn run_bench_gpu(args: &BenchGpuArgs) -> Result<()> {
             .add(&ctx, &bake::resolve_table(name))
             .map_err(runtime_error)?;
     }
+    let diffraction = DiffractionTable::load(&ctx, &diffraction_path).map_err(runtime_error)?;
     let passes = [
         BenchPass::Plain,
         BenchPass::Film(Technique::Lut),
         BenchPass::Film(Technique::Fourier),
         BenchPass::Film(Technique::Spectral),
+        BenchPass::Diffraction,
     ];
-    let results = run_bench(&ctx, &tables, &passes, &options).map_err(runtime_error)?;
+    let results = run_bench_with_diffraction(
+        &ctx,
+        &tables,
+        Some((&diffraction, &diffraction_options)),
+        &passes,
+        &options,
+    )
+    .map_err(runtime_error)?;
     let plain = results[0].median_ms;
     let lut = results[1].median_ms;
     println!(
-        "{}x{}, {} frames per pass, {} (fourier M = {}, spectral N = {})",
+        "{}x{}, {} frames per pass, {} (fourier M = {}, spectral N = {}, diffraction {} at a {} nm step)",
         args.width,
         args.height,
         args.frames,
@@ -1021,7 +1139,9 @@ fn run_bench_gpu(args: &BenchGpuArgs) -> Result<()> {
             "wall clock (no timestamp queries)"
         },
         args.harmonics,
-        args.wavelengths
+        args.wavelengths,
+        diffraction.name,
+        args.diffraction_step
     );
     println!(
         "{:<22} {:>11} {:>11} {:>10} {:>10}",

@@ -65,6 +65,19 @@ max_opd_nm = 2000.0
 levels = 2
 ";
 
+/// A small valid `diffraction` recipe of layout "integrated"; line 3 synthetic,
+/// 8 integrated_samples, 9 integrated_tolerance.
+const INTEGRATED: &str = "kind = \"diffraction\"
+[height_field]
+synthetic = \"sine:1.6:0.05\"
+[diffraction]
+layout = \"integrated\"
+coherence_diameter_um = 16.0
+wavelengths = \"380:780:20\"
+integrated_samples = 32
+integrated_tolerance = 0.01
+";
+
 /// A refractiveindex.info file with a tabulated n,k section; data rows on lines 4–6.
 const YAML: &str = "DATA:
   - type: tabulated nk
@@ -320,6 +333,38 @@ fn fixtures(d: &Path) -> Vec<Case> {
         ),
         ("fourier-negative-opd", edited(FOURIER, "2000.0", "-1.0")),
         ("fourier-nan-opd", edited(FOURIER, "2000.0", "nan")),
+        (
+            "integrated-zero-tolerance",
+            edited(
+                INTEGRATED,
+                "integrated_tolerance = 0.01",
+                "integrated_tolerance = 0.0",
+            ),
+        ),
+        (
+            "integrated-absurd-samples",
+            edited(
+                INTEGRATED,
+                "integrated_samples = 32",
+                "integrated_samples = 1000000000",
+            ),
+        ),
+        (
+            "integrated-too-large",
+            edited(
+                INTEGRATED,
+                "integrated_samples = 32",
+                "integrated_samples = 4096\ntaylor_tolerance = 1e-12",
+            ),
+        ),
+        (
+            "integrated-keys-on-terms",
+            edited(INTEGRATED, "layout = \"integrated\"", "layout = \"terms\""),
+        ),
+        (
+            "integrated-tall",
+            edited(INTEGRATED, "sine:1.6:0.05", "blazed:2.5:1.0"),
+        ),
     ];
     for (name, text) in recipes {
         write(&d.join(format!("r/{name}.toml")), text);
@@ -711,6 +756,47 @@ fn fixtures(d: &Path) -> Vec<Case> {
             &["binary.toml", "UTF-8"],
         ),
         with("recipe: a folder", bake("folder.toml"), &["folder.toml"]),
+        with(
+            "recipe: integrated tolerance zero",
+            bake("integrated-zero-tolerance.toml"),
+            &[
+                "integrated-zero-tolerance.toml:9",
+                "integrated_tolerance",
+                "positive",
+            ],
+        ),
+        with(
+            "recipe: integrated resolution absurd",
+            bake("integrated-absurd-samples.toml"),
+            &[
+                "integrated-absurd-samples.toml:8",
+                "integrated_samples",
+                "4096",
+            ],
+        ),
+        with(
+            "recipe: integrated table beyond the size limit",
+            bake("integrated-too-large.toml"),
+            &["integrated-too-large.toml:8", "bytes", "limit"],
+        ),
+        with(
+            "recipe: integrated keys on the terms layout",
+            bake("integrated-keys-on-terms.toml"),
+            &[
+                "integrated-keys-on-terms.toml:8",
+                "layout = \"integrated\" only",
+            ],
+        ),
+        with(
+            "recipe: integrated layout of a tall structure",
+            bake("integrated-tall.toml"),
+            &[
+                "integrated-tall.toml",
+                "exceeds integrated_tolerance 0.01",
+                "cancels catastrophically",
+                "layout = \"terms\"",
+            ],
+        ),
         // --- material YAML / CSV ---
         with(
             "yaml: wavelengths not increasing",
@@ -992,6 +1078,22 @@ fn fixtures(d: &Path) -> Vec<Case> {
             "runtime: table beyond the device's 3-D texture limit",
             render(&["--tables", "good/wide.json", "--tables", "fourier-srgb"]),
             &["film-lut `wide` cos θ axis needs 20000", "at most"],
+        ),
+        // --- diffraction scenes ---
+        with(
+            "render: diffraction wavelength step 0",
+            render(&["--scene", "cd-disc", "--wavelength-step", "0"]),
+            &["--wavelength-step", "0 nm"],
+        ),
+        with(
+            "render: diffraction environment samples beyond 8",
+            render(&["--scene", "snake-skin", "--env-samples", "99"]),
+            &["99"],
+        ),
+        with(
+            "render: diffraction scene given a film-lut table",
+            render(&["--scene", "cd-disc", "--tables", "film-dielectric"]),
+            &["film-dielectric", "diffraction table"],
         ),
         // --- flags ---
         case(

@@ -585,6 +585,7 @@ fn bench_gpu_reports_every_pass() {
         "film_lut",
         "film_fourier",
         "film_spectral",
+        "diffraction",
     ] {
         let line = stdout
             .lines()

@@ -68,6 +68,14 @@ fn recipes() -> Vec<(&'static str, String)> {
                 .to_string(),
         ),
     ];
+    // A diffraction table of layout "integrated" (rows of texels in parallel), on a
+    // 2-D field so that the window's y factor is exercised; coarse, hence the loose
+    // tolerance.
+    v.push((
+        "diffraction-integrated",
+        "kind = \"diffraction\"\n[colour]\nspace = \"rec2020\"\n[height_field]\nsynthetic = \"cd:3\"\nsamples = 64\npitch_um = 0.125\n[diffraction]\nlayout = \"integrated\"\ncoherence_diameter_um = 8.0\nwavelengths = \"380:780:20\"\ntaylor_tolerance = 1e-3\nintegrated_samples = 32\nintegrated_tolerance = 1.0\n"
+            .to_string(),
+    ));
     // Kinds added later: their default recipe with small counts, when the default set has
     // one.
     let rough = repo().join("tables/recipes/rough-film-dielectric.toml");

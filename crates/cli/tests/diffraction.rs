@@ -147,6 +147,94 @@ fn the_default_table_evaluates_like_its_height_field() {
     assert!(r1.iter().any(|r| r[2] > 1e-3));
 }
 
+/// `view_deg,X,Y,Z,R,G,B` rows of a `--color` run.
+fn colour_rows(o: &Output) -> Vec<Vec<f64>> {
+    let (header, rows) = rows(o);
+    assert_eq!(header, "view_deg,X,Y,Z,R,G,B");
+    rows
+}
+
+/// The largest |ΔR|, |ΔG|, |ΔB| between two colour runs over the same views.
+fn max_rgb_difference(a: &[Vec<f64>], b: &[Vec<f64>]) -> (f64, f64) {
+    assert_eq!(a.len(), b.len());
+    let mut worst = (0.0, 0.0);
+    for (a, b) in a.iter().zip(b) {
+        assert_eq!(a[0], b[0]);
+        for c in 4..7 {
+            let d = (a[c] - b[c]).abs();
+            if d > worst.0 {
+                worst = (d, a[0]);
+            }
+        }
+    }
+    worst
+}
+
+#[test]
+fn the_integrated_default_table_gives_the_colours_of_the_terms_table() {
+    // cd-tracks-fast is cd-tracks summed over wavelengths: the same colours within the
+    // integrated_tolerance its bake measured (0.01 of the specular white, which is
+    // RGB = (1, 1, 1)), read as a shader reads the table.
+    let dir = tempfile::tempdir().unwrap();
+    for incidence in ["0", "10", "-30"] {
+        let common = [
+            "--incidence",
+            incidence,
+            "--views",
+            "-44:44:0.25",
+            "--color",
+        ];
+        let mut a = vec!["diffraction", "--table", "cd-tracks-fast"];
+        a.extend(common);
+        let fast = nacre(&a, dir.path());
+        assert!(fast.status.success(), "{}", stderr(&fast));
+        let mut b = vec!["diffraction", "--table", "cd-tracks"];
+        b.extend(common);
+        let terms = nacre(&b, dir.path());
+        assert!(terms.status.success(), "{}", stderr(&terms));
+        let (fast, terms) = (colour_rows(&fast), colour_rows(&terms));
+        let (worst, at) = max_rgb_difference(&fast, &terms);
+        eprintln!("incidence {incidence}°: max |ΔRGB| {worst:.2e} at view {at}°");
+        assert!(worst < 0.01, "incidence {incidence}: {worst} at {at}");
+        // The specular highlight and the orders are there, not just agreement near zero.
+        assert!(terms.iter().any(|r| r[5] > 0.1));
+        // XYZ is the inverse of the output matrix applied to the stored RGB.
+        for (f, t) in fast.iter().zip(&terms) {
+            assert!((f[2] - t[2]).abs() < 0.02, "{f:?} {t:?}");
+        }
+    }
+}
+
+#[test]
+fn an_in_memory_integrated_table_evaluates_a_height_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let common = [
+        "sine:1.6:0.05",
+        "--coherence",
+        "16",
+        "--incidence",
+        "10",
+        "--views",
+        "-30:30:0.25",
+        "--wavelengths",
+        "380:780:10",
+        "--color",
+    ];
+    let mut a = vec!["diffraction"];
+    a.extend(common);
+    a.extend(["--layout", "integrated"]);
+    let fast = nacre(&a, dir.path());
+    assert!(fast.status.success(), "{}", stderr(&fast));
+    assert!(stderr(&fast).contains("integrated table of 128 x 256 texels"));
+    let mut b = vec!["diffraction"];
+    b.extend(common);
+    let terms = nacre(&b, dir.path());
+    assert!(terms.status.success(), "{}", stderr(&terms));
+    let (worst, at) = max_rgb_difference(&colour_rows(&fast), &colour_rows(&terms));
+    eprintln!("sine grating, --layout integrated: max |ΔRGB| {worst:.2e} at view {at}°");
+    assert!(worst < 0.01, "{worst} at {at}");
+}
+
 #[test]
 fn bad_input_exits_2_naming_the_flag() {
     let dir = tempfile::tempdir().unwrap();
@@ -177,6 +265,57 @@ fn bad_input_exits_2_naming_the_flag() {
             "--wavelengths",
         ),
         (&["--table", "no-such-table"], "no-such-table"),
+        // The integrated layout holds colours, summed over its own grid and colour space.
+        (
+            &["--table", "cd-tracks-fast", "--views", "-40:40:1"],
+            "--color",
+        ),
+        (
+            &[
+                "--table",
+                "cd-tracks-fast",
+                "--color",
+                "--wavelengths",
+                "400:700:10",
+            ],
+            "380:780:5",
+        ),
+        (
+            &[
+                "--table",
+                "cd-tracks-fast",
+                "--color",
+                "--space",
+                "rec2020",
+                "--views",
+                "0:10:1",
+            ],
+            "--space",
+        ),
+        (
+            &["--table", "cd-tracks", "--layout", "integrated", "--color"],
+            "--layout",
+        ),
+        (&["sine:1.6:0.05", "--layout", "integrated"], "--color"),
+        (
+            &["sine:1.6:0.05", "--layout", "fast", "--color"],
+            "--layout",
+        ),
+        (
+            &["sine:1.6:0.05", "--integrated-samples", "64", "--color"],
+            "--integrated-samples",
+        ),
+        (
+            &[
+                "sine:1.6:0.05",
+                "--layout",
+                "integrated",
+                "--integrated-samples",
+                "7",
+                "--color",
+            ],
+            "--integrated-samples",
+        ),
     ];
     for (args, needle) in cases {
         let mut a = vec!["diffraction"];
@@ -236,6 +375,17 @@ fn diffraction_map_png() {
             &["sine:1.6:0.05", "--exposure", "0", "-o", "m.png"][..],
             "--exposure",
         ),
+        (
+            &[
+                "--table",
+                "cd-tracks-fast",
+                "--max-view",
+                "60",
+                "-o",
+                "m.png",
+            ][..],
+            "45",
+        ),
     ] {
         let mut a = vec!["plot", "diffraction"];
         a.extend_from_slice(args);
@@ -244,4 +394,24 @@ fn diffraction_map_png() {
         assert!(stderr(&o).contains(needle), "{args:?}: {}", stderr(&o));
     }
     assert!(!dir.path().join("m.png").exists());
+    // A map from the integrated default table.
+    let o = nacre(
+        &[
+            "plot",
+            "diffraction",
+            "--table",
+            "cd-tracks-fast",
+            "--incidence",
+            "10",
+            "--max-view",
+            "35",
+            "--cells",
+            "40",
+            "-o",
+            "fast.png",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(dir.path().join("fast.png").exists());
 }

@@ -755,26 +755,57 @@ impl DiffractionSurface {
         self.transform_with(k * u, k * v, &|i| self.terms.sum_at(i, &c))
     }
 
+    /// The windowed transforms of the terms alone, P̃ₙ(ku, kv) = Σ_j Tₙ[j]
+    /// exp(−σ_s²|(ku, kv) − κ_j|²/2) for n = 0 … N, so that P̃ = Σₙ (kw)ⁿ/n! P̃ₙ (the
+    /// building blocks of the integrated layout, [`integrated`]).
+    pub fn transform_terms(&self, wavelength_nm: f64, u: f64, v: f64) -> Vec<C64> {
+        let k = k_per_um(wavelength_nm);
+        let order = self.terms.order;
+        let mut out = vec![C64::new(0.0, 0.0); order + 1];
+        let xs = self.axis_weights(k * u, true);
+        let ys = self.axis_weights(k * v, false);
+        for &(jy, wy) in &ys {
+            for &(jx, wx) in &xs {
+                if let Some(i) = self.terms.index(jx, jy) {
+                    let t = &self.terms.data[i * (order + 1)..(i + 1) * (order + 1)];
+                    for (o, t) in out.iter_mut().zip(t) {
+                        *o += t * (wx * wy);
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// The bins j within reach of spatial frequency `q` (rad/µm) along x (`along_x`) or
+    /// y, with their window weights exp(−σ_s²(q − κ_j)²/2) ≥ 10⁻¹⁰, in increasing j.
+    fn axis_weights(&self, q: f64, along_x: bool) -> Vec<(i64, f64)> {
+        let t = &self.terms;
+        let (n, reach) = if along_x {
+            (t.nx, self.reach.0)
+        } else {
+            (t.ny, self.reach.1)
+        };
+        let s2 = self.sigma_s_um * self.sigma_s_um;
+        let dk = 2.0 * PI / (n as f64 * t.pitch_um);
+        let lo = -((n / 2) as i64);
+        let hi = lo + n as i64 - 1;
+        let j0 = (q / dk).round() as i64;
+        let (a, b) = ((j0 - reach).max(lo), (j0 + reach).min(hi));
+        (a..=b)
+            .filter_map(move |j| {
+                let d = q - j as f64 * dk;
+                let wgt = (-0.5 * s2 * d * d).exp();
+                (wgt >= WINDOW_CUTOFF).then_some((j, wgt))
+            })
+            .collect()
+    }
+
     /// Σ_j P_j exp(−σ²|q − κ_j|²/2) for bin values given by `p(index)`.
     fn transform_with(&self, qx: f64, qy: f64, p: &dyn Fn(usize) -> C64) -> C64 {
         let t = &self.terms;
-        let s2 = self.sigma_s_um * self.sigma_s_um;
-        let axis = |q: f64, n: usize, reach: i64| {
-            let dk = 2.0 * PI / (n as f64 * t.pitch_um);
-            let lo = -((n / 2) as i64);
-            let hi = lo + n as i64 - 1;
-            let j0 = (q / dk).round() as i64;
-            let (a, b) = ((j0 - reach).max(lo), (j0 + reach).min(hi));
-            (a..=b)
-                .filter_map(move |j| {
-                    let d = q - j as f64 * dk;
-                    let wgt = (-0.5 * s2 * d * d).exp();
-                    (wgt >= WINDOW_CUTOFF).then_some((j, wgt))
-                })
-                .collect::<Vec<_>>()
-        };
-        let xs = axis(qx, t.nx, self.reach.0);
-        let ys = axis(qy, t.ny, self.reach.1);
+        let xs = self.axis_weights(qx, true);
+        let ys = self.axis_weights(qy, false);
         let mut sum = C64::new(0.0, 0.0);
         for &(jy, wy) in &ys {
             for &(jx, wx) in &xs {
@@ -882,6 +913,8 @@ impl SpectralGrid {
         xyz
     }
 }
+
+pub mod integrated;
 
 #[cfg(test)]
 mod tests;

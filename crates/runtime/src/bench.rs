@@ -1,6 +1,9 @@
 //! `nacre bench-gpu`: the cost of each technique's film term in a full-screen GGX pass,
 //! against the same pass with Schlick's Fresnel and no film (`shaders/plain.wgsl`,
-//! `shaders/bench.wgsl`).
+//! `shaders/bench.wgsl`), and the cost of the `diffraction` technique at the same
+//! resolution ([`BenchPass::Diffraction`]: every pixel evaluates Σ_λ ρ(λ) u(λ) for one
+//! directional light over a swirling grating direction, scene 2 of
+//! `shaders/diffraction_scene.wgsl`).
 //!
 //! Each pass draws one full-screen triangle into an `Rgba8Unorm` target. With
 //! `TIMESTAMP_QUERY` the GPU time of every pass comes from timestamps written at the
@@ -11,8 +14,10 @@
 use crate::bindings::{TechniqueBinding, TechniqueOptions};
 use crate::context::BufferInitExt;
 use crate::context::GpuContext;
+use crate::diffraction::{DiffractionOptions, DiffractionTable, ScenePass};
 use crate::error::{Error, Result};
 use crate::fullscreen;
+use crate::render::Light;
 use crate::shaders::{self, Technique};
 use crate::tables::TableSet;
 use std::time::Instant;
@@ -24,6 +29,8 @@ pub enum BenchPass {
     Plain,
     /// GGX with the technique's film term in place of Fresnel.
     Film(Technique),
+    /// The `diffraction` technique (layout "terms") for one directional light per pixel.
+    Diffraction,
 }
 
 impl BenchPass {
@@ -34,6 +41,7 @@ impl BenchPass {
             BenchPass::Film(Technique::Lut) => "film_lut",
             BenchPass::Film(Technique::Fourier) => "film_fourier",
             BenchPass::Film(Technique::Spectral) => "film_spectral",
+            BenchPass::Diffraction => "diffraction",
         }
     }
 }
@@ -95,6 +103,18 @@ struct BenchParams {
 pub fn run_bench(
     ctx: &GpuContext,
     tables: &TableSet,
+    passes: &[BenchPass],
+    options: &BenchOptions,
+) -> Result<Vec<BenchResult>> {
+    run_bench_with_diffraction(ctx, tables, None, passes, options)
+}
+
+/// [`run_bench`] with a `diffraction` table and its settings for [`BenchPass::Diffraction`]
+/// (an [`Error::Invalid`] when that pass is asked for without one).
+pub fn run_bench_with_diffraction(
+    ctx: &GpuContext,
+    tables: &TableSet,
+    diffraction: Option<(&DiffractionTable, &DiffractionOptions)>,
     passes: &[BenchPass],
     options: &BenchOptions,
 ) -> Result<Vec<BenchResult>> {
@@ -183,8 +203,30 @@ pub fn run_bench(
 
     let mut results = Vec::new();
     for &pass in passes {
+        if pass == BenchPass::Diffraction {
+            let (table, technique) = diffraction.ok_or_else(|| Error::Invalid {
+                context: "bench-gpu".into(),
+                message: "the diffraction pass needs a diffraction table".into(),
+            })?;
+            let scene = ScenePass::bench(
+                ctx,
+                table,
+                technique,
+                options.width,
+                options.height,
+                &Light {
+                    direction: [0.4, 0.6, 0.7],
+                    colour: [1.0; 3],
+                    intensity: 3.0,
+                },
+            )?;
+            results.push(time_pass(ctx, pass, &view, options, timestamps, |rp| {
+                scene.draw(rp)
+            })?);
+            continue;
+        }
         let binding = match pass {
-            BenchPass::Plain => None,
+            BenchPass::Plain | BenchPass::Diffraction => None,
             BenchPass::Film(t) => Some(TechniqueBinding::new(
                 ctx,
                 tables,
@@ -224,97 +266,113 @@ pub fn run_bench(
                 &[wgpu::TextureFormat::Rgba8Unorm],
             )
         })?;
-        let mut times_ms = Vec::new();
-        for frame in 0..options.warmup + options.frames {
-            let query = timestamps.then(|| {
-                (
-                    device.create_query_set(&wgpu::QuerySetDescriptor {
-                        label: Some("bench timestamps"),
-                        ty: wgpu::QueryType::Timestamp,
-                        count: 2,
-                    }),
-                    device.create_buffer(&wgpu::BufferDescriptor {
-                        label: Some("bench timestamps"),
-                        size: 16,
-                        usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                        mapped_at_creation: false,
-                    }),
-                    device.create_buffer(&wgpu::BufferDescriptor {
-                        label: Some("bench timestamps readback"),
-                        size: 16,
-                        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                        mapped_at_creation: false,
-                    }),
-                )
-            });
-            let start = Instant::now();
-            ctx.checked("drawing a bench frame", || {
-                let mut encoder = device.create_command_encoder(&Default::default());
-                {
-                    let mut rp = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                        label: Some(pass.name()),
-                        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                            view: &view,
-                            depth_slice: None,
-                            resolve_target: None,
-                            ops: wgpu::Operations {
-                                load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                                store: wgpu::StoreOp::Store,
-                            },
-                        })],
-                        depth_stencil_attachment: None,
-                        timestamp_writes: query.as_ref().map(|(q, _, _)| {
-                            wgpu::RenderPassTimestampWrites {
-                                query_set: q,
-                                beginning_of_pass_write_index: Some(0),
-                                end_of_pass_write_index: Some(1),
-                            }
-                        }),
-                        occlusion_query_set: None,
-                        multiview_mask: None,
-                    });
-                    rp.set_pipeline(&pipeline);
-                    rp.set_bind_group(0, &view_group, &[]);
-                    rp.set_bind_group(1, table_group, &[]);
-                    rp.draw(0..3, 0..1);
-                }
-                if let Some((q, resolve, readback)) = &query {
-                    encoder.resolve_query_set(q, 0..2, resolve, 0);
-                    encoder.copy_buffer_to_buffer(resolve, 0, readback, 0, 16);
-                }
-                ctx.queue.submit([encoder.finish()]);
-            })?;
-            let ms = match &query {
-                Some((_, _, readback)) => {
-                    readback.map_async(wgpu::MapMode::Read, .., |_| {});
-                    ctx.wait("timing a bench frame")?;
-                    let view = readback.get_mapped_range(..).map_err(|e| Error::Gpu {
-                        context: "reading timestamps".into(),
-                        message: e.to_string(),
-                    })?;
-                    let t: [u64; 2] = bytemuck::pod_read_unaligned(&view[..16]);
-                    drop(view);
-                    readback.unmap();
-                    t[1].saturating_sub(t[0]) as f64
-                        * f64::from(ctx.queue.get_timestamp_period())
-                        * 1e-6
-                }
-                None => {
-                    ctx.wait("timing a bench frame")?;
-                    start.elapsed().as_secs_f64() * 1e3
-                }
-            };
-            if frame >= options.warmup {
-                times_ms.push(ms);
-            }
-        }
-        times_ms.sort_by(f64::total_cmp);
-        results.push(BenchResult {
-            pass,
-            median_ms: times_ms[times_ms.len() / 2],
-            min_ms: times_ms[0],
-            timestamps,
-        });
+        results.push(time_pass(ctx, pass, &view, options, timestamps, |rp| {
+            rp.set_pipeline(&pipeline);
+            rp.set_bind_group(0, &view_group, &[]);
+            rp.set_bind_group(1, table_group, &[]);
+            rp.draw(0..3, 0..1);
+        })?);
     }
     Ok(results)
+}
+
+/// Draws `options.warmup + options.frames` frames of one pass into `view` (recorded by
+/// `draw`) and reports the median and fastest of the measured ones.
+fn time_pass(
+    ctx: &GpuContext,
+    pass: BenchPass,
+    view: &wgpu::TextureView,
+    options: &BenchOptions,
+    timestamps: bool,
+    draw: impl Fn(&mut wgpu::RenderPass<'_>),
+) -> Result<BenchResult> {
+    let device = &ctx.device;
+    let mut times_ms = Vec::new();
+    for frame in 0..options.warmup + options.frames {
+        let query = timestamps.then(|| {
+            (
+                device.create_query_set(&wgpu::QuerySetDescriptor {
+                    label: Some("bench timestamps"),
+                    ty: wgpu::QueryType::Timestamp,
+                    count: 2,
+                }),
+                device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("bench timestamps"),
+                    size: 16,
+                    usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                    mapped_at_creation: false,
+                }),
+                device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("bench timestamps readback"),
+                    size: 16,
+                    usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                }),
+            )
+        });
+        let start = Instant::now();
+        ctx.checked("drawing a bench frame", || {
+            let mut encoder = device.create_command_encoder(&Default::default());
+            {
+                let mut rp = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some(pass.name()),
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    })],
+                    depth_stencil_attachment: None,
+                    timestamp_writes: query.as_ref().map(|(q, _, _)| {
+                        wgpu::RenderPassTimestampWrites {
+                            query_set: q,
+                            beginning_of_pass_write_index: Some(0),
+                            end_of_pass_write_index: Some(1),
+                        }
+                    }),
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                draw(&mut rp);
+            }
+            if let Some((q, resolve, readback)) = &query {
+                encoder.resolve_query_set(q, 0..2, resolve, 0);
+                encoder.copy_buffer_to_buffer(resolve, 0, readback, 0, 16);
+            }
+            ctx.queue.submit([encoder.finish()]);
+        })?;
+        let ms = match &query {
+            Some((_, _, readback)) => {
+                readback.map_async(wgpu::MapMode::Read, .., |_| {});
+                ctx.wait("timing a bench frame")?;
+                let view = readback.get_mapped_range(..).map_err(|e| Error::Gpu {
+                    context: "reading timestamps".into(),
+                    message: e.to_string(),
+                })?;
+                let t: [u64; 2] = bytemuck::pod_read_unaligned(&view[..16]);
+                drop(view);
+                readback.unmap();
+                t[1].saturating_sub(t[0]) as f64
+                    * f64::from(ctx.queue.get_timestamp_period())
+                    * 1e-6
+            }
+            None => {
+                ctx.wait("timing a bench frame")?;
+                start.elapsed().as_secs_f64() * 1e3
+            }
+        };
+        if frame >= options.warmup {
+            times_ms.push(ms);
+        }
+    }
+    times_ms.sort_by(f64::total_cmp);
+    Ok(BenchResult {
+        pass,
+        median_ms: times_ms[times_ms.len() / 2],
+        min_ms: times_ms[0],
+        timestamps,
+    })
 }

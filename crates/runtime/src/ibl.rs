@@ -36,8 +36,11 @@
 //!
 //! E is where the film enters: `FilmEval::Exact` takes E from the `rough-film-lut` table
 //! (E_f, the film's spectral reflectance integrated over the GGX lobe for the actual view
-//! angle) and replaces L̃(r, α) by a film-weighted mean of L̃ over 16 visible normals of the
-//! lobe (`shaders/material.wgsl` has the equation and why); `FilmEval::NormalView`, the
+//! angle) and replaces L̃(r, α) by a film-weighted mean of L̃ over 32 visible normals of the
+//! lobe, each sample l_i read from the level whose GGX lobe matches its solid angle
+//! 1/(N p(l_i)) (filtered importance sampling, Křivánek & Colbert 2008; the levels then
+//! serve as a blur of adjustable width around any direction, not only as L̃(r, α) of the
+//! split sum; `shaders/material.wgsl` has the equations and why); `FilmEval::NormalView`, the
 //! engines' common shortcut, uses L̃(r, α) · R_f(n·v) · E₁(n·v, α) (the film evaluated once,
 //! at n·v, times the F = 1 albedo of [`ggx_albedo_table`]).
 //!

@@ -3,11 +3,14 @@
 //! A small wgpu library that a host engine uses with its own device: it loads baked nacre
 //! tables through their manifests ([`TableSet::load`]), uploads them as textures, and
 //! provides the WGSL modules under `shaders/` ([`shaders`]) that sample them, plus a headless
-//! renderer for `nacre render` and the GPU = CPU probe used by the tests.
+//! renderer for `nacre render` and the GPU = CPU probe used by the tests. `diffraction`
+//! tables load separately ([`diffraction::DiffractionTable::load`]) for the technique
+//! `diffraction` (Stam's diffraction BRDF from Taylor terms, `shaders/diffraction.wgsl`).
 
 pub mod bench;
 pub mod bindings;
 pub mod context;
+pub mod diffraction;
 pub mod error;
 pub mod fullscreen;
 pub mod gltf_assets;

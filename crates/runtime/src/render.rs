@@ -125,9 +125,10 @@ pub enum FilmEval {
     /// colour is evaluated once per pixel, at n·v, and used for every light and for the
     /// split-sum environment: L̃(r, α) R_f(n·v) E₁(n·v, α).
     NormalView,
-    /// Film per light at its half vector (F(ω_o·h)), and for the environment the split sum
-    /// L̃(r, α) E_f(n·v, α, d, n₂) with E_f the iridescent lobe's directional albedo from a
-    /// `rough-film-lut` table.
+    /// Film per light at its half vector (F(ω_o·h)), and for the environment the iridescent
+    /// lobe's directional albedo E_f(n·v, α, d, n₂) from a `rough-film-lut` table times the
+    /// film-weighted mean of the prefiltered environment over 32 visible normals of the lobe,
+    /// each read at its own footprint (filtered importance sampling).
     Exact,
 }
 

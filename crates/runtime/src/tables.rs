@@ -175,7 +175,7 @@ impl TableSet {
 }
 
 /// Checks that every file the manifest lists exists and has the recorded SHA-256.
-fn verify_files(manifest: &Manifest, manifest_path: &Path) -> Result<()> {
+pub(crate) fn verify_files(manifest: &Manifest, manifest_path: &Path) -> Result<()> {
     let dir = manifest_path.parent().unwrap_or(Path::new("."));
     for f in &manifest.files {
         let path = dir.join(&f.path);
@@ -194,7 +194,7 @@ fn verify_files(manifest: &Manifest, manifest_path: &Path) -> Result<()> {
     Ok(())
 }
 
-fn check_limit(ctx: &GpuContext, what: &str, needed: u64, limit: u32) -> Result<()> {
+pub(crate) fn check_limit(ctx: &GpuContext, what: &str, needed: u64, limit: u32) -> Result<()> {
     if needed > u64::from(limit) {
         return Err(Error::Limit {
             what: what.to_string(),

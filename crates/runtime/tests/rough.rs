@@ -9,9 +9,12 @@
 //!   sphere rendered to a linear float target by the exact path (`FilmEval::Exact`) and by the
 //!   film-at-n·v shortcut (`FilmEval::NormalView`) is compared with the reference by mean
 //!   CIEDE2000 over the sphere's pixels: the exact path must stay within
-//!   [`EXACT_MEAN_DE_MAX`] at every α and beat the shortcut by [`EXACT_GAIN_MIN`] at α ≥ 0.3;
-//!   both figures are printed. (Issue 6 asks for ≤ 1.0; the path does not reach it — the
-//!   README explains why — so these bounds guard the measured figures against regressions.)
+//!   [`EXACT_MEAN_DE_MAX`] = 1.0 (issue 6's target) at every α, and the shortcut must be
+//!   [`EXACT_GAIN_MIN`] times worse at α ≥ 0.3; both figures are printed;
+//! * on request (`cargo test --release -p nacre-runtime --test rough -- --ignored`), a CPU
+//!   twin of the exact path's environment estimator with the exact film term, swept over
+//!   the number of lobe samples: how the README's figures for 16, 32, 64 and 1024 samples
+//!   were measured.
 
 use nacre_runtime::render::{FilmEval, RenderOutput, Renderer, procedural_thickness_map};
 use nacre_runtime::rough_reference::{
@@ -21,16 +24,17 @@ use nacre_runtime::rough_reference::{
     write_linear_exr,
 };
 use nacre_runtime::{GpuContext, TableSet, Technique};
+use std::f64::consts::PI;
 use std::path::PathBuf;
 use std::sync::OnceLock;
 
-/// Largest mean ΔE2000 of the exact path against the reference at any α. Measured on
-/// lavapipe (llvmpipe, Mesa 22.3.6): 1.78 / 2.51 / 2.02 at α = 0.1 / 0.3 / 0.6 (README); the
-/// issue's target, 1.0, is not met.
-const EXACT_MEAN_DE_MAX: f64 = 2.8;
+/// Largest mean ΔE2000 of the exact path against the reference at any α: issue 6's target.
+/// Measured on lavapipe (llvmpipe, Mesa 22.3.6): 0.74 / 0.71 / 0.80 at α = 0.1 / 0.3 / 0.6
+/// (README).
+const EXACT_MEAN_DE_MAX: f64 = 1.0;
 
-/// Smallest ratio shortcut ΔE / exact ΔE at α ≥ 0.3 (measured 3.3 and 6.2 on lavapipe).
-const EXACT_GAIN_MIN: f64 = 2.0;
+/// Smallest ratio shortcut ΔE / exact ΔE at α ≥ 0.3 (measured 11.4 and 15.6 on lavapipe).
+const EXACT_GAIN_MIN: f64 = 5.0;
 
 fn ctx() -> &'static GpuContext {
     static CTX: OnceLock<GpuContext> = OnceLock::new();
@@ -220,4 +224,181 @@ fn write_strip(path: &std::path::Path, gpu: &[[f32; 3]], reference: &[[f32; 3]])
         gpu_seconds: 0.0,
     };
     image.write_png(path).unwrap();
+}
+
+/// One CPU twin of the exact path's environment estimator (`shaders/material.wgsl`, header):
+/// `samples` visible normals on a Fibonacci spiral (`grid`: a √N × √N grid of midpoints),
+/// each read from the prefiltered layers at α_i = `fis_scale` √(Ω_i/(4π)) (`None`: at α/2,
+/// the previous version), normalised by the rough-film-lut albedo.
+struct LobeEstimator {
+    samples: usize,
+    grid: bool,
+    fis_scale: Option<f64>,
+}
+
+/// Mean ΔE2000 of [`LobeEstimator`] + the directional light (closed form, as the reference)
+/// against the committed reference at `alpha`.
+fn twin_delta_e(estimator: &LobeEstimator, alpha: f64) -> f64 {
+    use nacre_bake::rough_lut::{LoadedRoughLut, RoughFilmLut};
+    use nacre_optics::microfacet::{ggx_d, radiance_directional, sample_ggx_vndf, smith_lambda};
+    use nacre_runtime::ibl::{
+        PREFILTER_LEVELS, PrefilteredEnvironment, env_direction_to_uv, sample_level_bilinear,
+        tangent_frame,
+    };
+    use nacre_runtime::rough_reference::{COMPARISON_FILM_IOR, COMPARISON_THICKNESS_NM};
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let c = colorimeter();
+    let baked = nacre_bake::bake::default_baked_dir();
+    let rough = LoadedRoughLut::load(&baked.join("rough-film-dielectric.json")).unwrap();
+    let env = comparison_environment();
+    let pre = PrefilteredEnvironment::cached(&env);
+    let o = comparison_options(alpha as f32, FilmEval::Exact, COMPARISON_SIZE);
+    let scale = f64::from(o.env_intensity);
+    // L̃(d, α) as env_prefiltered_radiance samples it.
+    let prefiltered = |d: [f64; 3], a: f64| -> [f64; 3] {
+        let (u, v) = env_direction_to_uv(d);
+        let last = (PREFILTER_LEVELS - 1) as f64;
+        let k = (a.clamp(0.0, 1.0).sqrt() * last).clamp(0.0, last);
+        let k0 = (k.floor() as usize).min(PREFILTER_LEVELS - 2);
+        let f = k - k0 as f64;
+        let lo = sample_level_bilinear(&pre.levels[k0], u, v);
+        let hi = sample_level_bilinear(&pre.levels[k0 + 1], u, v);
+        std::array::from_fn(|i| (lo[i] * (1.0 - f) + hi[i] * f) * scale)
+    };
+    let n = estimator.samples;
+    let points: Vec<(f64, f64)> = if estimator.grid {
+        let m = (n as f64).sqrt().round() as usize;
+        let mid = |i: usize| (i as f64 + 0.5) / m as f64;
+        (0..m * m).map(|i| (mid(i % m), mid(i / m))).collect()
+    } else {
+        let g = 0.5 * (3.0 - 5f64.sqrt());
+        (0..n)
+            .map(|i| ((i as f64 + 0.5) / n as f64, (i as f64 * g).fract()))
+            .collect()
+    };
+    let film = film_term_of(&o, &c).unwrap();
+    let light = o.light.direction.map(f64::from);
+    let light = light.map(|x| x / dot(light, light).sqrt());
+    let e_l: [f64; 3] =
+        std::array::from_fn(|k| f64::from(o.light.colour[k]) * f64::from(o.light.intensity));
+    let rays = camera_rays(&o.camera, o.width, o.height).unwrap();
+    let image: Vec<[f32; 3]> = rays
+        .iter()
+        .map(|ray| {
+            let Some(normal) = hit_sphere(ray) else {
+                return [0.0; 3];
+            };
+            let (t, b) = tangent_frame(normal);
+            let to_local = |w: [f64; 3]| [dot(w, t), dot(w, b), dot(w, normal)];
+            let to_world = |w: [f64; 3]| -> [f64; 3] {
+                std::array::from_fn(|k| w[0] * t[k] + w[1] * b[k] + w[2] * normal[k])
+            };
+            let mut wo = to_local(ray.dir.map(|x| -x));
+            wo[2] = wo[2].max(1e-4);
+            let wo = wo.map(|x| x / dot(wo, wo).sqrt());
+            let lambda_o = smith_lambda(wo, alpha);
+            let e_f = RoughFilmLut::lookup(
+                &rough.lut.axes,
+                &rough.lut.reflectance,
+                wo[2],
+                alpha,
+                f64::from(COMPARISON_THICKNESS_NM),
+                f64::from(COMPARISON_FILM_IOR),
+            );
+            let (mut num, mut den) = ([0.0f64; 3], [0.0f64; 3]);
+            for &(u1, u2) in &points {
+                let m = sample_ggx_vndf(wo, alpha, u1, u2);
+                let cos_d = dot(wo, m);
+                let wi: [f64; 3] = std::array::from_fn(|k| 2.0 * cos_d * m[k] - wo[k]);
+                if wi[2] <= 0.0 || cos_d <= 0.0 {
+                    continue;
+                }
+                let w = (1.0 + lambda_o) / (1.0 + lambda_o + smith_lambda(wi, alpha));
+                let a_i = match estimator.fis_scale {
+                    None => 0.5 * alpha,
+                    Some(k) => {
+                        k * (wo[2] * (1.0 + lambda_o) / (PI * n as f64 * ggx_d(m, alpha))).sqrt()
+                    }
+                };
+                let r = film.reflectance_colour(cos_d);
+                let l = prefiltered(to_world(wi), a_i);
+                for k in 0..3 {
+                    num[k] += w * r[k] * l[k];
+                    den[k] += w * r[k];
+                }
+            }
+            let direct = radiance_directional(&film, alpha, wo, to_local(light), 1.0);
+            std::array::from_fn(|k| {
+                let env = if den[k] > 1e-8 {
+                    e_f[k] * num[k] / den[k]
+                } else {
+                    0.0
+                };
+                (env + direct[k] * e_l[k]) as f32
+            })
+        })
+        .collect();
+    let (_, _, reference) = read_linear_exr(&golden_path(alpha)).unwrap();
+    mean_delta_e_2000(&image, &reference, &mask(), &c)
+}
+
+/// The README's sample-count sweep (CPU, ≈ 1 min in release): the error falls with the
+/// number of lobe samples, and 32 spiral samples with filtered importance sampling (the
+/// shader's choice) meet issue 6's target at every α.
+#[test]
+#[ignore = "a measurement on request: cargo test --release -p nacre-runtime --test rough -- --ignored"]
+fn lobe_sample_count_sweep() {
+    let cases = [
+        (
+            "16, 4 × 4 grid, α/2 (previous)",
+            LobeEstimator {
+                samples: 16,
+                grid: true,
+                fis_scale: None,
+            },
+        ),
+        (
+            "16, 4 × 4 grid, FIS k = 1",
+            LobeEstimator {
+                samples: 16,
+                grid: true,
+                fis_scale: Some(1.0),
+            },
+        ),
+        (
+            "32, spiral, FIS k = 0.7 (shader)",
+            LobeEstimator {
+                samples: 32,
+                grid: false,
+                fis_scale: Some(0.7),
+            },
+        ),
+        (
+            "64, spiral, FIS k = 0.7",
+            LobeEstimator {
+                samples: 64,
+                grid: false,
+                fis_scale: Some(0.7),
+            },
+        ),
+        (
+            "1024, spiral, FIS k = 0.7",
+            LobeEstimator {
+                samples: 1024,
+                grid: false,
+                fis_scale: Some(0.7),
+            },
+        ),
+    ];
+    for alpha in COMPARISON_ALPHAS {
+        let de: Vec<f64> = cases.iter().map(|(_, e)| twin_delta_e(e, alpha)).collect();
+        for ((name, _), d) in cases.iter().zip(&de) {
+            eprintln!("α {alpha}: {name}: mean ΔE2000 {d:.3}");
+        }
+        assert!(de[2] <= EXACT_MEAN_DE_MAX, "α {alpha}: {:.3}", de[2]);
+        assert!(
+            de[4] < de[3] && de[3] < de[2] && de[2] < de[0],
+            "α {alpha}: {de:?}"
+        );
+    }
 }

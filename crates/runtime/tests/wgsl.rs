@@ -389,3 +389,83 @@ fn the_runtimes_own_pipelines_validate_and_translate() {
     );
     translate("plain + bench", &module, &info);
 }
+
+/// The `diffraction` technique and its consumers (`shaders/diffraction.wgsl`,
+/// `shaders/diffraction_scene.wgsl`): they validate and translate to every backend, the
+/// technique alone binds group 1 only, and the uniforms have the documented layouts that
+/// `nacre_runtime::diffraction`'s `#[repr(C)]` mirrors reproduce.
+#[test]
+fn diffraction_technique_validates_and_translates() {
+    use nacre_runtime::diffraction::{
+        DIFFRACTION, DiffractionUniform, DiffractionViewUniform, compose,
+    };
+    let source = compose();
+    let (module, info) = validate(
+        "diffraction + diffraction_scene",
+        &source,
+        "diffraction.wgsl, diffraction_scene.wgsl",
+    );
+    translate("diffraction + diffraction_scene", &module, &info);
+    for entry in [
+        "diffraction_vs",
+        "diffraction_scene_fs",
+        "diffraction_probe",
+    ] {
+        assert!(
+            module.entry_points.iter().any(|e| e.name == entry),
+            "{entry} missing"
+        );
+    }
+    let layout = |name: &str| -> (u32, Vec<(String, u32)>) {
+        let (_, ty) = module
+            .types
+            .iter()
+            .find(|(_, t)| t.name.as_deref() == Some(name))
+            .unwrap_or_else(|| panic!("struct {name} not declared"));
+        let naga::TypeInner::Struct { ref members, span } = ty.inner else {
+            panic!("{name} is not a struct");
+        };
+        (
+            span,
+            members
+                .iter()
+                .map(|m| (m.name.clone().unwrap_or_default(), m.offset))
+                .collect(),
+        )
+    };
+    let (span, members) = layout("DiffractionParams");
+    assert_eq!(span as usize, std::mem::size_of::<DiffractionUniform>());
+    let offsets: Vec<u32> = members.iter().map(|m| m.1).collect();
+    assert_eq!(offsets, [0, 8, 16, 24, 32, 36, 40, 44, 48, 56]);
+    let (span, members) = layout("DiffractionView");
+    assert_eq!(span as usize, std::mem::size_of::<DiffractionViewUniform>());
+    let offsets: Vec<u32> = members.iter().map(|m| m.1).collect();
+    assert_eq!(
+        offsets,
+        [
+            0, 64, 76, 80, 92, 96, 108, 112, 120, 124, 128, 256, 384, 388, 392, 396
+        ]
+    );
+
+    // The technique alone, with a consumer that binds nothing: group 1 only.
+    let consumer = "
+@fragment
+fn fs_bindingless(@builtin(position) p: vec4<f32>) -> @location(0) vec4<f32> {
+    let frame = diffraction_frame(vec3<f32>(0.0, 0.0, 1.0), vec3<f32>(1.0, 0.0, 0.0));
+    let c = diffraction_colour(frame * vec3<f32>(-0.3, 0.0, 0.9), vec3<f32>(p.x, 0.0, 1.0));
+    return vec4<f32>(c + diffraction_specular_order_colour(p.y), 1.0);
+}
+";
+    let source = format!("{DIFFRACTION}\n{consumer}\n");
+    let (module, info) = validate("diffraction", &source, "diffraction.wgsl, consumer");
+    translate("diffraction", &module, &info);
+    for (_, g) in module.global_variables.iter() {
+        if let Some(b) = &g.binding {
+            assert_eq!(
+                b.group, 1,
+                "diffraction: `{:?}` is in group {}",
+                g.name, b.group
+            );
+        }
+    }
+}

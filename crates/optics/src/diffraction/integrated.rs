@@ -1,0 +1,575 @@
+//! The "integrated" (fast path) layout of diffraction tables: wavelength-integrated colour
+//! tables Iₚ(u, v), p = 0 … 2N, from which a shader rebuilds the colour of Stam's BRDF with
+//! one bilinear fetch per table and no loop over wavelengths (issue 7; the idea of
+//! precomputing what does not depend on w is Dhillon et al. 2014's, carried one step
+//! further here: the wavelength sum is done at bake time too).
+//!
+//! # Derivation
+//!
+//! With the windowed transform of term n alone (the module [`super`] docs),
+//!
+//! ```text
+//! P̃ₙ(q) = Σ_j Tₙ[j] exp(−σ_s²|q − κ_j|²/2),   P̃(ku, kv) = Σₙ (kw)ⁿ/n! · P̃ₙ(ku, kv),
+//! ```
+//!
+//! the squared modulus expands as a double sum whose imaginary parts cancel pairwise
+//! (the (n, m) and (m, n) terms are complex conjugates):
+//!
+//! ```text
+//! |P̃|² = Σ_{n,m=0}^{N} (kw)^{n+m}/(n! m!) · Re(P̃ₙ P̃ₘ*)
+//!      = Σ_{p=0}^{2N} wᵖ · kᵖ Σ_{n+m=p, n,m≤N} Re(P̃ₙ(ku, kv) P̃ₘ(ku, kv)*)/(n! m!).
+//! ```
+//!
+//! The relative reflectance is ρ = F²(θ_h) · G/w² · |P̃|². When F² does not depend on the
+//! wavelength ([`FresnelTerm::Unity`], or [`FresnelTerm::Index`] of one index, as
+//! `nacre diffraction --fresnel` evaluates it at 550 nm), neither does
+//! C(ω_i, ω_r) = F²(θ_h) · G/w², and the colour XYZ_c = Σ_λ u_c(λ) ρ(λ) of a
+//! [`SpectralGrid`] (weights u_c, perfect reflector Y = 1) factors as
+//!
+//! ```text
+//! colour_c(ω_i, ω_r) = C(ω_i, ω_r) · Σ_{p=0}^{2N} wᵖ · I_{p,c}(u, v),
+//! I_{p,c}(u, v) = Σ_λ u_c(λ) kᵖ Σ_{n+m=p} Re(P̃ₙ(ku, kv) P̃ₘ(ku, kv)*)/(n! m!),   k = 2π/λ.
+//! ```
+//!
+//! Iₚ depends on (u, v) only: w and the wavelength sum are out of the texture coordinates.
+//! Because n, m ≤ N on both sides, Σₚ wᵖ Iₚ is exactly the colour of the truncated terms
+//! layout (`|Σ_{n≤N}|²`), not a second truncation. The channels are stored in the
+//! colorimeter's output space (M · XYZ, linear; M = I for `xyz`): the sum is linear, so
+//! colour = C · Σₚ wᵖ (M·Iₚ) is what `SpectralGrid` + `output_from_xyz` give from the
+//! terms layout, and a shader needs no matrix.
+//!
+//! **Point symmetry: half the table.** A real height field has Tₙ[−j] = (−1)ⁿ conj Tₙ[j],
+//! hence P̃ₙ(−q) = (−1)ⁿ conj P̃ₙ(q) and Iₚ(−u, −v) = (−1)ᵖ Iₚ(u, v). The table stores
+//! u ≥ 0 only and a shader folds the other half over:
+//!
+//! ```text
+//! u < 0:  Σₚ wᵖ Iₚ(u, v) = Σₚ (−w)ᵖ Iₚ(−u, −v)      (evaluate at (−u, −v) with w → −w)
+//! ```
+//!
+//! The one exception is the unpaired Nyquist bin −M/2 of an even-sized DFT, which the
+//! window reaches only within a few 1/σ_s of the Nyquist limit; the measured
+//! reconstruction error below includes any trace of it (u < 0 is measured too).
+//!
+//! **Cancellation.** The terms wᵖ Iₚ grow like (2|kwh|)ᵖ/p! while their sum is the colour
+//! of |P̃|² ≤ 1, so for tall structures the sum cancels catastrophically in the f32 a
+//! shader stores and adds: with x = max |kwh| the rounding of the stored Iₚ is bounded by
+//! about 2⁻²⁴ Σₚ (2x)ᵖ/p! ≈ 6·10⁻⁸ e^{2x} of the white. The bound is pessimistic;
+//! [`IntegratedTable::storage_error`] measures it at texel centres: 1.0·10⁻⁷ of the white
+//! for the CD-like surface (x = 2.78), 10⁻⁴ for a 0.5 µm blazed grating (x ≈ 8), 24 for a
+//! 1 µm one (x ≈ 16). [`IntegratedTable::reconstruction_error`] measures the whole effect
+//! (f32 storage, bilinear interpolation, f32 Horner sum) against the f64 terms-layout
+//! colour.
+//!
+//! # Axes
+//!
+//! v spans [−u_max, u_max] and u the half [0, u_max] (u_max = 2 sin θ_max,
+//! [`WarpedAxis`]), on warped axes that pack texels near the specular direction
+//! u = v = 0, where the mirror lobe exp(−σ_s²k²(u² + v²)) is 1/(kσ_s) wide and where the
+//! v-profile of a 1-D grating is as sharp at every u. The full axis has n texels (n even);
+//! texel i has its centre at t_i = (2i + 1)/n − 1 and
+//!
+//! ```text
+//! forward:  t = sign(u) (|u|/u_max)^{1/γ},   x = (t + 1) n/2 − ½   (texel coordinate: centre of i at x = i)
+//! inverse:  u = u_max sign(t) |t|^γ
+//! ```
+//!
+//! The stored u columns are texels n/2 … n − 1 of that axis: column c = i − n/2 holds
+//! u = u_max ((2c + 1)/n)^γ, and a shader reads column coordinate x − n/2 (clamped to
+//! [0, n/2 − 1]: for u → 0 it clamps onto column 0, whose centre is at u_max n^{−γ}).
+//! The texel spacing is 2γ u_max |t|^{γ−1}/n: near the specular direction it shrinks like
+//! |u|^{(γ−1)/γ}, at the edge it is γ times the uniform spacing.
+
+use super::{DiffractionSurface, FresnelTerm, SpectralGrid, geometry_over_w2, k_per_um};
+use crate::C64;
+use crate::colour::Colorimeter;
+use crate::error::{Error, Result};
+use rayon::prelude::*;
+
+/// Most texels per axis of an integrated table.
+pub const MAX_INTEGRATED_SAMPLES: usize = 4096;
+
+/// A warped texture axis over [−u_max, u_max] packing texels near 0 (module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WarpedAxis {
+    /// u_max = 2 sin θ_max: the largest |u| (or |v|) served.
+    pub max_uv: f64,
+    /// The warp exponent γ ≥ 1 (1: uniform).
+    pub gamma: f64,
+    /// Texels n over [−u_max, u_max]: even, at least 4.
+    pub count: usize,
+}
+
+impl WarpedAxis {
+    /// An axis of `count` texels over [−`max_uv`, `max_uv`] with exponent `gamma`.
+    ///
+    /// # Errors
+    /// [`Error::OutOfRange`] for `max_uv` outside (0, 2], γ outside [1, 8] or a count
+    /// that is odd or outside 4 … [`MAX_INTEGRATED_SAMPLES`].
+    pub fn new(max_uv: f64, gamma: f64, count: usize) -> Result<Self> {
+        if !(max_uv > 0.0 && max_uv <= 2.0) {
+            return Err(Error::OutOfRange {
+                what: "largest |u|, |v| of an integrated table",
+                value: max_uv,
+                expected: "a number in (0, 2]",
+            });
+        }
+        if !(1.0..=8.0).contains(&gamma) {
+            return Err(Error::OutOfRange {
+                what: "integrated-table warp exponent γ",
+                value: gamma,
+                expected: "a number in [1, 8]",
+            });
+        }
+        if !(4..=MAX_INTEGRATED_SAMPLES).contains(&count) || count % 2 == 1 {
+            return Err(Error::OutOfRange {
+                what: "integrated-table texels per axis",
+                value: count as f64,
+                expected: "an even number from 4 to 4096",
+            });
+        }
+        Ok(WarpedAxis {
+            max_uv,
+            gamma,
+            count,
+        })
+    }
+
+    /// u at the centre of texel i (inverse mapping).
+    pub fn texel_centre(&self, i: usize) -> f64 {
+        let t = (2.0 * i as f64 + 1.0) / self.count as f64 - 1.0;
+        self.max_uv * t.signum() * t.abs().powf(self.gamma)
+    }
+
+    /// The continuous texel coordinate of u (forward mapping): texel i's centre is at i;
+    /// clamped to [0, n − 1] (clamp-to-edge).
+    pub fn coordinate(&self, u: f64) -> f64 {
+        let a = (u.abs() / self.max_uv).min(1.0);
+        let t = u.signum() * a.powf(1.0 / self.gamma);
+        ((t + 1.0) * 0.5 * self.count as f64 - 0.5).clamp(0.0, self.count as f64 - 1.0)
+    }
+}
+
+/// An integrated table: I_{p,c}(u, v) for p = 0 … 2N, u ≥ 0 (n/2 columns) and v over the
+/// whole axis (n rows), stored as f32 in the colorimeter's output space (module docs).
+#[derive(Clone, Debug, PartialEq)]
+pub struct IntegratedTable {
+    axis: WarpedAxis,
+    order: usize,
+    /// `values[(p * n + iv) * n/2 + c]`: layer p, row v, column c (u ≥ 0).
+    values: Vec<[f32; 3]>,
+}
+
+impl IntegratedTable {
+    /// Computes the table of `surface` for the wavelengths and weights of `grid`, stored in
+    /// `colorimeter`'s output space. Rows of texels in parallel; each row is summed in a
+    /// fixed order, so the values do not depend on the thread count.
+    ///
+    /// Per row (fixed v) and wavelength the window's y factor is applied once to every
+    /// column of bins (R_n[jₓ] = Σ_{j_y} g_y Tₙ[jₓ, j_y]); each texel then needs only
+    /// its x factor.
+    pub fn compute(
+        surface: &DiffractionSurface,
+        grid: &SpectralGrid,
+        colorimeter: &Colorimeter,
+        axis: WarpedAxis,
+    ) -> Self {
+        let terms = surface.terms();
+        let order = terms.order();
+        let terms_per_bin = order + 1;
+        let layers = 2 * order + 1;
+        let (nx, ny) = terms.size();
+        let n = axis.count;
+        let half = n / 2;
+        let inv_fact: Vec<f64> = (0..=order)
+            .scan(1.0, |f, i| {
+                if i > 0 {
+                    *f /= i as f64;
+                }
+                Some(*f)
+            })
+            .collect();
+        let matrix = colorimeter.matrix();
+        let columns_u: Vec<f64> = (half..n).map(|i| axis.texel_centre(i)).collect();
+        let rows: Vec<Vec<[f32; 3]>> = (0..n)
+            .into_par_iter()
+            .map(|iv| {
+                let v = axis.texel_centre(iv);
+                let mut acc = vec![[0.0f64; 3]; half * layers];
+                let mut r = vec![C64::new(0.0, 0.0); nx * terms_per_bin];
+                let mut pt = vec![C64::new(0.0, 0.0); terms_per_bin];
+                let mut q = vec![0.0f64; layers];
+                let mut k_pow = vec![0.0f64; layers];
+                for (&wavelength, weight) in grid.wavelengths_nm().iter().zip(&grid.xyz_weights) {
+                    let k = k_per_um(wavelength);
+                    r.fill(C64::new(0.0, 0.0));
+                    for (jy, wy) in surface.axis_weights(k * v, false) {
+                        let sy = (jy + (ny / 2) as i64) as usize;
+                        let row =
+                            &terms.data[sy * nx * terms_per_bin..(sy + 1) * nx * terms_per_bin];
+                        for (r, t) in r.iter_mut().zip(row) {
+                            *r += t * wy;
+                        }
+                    }
+                    let mut kp = 1.0;
+                    for v in k_pow.iter_mut() {
+                        *v = kp;
+                        kp *= k;
+                    }
+                    for (c, &u) in columns_u.iter().enumerate() {
+                        pt.fill(C64::new(0.0, 0.0));
+                        for (jx, wx) in surface.axis_weights(k * u, true) {
+                            let sx = (jx + (nx / 2) as i64) as usize;
+                            let bins = &r[sx * terms_per_bin..(sx + 1) * terms_per_bin];
+                            for (p, b) in pt.iter_mut().zip(bins) {
+                                *p += b * wx;
+                            }
+                        }
+                        // kᵖ Σ_{n+m=p} Re(P̃ₙ P̃ₘ*)/(n! m!), the (m, n) twin of n < m doubling it.
+                        q.fill(0.0);
+                        for a in 0..=order {
+                            for b in a..=order {
+                                let re = pt[a].re * pt[b].re + pt[a].im * pt[b].im;
+                                let twin = if a == b { 1.0 } else { 2.0 };
+                                q[a + b] += twin * re * inv_fact[a] * inv_fact[b];
+                            }
+                        }
+                        let cell = &mut acc[c * layers..(c + 1) * layers];
+                        for ((cell, q), kp) in cell.iter_mut().zip(&q).zip(&k_pow) {
+                            let s = q * kp;
+                            for ch in 0..3 {
+                                cell[ch] += weight[ch] * s;
+                            }
+                        }
+                    }
+                }
+                // Layer-major within the row, in the output space: out[p * half + c].
+                let mut out = vec![[0.0f32; 3]; layers * half];
+                for c in 0..half {
+                    for p in 0..layers {
+                        let xyz = acc[c * layers + p];
+                        let rgb: [f64; 3] = std::array::from_fn(|i| {
+                            matrix[i][0] * xyz[0] + matrix[i][1] * xyz[1] + matrix[i][2] * xyz[2]
+                        });
+                        out[p * half + c] = rgb.map(|v| v as f32);
+                    }
+                }
+                out
+            })
+            .collect();
+        let mut values = vec![[0.0f32; 3]; layers * n * half];
+        for (iv, row) in rows.iter().enumerate() {
+            for p in 0..layers {
+                values[(p * n + iv) * half..(p * n + iv + 1) * half]
+                    .copy_from_slice(&row[p * half..(p + 1) * half]);
+            }
+        }
+        IntegratedTable {
+            axis,
+            order,
+            values,
+        }
+    }
+
+    /// A table from stored values (`values[(p * n + iv) * n/2 + c]`, p = 0 … 2N), e.g.
+    /// read back from a baked file.
+    ///
+    /// # Errors
+    /// [`Error::OutOfRange`] when the value count is not (2N + 1)·n·n/2.
+    pub fn from_values(axis: WarpedAxis, order: usize, values: Vec<[f32; 3]>) -> Result<Self> {
+        let expected = (2 * order + 1) * axis.count * (axis.count / 2);
+        if values.len() != expected {
+            return Err(Error::OutOfRange {
+                what: "integrated-table values",
+                value: values.len() as f64,
+                expected: "(2N + 1) × n × n/2 texels",
+            });
+        }
+        Ok(IntegratedTable {
+            axis,
+            order,
+            values,
+        })
+    }
+
+    /// The axis (v whole, u its half u ≥ 0).
+    pub fn axis(&self) -> WarpedAxis {
+        self.axis
+    }
+
+    /// The Taylor order N of the terms the table was built from.
+    pub fn order(&self) -> usize {
+        self.order
+    }
+
+    /// Layers 2N + 1.
+    pub fn layers(&self) -> usize {
+        2 * self.order + 1
+    }
+
+    /// (columns, rows) = (n/2, n) of each layer.
+    pub fn size(&self) -> (usize, usize) {
+        (self.axis.count / 2, self.axis.count)
+    }
+
+    /// I_p at column c (u ≥ 0) and row iv, output space.
+    pub fn texel(&self, p: usize, c: usize, iv: usize) -> [f32; 3] {
+        let (w, h) = self.size();
+        self.values[(p * h + iv) * w + c]
+    }
+
+    /// Every value, `[(p * n + iv) * n/2 + c]`.
+    pub fn values(&self) -> &[[f32; 3]] {
+        &self.values
+    }
+
+    /// Σₚ wᵖ Iₚ(u, v) as a shader computes it: the fold u < 0 → (−u, −v, −w), the texel
+    /// coordinates of the forward mapping (clamped to the edge), bilinear weights, and
+    /// the Horner sum (…(I_{2N} w + I_{2N−1}) w + …) w + I₀, all in f32.
+    pub fn sum_at(&self, u: f64, v: f64, w: f64) -> [f64; 3] {
+        let (u, v, w) = if u < 0.0 { (-u, -v, -w) } else { (u, v, w) };
+        let (cols, rows) = self.size();
+        let split = |x: f64, n: usize| {
+            let x = x.clamp(0.0, (n - 1) as f64);
+            let i0 = (x.floor() as usize).min(n - 2);
+            (i0, (x - i0 as f64) as f32)
+        };
+        let (x0, fx) = split(self.axis.coordinate(u) - cols as f64, cols);
+        let (y0, fy) = split(self.axis.coordinate(v), rows);
+        let w = w as f32;
+        let mut acc = [0.0f32; 3];
+        for p in (0..self.layers()).rev() {
+            let a = self.texel(p, x0, y0);
+            let b = self.texel(p, x0 + 1, y0);
+            let c = self.texel(p, x0, y0 + 1);
+            let d = self.texel(p, x0 + 1, y0 + 1);
+            for ch in 0..3 {
+                let lo = a[ch] + fx * (b[ch] - a[ch]);
+                let hi = c[ch] + fx * (d[ch] - c[ch]);
+                acc[ch] = acc[ch] * w + (lo + fy * (hi - lo));
+            }
+        }
+        acc.map(f64::from)
+    }
+
+    /// The colour (output space) C(ω_i, ω_r) · Σₚ wᵖ Iₚ(u, v) with
+    /// C = F²(θ_h) · G/w² (module docs); 0 when either direction is at or below the
+    /// horizon. F² must not depend on the wavelength, which [`FresnelTerm`] guarantees.
+    pub fn colour(&self, omega_i: [f64; 3], omega_r: [f64; 3], fresnel: FresnelTerm) -> [f64; 3] {
+        let g = geometry_over_w2(omega_i, omega_r);
+        if g == 0.0 {
+            return [0.0; 3];
+        }
+        let [u, v, w] = std::array::from_fn(|i| -omega_i[i] - omega_r[i]);
+        let cos_h =
+            -(omega_i[0] * u + omega_i[1] * v + omega_i[2] * w) / (u * u + v * v + w * w).sqrt();
+        let c = fresnel.reflectance(cos_h) * g;
+        self.sum_at(u, v, w).map(|s| c * s)
+    }
+
+    /// Measures the table against the terms layout: for every (ω_i, ω_r) of `pairs`, the
+    /// colour of [`IntegratedTable::colour`] against the exact colour of `surface`
+    /// (f64 terms, ρ per wavelength, [`SpectralGrid::xyz`], `output_from_xyz`), both with
+    /// F = 1. The metric is the largest |Δ| of any output channel divided by that
+    /// channel's white (the colour ρ ≡ 1 gives: a flat perfect mirror seen in its specular
+    /// direction), i.e. errors in units of the specular white. Pairs in parallel; the
+    /// maximum is taken in pair order, so the result does not depend on the thread count.
+    pub fn reconstruction_error(
+        &self,
+        surface: &DiffractionSurface,
+        grid: &SpectralGrid,
+        colorimeter: &Colorimeter,
+        pairs: &[([f64; 3], [f64; 3])],
+    ) -> ReconstructionError {
+        let white = colorimeter.output_from_xyz(grid.xyz(&vec![1.0; grid.wavelengths_nm().len()]));
+        let errors: Vec<(f64, usize, [f64; 3], [f64; 3])> = pairs
+            .par_iter()
+            .map(|&(wi, wr)| {
+                let rho: Vec<f64> = grid
+                    .wavelengths_nm()
+                    .iter()
+                    .map(|&l| surface.relative_reflectance(wi, wr, l, FresnelTerm::Unity))
+                    .collect();
+                let exact = colorimeter.output_from_xyz(grid.xyz(&rho));
+                let fast = self.colour(wi, wr, FresnelTerm::Unity);
+                let (mut worst, mut channel) = (0.0f64, 0);
+                for c in 0..3 {
+                    let e = (fast[c] - exact[c]).abs() / white[c].abs().max(1e-300);
+                    if !(e <= worst) {
+                        worst = e;
+                        channel = c;
+                    }
+                }
+                (worst, channel, exact, fast)
+            })
+            .collect();
+        let mut report = ReconstructionError {
+            max_error: 0.0,
+            mean_error: 0.0,
+            omega_i: [0.0, 0.0, 1.0],
+            omega_r: [0.0, 0.0, 1.0],
+            channel: 0,
+            exact: [0.0; 3],
+            integrated: [0.0; 3],
+            pairs: pairs.len(),
+        };
+        let mut sum = 0.0;
+        for (i, &(e, channel, exact, integrated)) in errors.iter().enumerate() {
+            sum += e;
+            if !(e <= report.max_error) {
+                report = ReconstructionError {
+                    max_error: e,
+                    omega_i: pairs[i].0,
+                    omega_r: pairs[i].1,
+                    channel,
+                    exact,
+                    integrated,
+                    ..report
+                };
+            }
+        }
+        report.mean_error = sum / pairs.len().max(1) as f64;
+        report
+    }
+}
+
+impl IntegratedTable {
+    /// The error of f32 storage and the f32 Horner sum alone (no interpolation): at the
+    /// centres of every `stride`-th column and row, |Σₚ wᵖ Iₚ − M Σ_λ u(λ)|P̃(λ)|²| for
+    /// w = −2 and w = `w_min` (the smallest |w| served, −2 cos θ_max), P̃ from `surface`'s
+    /// f64 terms, in units of the specular white as in
+    /// [`IntegratedTable::reconstruction_error`]. This isolates the catastrophic
+    /// cancellation of the sum for tall structures (module docs). Texels in parallel, the
+    /// maximum in a fixed order.
+    pub fn storage_error(
+        &self,
+        surface: &DiffractionSurface,
+        grid: &SpectralGrid,
+        colorimeter: &Colorimeter,
+        stride: usize,
+        w_min: f64,
+    ) -> f64 {
+        let white = colorimeter.output_from_xyz(grid.xyz(&vec![1.0; grid.wavelengths_nm().len()]));
+        let (cols, rows) = self.size();
+        let stride = stride.max(1);
+        let probes: Vec<(f64, f64, f64)> = (0..rows)
+            .step_by(stride)
+            .flat_map(|iv| {
+                (0..cols)
+                    .step_by(stride)
+                    .flat_map(move |c| [-2.0, w_min].map(|w| (c, iv, w)))
+            })
+            .map(|(c, iv, w)| {
+                (
+                    self.axis.texel_centre(cols + c),
+                    self.axis.texel_centre(iv),
+                    w,
+                )
+            })
+            .collect();
+        let errors: Vec<f64> = probes
+            .par_iter()
+            .map(|&(u, v, w)| {
+                let p2: Vec<f64> = grid
+                    .wavelengths_nm()
+                    .iter()
+                    .map(|&l| surface.transform(l, u, v, w).norm_sqr())
+                    .collect();
+                let exact = colorimeter.output_from_xyz(grid.xyz(&p2));
+                let fast = self.sum_at(u, v, w);
+                (0..3)
+                    .map(|c| (fast[c] - exact[c]).abs() / white[c].abs().max(1e-300))
+                    .fold(0.0, |m: f64, e| if e <= m { m } else { e })
+            })
+            .collect();
+        errors
+            .into_iter()
+            .fold(0.0, |m: f64, e| if e <= m { m } else { e })
+    }
+}
+
+/// The outcome of [`IntegratedTable::reconstruction_error`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReconstructionError {
+    /// The largest error, in units of the specular white (NaN when a value was not finite).
+    pub max_error: f64,
+    /// The mean of the per-pair errors.
+    pub mean_error: f64,
+    /// Light direction of the worst pair.
+    pub omega_i: [f64; 3],
+    /// View direction of the worst pair.
+    pub omega_r: [f64; 3],
+    /// Output channel (0, 1, 2) of the worst error.
+    pub channel: usize,
+    /// Terms-layout colour there.
+    pub exact: [f64; 3],
+    /// Integrated-layout colour there.
+    pub integrated: [f64; 3],
+    /// Pairs compared.
+    pub pairs: usize,
+}
+
+/// The light/view pairs [`IntegratedTable::reconstruction_error`] is measured on for a
+/// table serving polar angles up to `max_angle_deg`:
+///
+/// * lights at θ_i ∈ {0, ½, 1}·θ_max (the edge pulled in by 10⁻⁶°) and azimuths
+///   φ_i ∈ {0°, 30°, 90°} (one light at the normal);
+/// * for each light, views on a 25 × 25 grid of the projected disc of radius sin θ_max
+///   (off-plane views included), the specular view and views 0.02°, 0.05°, 0.1°,
+///   0.2°, 0.5° and 1° from it in four directions (the mirror lobe), and in-plane views
+///   every 0.5° (across the grating lines and along them).
+pub fn check_directions(max_angle_deg: f64) -> Vec<([f64; 3], [f64; 3])> {
+    let theta_max = max_angle_deg - 1e-6;
+    let radius = theta_max.to_radians().sin();
+    let dir = |theta_deg: f64, phi_deg: f64| {
+        let (st, ct) = theta_deg.to_radians().sin_cos();
+        let (sp, cp) = phi_deg.to_radians().sin_cos();
+        [st * cp, st * sp, ct]
+    };
+    let mut lights = vec![[0.0, 0.0, 1.0]];
+    for frac in [0.5, 1.0] {
+        for phi in [0.0, 30.0, 90.0] {
+            let d = dir(frac * theta_max, phi);
+            lights.push([-d[0], -d[1], d[2]]);
+        }
+    }
+    let mut pairs = Vec::new();
+    for wi in lights {
+        let m = 25;
+        for iy in 0..m {
+            for ix in 0..m {
+                let at = |i: usize| radius * (2.0 * i as f64 / (m - 1) as f64 - 1.0);
+                let (x, y) = (at(ix), at(iy));
+                let r2 = x * x + y * y;
+                if r2 <= radius * radius {
+                    pairs.push((wi, [x, y, (1.0 - r2).sqrt()]));
+                }
+            }
+        }
+        // The specular view and the lobe around it.
+        let spec = [-wi[0], -wi[1], wi[2]];
+        let theta_s = spec[2].acos().to_degrees();
+        let phi_s = if spec[0] == 0.0 && spec[1] == 0.0 {
+            0.0
+        } else {
+            spec[1].atan2(spec[0]).to_degrees()
+        };
+        pairs.push((wi, spec));
+        for off in [0.02, 0.05, 0.1, 0.2, 0.5, 1.0] {
+            for (dt, dp) in [(off, 0.0), (-off, 0.0), (0.0, off), (0.0, -off)] {
+                let t = theta_s + dt;
+                // An azimuth step of `off` degrees of arc at θ_s.
+                let p = phi_s + dp / theta_s.to_radians().sin().max(1e-3);
+                if t.abs() <= theta_max {
+                    pairs.push((wi, dir(t, p)));
+                }
+            }
+        }
+        let steps = (2.0 * theta_max / 0.5).floor() as i64;
+        for s in 0..=steps {
+            let t = -theta_max + 0.5 * s as f64;
+            pairs.push((wi, dir(t, 0.0)));
+            pairs.push((wi, dir(t, 90.0)));
+        }
+    }
+    pairs
+}

@@ -1,0 +1,400 @@
+//! The `diffraction` technique (`nacre_runtime::diffraction`, `shaders/diffraction.wgsl`):
+//!
+//! * GPU = CPU: the compute probe against `DiffractionSurface::relative_reflectance` summed
+//!   over the same `SpectralGrid`, for the default set's CD and ridge tables, over in-plane
+//!   sweeps that cross the grating orders and random out-of-plane directions;
+//! * bad directions (NaN, ±∞, huge, zero, below the horizon) give finite colours;
+//! * the loader checks kind, layout and SHA-256;
+//! * the `cd-disc` and `snake-skin` scenes are deterministic and show diffraction colours
+//!   (saturated pixels whose hue spans the rainbow), which the specular order alone cannot.
+//!
+//! A missing adapter fails these tests: they never skip.
+
+use nacre_bake::bake::default_baked_dir;
+use nacre_optics::C64;
+use nacre_optics::diffraction::{DiffractionSurface, FresnelTerm, in_plane_directions};
+use nacre_runtime::GpuContext;
+use nacre_runtime::diffraction::{
+    DiffractionBinding, DiffractionOptions, DiffractionScene, DiffractionSceneOptions,
+    DiffractionTable, render_diffraction_scene, run_probe,
+};
+use rayon::prelude::*;
+use std::sync::OnceLock;
+
+fn ctx() -> &'static GpuContext {
+    static CTX: OnceLock<GpuContext> = OnceLock::new();
+    CTX.get_or_init(|| {
+        let ctx = GpuContext::new_headless().unwrap_or_else(|e| {
+            panic!("the GPU tests need an adapter (CI installs mesa-vulkan-drivers): {e}")
+        });
+        eprintln!("adapter: {}", ctx.describe());
+        ctx
+    })
+}
+
+fn table(name: &str) -> &'static DiffractionTable {
+    static CD: OnceLock<DiffractionTable> = OnceLock::new();
+    static RIDGES: OnceLock<DiffractionTable> = OnceLock::new();
+    let cell = match name {
+        "cd-tracks" => &CD,
+        "snake-ridges" => &RIDGES,
+        other => panic!("no table {other}"),
+    };
+    cell.get_or_init(|| {
+        DiffractionTable::load(ctx(), &default_baked_dir().join(format!("{name}.json"))).unwrap()
+    })
+}
+
+/// Deterministic uniform numbers in [0, 1).
+struct Lcg(u64);
+impl Lcg {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// In-plane sweeps (incidences 0°, 20°, 40°; views −45° … 45° every 0.25°, crossing the
+/// orders m = −2 … 2 of the 1.6 µm tracks) and `random` directions within 45° of the normal.
+fn directions(random: usize) -> Vec<([f64; 3], [f64; 3])> {
+    let mut pairs = Vec::new();
+    for incidence in [0.0, 20.0, 40.0] {
+        for i in 0..=360 {
+            pairs.push(in_plane_directions(incidence, -45.0 + 0.25 * f64::from(i)));
+        }
+    }
+    let mut rng = Lcg(11);
+    let dir = |rng: &mut Lcg| {
+        let theta = (rng.next() * 45.0).to_radians();
+        let phi = rng.next() * std::f64::consts::TAU;
+        [
+            theta.sin() * phi.cos(),
+            theta.sin() * phi.sin(),
+            theta.cos(),
+        ]
+    };
+    for _ in 0..random {
+        let wi = dir(&mut rng);
+        // Views near the specular direction and anywhere.
+        let wr = if rng.next() < 0.5 {
+            let s = [-wi[0], -wi[1], wi[2]];
+            let j = dir(&mut rng);
+            let m = [s[0] + 0.05 * j[0], s[1] + 0.05 * j[1], s[2]];
+            let l = (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]).sqrt();
+            m.map(|x| x / l)
+        } else {
+            dir(&mut rng)
+        };
+        pairs.push((wi, wr));
+    }
+    pairs
+}
+
+/// Max |GPU − CPU| over channels and the pair where it occurs, and the largest CPU channel.
+fn compare(
+    name: &str,
+    options: &DiffractionOptions,
+    pairs: &[([f64; 3], [f64; 3])],
+) -> (f64, f64, f64) {
+    let ctx = ctx();
+    let table = table(name);
+    let binding = DiffractionBinding::new(ctx, table, options).unwrap();
+    let colorimeter = table.colorimeter().unwrap();
+    let surface = DiffractionSurface::new(table.terms.clone(), table.record.sigma_s_um).unwrap();
+    let grid = &binding.grid;
+    let f32s = |v: [f64; 3]| v.map(|x| x as f32);
+    let gpu = run_probe(
+        ctx,
+        &binding,
+        &pairs
+            .iter()
+            .map(|(i, r)| (f32s(*i), f32s(*r)))
+            .collect::<Vec<_>>(),
+    )
+    .unwrap();
+    let cpu: Vec<([f64; 3], [f64; 3])> = pairs
+        .par_iter()
+        .map(|(wi, wr)| {
+            // The CPU sees the same f32-rounded directions as the GPU.
+            let (wi, wr) = (
+                wi.map(|x| f64::from(x as f32)),
+                wr.map(|x| f64::from(x as f32)),
+            );
+            let rho: Vec<f64> = grid
+                .wavelengths_nm()
+                .iter()
+                .map(|&l| surface.relative_reflectance(wi, wr, l, options.fresnel))
+                .collect();
+            let colour = colorimeter.output_from_xyz(grid.xyz(&rho));
+            // The specular order at cos θ = ω_r.z: F² |P_DC(k w)|², w = −2 cos θ.
+            let c = wr[2].clamp(0.0, 1.0);
+            let spec: Vec<f64> = grid
+                .wavelengths_nm()
+                .iter()
+                .map(|&l| {
+                    if c <= 0.0 {
+                        return 0.0;
+                    }
+                    let kw = -2.0 * c * std::f64::consts::TAU / (l * 1e-3);
+                    let mut term = 1.0;
+                    let mut p = C64::new(0.0, 0.0);
+                    for n in 0..=table.terms.order() {
+                        if n > 0 {
+                            term *= kw / n as f64;
+                        }
+                        p += table.terms.bin(n, 0, 0).unwrap() * term;
+                    }
+                    options.fresnel.reflectance(c) * p.norm_sqr()
+                })
+                .collect();
+            (colour, colorimeter.output_from_xyz(grid.xyz(&spec)))
+        })
+        .collect();
+    let (mut worst, mut worst_spec, mut peak) = (0.0f64, 0.0f64, 0.0f64);
+    let mut at = 0;
+    for (k, (g, (c, s))) in gpu.iter().zip(&cpu).enumerate() {
+        for ch in 0..3 {
+            let d = (f64::from(g.colour[ch]) - c[ch]).abs();
+            if d.is_nan() || d > worst {
+                worst = d;
+                at = k;
+            }
+            worst_spec = worst_spec.max((f64::from(g.specular_order[ch]) - s[ch]).abs());
+            peak = peak.max(c[ch].abs());
+        }
+    }
+    eprintln!(
+        "{name} ({} wavelengths, {:?}): {} pairs, max |GPU − CPU| = {worst:.2e} at {:?} (GPU {:?}, CPU {:?}); specular order {worst_spec:.2e}; largest channel {peak:.3}",
+        grid.wavelengths_nm().len(),
+        options.fresnel,
+        pairs.len(),
+        pairs[at],
+        gpu[at].colour,
+        cpu[at].0
+    );
+    (worst, worst_spec, peak)
+}
+
+// Tolerances, set on Mesa lavapipe (llvmpipe, LLVM 15, Mesa 22.3.6), which measured
+// 3.6 · 10⁻⁶ (colour) and 5.0 · 10⁻⁷ (specular order) for cd-tracks: the shader drops
+// window weights ≤ 4.5 · 10⁻⁴ (R = 2 for both tables) where the CPU keeps every weight
+// ≥ 10⁻¹⁰, and sums the Taylor series in f32 (rounding ≲ 10⁻⁶ · e^{max |kwh|}); colours are
+// O(1) at the specular peak (the largest channel of the sweep is printed).
+const COLOUR_TOLERANCE: f64 = 2e-5;
+const SPECULAR_ORDER_TOLERANCE: f64 = 5e-6;
+
+#[test]
+fn cd_tracks_gpu_matches_the_cpu() {
+    let pairs = directions(400);
+    let (worst, spec, peak) = compare("cd-tracks", &DiffractionOptions::default(), &pairs);
+    assert!(peak > 0.1, "the sweep never reaches a bright order: {peak}");
+    assert!(worst <= COLOUR_TOLERANCE, "{worst:e}");
+    assert!(spec <= SPECULAR_ORDER_TOLERANCE, "{spec:e}");
+    // A coarser grid (10 nm, its own weights) and a Fresnel factor of an aluminium-like index.
+    let options = DiffractionOptions {
+        wavelength_step_nm: Some(10.0),
+        fresnel: FresnelTerm::Index(C64::new(1.2, 7.0)),
+        ..DiffractionOptions::default()
+    };
+    let (worst, spec, _) = compare("cd-tracks", &options, &pairs[..600]);
+    assert!(worst <= COLOUR_TOLERANCE, "{worst:e}");
+    assert!(spec <= SPECULAR_ORDER_TOLERANCE, "{spec:e}");
+}
+
+#[test]
+fn ridge_grating_gpu_matches_the_cpu() {
+    let pairs = directions(400);
+    let (worst, spec, peak) = compare("snake-ridges", &DiffractionOptions::default(), &pairs);
+    assert!(peak > 0.1, "the sweep never reaches a bright order: {peak}");
+    assert!(worst <= COLOUR_TOLERANCE, "{worst:e}");
+    assert!(spec <= SPECULAR_ORDER_TOLERANCE, "{spec:e}");
+}
+
+#[test]
+fn bad_directions_give_finite_colours() {
+    let ctx = ctx();
+    let binding =
+        DiffractionBinding::new(ctx, table("cd-tracks"), &DiffractionOptions::default()).unwrap();
+    let specials = [
+        f32::NAN,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        f32::MAX,
+        -f32::MAX,
+        1e30,
+        -1e30,
+        1e-38,
+        0.0,
+        -0.0,
+        -1.0,
+        1.0,
+        0.5,
+    ];
+    let mut pairs = Vec::new();
+    for &a in &specials {
+        for &b in &specials {
+            pairs.push(([a, b, 1.0], [0.3, 0.0, b]));
+            pairs.push(([0.1, a, b], [a, 0.2, 0.9]));
+            pairs.push(([a, a, a], [b, b, b]));
+        }
+    }
+    let out = run_probe(ctx, &binding, &pairs).unwrap();
+    for ((wi, wr), o) in pairs.iter().zip(&out) {
+        for v in o.colour.iter().chain(&o.specular_order) {
+            assert!(v.is_finite(), "{wi:?}, {wr:?} -> {o:?}: not finite");
+        }
+    }
+    // Huge but valid directions are the unit ones.
+    let unit = run_probe(ctx, &binding, &[([-0.2, 0.0, 0.9], [0.2, 0.0, 0.9])]).unwrap();
+    let huge = run_probe(ctx, &binding, &[([-2e37, 0.0, 9e37], [2e37, 0.0, 9e37])]).unwrap();
+    for c in 0..3 {
+        assert!((unit[0].colour[c] - huge[0].colour[c]).abs() <= 1e-5 * unit[0].colour[c].max(1.0));
+    }
+}
+
+#[test]
+fn loader_checks_kind_layout_and_checksums() {
+    let ctx = ctx();
+    let baked = default_baked_dir();
+    let err = DiffractionTable::load(ctx, &baked.join("film-dielectric.json"))
+        .err()
+        .expect("a film-lut table is not a diffraction table");
+    assert!(
+        err.to_string().contains("not a `diffraction` table"),
+        "{err}"
+    );
+
+    let dir = tempfile::tempdir().unwrap();
+    let manifest = std::fs::read_to_string(baked.join("snake-ridges.json")).unwrap();
+    for f in std::fs::read_dir(&baked).unwrap() {
+        let f = f.unwrap();
+        let name = f.file_name().to_string_lossy().into_owned();
+        if name.starts_with("snake-ridges.") {
+            std::fs::copy(f.path(), dir.path().join(&name)).unwrap();
+        }
+    }
+    let path = dir.path().join("snake-ridges.json");
+    DiffractionTable::load(ctx, &path).unwrap();
+    // Another layout is named in the error.
+    std::fs::write(
+        &path,
+        manifest.replacen("\"layout\": \"terms\"", "\"layout\": \"integrated\"", 1),
+    )
+    .unwrap();
+    let err = DiffractionTable::load(ctx, &path)
+        .err()
+        .expect("unknown layout");
+    assert!(err.to_string().contains("integrated"), "{err}");
+    // A changed terms file fails its checksum.
+    std::fs::write(&path, &manifest).unwrap();
+    let exr = dir.path().join("snake-ridges.terms.exr");
+    let mut bytes = std::fs::read(&exr).unwrap();
+    let last = bytes.len() - 1;
+    bytes[last] ^= 0x55;
+    std::fs::write(&exr, bytes).unwrap();
+    let err = DiffractionTable::load(ctx, &path)
+        .err()
+        .expect("bad checksum");
+    assert!(err.to_string().contains("SHA-256"), "{err}");
+}
+
+/// Hue (degrees), saturation and value of an sRGB pixel.
+fn hsv(p: &[u8]) -> (f64, f64, f64) {
+    let [r, g, b] = [p[0], p[1], p[2]].map(|c| f64::from(c) / 255.0);
+    let max = r.max(g).max(b);
+    let min = r.min(g).min(b);
+    let d = max - min;
+    let h = if d == 0.0 {
+        0.0
+    } else if max == r {
+        60.0 * ((g - b) / d).rem_euclid(6.0)
+    } else if max == g {
+        60.0 * ((b - r) / d + 2.0)
+    } else {
+        60.0 * ((r - g) / d + 4.0)
+    };
+    (h, if max > 0.0 { d / max } else { 0.0 }, max)
+}
+
+/// Saturated pixels (s > 0.5, v > 0.15) and how many 30° hue sectors they fill.
+fn colourfulness(pixels: &[u8]) -> (usize, usize) {
+    let mut sectors = [0usize; 12];
+    let mut count = 0;
+    for p in pixels.chunks_exact(4) {
+        let (h, s, v) = hsv(p);
+        if s > 0.5 && v > 0.15 {
+            count += 1;
+            sectors[(h / 30.0) as usize % 12] += 1;
+        }
+    }
+    (count, sectors.iter().filter(|&&n| n >= 2).count())
+}
+
+#[test]
+fn scenes_show_rainbows_and_are_deterministic() {
+    let ctx = ctx();
+    for scene in DiffractionScene::ALL {
+        let table = table(scene.default_table());
+        let mut options = DiffractionSceneOptions::new(scene);
+        options.width = 100;
+        options.height = 75;
+        let a = render_diffraction_scene(ctx, table, &options).unwrap();
+        let b = render_diffraction_scene(ctx, table, &options).unwrap();
+        assert!(a.pixels == b.pixels, "{}: not deterministic", scene.name());
+        // Written for inspection (also when an assertion below fails).
+        let out = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+            .join(format!("diffraction-{}.png", scene.name()));
+        a.write_png(&out).unwrap();
+        eprintln!("wrote {}", out.display());
+        let (count, sectors) = colourfulness(&a.pixels);
+        eprintln!(
+            "{}: {count} saturated pixels over {sectors} hue sectors of 30° ({:.2} s)",
+            scene.name(),
+            a.gpu_seconds
+        );
+        assert!(count >= 40, "{}: {count} saturated pixels", scene.name());
+        assert!(sectors >= 5, "{}: hues in {sectors} sectors", scene.name());
+        // Without the light and the environment samples only the specular order remains:
+        // no rainbow.
+        options.light.intensity = 0.0;
+        options.env_samples = 0;
+        let plain = render_diffraction_scene(ctx, table, &options).unwrap();
+        let (count, sectors) = colourfulness(&plain.pixels);
+        eprintln!(
+            "{} without diffracted lights: {count} saturated pixels, {sectors} sectors",
+            scene.name()
+        );
+        assert!(sectors < 5, "{}: {sectors} sectors", scene.name());
+    }
+}
+
+#[test]
+fn scene_settings_are_checked() {
+    let ctx = ctx();
+    let table = table("cd-tracks");
+    let mut options = DiffractionSceneOptions::new(DiffractionScene::CdDisc);
+    options.width = 0;
+    assert!(render_diffraction_scene(ctx, table, &options).is_err());
+    let mut options = DiffractionSceneOptions::new(DiffractionScene::CdDisc);
+    options.exposure_ev = f32::NAN;
+    assert!(render_diffraction_scene(ctx, table, &options).is_err());
+    let mut options = DiffractionSceneOptions::new(DiffractionScene::CdDisc);
+    options.env_samples = 99;
+    assert!(render_diffraction_scene(ctx, table, &options).is_err());
+    let mut options = DiffractionSceneOptions::new(DiffractionScene::CdDisc);
+    options.technique.wavelength_step_nm = Some(0.0);
+    assert!(render_diffraction_scene(ctx, table, &options).is_err());
+    options.technique.wavelength_step_nm = Some(f64::NAN);
+    assert!(render_diffraction_scene(ctx, table, &options).is_err());
+    let mut options = DiffractionSceneOptions::new(DiffractionScene::CdDisc);
+    options.environment = Some("/nonexistent/env.exr".into());
+    assert!(render_diffraction_scene(ctx, table, &options).is_err());
+    assert!("disc".parse::<DiffractionScene>().is_err());
+    assert_eq!(
+        "CD-Disc".parse::<DiffractionScene>().unwrap(),
+        DiffractionScene::CdDisc
+    );
+}

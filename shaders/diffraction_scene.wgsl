@@ -1,0 +1,308 @@
+// nacre · shaders/diffraction_scene.wgsl
+//
+// Consumers of the `diffraction` technique (composed after diffraction.wgsl by
+// `nacre_runtime::diffraction`): the ray-cast scenes of `nacre render --scene cd-disc |
+// snake-skin`, the bench pass of `nacre bench-gpu`, and the GPU = CPU probe (compute).
+//
+// Symbols
+//   p, n          hit point and unit normal (world units; y up)
+//   t             direction across the grating lines at p (the grating tangent map below)
+//   ω_i, ω_r      towards the light, towards the eye;  F = diffraction_frame(n, t)
+//   L_k, ω_k      radiance and direction of the light (k = 0) and of the environment samples
+//
+// Radiance leaving a grating point towards the eye:
+//
+//   L = Σ_k I_k · Σ_λ ρ(F ω_k, F ω_r, λ) u(λ)              light + environment samples
+//     + L_env(reflect(−ω_r, n)) ⊙ Σ_λ F² |P_DC(k w)|² u(λ)  the specular order of the environment
+//     + base (snake skin only: a dark diffuse layer, albedo × (n·ω_0 E_0 + ambient))
+//
+// I_k = E_k · (σ_s k₀)²/π is the radiance of source k's mirror image spread over the
+// coherence lobe (E_k its irradiance at normal incidence, k₀ = 2π/555 nm; computed on the
+// CPU, `nacre_runtime::diffraction::lobe_gain`): a flat mirror's lobe |P̃|² integrates to
+// π/(σ_s k)² over (u, v), so ρ · I is the reflected radiance (Stam's k² included at 555 nm).
+//
+// The environment enters twice, as a documented approximation: its mirror image through the
+// zeroth order (exact for an extended source: the order keeps |P_DC|² of the radiance), and
+// the K brightest texels of a 32 × 16 downsampled copy as directional samples
+// (`DiffractionView.samples`, chosen on the CPU at least 25° apart above the horizon, each
+// with E_k = L_texel · Ω_texel) whose diffracted orders are evaluated like the light's:
+// extended sources are thus diffracted as if they were points (thin rainbow lines, with the
+// right total power, instead of wide smeared bands).
+//
+// Scenes (ViewParams.scene):
+//   0 cd-disc     an annulus in the plane y = 0 centred at the origin: a clear hub
+//                 (r < 0.38, a plain mirror with F² of the hub), the data area (0.38 ≤ r ≤ 0.98)
+//                 whose tracks are circles (t = the radial direction) and a clear rim; the
+//                 centre hole (r < 0.12) shows the background.
+//   1 snake-skin  a patch of the cylinder y² + z² = 1 (axis x, |x| ≤ 1.6, within 75° of the top),
+//                 tiled with domed diamond scales (a rhombic lattice in (x, arc length));
+//                 in each scale the ridges run along the body with a per-scale random
+//                 rotation of ±15° and a fan of ±12° across the scale; t is perpendicular
+//                 to the ridges in the tangent plane. The scales' dark skin shows between
+//                 the coloured orders.
+//   2 bench       `nacre bench-gpu`: the sphere-like normal field of bench.wgsl over the
+//                 whole target, t swirling over the screen, the light only, no environment.
+//
+// Output: linear radiance × 2^exposure, tone mapped c/(1 + max channel) (hue-preserving
+// Reinhard on the largest channel), sRGB-encoded into an Rgba8Unorm target.
+
+// Byte layout (400 bytes; `nacre_runtime::diffraction::DiffractionViewUniform` mirrors it):
+//
+//   offset size field
+//        0   64 inv_view_proj: mat4x4<f32>  clip (x, y ∈ [−1, 1], z ∈ [0, 1]) → world
+//       64   12 eye: vec3<f32>              camera position
+//       76    4 exposure: f32               2^EV
+//       80   12 light_direction: vec3<f32>  towards the light (unit)
+//       92    4 light_intensity: f32        I_0 = E_0 (σ_s k₀)²/π
+//      96   12 light_colour: vec3<f32>
+//      108    4 env_intensity: f32
+//      112    8 resolution: vec2<f32>       pixels
+//      120    4 scene: u32
+//      124    4 sample_count: u32           environment samples used (≤ 8)
+//      128  128 samples: array<vec4<f32>, 8>          direction xyz (unit), w unused
+//      256  128 sample_radiance: array<vec4<f32>, 8>  I_k rgb (× env_intensity on the CPU)
+//      384    4 light_irradiance: f32       E_0 (the snake's diffuse skin)
+//      388   12 _pad0, _pad1, _pad2: f32
+struct DiffractionView {
+    inv_view_proj: mat4x4<f32>,
+    eye: vec3<f32>,
+    exposure: f32,
+    light_direction: vec3<f32>,
+    light_intensity: f32,
+    light_colour: vec3<f32>,
+    env_intensity: f32,
+    resolution: vec2<f32>,
+    scene: u32,
+    sample_count: u32,
+    samples: array<vec4<f32>, 8>,
+    sample_radiance: array<vec4<f32>, 8>,
+    light_irradiance: f32,
+    _pad0: f32,
+    _pad1: f32,
+    _pad2: f32,
+}
+
+@group(0) @binding(0) var<uniform> view: DiffractionView;
+@group(0) @binding(1) var environment: texture_2d<f32>;
+@group(0) @binding(2) var environment_sampler: sampler;
+
+const SCENE_PI: f32 = 3.14159265358979;
+
+@vertex
+fn diffraction_vs(@builtin(vertex_index) index: u32) -> @builtin(position) vec4<f32> {
+    let x = f32(i32(index & 1u) * 4 - 1);
+    let y = f32(i32(index >> 1u) * 4 - 1);
+    return vec4<f32>(x, y, 0.0, 1.0);
+}
+
+// Equirectangular (u, v) of a unit direction (nacre_runtime::ibl::env_direction_to_uv).
+fn scene_env_uv(d: vec3<f32>) -> vec2<f32> {
+    let u = 0.5 + atan2(d.x, -d.z) / (2.0 * SCENE_PI);
+    let v = acos(clamp(d.y, -1.0, 1.0)) / SCENE_PI;
+    return vec2<f32>(u, v);
+}
+
+fn scene_env(d: vec3<f32>, lod: f32) -> vec3<f32> {
+    return textureSampleLevel(environment, environment_sampler, scene_env_uv(d), lod).rgb * view.env_intensity;
+}
+
+// Deterministic hash of a lattice cell, in [0, 1)².
+fn scene_hash(c: vec2<i32>) -> vec2<f32> {
+    var h = (bitcast<u32>(c.x) * 0x9e3779b9u) ^ (bitcast<u32>(c.y) * 0x85ebca6bu + 0x632be5abu);
+    h ^= h >> 16u;
+    h *= 0x7feb352du;
+    h ^= h >> 15u;
+    let h2 = h * 0x846ca68bu;
+    return vec2<f32>(f32(h >> 8u), f32((h2 ^ (h2 >> 16u)) >> 8u)) / 16777216.0;
+}
+
+struct Surface {
+    hit: bool,
+    position: vec3<f32>,
+    normal: vec3<f32>,
+    across: vec3<f32>,      // t: across the grating lines
+    grating: f32,           // 1 on the grating, 0 on clear parts
+    base: vec3<f32>,        // diffuse albedo under the grating (0: none)
+}
+
+fn miss() -> Surface {
+    var s: Surface;
+    s.hit = false;
+    return s;
+}
+
+fn cd_disc(origin: vec3<f32>, dir: vec3<f32>) -> Surface {
+    if abs(dir.y) < 1e-6 {
+        return miss();
+    }
+    let t = -origin.y / dir.y;
+    if t <= 0.0 {
+        return miss();
+    }
+    let p = origin + t * dir;
+    let r = length(p.xz);
+    if r > 1.0 || r < 0.12 {
+        return miss();
+    }
+    var s: Surface;
+    s.hit = true;
+    s.position = p;
+    // Seen from below, the disc's other face (the same tracks mirrored).
+    s.normal = vec3<f32>(0.0, sign(origin.y), 0.0);
+    s.across = vec3<f32>(p.x, 0.0, p.z) / max(r, 1e-6);
+    s.grating = select(0.0, 1.0, r >= 0.38 && r <= 0.98);
+    s.base = vec3<f32>(0.0);
+    return s;
+}
+
+fn snake_skin(origin: vec3<f32>, dir: vec3<f32>) -> Surface {
+    // Cylinder y² + z² = 1 around the x axis: the outer hit.
+    let a = dir.y * dir.y + dir.z * dir.z;
+    let b = origin.y * dir.y + origin.z * dir.z;
+    let c = origin.y * origin.y + origin.z * origin.z - 1.0;
+    let disc = b * b - a * c;
+    if a < 1e-8 || disc < 0.0 {
+        return miss();
+    }
+    let t = (-b - sqrt(disc)) / a;
+    if t <= 0.0 {
+        return miss();
+    }
+    let p = origin + t * dir;
+    let phi = atan2(p.z, p.y); // 0 at the top, towards +z
+    if abs(p.x) > 1.6 || abs(phi) > 1.31 {
+        return miss();
+    }
+    let n0 = vec3<f32>(0.0, p.y, p.z);
+    let along = vec3<f32>(1.0, 0.0, 0.0);
+    let around = vec3<f32>(0.0, -p.z, p.y); // d p / d phi
+    // Rhombic scale lattice in (x, arc length): cells 0.4 long, 0.3 wide, a 45° grid.
+    let q = vec2<f32>(p.x / 0.4, phi / 0.3);
+    let g = vec2<f32>(q.x + q.y, q.x - q.y);
+    let cell = vec2<i32>(floor(g));
+    let f = fract(g) - 0.5; // in the cell, [−0.5, 0.5)²
+    let rnd = scene_hash(cell);
+    // Local position within the scale along the body (a) and across it (b), in [−0.5, 0.5].
+    let la = 0.5 * (f.x + f.y);
+    let lb = 0.5 * (f.x - f.y);
+    // Dome: the normal tilts towards the scale's edges; keel ridge along the middle.
+    let tilt = 0.55 * la * along + 0.9 * lb * normalize(around);
+    var s: Surface;
+    s.hit = true;
+    s.position = p;
+    s.normal = normalize(n0 - tilt);
+    // Ridge direction: along the body, rotated per scale (±15°) and fanned across it (±12°).
+    let angle = (rnd.x - 0.5) * 0.52 + lb * 0.84;
+    let ridge = cos(angle) * along + sin(angle) * normalize(around);
+    s.across = cross(s.normal, ridge);
+    // Scale edges (the skin between the scales) are matt, without a grating.
+    let edge = max(abs(f.x), abs(f.y));
+    s.grating = 1.0 - smoothstep(0.42, 0.5, edge);
+    let tint = 0.6 + 0.4 * rnd.y;
+    s.base = vec3<f32>(0.022, 0.018, 0.014) * tint;
+    return s;
+}
+
+// World direction into the grating frame of the surface.
+fn scene_shade(s: Surface, to_eye: vec3<f32>) -> vec3<f32> {
+    let frame = diffraction_frame(s.normal, s.across);
+    let wr = frame * to_eye;
+    var radiance = vec3<f32>(0.0);
+    let light = normalize(view.light_direction);
+    let light_radiance = view.light_colour * view.light_intensity;
+    if s.grating > 0.0 {
+        var diffracted = diffraction_colour(frame * light, wr) * light_radiance;
+        let count = min(view.sample_count, 8u);
+        for (var k = 0u; k < count; k++) {
+            diffracted += diffraction_colour(frame * view.samples[k].xyz, wr) * view.sample_radiance[k].rgb;
+        }
+        radiance += s.grating * diffracted;
+    }
+    // The environment through the specular order (the clear parts: a plain mirror, F² only).
+    let n = s.normal;
+    let cos_v = dot(n, to_eye);
+    let mirror = reflect(-to_eye, n);
+    let env = scene_env(mirror, 1.0);
+    let specular = diffraction_specular_order_colour(cos_v);
+    let clear = vec3<f32>(diffraction_fresnel(cos_v));
+    radiance += env * mix(clear, specular, s.grating);
+    // The snake's dark skin: diffuse under the light and a constant sky term.
+    let n_dot_l = max(dot(n, light), 0.0);
+    radiance += s.base * (n_dot_l * view.light_colour * view.light_irradiance + vec3<f32>(0.6) * view.env_intensity);
+    return radiance;
+}
+
+fn scene_display(radiance: vec3<f32>) -> vec4<f32> {
+    var c = max(radiance * view.exposure, vec3<f32>(0.0));
+    if !diffraction_finite3(c) {
+        c = vec3<f32>(0.0);
+    }
+    let peak = max(c.r, max(c.g, c.b));
+    let mapped = c / (1.0 + peak);
+    let lo = mapped * 12.92;
+    let hi = 1.055 * pow(mapped, vec3<f32>(1.0 / 2.4)) - 0.055;
+    return vec4<f32>(select(hi, lo, mapped <= vec3<f32>(0.0031308)), 1.0);
+}
+
+fn scene_bench(position: vec2<f32>) -> vec3<f32> {
+    let p = (position / view.resolution) * 2.0 - 1.0;
+    let aspect = view.resolution.x / view.resolution.y;
+    let xy = vec2<f32>(p.x * aspect, -p.y) * 1.1;
+    let r2 = dot(xy, xy);
+    var n = normalize(vec3<f32>(0.0, 0.6, 0.8));
+    if r2 < 1.0 {
+        n = vec3<f32>(xy, sqrt(1.0 - r2));
+    }
+    let swirl = sin(7.0 * xy.x + 3.0 * sin(5.0 * xy.y)) * cos(6.0 * xy.y - 2.0 * xy.x);
+    let across = vec3<f32>(cos(3.0 * swirl), sin(3.0 * swirl), 0.0);
+    let frame = diffraction_frame(n, across);
+    let v = vec3<f32>(0.0, 0.0, 1.0);
+    let l = normalize(view.light_direction);
+    return diffraction_colour(frame * l, frame * v) * view.light_colour * view.light_intensity;
+}
+
+@fragment
+fn diffraction_scene_fs(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
+    if view.scene == 2u {
+        return scene_display(scene_bench(position.xy));
+    }
+    let ndc = vec2<f32>(
+        position.x / view.resolution.x * 2.0 - 1.0,
+        1.0 - position.y / view.resolution.y * 2.0,
+    );
+    let near = view.inv_view_proj * vec4<f32>(ndc, 0.0, 1.0);
+    let far = view.inv_view_proj * vec4<f32>(ndc, 1.0, 1.0);
+    let origin = near.xyz / near.w;
+    let dir = normalize(far.xyz / far.w - origin);
+    var s: Surface;
+    if view.scene == 0u {
+        s = cd_disc(origin, dir);
+    } else {
+        s = snake_skin(origin, dir);
+    }
+    if !s.hit {
+        return scene_display(scene_env(dir, 0.0));
+    }
+    return scene_display(scene_shade(s, -dir));
+}
+
+// ─── GPU = CPU probe (compute) ──────────────────────────────────────────────────────────
+//
+// Input i: probe_in[2i] = ω_i, probe_in[2i + 1] = ω_r (xyz, grating frame; any values).
+// Output i: probe_out[2i] = diffraction_colour(ω_i, ω_r),
+//           probe_out[2i + 1] = diffraction_specular_order_colour(ω_r.z).
+
+@group(2) @binding(0) var<storage, read> probe_in: array<vec4<f32>>;
+@group(2) @binding(1) var<storage, read_write> probe_out: array<vec4<f32>>;
+
+@compute @workgroup_size(64)
+fn diffraction_probe(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    if 2u * i + 1u >= arrayLength(&probe_in) {
+        return;
+    }
+    let wi = probe_in[2u * i].xyz;
+    let wr = probe_in[2u * i + 1u].xyz;
+    probe_out[2u * i] = vec4<f32>(diffraction_colour(wi, wr), 0.0);
+    probe_out[2u * i + 1u] = vec4<f32>(diffraction_specular_order_colour(wr.z), 0.0);
+}
