@@ -13,23 +13,12 @@ use nacre_runtime::gltf_scene::GltfScene;
 use nacre_runtime::mesh::{fit_camera, render_gltf};
 use nacre_runtime::render::{RenderedImage, SceneKind, SceneOptions};
 use nacre_runtime::shaders::{MATERIAL, MESH, compose};
-use nacre_runtime::{GpuContext, TableSet, Technique};
+use nacre_runtime::{TableSet, Technique};
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
 
-fn ctx() -> &'static GpuContext {
-    static CTX: OnceLock<GpuContext> = OnceLock::new();
-    CTX.get_or_init(|| {
-        GpuContext::new_headless().unwrap_or_else(|e| {
-            panic!("the glTF tests need an adapter (CI installs mesa-vulkan-drivers): {e}")
-        })
-    })
-}
-
-fn repo_root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
+mod support;
+use support::{ctx, repo_root};
 
 fn asset_dir() -> PathBuf {
     repo_root().join("tests/golden/gltf")

@@ -12,19 +12,11 @@ use nacre_optics::fourier::Harmonics;
 use nacre_optics::{C64, Material};
 use nacre_runtime::bindings::{SpectralSetup, TechniqueBinding, TechniqueOptions};
 use nacre_runtime::probe::run_probe;
-use nacre_runtime::{FilmInput, GpuContext, TableSet, Technique};
-use std::sync::{Arc, OnceLock};
+use nacre_runtime::{FilmInput, TableSet, Technique};
+use std::sync::Arc;
 
-fn ctx() -> &'static GpuContext {
-    static CTX: OnceLock<GpuContext> = OnceLock::new();
-    CTX.get_or_init(|| {
-        let ctx = GpuContext::new_headless().unwrap_or_else(|e| {
-            panic!("the GPU tests need an adapter (CI installs mesa-vulkan-drivers): {e}")
-        });
-        eprintln!("adapter: {}", ctx.describe());
-        ctx
-    })
-}
+mod support;
+use support::ctx;
 
 /// Deterministic uniform numbers in [0, 1).
 struct Lcg(u64);

@@ -9,20 +9,11 @@ use nacre_bake::bake::{Manifest, default_baked_dir};
 use nacre_optics::C64;
 use nacre_runtime::bindings::{TechniqueBinding, TechniqueOptions};
 use nacre_runtime::probe::run_probe;
-use nacre_runtime::{FilmInput, GpuContext, TableSet, Technique};
+use nacre_runtime::{FilmInput, TableSet, Technique};
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
 
-fn ctx() -> &'static GpuContext {
-    static CTX: OnceLock<GpuContext> = OnceLock::new();
-    CTX.get_or_init(|| {
-        let ctx = GpuContext::new_headless().unwrap_or_else(|e| {
-            panic!("the GPU tests need an adapter (CI installs mesa-vulkan-drivers): {e}")
-        });
-        eprintln!("adapter: {}", ctx.describe());
-        ctx
-    })
-}
+mod support;
+use support::ctx;
 
 fn manifest(name: &str) -> PathBuf {
     default_baked_dir().join(format!("{name}.json"))

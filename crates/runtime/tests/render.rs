@@ -17,25 +17,12 @@ use nacre_runtime::render::{
     default_environment_path, procedural_environment, render_scene,
 };
 use nacre_runtime::shaders::{MATERIAL, SCENE, compose};
-use nacre_runtime::{GpuContext, TableSet, Technique};
+use nacre_runtime::{TableSet, Technique};
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
 
-fn ctx() -> &'static GpuContext {
-    static CTX: OnceLock<GpuContext> = OnceLock::new();
-    CTX.get_or_init(|| {
-        let ctx = GpuContext::new_headless().unwrap_or_else(|e| {
-            panic!("the render tests need an adapter (CI installs mesa-vulkan-drivers): {e}")
-        });
-        eprintln!("adapter: {}", ctx.describe());
-        ctx
-    })
-}
-
-fn repo_root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
+mod support;
+use support::{ctx, repo_root, translate};
 
 fn golden_dir() -> PathBuf {
     repo_root().join("tests/golden/render")
@@ -63,52 +50,6 @@ fn tables_for(scene: SceneKind) -> TableSet {
 }
 
 // ─── Shaders, no GPU ───────────────────────────────────────────────────────────────────────
-
-/// Translates to SPIR-V, MSL, HLSL and GLSL (4.50 core and ES 3.10, per entry point), as
-/// `tests/wgsl.rs` does for the other compositions.
-fn translate(name: &str, module: &naga::Module, info: &naga::valid::ModuleInfo) {
-    use naga::back::{glsl, hlsl, msl, spv};
-    spv::write_vec(module, info, &spv::Options::default(), None)
-        .unwrap_or_else(|e| panic!("{name}: SPIR-V: {e}"));
-    let msl_options = msl::Options {
-        lang_version: (2, 0),
-        ..msl::Options::default()
-    };
-    msl::write_string(module, info, &msl_options, &msl::PipelineOptions::default())
-        .unwrap_or_else(|e| panic!("{name}: MSL: {e}"));
-    let mut hlsl_out = String::new();
-    hlsl::Writer::new(
-        &mut hlsl_out,
-        &hlsl::Options::default(),
-        &hlsl::PipelineOptions::default(),
-    )
-    .write(module, info, None)
-    .unwrap_or_else(|e| panic!("{name}: HLSL: {e}"));
-    for version in [glsl::Version::Desktop(450), glsl::Version::new_gles(310)] {
-        for entry in &module.entry_points {
-            let options = glsl::Options {
-                version,
-                ..glsl::Options::default()
-            };
-            let pipeline = glsl::PipelineOptions {
-                shader_stage: entry.stage,
-                entry_point: entry.name.clone(),
-                multiview: None,
-            };
-            let mut out = String::new();
-            glsl::Writer::new(
-                &mut out,
-                module,
-                info,
-                &options,
-                &pipeline,
-                naga::proc::BoundsCheckPolicies::default(),
-            )
-            .and_then(|mut w| w.write())
-            .unwrap_or_else(|e| panic!("{name}: GLSL {version} `{}`: {e}", entry.name));
-        }
-    }
-}
 
 #[test]
 fn scene_pipelines_validate_for_every_technique() {

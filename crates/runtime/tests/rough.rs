@@ -23,10 +23,12 @@ use nacre_runtime::rough_reference::{
     mean_delta_e_2000, read_linear_exr, render_reference, render_reference_pixels,
     write_linear_exr,
 };
-use nacre_runtime::{GpuContext, TableSet, Technique};
+use nacre_runtime::{TableSet, Technique};
 use std::f64::consts::PI;
 use std::path::PathBuf;
-use std::sync::OnceLock;
+
+mod support;
+use support::ctx;
 
 /// Largest mean ΔE2000 of the exact path against the reference at any α: issue 6's target.
 /// Measured on lavapipe (llvmpipe, Mesa 22.3.6): 0.74 / 0.71 / 0.80 at α = 0.1 / 0.3 / 0.6
@@ -35,17 +37,6 @@ const EXACT_MEAN_DE_MAX: f64 = 1.0;
 
 /// Smallest ratio shortcut ΔE / exact ΔE at α ≥ 0.3 (measured 11.4 and 15.6 on lavapipe).
 const EXACT_GAIN_MIN: f64 = 5.0;
-
-fn ctx() -> &'static GpuContext {
-    static CTX: OnceLock<GpuContext> = OnceLock::new();
-    CTX.get_or_init(|| {
-        let ctx = GpuContext::new_headless().unwrap_or_else(|e| {
-            panic!("the rough-sphere tests need an adapter (CI installs mesa-vulkan-drivers): {e}")
-        });
-        eprintln!("adapter: {}", ctx.describe());
-        ctx
-    })
-}
 
 fn golden_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/golden/rough")

@@ -4,9 +4,10 @@
 //! `bytemuck` mirrors rely on, and that every `.wgsl` file opens with a comment header.
 
 use nacre_runtime::shaders::{COMMON, LUT_MAPPING, Technique, compose};
-use naga::back::{glsl, hlsl, msl, spv};
-use naga::valid::{Capabilities, ModuleInfo, ValidationFlags, Validator};
 use std::path::PathBuf;
+
+mod support;
+use support::{translate, validate};
 
 /// A tiny consumer: a fragment entry point fed from a group-2 uniform and the fragment
 /// position, writing reflectance and transmittance so that nothing is dead code, and a compute
@@ -107,71 +108,6 @@ fn composition(technique: Technique, consumer: &[(&str, &str)]) -> (String, Stri
         line += lines;
     }
     (source, map.join(", "))
-}
-
-/// Parses and validates `source`, panicking with naga's annotated report (line and column in
-/// the composed source; `map` says which module a line belongs to) on failure.
-fn validate(name: &str, source: &str, map: &str) -> (naga::Module, ModuleInfo) {
-    let module = naga::front::wgsl::parse_str(source).unwrap_or_else(|e| {
-        panic!(
-            "{name}: WGSL parse error\n{}\ncomposed source: {map}",
-            e.emit_to_string(source)
-        )
-    });
-    let info = Validator::new(ValidationFlags::all(), Capabilities::default())
-        .validate(&module)
-        .unwrap_or_else(|e| {
-            panic!(
-                "{name}: validation error\n{}\ncomposed source: {map}",
-                e.emit_to_string(source)
-            )
-        });
-    (module, info)
-}
-
-/// Translates to SPIR-V, MSL, HLSL and GLSL (4.50 core and ES 3.10, per entry point).
-fn translate(name: &str, module: &naga::Module, info: &ModuleInfo) {
-    spv::write_vec(module, info, &spv::Options::default(), None)
-        .unwrap_or_else(|e| panic!("{name}: SPIR-V: {e}"));
-
-    let msl_options = msl::Options {
-        lang_version: (2, 0),
-        ..msl::Options::default()
-    };
-    msl::write_string(module, info, &msl_options, &msl::PipelineOptions::default())
-        .unwrap_or_else(|e| panic!("{name}: MSL: {e}"));
-
-    let mut hlsl_out = String::new();
-    let hlsl_options = hlsl::Options::default();
-    let hlsl_pipeline = hlsl::PipelineOptions::default();
-    hlsl::Writer::new(&mut hlsl_out, &hlsl_options, &hlsl_pipeline)
-        .write(module, info, None)
-        .unwrap_or_else(|e| panic!("{name}: HLSL: {e}"));
-
-    for version in [glsl::Version::Desktop(450), glsl::Version::new_gles(310)] {
-        for entry in &module.entry_points {
-            let options = glsl::Options {
-                version,
-                ..glsl::Options::default()
-            };
-            let pipeline = glsl::PipelineOptions {
-                shader_stage: entry.stage,
-                entry_point: entry.name.clone(),
-                multiview: None,
-            };
-            let mut out = String::new();
-            glsl::Writer::new(
-                &mut out,
-                module,
-                info,
-                &options,
-                &pipeline,
-                naga::proc::BoundsCheckPolicies::default(),
-            )
-            .and_then(|mut w| w.write())
-            .unwrap_or_else(|e| panic!("{name}: GLSL {version} `{}`: {e}", entry.name));
-        }
-    }
 }
 
 #[test]

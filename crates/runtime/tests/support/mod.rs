@@ -1,0 +1,93 @@
+//! Helpers shared by the runtime's integration tests (`mod support;` in each test file).
+//! Each test binary uses only some of them.
+#![allow(dead_code)]
+
+use nacre_runtime::GpuContext;
+use naga::back::{glsl, hlsl, msl, spv};
+use naga::valid::{Capabilities, ModuleInfo, ValidationFlags, Validator};
+use std::path::PathBuf;
+use std::sync::OnceLock;
+
+/// The test binary's GPU context, created once. A missing adapter fails the test that asks
+/// for it — GPU tests never skip (CI installs `mesa-vulkan-drivers`, Mesa's lavapipe).
+pub fn ctx() -> &'static GpuContext {
+    static CTX: OnceLock<GpuContext> = OnceLock::new();
+    CTX.get_or_init(|| {
+        let ctx = GpuContext::new_headless().unwrap_or_else(|e| {
+            panic!("the GPU tests need an adapter (CI installs mesa-vulkan-drivers): {e}")
+        });
+        eprintln!("adapter: {}", ctx.describe());
+        ctx
+    })
+}
+
+/// The repository root.
+pub fn repo_root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// Parses and validates WGSL `source`, panicking with naga's annotated report (line and
+/// column in `source`; `map` says which module a line of a composed source belongs to).
+pub fn validate(name: &str, source: &str, map: &str) -> (naga::Module, ModuleInfo) {
+    let module = naga::front::wgsl::parse_str(source).unwrap_or_else(|e| {
+        panic!(
+            "{name}: WGSL parse error\n{}\ncomposed source: {map}",
+            e.emit_to_string(source)
+        )
+    });
+    let info = Validator::new(ValidationFlags::all(), Capabilities::default())
+        .validate(&module)
+        .unwrap_or_else(|e| {
+            panic!(
+                "{name}: validation error\n{}\ncomposed source: {map}",
+                e.emit_to_string(source)
+            )
+        });
+    (module, info)
+}
+
+/// Translates a validated module to SPIR-V, MSL, HLSL and GLSL (4.50 core and ES 3.10, per
+/// entry point): what every backend of wgpu would be given.
+pub fn translate(name: &str, module: &naga::Module, info: &ModuleInfo) {
+    spv::write_vec(module, info, &spv::Options::default(), None)
+        .unwrap_or_else(|e| panic!("{name}: SPIR-V: {e}"));
+
+    let msl_options = msl::Options {
+        lang_version: (2, 0),
+        ..msl::Options::default()
+    };
+    msl::write_string(module, info, &msl_options, &msl::PipelineOptions::default())
+        .unwrap_or_else(|e| panic!("{name}: MSL: {e}"));
+
+    let mut hlsl_out = String::new();
+    let hlsl_options = hlsl::Options::default();
+    let hlsl_pipeline = hlsl::PipelineOptions::default();
+    hlsl::Writer::new(&mut hlsl_out, &hlsl_options, &hlsl_pipeline)
+        .write(module, info, None)
+        .unwrap_or_else(|e| panic!("{name}: HLSL: {e}"));
+
+    for version in [glsl::Version::Desktop(450), glsl::Version::new_gles(310)] {
+        for entry in &module.entry_points {
+            let options = glsl::Options {
+                version,
+                ..glsl::Options::default()
+            };
+            let pipeline = glsl::PipelineOptions {
+                shader_stage: entry.stage,
+                entry_point: entry.name.clone(),
+                multiview: None,
+            };
+            let mut out = String::new();
+            glsl::Writer::new(
+                &mut out,
+                module,
+                info,
+                &options,
+                &pipeline,
+                naga::proc::BoundsCheckPolicies::default(),
+            )
+            .and_then(|mut w| w.write())
+            .unwrap_or_else(|e| panic!("{name}: GLSL {version} `{}`: {e}", entry.name));
+        }
+    }
+}
