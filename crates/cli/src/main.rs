@@ -78,15 +78,18 @@ const BENCH_GPU_EXAMPLES: &str = "\
 Every pass shades each pixel of a WIDTHxHEIGHT target with the same GGX microfacet material
 (shaders/bench.wgsl); only the Fresnel term differs: Schlick (plain), film_lut, film_fourier
 (M harmonics) or film_spectral (N wavelengths). A last pass times the diffraction technique
-at the same resolution (one directional light per pixel, the --diffraction table, Sigma over
-the --diffraction-step grid). Times are GPU timestamps of the render pass where the adapter
-supports them, else wall clock per frame; the median is reported.
+at the same resolution (one directional light per pixel, the --diffraction table: layout
+\"terms\" sums over the --diffraction-step grid, layout \"integrated\" reads the sum baked into
+the table). Times are GPU timestamps of the render pass where the adapter supports them,
+else wall clock per frame; the median is reported.
 
 Examples:
   # 1920x1080, 30 frames per pass, default tables (film-dielectric + fourier-srgb)
   nacre bench-gpu
   # a quick look on a software rasteriser
-  nacre bench-gpu --width 640 --height 360 --frames 5";
+  nacre bench-gpu --width 640 --height 360 --frames 5
+  # the diffraction pass on the fast (integrated) table of the same CD surface
+  nacre bench-gpu --width 320 --height 180 --frames 5 --diffraction cd-tracks-fast";
 
 #[derive(Args)]
 struct BenchGpuArgs {
@@ -108,12 +111,14 @@ struct BenchGpuArgs {
     /// Tables to load (repeatable) [default: film-dielectric + fourier-srgb].
     #[arg(long = "tables", value_name = "NAME|PATH")]
     tables: Vec<String>,
-    /// The diffraction table of the `diffraction` pass (default-set name or manifest path).
+    /// The diffraction table of the `diffraction` pass (default-set name or manifest path;
+    /// layout "terms" or "integrated", e.g. cd-tracks-fast).
     #[arg(long, value_name = "NAME|PATH", default_value = "cd-tracks")]
     diffraction: String,
-    /// Wavelength step of the `diffraction` pass's colour sum, nm (as `nacre render`).
-    #[arg(long, value_name = "NM", default_value_t = 10.0)]
-    diffraction_step: f64,
+    /// Wavelength step of the `diffraction` pass's colour sum, nm (as `nacre render`; layout
+    /// "terms" only) [default: 10].
+    #[arg(long, value_name = "NM")]
+    diffraction_step: Option<f64>,
 }
 
 const BAKE_EXAMPLES: &str = "\
@@ -259,6 +264,8 @@ Examples:
   nacre render --gltf tests/golden/gltf/sweep-thickness.glb --width 1000 --height 260 -o sweep.png
   # diffraction (technique `diffraction`, tables cd-tracks / snake-ridges): a CD and snake scales
   nacre render --scene cd-disc -o cd.png && nacre render --scene snake-skin -o snake.png
+  # the CD from the fast table (layout \"integrated\": the wavelength sum baked in)
+  nacre render --scene cd-disc --tables cd-tracks-fast -o cd-fast.png
 
 With --gltf, each material maps onto nacre's: iridescenceIor → film index, d = mix(thickness
 minimum, maximum, g) with g the thickness texture's green channel (PNG; g = 1 without one),
@@ -292,7 +299,8 @@ struct RenderArgs {
     gltf: Option<PathBuf>,
     /// A table to load (repeatable): default-set name or manifest path [default: the scene's
     /// film-lut (sphere film-dielectric, bubble soap-film, plane oil-slick) + fourier-srgb;
-    /// cd-disc and snake-skin take one diffraction table: cd-tracks, snake-ridges].
+    /// cd-disc and snake-skin take one diffraction table, either layout: cd-tracks,
+    /// snake-ridges; cd-tracks-fast is the integrated table of the CD].
     #[arg(long = "tables", value_name = "NAME|PATH")]
     tables: Vec<String>,
     /// Technique: lut, fourier or spectral.
@@ -321,9 +329,10 @@ struct RenderArgs {
     #[arg(long, value_name = "N")]
     wavelengths: Option<usize>,
     /// Diffraction scenes: wavelength step of the colour sum, nm, over the table's range (the
-    /// table's own step, 5 nm for the default set, is the CPU's grid).
-    #[arg(long, value_name = "NM", default_value_t = 10.0)]
-    wavelength_step: f64,
+    /// table's own step, 5 nm for the default set, is the CPU's grid); layout "terms" only
+    /// (an integrated table's sum is fixed at bake time) [default: 10].
+    #[arg(long, value_name = "NM")]
+    wavelength_step: Option<f64>,
     /// Diffraction scenes: brightest environment directions diffracted like the light (0 to 8).
     #[arg(long, value_name = "K", default_value_t = 4)]
     env_samples: usize,
@@ -941,7 +950,8 @@ fn run_render_diffraction(
 ) -> Result<()> {
     use nacre_runtime::GpuContext;
     use nacre_runtime::diffraction::{
-        DiffractionSceneOptions, DiffractionTable, render_diffraction_scene, wavelength_grid,
+        DiffractionLayout, DiffractionSceneOptions, DiffractionTables, render_diffraction_scene,
+        wavelength_grid,
     };
     let name = match args.tables.as_slice() {
         [] => scene.default_table().to_string(),
@@ -959,7 +969,6 @@ fn run_render_diffraction(
     options.environment = args.env.clone();
     options.exposure_ev = args.exposure;
     options.env_samples = args.env_samples;
-    options.technique.wavelength_step_nm = Some(args.wavelength_step);
     // Check the settings and read every input before starting the GPU: bad input fails fast.
     options.validate().map_err(runtime_error)?;
     let path = bake::resolve_table(&name);
@@ -976,31 +985,43 @@ fn run_render_diffraction(
                 scene.name()
             ),
         })?;
-    wavelength_grid(&record, Some(args.wavelength_step)).map_err(|_| {
-        nacre_bake::error::Error::Invalid {
-            context: "--wavelength-step".into(),
-            message: format!(
-                "{} nm over {}–{} nm (expected 2 to 4096 wavelengths)",
-                args.wavelength_step, record.wavelength_min_nm, record.wavelength_max_nm
-            ),
+    let layout = DiffractionLayout::of(&record, &path).map_err(runtime_error)?;
+    let sum = match layout {
+        DiffractionLayout::Terms { .. } => {
+            let step_nm = args.wavelength_step.unwrap_or(DEFAULT_WAVELENGTH_STEP_NM);
+            wavelength_grid(&record, Some(step_nm)).map_err(|_| {
+                nacre_bake::error::Error::Invalid {
+                    context: "--wavelength-step".into(),
+                    message: format!(
+                        "{step_nm} nm over {}–{} nm (expected 2 to 4096 wavelengths)",
+                        record.wavelength_min_nm, record.wavelength_max_nm
+                    ),
+                }
+            })?;
+            options.technique.wavelength_step_nm = Some(step_nm);
+            format!("{step_nm} nm step")
         }
-    })?;
+        DiffractionLayout::Integrated { .. } => {
+            refuse_step_for_integrated("--wavelength-step", args.wavelength_step, &manifest)?;
+            "integrated".to_string()
+        }
+    };
     if let Some(path) = &options.environment {
         nacre_runtime::render::EnvironmentMap::load(path).map_err(runtime_error)?;
     }
     let ctx = GpuContext::new_headless().map_err(runtime_error)?;
     eprintln!("adapter: {}", ctx.describe());
-    let table = DiffractionTable::load(&ctx, &path).map_err(runtime_error)?;
+    let table =
+        DiffractionTables::load(&ctx, &path, options.technique.fresnel).map_err(runtime_error)?;
     let start = std::time::Instant::now();
     let image = render_diffraction_scene(&ctx, &table, &options).map_err(runtime_error)?;
     let total = start.elapsed().as_secs_f64();
     let png = image.encode_png().map_err(runtime_error)?;
     write_atomic(&args.output, |w| w.write_all(&png))?;
     eprintln!(
-        "rendered {} (diffraction, {}, {} nm step) at {}x{} in {:.2} s (render pass {:.2} s) -> {}",
+        "rendered {} (diffraction, {}, {sum}) at {}x{} in {:.2} s (render pass {:.2} s) -> {}",
         scene.name(),
-        table.name,
-        args.wavelength_step,
+        table.name(),
         image.width,
         image.height,
         total,
@@ -1008,6 +1029,29 @@ fn run_render_diffraction(
         args.output.display()
     );
     Ok(())
+}
+
+/// Default wavelength step of the terms technique's colour sum, nm (`nacre render
+/// --wavelength-step`, `nacre bench-gpu --diffraction-step`).
+const DEFAULT_WAVELENGTH_STEP_NM: f64 = 10.0;
+
+/// An integrated `diffraction` table's wavelength sum was done at bake time: refuses `flag`
+/// when it was given for one.
+fn refuse_step_for_integrated(
+    flag: &str,
+    step_nm: Option<f64>,
+    manifest: &bake::Manifest,
+) -> Result<()> {
+    match step_nm {
+        None => Ok(()),
+        Some(step_nm) => Err(nacre_bake::error::Error::Invalid {
+            context: flag.into(),
+            message: format!(
+                "{step_nm} nm: table `{}` has the layout \"integrated\", whose wavelength sum was done at bake time (the manifest's grid); the step applies to layout \"terms\" tables only",
+                manifest.name
+            ),
+        }),
+    }
 }
 
 /// `nacre render --scene rough-row`: the shortcut, exact and Monte Carlo rows.
@@ -1074,7 +1118,7 @@ fn run_render_rough_row(args: &RenderArgs) -> Result<()> {
 fn run_bench_gpu(args: &BenchGpuArgs) -> Result<()> {
     use nacre_runtime::bench::{BenchOptions, BenchPass, run_bench_with_diffraction};
     use nacre_runtime::bindings::TechniqueOptions;
-    use nacre_runtime::diffraction::{DiffractionOptions, DiffractionTable};
+    use nacre_runtime::diffraction::{DiffractionLayout, DiffractionOptions, DiffractionTables};
     use nacre_runtime::{GpuContext, TableSet, Technique};
     let names: Vec<String> = if args.tables.is_empty() {
         vec!["film-dielectric".into(), "fourier-srgb".into()]
@@ -1085,10 +1129,29 @@ fn run_bench_gpu(args: &BenchGpuArgs) -> Result<()> {
         bake::Manifest::read(&bake::resolve_table(name))?;
     }
     let diffraction_path = bake::resolve_table(&args.diffraction);
-    bake::Manifest::read(&diffraction_path)?;
-    let diffraction_options = DiffractionOptions {
-        wavelength_step_nm: Some(args.diffraction_step),
-        ..DiffractionOptions::default()
+    let diffraction_manifest = bake::Manifest::read(&diffraction_path)?;
+    let mut diffraction_options = DiffractionOptions::default();
+    // The sum the diffraction pass does, for the report.
+    let diffraction_sum = match diffraction_manifest
+        .diffraction
+        .as_ref()
+        .map(|record| DiffractionLayout::of(record, &diffraction_path).map_err(runtime_error))
+    {
+        Some(Ok(DiffractionLayout::Integrated { .. })) => {
+            refuse_step_for_integrated(
+                "--diffraction-step",
+                args.diffraction_step,
+                &diffraction_manifest,
+            )?;
+            "(layout integrated)".to_string()
+        }
+        Some(Err(e)) => return Err(e),
+        // Another kind fails in the loader, with its message.
+        Some(Ok(DiffractionLayout::Terms { .. })) | None => {
+            let step_nm = args.diffraction_step.unwrap_or(DEFAULT_WAVELENGTH_STEP_NM);
+            diffraction_options.wavelength_step_nm = Some(step_nm);
+            format!("at a {step_nm} nm step")
+        }
     };
     let mut technique = TechniqueOptions {
         harmonics: args.harmonics,
@@ -1110,7 +1173,8 @@ fn run_bench_gpu(args: &BenchGpuArgs) -> Result<()> {
             .add(&ctx, &bake::resolve_table(name))
             .map_err(runtime_error)?;
     }
-    let diffraction = DiffractionTable::load(&ctx, &diffraction_path).map_err(runtime_error)?;
+    let diffraction = DiffractionTables::load(&ctx, &diffraction_path, diffraction_options.fresnel)
+        .map_err(runtime_error)?;
     let passes = [
         BenchPass::Plain,
         BenchPass::Film(Technique::Lut),
@@ -1129,7 +1193,7 @@ fn run_bench_gpu(args: &BenchGpuArgs) -> Result<()> {
     let plain = results[0].median_ms;
     let lut = results[1].median_ms;
     println!(
-        "{}x{}, {} frames per pass, {} (fourier M = {}, spectral N = {}, diffraction {} at a {} nm step)",
+        "{}x{}, {} frames per pass, {} (fourier M = {}, spectral N = {}, diffraction {} {})",
         args.width,
         args.height,
         args.frames,
@@ -1140,8 +1204,8 @@ fn run_bench_gpu(args: &BenchGpuArgs) -> Result<()> {
         },
         args.harmonics,
         args.wavelengths,
-        diffraction.name,
-        args.diffraction_step
+        diffraction.name(),
+        diffraction_sum
     );
     println!(
         "{:<22} {:>11} {:>11} {:>10} {:>10}",

@@ -1086,6 +1086,18 @@ fn fixtures(d: &Path) -> Vec<Case> {
             &["--wavelength-step", "0 nm"],
         ),
         with(
+            "render: diffraction wavelength step with an integrated table",
+            render(&[
+                "--scene",
+                "cd-disc",
+                "--tables",
+                "cd-tracks-fast",
+                "--wavelength-step",
+                "5",
+            ]),
+            &["--wavelength-step", "cd-tracks-fast", "\"integrated\""],
+        ),
+        with(
             "render: diffraction environment samples beyond 8",
             render(&["--scene", "snake-skin", "--env-samples", "99"]),
             &["99"],
@@ -1171,6 +1183,17 @@ fn fixtures(d: &Path) -> Vec<Case> {
             "flag: bench-gpu zero width",
             &["bench-gpu", "--width", "0", "--frames", "1"],
             &["0×1080", "1 to"],
+        ),
+        case(
+            "flag: bench-gpu diffraction step with an integrated table",
+            &[
+                "bench-gpu",
+                "--diffraction",
+                "cd-tracks-fast",
+                "--diffraction-step",
+                "5",
+            ],
+            &["--diffraction-step", "cd-tracks-fast", "\"integrated\""],
         ),
         case(
             "flag: bench-gpu zero frames",

@@ -600,6 +600,35 @@ fn bench_gpu_reports_every_pass() {
             .unwrap();
         assert!(ms.is_finite() && ms >= 0.0, "{line}");
     }
+    assert!(
+        stdout.contains("diffraction cd-tracks at a 10 nm step"),
+        "{stdout}"
+    );
+    // The diffraction pass on the integrated table of the same surface (the fast path).
+    let o = nacre(
+        &[
+            "bench-gpu",
+            "--width",
+            "64",
+            "--height",
+            "32",
+            "--frames",
+            "2",
+            "--diffraction",
+            "cd-tracks-fast",
+        ],
+        &repo,
+    );
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        stdout.contains("diffraction cd-tracks-fast (layout integrated)"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.lines().any(|l| l.starts_with("diffraction ")),
+        "{stdout}"
+    );
     let bad = nacre(
         &[
             "bench-gpu",
@@ -613,6 +642,42 @@ fn bench_gpu_reports_every_pass() {
         &repo,
     );
     assert_eq!(bad.status.code(), Some(2));
+}
+
+/// `nacre render --scene cd-disc | snake-skin --tables cd-tracks-fast`: the diffraction
+/// scenes draw from an integrated table (the fast path) as from a terms table.
+#[test]
+fn render_diffraction_scenes_take_an_integrated_table() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    for scene in ["cd-disc", "snake-skin"] {
+        let out = format!("{scene}.png");
+        let o = nacre(
+            &[
+                "render",
+                "--scene",
+                scene,
+                "--tables",
+                "cd-tracks-fast",
+                "--width",
+                "40",
+                "--height",
+                "30",
+                "-o",
+                &out,
+            ],
+            d,
+        );
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(
+            stderr(&o).contains(&format!(
+                "rendered {scene} (diffraction, cd-tracks-fast, integrated)"
+            )),
+            "{}",
+            stderr(&o)
+        );
+        assert_eq!(png_size(&std::fs::read(d.join(&out)).unwrap()), (40, 30));
+    }
 }
 
 /// `nacre render --gltf`: a committed sweep renders; bad glTF files exit 2 with one message

@@ -3,7 +3,8 @@
 //! `shaders/bench.wgsl`), and the cost of the `diffraction` technique at the same
 //! resolution ([`BenchPass::Diffraction`]: every pixel evaluates Σ_λ ρ(λ) u(λ) for one
 //! directional light over a swirling grating direction, scene 2 of
-//! `shaders/diffraction_scene.wgsl`).
+//! `shaders/diffraction_scene.wgsl`; with a layout "integrated" table, the same pass reads
+//! the baked wavelength sum instead, `shaders/diffraction_integrated.wgsl`).
 //!
 //! Each pass draws one full-screen triangle into an `Rgba8Unorm` target. With
 //! `TIMESTAMP_QUERY` the GPU time of every pass comes from timestamps written at the
@@ -14,7 +15,7 @@
 use crate::bindings::{TechniqueBinding, TechniqueOptions};
 use crate::context::BufferInitExt;
 use crate::context::GpuContext;
-use crate::diffraction::{DiffractionOptions, DiffractionTable, ScenePass};
+use crate::diffraction::{DiffractionOptions, DiffractionTables, ScenePass};
 use crate::error::{Error, Result};
 use crate::fullscreen;
 use crate::render::Light;
@@ -29,7 +30,8 @@ pub enum BenchPass {
     Plain,
     /// GGX with the technique's film term in place of Fresnel.
     Film(Technique),
-    /// The `diffraction` technique (layout "terms") for one directional light per pixel.
+    /// The `diffraction` technique (the table's layout, "terms" or "integrated") for one
+    /// directional light per pixel.
     Diffraction,
 }
 
@@ -114,7 +116,7 @@ pub fn run_bench(
 pub fn run_bench_with_diffraction(
     ctx: &GpuContext,
     tables: &TableSet,
-    diffraction: Option<(&DiffractionTable, &DiffractionOptions)>,
+    diffraction: Option<(&DiffractionTables, &DiffractionOptions)>,
     passes: &[BenchPass],
     options: &BenchOptions,
 ) -> Result<Vec<BenchResult>> {

@@ -1,5 +1,5 @@
 //! The `diffraction` technique on the GPU: loading baked `diffraction` tables (layout
-//! "terms") through their manifests, the technique's bind group (`shaders/diffraction.wgsl`),
+//! "terms"; either layout through [`DiffractionTables`]) through their manifests, the technique's bind group (`shaders/diffraction.wgsl`),
 //! the GPU = CPU probe, and the ray-cast scenes of `nacre render --scene cd-disc |
 //! snake-skin` (`shaders/diffraction_scene.wgsl`).
 //!
@@ -14,12 +14,18 @@
 //! ([`nacre_bake::bake::Manifest::load_diffraction`]); every file is checked against its
 //! manifest's SHA-256 and the texture against the device's limits before upload.
 //!
-//! The loader dispatches on the manifest's `layout` ([`DiffractionLayout`]): "terms" is the
-//! only one the runtime knows; another layout is an [`Error::Manifest`] naming it.
+//! [`DiffractionTables::load`] dispatches on the manifest's `layout` ([`DiffractionLayout`]):
+//! "terms" loads as a [`DiffractionTable`] (this module), "integrated" (the fast path, the
+//! wavelength sum done at bake time) as a [`DiffractionIntegrated`]; another layout is an
+//! [`Error::Manifest`] naming it. The scenes, the bench pass ([`ScenePass`]) and
+//! [`render_diffraction_scene`] take either: an integrated table runs the same consumers
+//! (`shaders/diffraction_scene.wgsl`) through the adapter
+//! `shaders/diffraction_integrated_technique.wgsl`
+//! ([`crate::diffraction_integrated::compose_scene`]) with its own bind group at group 1.
 //!
 //! # Spectral sum
 //!
-//! The technique sums ρ(λ) u(λ) over a regular wavelength grid uploaded with the table
+//! The terms technique sums ρ(λ) u(λ) over a regular wavelength grid uploaded with the table
 //! ([`DiffractionOptions::wavelength_step_nm`]): by default the table's own grid (the one the
 //! CPU evaluation uses, `nacre diffraction --color`); a coarser step trades accuracy for
 //! speed (10 nm halves the cost of the 5 nm default set). Each grid gets its own CIE weights
@@ -35,6 +41,7 @@
 //! a one-row (1-D) grating has R = 0 along y.
 
 use crate::context::{BufferInitExt, GpuContext};
+use crate::diffraction_integrated::{self, DiffractionIntegrated};
 use crate::error::{Error, Result};
 use crate::fullscreen;
 use crate::readback::read_texture;
@@ -76,22 +83,147 @@ pub enum DiffractionLayout {
         /// N.
         order: usize,
     },
+    /// "integrated": the wavelength-integrated colour tables I₀ … I₂N, `order` = N
+    /// ([`crate::diffraction_integrated`]).
+    Integrated {
+        /// N.
+        order: usize,
+    },
 }
 
 impl DiffractionLayout {
-    fn of(record: &DiffractionRecord, manifest_path: &Path) -> Result<Self> {
-        match record.layout.as_str() {
-            "terms" => Ok(DiffractionLayout::Terms {
+    /// The layout of `record`, read from the manifest at `manifest_path`.
+    ///
+    /// # Errors
+    /// [`Error::Manifest`] naming a layout the runtime does not know, or an "integrated"
+    /// record without its `integrated` part.
+    pub fn of(record: &DiffractionRecord, manifest_path: &Path) -> Result<Self> {
+        let bad = |message: String| Error::Manifest {
+            path: manifest_path.to_path_buf(),
+            message,
+        };
+        match (record.layout.as_str(), &record.integrated) {
+            ("terms", _) => Ok(DiffractionLayout::Terms {
                 order: record.taylor_order,
             }),
-            other => Err(Error::Manifest {
-                path: manifest_path.to_path_buf(),
-                message: format!(
-                    "diffraction layout `{other}` has no GPU technique (the runtime samples layout \"terms\")"
-                ),
+            ("integrated", Some(_)) => Ok(DiffractionLayout::Integrated {
+                order: record.taylor_order,
             }),
+            ("integrated", None) => Err(bad(
+                "diffraction layout \"integrated\" without its `integrated` record".into(),
+            )),
+            (other, _) => Err(bad(format!(
+                "diffraction layout `{other}` has no GPU technique (the runtime samples layouts \"terms\" and \"integrated\")"
+            ))),
         }
     }
+
+    /// The manifest's name of the layout: "terms" or "integrated".
+    pub fn name(self) -> &'static str {
+        match self {
+            DiffractionLayout::Terms { .. } => "terms",
+            DiffractionLayout::Integrated { .. } => "integrated",
+        }
+    }
+}
+
+/// A `diffraction` table on the GPU in either layout, as [`DiffractionTables::load`] reads it
+/// from its manifest: what the scenes ([`render_diffraction_scene`]) and the bench pass
+/// ([`ScenePass::bench`]) take.
+pub enum DiffractionTables {
+    /// Layout "terms": the Taylor terms, summed over wavelengths per pixel.
+    Terms(Box<DiffractionTable>),
+    /// Layout "integrated": the wavelength sum done at bake time (the fast path).
+    Integrated(Box<DiffractionIntegrated>),
+}
+
+impl DiffractionTables {
+    /// Reads the manifest at `manifest_path` and loads the table by its layout:
+    /// [`DiffractionTable::load`] for "terms",
+    /// [`DiffractionIntegrated::load`] for "integrated", whose uniform holds `fresnel` (the F²
+    /// the scene consumers apply; the terms technique takes F² from
+    /// [`DiffractionOptions::fresnel`] instead, and ignores this argument).
+    ///
+    /// # Errors
+    /// As the loaders; [`Error::Manifest`] for a table of another kind or an unknown layout.
+    pub fn load(
+        ctx: &GpuContext,
+        manifest_path: &Path,
+        fresnel: FresnelTerm,
+    ) -> Result<DiffractionTables> {
+        let record = diffraction_record(manifest_path)?.1;
+        Ok(match DiffractionLayout::of(&record, manifest_path)? {
+            DiffractionLayout::Terms { .. } => {
+                DiffractionTables::Terms(Box::new(DiffractionTable::load(ctx, manifest_path)?))
+            }
+            DiffractionLayout::Integrated { .. } => DiffractionTables::Integrated(Box::new(
+                DiffractionIntegrated::load(ctx, manifest_path, fresnel)?,
+            )),
+        })
+    }
+
+    /// Table name.
+    pub fn name(&self) -> &str {
+        match self {
+            DiffractionTables::Terms(t) => &t.name,
+            DiffractionTables::Integrated(t) => &t.name,
+        }
+    }
+
+    /// The manifest's `diffraction` record.
+    pub fn record(&self) -> &DiffractionRecord {
+        match self {
+            DiffractionTables::Terms(t) => &t.record,
+            DiffractionTables::Integrated(t) => &t.record,
+        }
+    }
+
+    /// The layout.
+    pub fn layout(&self) -> DiffractionLayout {
+        match self {
+            DiffractionTables::Terms(t) => t.layout,
+            DiffractionTables::Integrated(t) => DiffractionLayout::Integrated {
+                order: t.record.taylor_order,
+            },
+        }
+    }
+}
+
+impl From<DiffractionTable> for DiffractionTables {
+    fn from(table: DiffractionTable) -> Self {
+        DiffractionTables::Terms(Box::new(table))
+    }
+}
+
+impl From<DiffractionIntegrated> for DiffractionTables {
+    fn from(table: DiffractionIntegrated) -> Self {
+        DiffractionTables::Integrated(Box::new(table))
+    }
+}
+
+/// The manifest at `manifest_path` and its `diffraction` record.
+///
+/// # Errors
+/// [`Error::Manifest`] for a table of another kind or a manifest without the record.
+fn diffraction_record(manifest_path: &Path) -> Result<(Manifest, DiffractionRecord)> {
+    let manifest = Manifest::read(manifest_path)?;
+    if manifest.kind != "diffraction" {
+        return Err(Error::Manifest {
+            path: manifest_path.to_path_buf(),
+            message: format!(
+                "table `{}` is a `{}` table, not a `diffraction` table",
+                manifest.name, manifest.kind
+            ),
+        });
+    }
+    let record = manifest
+        .diffraction
+        .clone()
+        .ok_or_else(|| Error::Manifest {
+            path: manifest_path.to_path_buf(),
+            message: "a diffraction manifest without its `diffraction` record".into(),
+        })?;
+    Ok((manifest, record))
 }
 
 /// A `diffraction` table on the GPU.
@@ -118,29 +250,23 @@ impl DiffractionTable {
     ///
     /// # Errors
     /// [`Error::Table`] for unreadable or malformed files; [`Error::Manifest`] for a table
-    /// of another kind or layout, a file that does not match its manifest, or an order above
-    /// [`MAX_TAYLOR_ORDER`]; [`Error::Limit`] when the texture exceeds the device.
+    /// of another kind or layout (an "integrated" table loads with
+    /// [`DiffractionTables::load`]), a file that does not match its manifest, or an order
+    /// above [`MAX_TAYLOR_ORDER`]; [`Error::Limit`] when the texture exceeds the device.
     pub fn load(ctx: &GpuContext, manifest_path: &Path) -> Result<DiffractionTable> {
-        let manifest = Manifest::read(manifest_path)?;
-        if manifest.kind != "diffraction" {
+        let (manifest, record) = diffraction_record(manifest_path)?;
+        let layout = DiffractionLayout::of(&record, manifest_path)?;
+        let DiffractionLayout::Terms { order } = layout else {
             return Err(Error::Manifest {
                 path: manifest_path.to_path_buf(),
                 message: format!(
-                    "table `{}` is a `{}` table, not a `diffraction` table",
-                    manifest.name, manifest.kind
+                    "diffraction table `{}` has the layout \"{}\", not \"terms\" (DiffractionTables::load loads either layout)",
+                    manifest.name,
+                    layout.name()
                 ),
             });
-        }
+        };
         verify_files(&manifest, manifest_path)?;
-        let record = manifest
-            .diffraction
-            .clone()
-            .ok_or_else(|| Error::Manifest {
-                path: manifest_path.to_path_buf(),
-                message: "a diffraction manifest without its `diffraction` record".into(),
-            })?;
-        let layout = DiffractionLayout::of(&record, manifest_path)?;
-        let DiffractionLayout::Terms { order } = layout;
         if order > MAX_TAYLOR_ORDER {
             return Err(Error::Manifest {
                 path: manifest_path.to_path_buf(),
@@ -286,15 +412,21 @@ impl DiffractionTable {
     }
 }
 
-/// Settings of the technique.
+/// Settings of the technique. The wavelength step and the window tolerance shape the terms
+/// technique's sums; an "integrated" table's sum was done at bake time (on its manifest's
+/// wavelength grid, with the whole window), so it leaves them unused (`nacre render` and
+/// `nacre bench-gpu` refuse the flags that set them for one).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DiffractionOptions {
     /// Step of the wavelength grid of the colour sum, nm (the table's range); `None` = the
-    /// table's own step (the CPU's grid).
+    /// table's own step (the CPU's grid). Layout "terms" only.
     pub wavelength_step_nm: Option<f64>,
-    /// The Fresnel factor F² (default: 1, a perfect reflector).
+    /// The Fresnel factor F² (default: 1, a perfect reflector). An integrated table holds
+    /// its F² in its uniform ([`DiffractionTables::load`]); a scene or bench pass refuses
+    /// one loaded with another F².
     pub fresnel: FresnelTerm,
-    /// Largest window weight the neighbourhood may drop (default 10⁻³; module docs).
+    /// Largest window weight the neighbourhood may drop (default 10⁻³; module docs). Layout
+    /// "terms" only.
     pub window_tolerance: f64,
 }
 
@@ -392,7 +524,25 @@ pub struct DiffractionBinding {
     pub grid: SpectralGrid,
 }
 
+/// Mesa's llvmpipe (the rasteriser behind lavapipe) ends every shader invocation after
+/// 65,535 loop iterations in all — gallivm's `LP_MAX_TGSI_LOOP_ITERATIONS`, "shared between
+/// every loop in a shader", an infinite-loop guard — and carries on with the loops cut
+/// short, so a longer sum silently draws a wrong picture. Hardware drivers have no such cap.
+pub const LLVMPIPE_LOOP_LIMIT: u64 = 65_535;
+
 impl DiffractionBinding {
+    /// An upper bound on the loop iterations of one `diffraction_colour` call
+    /// (`shaders/diffraction.wgsl`): per wavelength, one of the colour loop, N + 1 Taylor
+    /// coefficients, and 2R_y + 1 rows of 2R_x + 1 bins of ⌈(N + 1)/2⌉ layer loads each.
+    pub fn loop_iterations_per_colour(&self) -> u64 {
+        let u = &self.uniform;
+        let order = u64::from(u.order);
+        let layers = (order + 2) / 2;
+        let rows = 2 * u64::from(u.radius[1].unsigned_abs()) + 1;
+        let bins = 2 * u64::from(u.radius[0].unsigned_abs()) + 1;
+        u64::from(u.wavelength_count) * (1 + (order + 1) + rows * (1 + bins * (1 + layers)))
+    }
+
     /// Builds the technique's group 1 for `table`.
     ///
     /// # Errors
@@ -795,7 +945,8 @@ pub struct DiffractionSceneOptions {
     pub light: Light,
     /// Exposure, EV stops.
     pub exposure_ev: f32,
-    /// The technique's settings (default here: a 10 nm wavelength step).
+    /// The technique's settings (default here: a 10 nm wavelength step, which an
+    /// integrated table leaves unused: [`DiffractionOptions`]).
     pub technique: DiffractionOptions,
 }
 
@@ -1007,24 +1158,66 @@ fn view_group(
     })
 }
 
+/// Group 1 of a scene pass: the technique of the table's layout.
+enum SceneTechnique {
+    /// Layout "terms": the table, its uniform and the spectral weights.
+    Terms(DiffractionBinding),
+    /// Layout "integrated": the table's own bind group
+    /// ([`DiffractionIntegrated::bind_group`]).
+    Integrated {
+        layout: wgpu::BindGroupLayout,
+        bind_group: wgpu::BindGroup,
+    },
+}
+
 /// The scene (or bench) pipeline with its groups 0 and 1, ready to draw.
 pub struct ScenePass {
     pipeline: wgpu::RenderPipeline,
     view: ViewGroup,
-    technique: DiffractionBinding,
+    technique: SceneTechnique,
 }
 
 impl ScenePass {
+    /// Group 1 and the source for `table`: the terms technique ([`compose`]) with a
+    /// [`DiffractionBinding`], or the integrated module with the adapter
+    /// ([`diffraction_integrated::compose_scene`]) and the table's own bind group.
     fn new(
         ctx: &GpuContext,
-        table: &DiffractionTable,
+        table: &DiffractionTables,
         technique: &DiffractionOptions,
         uniform: &DiffractionViewUniform,
         env: &EnvironmentMap,
     ) -> Result<ScenePass> {
-        let technique = DiffractionBinding::new(ctx, table, technique)?;
+        let (technique, source) = match table {
+            DiffractionTables::Terms(t) => (
+                SceneTechnique::Terms(DiffractionBinding::new(ctx, t, technique)?),
+                compose(),
+            ),
+            DiffractionTables::Integrated(t) => {
+                let wanted = diffraction_integrated::fresnel_parameters(technique.fresnel)?;
+                if wanted != (t.uniform.fresnel_kind, t.uniform.fresnel_ior) {
+                    return Err(Error::Invalid {
+                        context: format!("integrated diffraction `{}`", t.name),
+                        message: format!(
+                            "the table was loaded with another Fresnel factor than the pass's {:?} (load it with that one)",
+                            technique.fresnel
+                        ),
+                    });
+                }
+                (
+                    SceneTechnique::Integrated {
+                        layout: t.bind_group_layout().clone(),
+                        bind_group: t.bind_group().clone(),
+                    },
+                    diffraction_integrated::compose_scene(),
+                )
+            }
+        };
+        let technique_layout = match &technique {
+            SceneTechnique::Terms(b) => &b.layout,
+            SceneTechnique::Integrated { layout, .. } => layout,
+        };
         let view = view_group(ctx, uniform, env)?;
-        let source = compose();
         let device = &ctx.device;
         let pipeline = ctx.checked("building the diffraction pipeline", || {
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -1033,7 +1226,7 @@ impl ScenePass {
             });
             let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("diffraction scene"),
-                bind_group_layouts: &[Some(&view.layout), Some(&technique.layout)],
+                bind_group_layouts: &[Some(&view.layout), Some(technique_layout)],
                 immediate_size: 0,
             });
             fullscreen::pipeline(
@@ -1053,10 +1246,11 @@ impl ScenePass {
     }
 
     /// The bench pass of `nacre bench-gpu`: every pixel of a `width × height` target shaded
-    /// with the technique (scene 2 of `shaders/diffraction_scene.wgsl`), lit by `light`.
+    /// with the technique of `table`'s layout (scene 2 of `shaders/diffraction_scene.wgsl`),
+    /// lit by `light`.
     pub fn bench(
         ctx: &GpuContext,
-        table: &DiffractionTable,
+        table: &DiffractionTables,
         technique: &DiffractionOptions,
         width: u32,
         height: u32,
@@ -1066,7 +1260,7 @@ impl ScenePass {
         uniform.exposure = 1.0;
         uniform.light_direction = unit(light.direction);
         uniform.light_colour = light.colour;
-        uniform.light_intensity = light.intensity * lobe_gain(&table.record);
+        uniform.light_intensity = light.intensity * lobe_gain(table.record());
         uniform.light_irradiance = light.intensity;
         uniform.resolution = [width as f32, height as f32];
         uniform.scene = 2;
@@ -1075,20 +1269,58 @@ impl ScenePass {
             height: 1,
             rgb: vec![[0.0; 3]],
         };
-        ScenePass::new(ctx, table, technique, &uniform, &env)
+        let pass = ScenePass::new(ctx, table, technique, &uniform, &env)?;
+        pass.check_loop_cap(ctx, 1, "bench")?;
+        Ok(pass)
+    }
+
+    /// On llvmpipe, refuses a terms-layout pass whose per-pixel loops — `diffracted` calls of
+    /// `diffraction_colour` plus the specular order — could run past
+    /// [`LLVMPIPE_LOOP_LIMIT`], which would silently cut them short. The estimate counts
+    /// the sums' own loops; llvmpipe's count runs ~20 % higher (cd-disc went wrong from 56
+    /// wavelengths on, an estimate of 54,824), so the pass is refused above three quarters of
+    /// the cap. Other adapters and integrated tables (a few dozen iterations) always pass.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] naming the way out (a coarser step, fewer samples, the fast layout).
+    pub fn check_loop_cap(&self, ctx: &GpuContext, diffracted: u64, what: &str) -> Result<()> {
+        let Some(binding) = self.technique() else {
+            return Ok(());
+        };
+        let u = &binding.uniform;
+        let specular = u64::from(u.wavelength_count) * (u64::from(u.order) + 3);
+        let needed = diffracted * binding.loop_iterations_per_colour() + specular;
+        if ctx.info.name.contains("llvmpipe") && needed > LLVMPIPE_LOOP_LIMIT * 3 / 4 {
+            return Err(Error::Invalid {
+                context: format!("the diffraction {what} pass on {}", ctx.info.name),
+                message: format!(
+                    "needs about {needed} shader loop iterations per pixel ({diffracted} diffracted lights × {} wavelengths), more than llvmpipe allows with margin (it stops every shader invocation after {LLVMPIPE_LOOP_LIMIT} and would draw a wrong picture): use a coarser --wavelength-step (--diffraction-step in bench-gpu), fewer --env-samples, or a table in the layout \"integrated\" (e.g. --tables cd-tracks-fast)",
+                    u.wavelength_count
+                ),
+            });
+        }
+        Ok(())
     }
 
     /// Records the draw into `pass` (a render pass on a [`crate::render::TARGET_FORMAT`] target).
     pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &self.view.group, &[]);
-        pass.set_bind_group(1, &self.technique.bind_group, &[]);
+        let technique = match &self.technique {
+            SceneTechnique::Terms(b) => &b.bind_group,
+            SceneTechnique::Integrated { bind_group, .. } => bind_group,
+        };
+        pass.set_bind_group(1, technique, &[]);
         pass.draw(0..3, 0..1);
     }
 
-    /// The technique's bind group (uniform, spectrum) as built.
-    pub fn technique(&self) -> &DiffractionBinding {
-        &self.technique
+    /// The terms technique's bind group (uniform, spectrum) as built; `None` for an
+    /// integrated table (its group 1 is the table's own).
+    pub fn technique(&self) -> Option<&DiffractionBinding> {
+        match &self.technique {
+            SceneTechnique::Terms(b) => Some(b),
+            SceneTechnique::Integrated { .. } => None,
+        }
     }
 }
 
@@ -1115,13 +1347,15 @@ fn unit(v: [f32; 3]) -> [f32; 3] {
     }
 }
 
-/// Renders a diffraction scene with `table` and reads it back as sRGB-encoded RGBA8.
+/// Renders a diffraction scene with `table` (either layout) and reads it back as
+/// sRGB-encoded RGBA8.
 ///
 /// # Errors
-/// [`Error::Invalid`] for bad options; environment and GPU errors as [`crate::render`].
+/// [`Error::Invalid`] for bad options (and an integrated table loaded with another F² than
+/// `options.technique.fresnel`); environment and GPU errors as [`crate::render`].
 pub fn render_diffraction_scene(
     ctx: &GpuContext,
-    table: &DiffractionTable,
+    table: &DiffractionTables,
     options: &DiffractionSceneOptions,
 ) -> Result<RenderedImage> {
     options.validate()?;
@@ -1139,7 +1373,7 @@ pub fn render_diffraction_scene(
         .inverse_view_projection(f64::from(width) / f64::from(height))?;
     uniform.eye = options.camera.eye;
     uniform.exposure = 2f32.powf(options.exposure_ev);
-    let gain = lobe_gain(&table.record);
+    let gain = lobe_gain(table.record());
     uniform.light_direction = unit(options.light.direction);
     uniform.light_colour = options.light.colour;
     uniform.light_intensity = options.light.intensity * gain;
@@ -1155,6 +1389,8 @@ pub fn render_diffraction_scene(
             [l[0], l[1], l[2], 0.0].map(|x| x * options.env_intensity * gain);
     }
     let pass = ScenePass::new(ctx, table, &options.technique, &uniform, &env)?;
+    // The light and every environment sample are diffracted.
+    pass.check_loop_cap(ctx, 1 + samples.len() as u64, options.scene.name())?;
     let device = &ctx.device;
     let target = ctx.checked("creating the diffraction target", || {
         device.create_texture(&wgpu::TextureDescriptor {

@@ -4,13 +4,16 @@
 //! tables through their manifests ([`TableSet::load`]), uploads them as textures, and
 //! provides the WGSL modules under `shaders/` ([`shaders`]) that sample them, plus a headless
 //! renderer for `nacre render` and the GPU = CPU probe used by the tests. `diffraction`
-//! tables load separately ([`diffraction::DiffractionTable::load`]) for the technique
-//! `diffraction` (Stam's diffraction BRDF from Taylor terms, `shaders/diffraction.wgsl`).
+//! tables load separately ([`diffraction::DiffractionTables::load`], either layout) for the
+//! technique `diffraction` (Stam's diffraction BRDF from Taylor terms,
+//! `shaders/diffraction.wgsl`, or from the wavelength-integrated tables of the fast path,
+//! `shaders/diffraction_integrated.wgsl`).
 
 pub mod bench;
 pub mod bindings;
 pub mod context;
 pub mod diffraction;
+pub mod diffraction_integrated;
 pub mod error;
 pub mod fullscreen;
 pub mod gltf_assets;

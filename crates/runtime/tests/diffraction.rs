@@ -4,9 +4,12 @@
 //!   over the same `SpectralGrid`, for the default set's CD and ridge tables, over in-plane
 //!   sweeps that cross the grating orders and random out-of-plane directions;
 //! * bad directions (NaN, ±∞, huge, zero, below the horizon) give finite colours;
-//! * the loader checks kind, layout and SHA-256;
+//! * the loaders check kind, layout and SHA-256, and `DiffractionTables::load` dispatches on
+//!   the layout;
 //! * the `cd-disc` and `snake-skin` scenes are deterministic and show diffraction colours
-//!   (saturated pixels whose hue spans the rainbow), which the specular order alone cannot.
+//!   (saturated pixels whose hue spans the rainbow), which the specular order alone cannot;
+//! * the `cd-disc` scene from the integrated table `cd-tracks-fast` (the fast path) matches
+//!   the one from the terms table `cd-tracks` of the same surface, rainbow included.
 //!
 //! A missing adapter fails these tests: they never skip.
 
@@ -15,8 +18,9 @@ use nacre_optics::C64;
 use nacre_optics::diffraction::{DiffractionSurface, FresnelTerm, in_plane_directions};
 use nacre_runtime::GpuContext;
 use nacre_runtime::diffraction::{
-    DiffractionBinding, DiffractionOptions, DiffractionScene, DiffractionSceneOptions,
-    DiffractionTable, render_diffraction_scene, run_probe,
+    DiffractionBinding, DiffractionLayout, DiffractionOptions, DiffractionScene,
+    DiffractionSceneOptions, DiffractionTable, DiffractionTables, render_diffraction_scene,
+    run_probe,
 };
 use rayon::prelude::*;
 use std::sync::OnceLock;
@@ -32,17 +36,30 @@ fn ctx() -> &'static GpuContext {
     })
 }
 
-fn table(name: &str) -> &'static DiffractionTable {
-    static CD: OnceLock<DiffractionTable> = OnceLock::new();
-    static RIDGES: OnceLock<DiffractionTable> = OnceLock::new();
+/// A default-set table through the dispatching loader (an integrated one with F² = 1, the
+/// `cd-disc` scene's).
+fn tables(name: &str) -> &'static DiffractionTables {
+    static CD: OnceLock<DiffractionTables> = OnceLock::new();
+    static CD_FAST: OnceLock<DiffractionTables> = OnceLock::new();
+    static RIDGES: OnceLock<DiffractionTables> = OnceLock::new();
     let cell = match name {
         "cd-tracks" => &CD,
+        "cd-tracks-fast" => &CD_FAST,
         "snake-ridges" => &RIDGES,
         other => panic!("no table {other}"),
     };
     cell.get_or_init(|| {
-        DiffractionTable::load(ctx(), &default_baked_dir().join(format!("{name}.json"))).unwrap()
+        let path = default_baked_dir().join(format!("{name}.json"));
+        DiffractionTables::load(ctx(), &path, FresnelTerm::Unity).unwrap()
     })
+}
+
+/// A default-set table of layout "terms".
+fn table(name: &str) -> &'static DiffractionTable {
+    match tables(name) {
+        DiffractionTables::Terms(t) => t,
+        DiffractionTables::Integrated(_) => panic!("{name} is not a terms table"),
+    }
 }
 
 /// Deterministic uniform numbers in [0, 1).
@@ -278,16 +295,50 @@ fn loader_checks_kind_layout_and_checksums() {
     }
     let path = dir.path().join("snake-ridges.json");
     DiffractionTable::load(ctx, &path).unwrap();
-    // Another layout is named in the error.
-    std::fs::write(
-        &path,
-        manifest.replacen("\"layout\": \"terms\"", "\"layout\": \"integrated\"", 1),
-    )
-    .unwrap();
-    let err = DiffractionTable::load(ctx, &path)
+    // The dispatching loader reads either layout of the default set …
+    for (name, layout) in [("snake-ridges", "terms"), ("cd-tracks-fast", "integrated")] {
+        let t =
+            DiffractionTables::load(ctx, &baked.join(format!("{name}.json")), FresnelTerm::Unity)
+                .unwrap();
+        assert_eq!((t.name(), t.layout().name()), (name, layout));
+        assert_eq!(
+            t.layout(),
+            DiffractionLayout::of(t.record(), &path).unwrap()
+        );
+    }
+    // … the terms loader refuses an integrated table and points to it …
+    let err = DiffractionTable::load(ctx, &baked.join("cd-tracks-fast.json"))
         .err()
-        .expect("unknown layout");
-    assert!(err.to_string().contains("integrated"), "{err}");
+        .expect("an integrated table is not a terms table");
+    assert!(
+        err.to_string().contains("\"integrated\", not \"terms\"")
+            && err.to_string().contains("DiffractionTables::load"),
+        "{err}"
+    );
+    // … a manifest that says "integrated" without the integrated record is refused by both,
+    // and an unknown layout is named in the error.
+    for (layout, expected) in [
+        ("integrated", "without its `integrated` record"),
+        ("spectral", "layout `spectral`"),
+    ] {
+        std::fs::write(
+            &path,
+            manifest.replacen(
+                "\"layout\": \"terms\"",
+                &format!("\"layout\": \"{layout}\""),
+                1,
+            ),
+        )
+        .unwrap();
+        let err = DiffractionTables::load(ctx, &path, FresnelTerm::Unity)
+            .err()
+            .expect("a bad layout");
+        assert!(err.to_string().contains(expected), "{err}");
+        let err = DiffractionTable::load(ctx, &path)
+            .err()
+            .expect("a bad layout");
+        assert!(err.to_string().contains(expected), "{err}");
+    }
     // A changed terms file fails its checksum.
     std::fs::write(&path, &manifest).unwrap();
     let exr = dir.path().join("snake-ridges.terms.exr");
@@ -337,7 +388,7 @@ fn colourfulness(pixels: &[u8]) -> (usize, usize) {
 fn scenes_show_rainbows_and_are_deterministic() {
     let ctx = ctx();
     for scene in DiffractionScene::ALL {
-        let table = table(scene.default_table());
+        let table = tables(scene.default_table());
         let mut options = DiffractionSceneOptions::new(scene);
         options.width = 100;
         options.height = 75;
@@ -374,7 +425,7 @@ fn scenes_show_rainbows_and_are_deterministic() {
 #[test]
 fn scene_settings_are_checked() {
     let ctx = ctx();
-    let table = table("cd-tracks");
+    let table = tables("cd-tracks");
     let mut options = DiffractionSceneOptions::new(DiffractionScene::CdDisc);
     options.width = 0;
     assert!(render_diffraction_scene(ctx, table, &options).is_err());
@@ -397,4 +448,114 @@ fn scene_settings_are_checked() {
         "CD-Disc".parse::<DiffractionScene>().unwrap(),
         DiffractionScene::CdDisc
     );
+}
+
+/// On llvmpipe (lavapipe), a terms-layout scene whose per-pixel loops would run past the
+/// driver's 65,535-iteration cap (which silently cuts them short) is refused with the way
+/// out; the integrated table of the same surface renders, and so does the default step. On
+/// other adapters the fine step renders.
+#[test]
+fn scenes_beyond_llvmpipes_loop_cap_are_refused_there() {
+    let ctx = ctx();
+    let mut options = DiffractionSceneOptions::new(DiffractionScene::CdDisc);
+    (options.width, options.height) = (16, 12);
+    let default_step = render_diffraction_scene(ctx, tables("cd-tracks"), &options);
+    assert!(default_step.is_ok(), "{:?}", default_step.err());
+    options.technique.wavelength_step_nm = Some(5.0);
+    let fine = render_diffraction_scene(ctx, tables("cd-tracks"), &options);
+    if ctx.info.name.contains("llvmpipe") {
+        let message = fine.expect_err("refused on llvmpipe").to_string();
+        for needle in ["65535", "--wavelength-step", "integrated"] {
+            assert!(message.contains(needle), "{needle}: {message}");
+        }
+        options.technique.wavelength_step_nm = None;
+        assert!(render_diffraction_scene(ctx, tables("cd-tracks-fast"), &options).is_ok());
+    } else {
+        assert!(fine.is_ok(), "{}: {:?}", ctx.info.name, fine.err());
+    }
+}
+
+/// Linear value of an 8-bit sRGB-encoded channel (IEC 61966-2-1).
+fn srgb_to_linear(c: u8) -> f64 {
+    let c = f64::from(c) / 255.0;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// Mean and largest |a − b| over the pixels' linear RGB channels.
+fn linear_difference(a: &[u8], b: &[u8]) -> (f64, f64) {
+    assert_eq!(a.len(), b.len());
+    let (mut sum, mut max, mut n) = (0.0, 0.0f64, 0usize);
+    for (p, q) in a.chunks_exact(4).zip(b.chunks_exact(4)) {
+        for c in 0..3 {
+            let d = (srgb_to_linear(p[c]) - srgb_to_linear(q[c])).abs();
+            sum += d;
+            max = max.max(d);
+            n += 1;
+        }
+    }
+    (sum / n as f64, max)
+}
+
+/// The fast path against the reference: `cd-disc` at 100 × 75 from `cd-tracks-fast` (layout
+/// "integrated", summed over the table's 5 nm grid at bake time) and from `cd-tracks`
+/// (layout "terms", the same surface) at the scene's default 10 nm step. Measured on Mesa
+/// lavapipe (llvmpipe 15, x86-64): mean linear |Δ| 3.9 · 10⁻³ (largest 0.33, at a few pixels
+/// on the rainbow's edges), 1 · 10⁻⁵ for the specular order alone; bound [`MEAN_BOUND`].
+/// Both show the rainbow; without the lights neither does.
+const MEAN_BOUND: f64 = 8e-3;
+
+#[test]
+fn fast_table_renders_the_cd_disc_like_the_terms_table() {
+    let ctx = ctx();
+    let mut options = DiffractionSceneOptions::new(DiffractionScene::CdDisc);
+    options.width = 100;
+    options.height = 75;
+    let fast = render_diffraction_scene(ctx, tables("cd-tracks-fast"), &options).unwrap();
+    let reference = render_diffraction_scene(ctx, tables("cd-tracks"), &options).unwrap();
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
+    fast.write_png(&dir.join("diffraction-cd-disc-fast.png"))
+        .unwrap();
+    let (mean, max) = linear_difference(&fast.pixels, &reference.pixels);
+    eprintln!(
+        "cd-disc, integrated vs terms (10 nm): mean |Δ| {mean:.2e}, max {max:.3} (linear); render passes {:.2} s (integrated), {:.2} s (terms)",
+        fast.gpu_seconds, reference.gpu_seconds
+    );
+    assert!(mean <= MEAN_BOUND, "mean |Δ| {mean} > {MEAN_BOUND}");
+    for (what, image) in [("integrated", &fast), ("terms", &reference)] {
+        let (count, sectors) = colourfulness(&image.pixels);
+        eprintln!("{what}: {count} saturated pixels over {sectors} hue sectors of 30°");
+        assert!(count >= 40, "{what}: {count} saturated pixels");
+        assert!(sectors >= 5, "{what}: hues in {sectors} sectors");
+    }
+    options.light.intensity = 0.0;
+    options.env_samples = 0;
+    let plain = render_diffraction_scene(ctx, tables("cd-tracks-fast"), &options).unwrap();
+    let plain_terms = render_diffraction_scene(ctx, tables("cd-tracks"), &options).unwrap();
+    let (specular_mean, _) = linear_difference(&plain.pixels, &plain_terms.pixels);
+    let (count, sectors) = colourfulness(&plain.pixels);
+    eprintln!(
+        "integrated without diffracted lights: {count} saturated pixels, {sectors} sectors; mean |Δ| {specular_mean:.1e} against terms"
+    );
+    assert!(sectors < 5, "integrated: {sectors} sectors");
+    assert!(
+        specular_mean <= 1e-4,
+        "specular order: mean |Δ| {specular_mean}"
+    );
+}
+
+/// An integrated table holds its F² in its uniform: a scene whose Fresnel factor differs
+/// from the one it was loaded with (the snake's keratin against the CD's F² = 1) is refused.
+#[test]
+fn integrated_table_with_another_fresnel_is_refused() {
+    let ctx = ctx();
+    let mut options = DiffractionSceneOptions::new(DiffractionScene::SnakeSkin);
+    options.width = 8;
+    options.height = 6;
+    let err =
+        render_diffraction_scene(ctx, tables("cd-tracks-fast"), &options).expect_err("another F²");
+    assert!(err.to_string().contains("Fresnel"), "{err}");
 }

@@ -11,7 +11,7 @@
 use nacre_runtime::gltf_assets::{SPHERE_SPACING, SWEEPS, sweep_glb};
 use nacre_runtime::gltf_scene::GltfScene;
 use nacre_runtime::mesh::{fit_camera, render_gltf};
-use nacre_runtime::render::{RenderedImage, SceneKind, SceneOptions};
+use nacre_runtime::render::{FilmEval, RenderedImage, SceneKind, SceneOptions};
 use nacre_runtime::shaders::{MATERIAL, MESH, compose};
 use nacre_runtime::{TableSet, Technique};
 use naga::valid::{Capabilities, ValidationFlags, Validator};
@@ -196,6 +196,66 @@ fn sweeps_render_and_parameters_change_colours() {
                     out.notes
                 );
             }
+        }
+    }
+}
+
+/// The rough-film paths of issue 6 on glTF meshes: `nv` and `exact` render the thickness
+/// sweep (roughnessFactor 0.2, GGX α 0.04) with the same coverage as `classic`, keep the
+/// five thicknesses apart, stay close to `classic` at this low roughness (the paths differ
+/// in how they light the environment, not in the film), and really are other paths (the
+/// images differ). `exact` needs the rough-film-lut table and refuses to run without it.
+#[test]
+fn gltf_meshes_render_with_the_rough_film_paths() {
+    let ctx = ctx();
+    let mut tables = tables();
+    let scene = GltfScene::load(&asset_dir().join("sweep-thickness.glb")).unwrap();
+    let render = |tables: &TableSet, film_eval: FilmEval| {
+        let mut o = options();
+        o.film_eval = film_eval;
+        render_gltf(ctx, tables, Technique::Lut, &scene, &o)
+    };
+    let err = render(&tables, FilmEval::Exact)
+        .err()
+        .expect("exact without its table");
+    assert!(err.to_string().contains("rough-film-lut"), "{err}");
+    let baked = nacre_bake::bake::default_baked_dir();
+    tables
+        .add(ctx, &baked.join("rough-film-dielectric.json"))
+        .unwrap();
+    let classic = render(&tables, FilmEval::Classic).unwrap().image;
+    let background = |image: &RenderedImage| [image.pixels[0], image.pixels[1], image.pixels[2]];
+    let covered = |image: &RenderedImage| {
+        let bg = background(image);
+        image
+            .pixels
+            .chunks_exact(4)
+            .filter(|p| [p[0], p[1], p[2]] != bg)
+            .count()
+    };
+    let reference: Vec<[f64; 3]> = (0..5).map(|k| sphere_colour(&scene, &classic, k)).collect();
+    for film_eval in [FilmEval::NormalView, FilmEval::Exact] {
+        let name = format!("{film_eval:?}");
+        let out = render(&tables, film_eval).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let image = &out.image;
+        let (a, b) = (covered(image) as f64, covered(&classic) as f64);
+        assert!(
+            (a - b).abs() <= 0.02 * b,
+            "{name}: covers {a} pixels, classic {b}"
+        );
+        assert_ne!(
+            image.pixels, classic.pixels,
+            "{name}: same image as classic"
+        );
+        let colours: Vec<[f64; 3]> = (0..5).map(|k| sphere_colour(&scene, image, k)).collect();
+        eprintln!("{name}: {colours:?} (classic {reference:?})");
+        for (k, (c, r)) in colours.iter().zip(&reference).enumerate() {
+            let d = distance(*c, *r);
+            assert!(d <= 20.0, "{name}: sphere {k} {c:?} vs classic {r:?} ({d})");
+        }
+        for (a, b) in [(0, 1), (1, 2), (2, 3), (3, 4), (0, 4)] {
+            let d = distance(colours[a], colours[b]);
+            assert!(d >= 4.0, "{name}: spheres {a} and {b} look alike ({d})");
         }
     }
 }

@@ -1,0 +1,620 @@
+//! The `diffraction` technique for layout "integrated" (issue 7, the fast path): loading a
+//! baked integrated table through its manifest, its bind group
+//! (`shaders/diffraction_integrated.wgsl`), its GPU = CPU probe
+//! (`shaders/diffraction_integrated_probe.wgsl`), and the adapter that lets the terms
+//! technique's consumers run on it (`shaders/diffraction_integrated_technique.wgsl`).
+//!
+//! # What the table holds and how the shader rebuilds the colour
+//!
+//! Iₚ(u, v), p = 0 … 2N, wavelength-integrated colour tables in the manifest's output space
+//! such that colour = F²(θ_h) · G/w² · Σₚ wᵖ Iₚ(u, v), (u, v, w) = −ω_i − ω_r
+//! (Stam 1999; Dhillon et al. 2014; derivation in
+//! [`nacre_optics::diffraction::integrated`], files in [`nacre_bake::diffraction_integrated`]).
+//! The shader folds u < 0 onto u ≥ 0 ((u, v, w) → (−u, −v, −w), since
+//! Iₚ(−u, −v) = (−1)ᵖ Iₚ(u, v)), maps u and v to texel coordinates on the warped axes,
+//! reads every layer bilinearly from four `textureLoad`s and sums by Horner in w. It is the
+//! GPU twin of [`IntegratedTable::colour`]: the same fold, forward mapping, clamping,
+//! bilinear weights and f32 Horner order.
+//!
+//! # Upload
+//!
+//! One 2-D array texture, `Rgba32Float`, n/2 × n texels (u ≥ 0 columns, v rows), 2N + 1
+//! layers, layer p = (Iₚ ch 0, ch 1, ch 2, 0) — the layout of the table's KTX2 file. The
+//! texels come from the EXR file, else the KTX2 file
+//! ([`nacre_bake::bake::Manifest::load_diffraction_integrated`]); every file is checked
+//! against its manifest's SHA-256 and the texture against the device's limits first.
+//!
+//! # Bind group (group 1 of a pipeline; fragment and compute)
+//!
+//! | binding | resource | WGSL |
+//! |---|---|---|
+//! | 0 | uniform [`DiffractionIntegratedUniform`] (32 bytes): layer size, 2N + 1, u_max, 1/γ, the host's F² | `diffraction_integrated: DiffractionIntegratedParams` |
+//! | 1 | the table, `texture_2d_array<f32>`, unfilterable (`textureLoad` only) | `diffraction_integrated_table` |
+//!
+//! # Using it from a scene shader
+//!
+//! Compose [`WGSL`] before the consumer and bind [`DiffractionIntegrated::bind_group`] at
+//! group 1 of a pipeline layout that has [`DiffractionIntegrated::bind_group_layout`] there:
+//!
+//! ```wgsl
+//! let frame = diffraction_integrated_frame(normal, across_the_lines); // rows x, y, n
+//! let c = diffraction_integrated_colour(frame * to_light, frame * to_eye,
+//!                                       diffraction_integrated.fresnel_kind,
+//!                                       diffraction_integrated.fresnel_ior);
+//! radiance += c * light_radiance;
+//! ```
+//!
+//! A consumer written for the terms technique (`shaders/diffraction_scene.wgsl`, which calls
+//! `diffraction_colour`, `diffraction_specular_order_colour`, `diffraction_fresnel`,
+//! `diffraction_frame`, `diffraction_finite3`) runs unchanged on an integrated table when
+//! composed as [`compose_scene`]: [`TECHNIQUE_ADAPTER`] defines those names from this module,
+//! with F² from the uniform ([`run_scene_probe`] runs that composition's probe entry point on
+//! the device). Its `diffraction_specular_order_colour` is the mirror-lobe peak
+//! F² Σₚ (−2 cos θ)ᵖ Iₚ(0, 0), the colour of |P̃(0, 0)|², which differs from the terms
+//! technique's F² |P_DC|² by the window-weighted bins next to DC (1.4 · 10⁻⁴ of the white
+//! for the CD table).
+//!
+//! # Cost
+//!
+//! 4 (2N + 1) texel loads and 3 (2N + 1) multiply-adds per call (the CD table, N = 11: 92
+//! loads), independent of the number of wavelengths; the terms technique loads
+//! ⌈(N + 1)/2⌉ layers per bin for (2R + 1)² bins per wavelength (the CD table at 5 nm:
+//! 6 × 25 × 81 = 12 150 loads).
+
+use crate::context::{BufferInitExt, GpuContext};
+use crate::error::{Error, Result};
+use crate::tables::{check_limit, verify_files};
+use bytemuck::{Pod, Zeroable};
+use nacre_bake::bake::Manifest;
+use nacre_bake::diffraction::DiffractionRecord;
+use nacre_bake::diffraction_integrated::IntegratedRecord;
+use nacre_optics::colour::Colorimeter;
+use nacre_optics::diffraction::FresnelTerm;
+use nacre_optics::diffraction::integrated::IntegratedTable;
+use std::path::{Path, PathBuf};
+
+/// The technique module (`shaders/diffraction_integrated.wgsl`): bind group 1 and the
+/// functions `diffraction_integrated_colour`, `diffraction_integrated_specular_colour`,
+/// `diffraction_integrated_frame`, `diffraction_integrated_fresnel`.
+pub const WGSL: &str = include_str!("../../../shaders/diffraction_integrated.wgsl");
+/// `shaders/diffraction_integrated_technique.wgsl`: the names a terms-technique consumer
+/// calls (`diffraction_colour`, …), defined from [`WGSL`] with F² from the uniform.
+pub const TECHNIQUE_ADAPTER: &str =
+    include_str!("../../../shaders/diffraction_integrated_technique.wgsl");
+/// `shaders/diffraction_integrated_probe.wgsl`: the compute probe (entry point
+/// `diffraction_integrated_probe`; group 2 its buffers).
+pub const PROBE: &str = include_str!("../../../shaders/diffraction_integrated_probe.wgsl");
+
+/// The probe pipeline's source: [`WGSL`] then [`PROBE`].
+pub fn compose_probe() -> String {
+    format!("{WGSL}\n{PROBE}\n")
+}
+
+/// The scene pipeline's source: [`WGSL`], [`TECHNIQUE_ADAPTER`], then the terms technique's
+/// consumers ([`crate::diffraction::DIFFRACTION_SCENE`]: scenes, bench pass, probe).
+pub fn compose_scene() -> String {
+    format!(
+        "{WGSL}\n{TECHNIQUE_ADAPTER}\n{}\n",
+        crate::diffraction::DIFFRACTION_SCENE
+    )
+}
+
+/// Mirror of `DiffractionIntegratedParams` (shaders/diffraction_integrated.wgsl, 32 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct DiffractionIntegratedUniform {
+    /// (columns n/2, rows n) of a layer.
+    pub size: [u32; 2],
+    /// Layers 2N + 1.
+    pub layers: u32,
+    /// The host's F² (used by [`TECHNIQUE_ADAPTER`]): 0 = 1; 1 = Fresnel of `fresnel_ior`.
+    pub fresnel_kind: u32,
+    /// u_max = 2 sin θ_max.
+    pub max_uv: f32,
+    /// 1/γ, the inverse warp exponent.
+    pub inv_gamma: f32,
+    /// (n, κ) of the bulk material (`fresnel_kind` 1).
+    pub fresnel_ior: [f32; 2],
+}
+
+/// (kind, (n, κ)) of `fresnel` as the shader takes it.
+///
+/// # Errors
+/// [`Error::Invalid`] for an index that is not finite with n > 0, κ ≥ 0.
+pub fn fresnel_parameters(fresnel: FresnelTerm) -> Result<(u32, [f32; 2])> {
+    match fresnel {
+        FresnelTerm::Unity => Ok((0, [1.0, 0.0])),
+        FresnelTerm::Index(n) => {
+            if !(n.re.is_finite() && n.im.is_finite() && n.re > 0.0 && n.im >= 0.0) {
+                return Err(Error::Invalid {
+                    context: "diffraction Fresnel index".into(),
+                    message: format!("{n} (expected n > 0, κ ≥ 0, finite)"),
+                });
+            }
+            Ok((1, [n.re as f32, n.im as f32]))
+        }
+    }
+}
+
+/// An integrated `diffraction` table on the GPU with its bind group (module docs).
+pub struct DiffractionIntegrated {
+    /// Table name.
+    pub name: String,
+    /// The manifest it was loaded from.
+    pub manifest_path: PathBuf,
+    /// The manifest.
+    pub manifest: Manifest,
+    /// The manifest's `diffraction` record (N, u_max, wavelengths, …).
+    pub record: DiffractionRecord,
+    /// Its `integrated` part (axes, measured reconstruction error).
+    pub integrated: IntegratedRecord,
+    /// The table as uploaded (f32 values), for CPU twins ([`IntegratedTable::colour`]).
+    pub table: IntegratedTable,
+    /// The 2-D array `Rgba32Float` texture (module docs).
+    pub texture: wgpu::Texture,
+    /// The uniform as uploaded.
+    pub uniform: DiffractionIntegratedUniform,
+    layout: wgpu::BindGroupLayout,
+    bind_group: wgpu::BindGroup,
+}
+
+impl DiffractionIntegrated {
+    /// The technique's WGSL ([`WGSL`]).
+    pub const WGSL: &'static str = WGSL;
+
+    /// Reads the manifest at `manifest_path`, checks its files' SHA-256 and the device's
+    /// limits, reads the table and uploads it with a uniform whose F² is `fresnel` (what
+    /// [`TECHNIQUE_ADAPTER`] applies; `diffraction_integrated_colour` takes F² as arguments).
+    ///
+    /// # Errors
+    /// [`Error::Table`] for unreadable or malformed files; [`Error::Manifest`] for a table of
+    /// another kind or layout, or a file that does not match its manifest; [`Error::Limit`]
+    /// when the texture exceeds the device; [`Error::Invalid`] for a bad Fresnel index.
+    pub fn load(
+        ctx: &GpuContext,
+        manifest_path: &Path,
+        fresnel: FresnelTerm,
+    ) -> Result<DiffractionIntegrated> {
+        let (fresnel_kind, fresnel_ior) = fresnel_parameters(fresnel)?;
+        let bad = |message: String| Error::Manifest {
+            path: manifest_path.to_path_buf(),
+            message,
+        };
+        let manifest = Manifest::read(manifest_path)?;
+        if manifest.kind != "diffraction" {
+            return Err(bad(format!(
+                "table `{}` is a `{}` table, not a `diffraction` table",
+                manifest.name, manifest.kind
+            )));
+        }
+        verify_files(&manifest, manifest_path)?;
+        let record = manifest
+            .diffraction
+            .clone()
+            .ok_or_else(|| bad("a diffraction manifest without its `diffraction` record".into()))?;
+        let integrated = match (&record.integrated, record.layout.as_str()) {
+            (Some(s), "integrated") => s.clone(),
+            (_, layout) => {
+                return Err(bad(format!(
+                    "diffraction table `{}` has the layout \"{layout}\", not \"integrated\" (nacre_runtime::diffraction::DiffractionTables::load loads either layout)",
+                    manifest.name
+                )));
+            }
+        };
+        let limits = ctx.device.limits();
+        for (what, n, limit) in [
+            (
+                "width",
+                integrated.samples_u,
+                limits.max_texture_dimension_2d,
+            ),
+            (
+                "height",
+                integrated.samples_v,
+                limits.max_texture_dimension_2d,
+            ),
+            ("layers", integrated.layers, limits.max_texture_array_layers),
+        ] {
+            check_limit(
+                ctx,
+                &format!("integrated diffraction `{}` {what}", manifest.name),
+                n as u64,
+                limit,
+            )?;
+        }
+        let (_, table) = manifest.load_diffraction_integrated(manifest_path)?;
+        let (cols, rows) = table.size();
+        let layers = table.layers();
+        if (cols, rows, layers)
+            != (
+                integrated.samples_u,
+                integrated.samples_v,
+                integrated.layers,
+            )
+        {
+            return Err(bad(format!(
+                "the integrated file holds {cols} × {rows} × {layers} texels; the manifest says {} × {} × {}",
+                integrated.samples_u, integrated.samples_v, integrated.layers
+            )));
+        }
+        let axis = table.axis();
+        let uniform = DiffractionIntegratedUniform {
+            size: [cols as u32, rows as u32],
+            layers: layers as u32,
+            fresnel_kind,
+            max_uv: axis.max_uv as f32,
+            inv_gamma: (1.0 / axis.gamma) as f32,
+            fresnel_ior,
+        };
+        let texels: Vec<f32> = table
+            .values()
+            .iter()
+            .flat_map(|v| [v[0], v[1], v[2], 0.0])
+            .collect();
+        let name = manifest.name.clone();
+        let device = &ctx.device;
+        let (texture, layout, bind_group) =
+            ctx.checked("uploading an integrated diffraction table", || {
+                let size = wgpu::Extent3d {
+                    width: cols as u32,
+                    height: rows as u32,
+                    depth_or_array_layers: layers as u32,
+                };
+                let texture = device.create_texture(&wgpu::TextureDescriptor {
+                    label: Some(&name),
+                    size,
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format: wgpu::TextureFormat::Rgba32Float,
+                    usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                    view_formats: &[],
+                });
+                ctx.queue.write_texture(
+                    wgpu::TexelCopyTextureInfo {
+                        texture: &texture,
+                        mip_level: 0,
+                        origin: wgpu::Origin3d::ZERO,
+                        aspect: wgpu::TextureAspect::All,
+                    },
+                    bytemuck::cast_slice(&texels),
+                    wgpu::TexelCopyBufferLayout {
+                        offset: 0,
+                        bytes_per_row: Some(cols as u32 * 16),
+                        rows_per_image: Some(rows as u32),
+                    },
+                    size,
+                );
+                let visibility = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
+                let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                    label: Some("diffraction integrated technique"),
+                    entries: &[
+                        // 0: DiffractionIntegratedParams.
+                        wgpu::BindGroupLayoutEntry {
+                            binding: 0,
+                            visibility,
+                            ty: wgpu::BindingType::Buffer {
+                                ty: wgpu::BufferBindingType::Uniform,
+                                has_dynamic_offset: false,
+                                min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<
+                                    DiffractionIntegratedUniform,
+                                >(
+                                )
+                                    as u64),
+                            },
+                            count: None,
+                        },
+                        // 1: the Iₚ layers, Rgba32Float, read with textureLoad.
+                        wgpu::BindGroupLayoutEntry {
+                            binding: 1,
+                            visibility,
+                            ty: wgpu::BindingType::Texture {
+                                sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                                view_dimension: wgpu::TextureViewDimension::D2Array,
+                                multisampled: false,
+                            },
+                            count: None,
+                        },
+                    ],
+                });
+                let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("DiffractionIntegratedParams"),
+                    contents: bytemuck::bytes_of(&uniform),
+                    usage: wgpu::BufferUsages::UNIFORM,
+                });
+                let view = texture.create_view(&wgpu::TextureViewDescriptor {
+                    dimension: Some(wgpu::TextureViewDimension::D2Array),
+                    ..Default::default()
+                });
+                let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("diffraction integrated technique"),
+                    layout: &layout,
+                    entries: &[
+                        wgpu::BindGroupEntry {
+                            binding: 0,
+                            resource: buffer.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 1,
+                            resource: wgpu::BindingResource::TextureView(&view),
+                        },
+                    ],
+                });
+                (texture, layout, bind_group)
+            })?;
+        Ok(DiffractionIntegrated {
+            name: manifest.name.clone(),
+            manifest_path: manifest_path.to_path_buf(),
+            manifest,
+            record,
+            integrated,
+            table,
+            texture,
+            uniform,
+            layout,
+            bind_group,
+        })
+    }
+
+    /// The layout of group 1 (module docs: binding 0 the uniform, 1 the table; fragment and
+    /// compute stages).
+    pub fn bind_group_layout(&self) -> &wgpu::BindGroupLayout {
+        &self.layout
+    }
+
+    /// The bind group of group 1.
+    pub fn bind_group(&self) -> &wgpu::BindGroup {
+        &self.bind_group
+    }
+
+    /// The colorimeter recorded in the manifest (observer, illuminant, output space).
+    pub fn colorimeter(&self) -> Result<Colorimeter> {
+        Ok(self.manifest.colorimeter(&self.manifest_path)?)
+    }
+
+    /// Texel loads per `diffraction_integrated_colour` call: 4 (2N + 1).
+    pub fn texel_loads_per_call(&self) -> usize {
+        4 * self.table.layers()
+    }
+}
+
+/// One probe evaluation: a light/view pair in the grating frame (any values, unit or not,
+/// finite or not), F², and the cos θ of a `diffraction_integrated_specular_colour` call.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ProbeCase {
+    /// ω_i, towards the light.
+    pub omega_i: [f32; 3],
+    /// ω_r, towards the viewer.
+    pub omega_r: [f32; 3],
+    /// F²; an index is passed to the shader as given (f32), unchecked.
+    pub fresnel: FresnelTerm,
+    /// cos θ of the specular-colour call.
+    pub cos_theta: f32,
+}
+
+/// One probe result.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ProbeOutput {
+    /// `diffraction_integrated_colour(ω_i, ω_r, F²)`, output space.
+    pub colour: [f32; 3],
+    /// `diffraction_integrated_specular_colour(cos θ, F²)`.
+    pub specular: [f32; 3],
+}
+
+/// Evaluates the technique for every case in a compute pass
+/// (`shaders/diffraction_integrated_probe.wgsl`) and reads the colours back.
+///
+/// # Errors
+/// [`Error::Invalid`] for more cases than one dispatch takes; [`Error::Gpu`] or
+/// [`Error::DeviceLost`] from the device.
+pub fn run_probe(
+    ctx: &GpuContext,
+    technique: &DiffractionIntegrated,
+    cases: &[ProbeCase],
+) -> Result<Vec<ProbeOutput>> {
+    let input: Vec<[f32; 4]> = cases
+        .iter()
+        .flat_map(|c| {
+            let (kind, ior) = match c.fresnel {
+                FresnelTerm::Unity => (0.0, [1.0, 0.0]),
+                FresnelTerm::Index(n) => (1.0, [n.re as f32, n.im as f32]),
+            };
+            let (i, r) = (c.omega_i, c.omega_r);
+            [
+                [i[0], i[1], i[2], kind],
+                [r[0], r[1], r[2], 0.0],
+                [ior[0], ior[1], c.cos_theta, 0.0],
+            ]
+        })
+        .collect();
+    let values = dispatch(
+        ctx,
+        technique,
+        &compose_probe(),
+        "diffraction_integrated_probe",
+        &input,
+        cases.len(),
+    )?;
+    Ok(values
+        .chunks_exact(2)
+        .map(|c| ProbeOutput {
+            colour: [c[0][0], c[0][1], c[0][2]],
+            specular: [c[1][0], c[1][1], c[1][2]],
+        })
+        .collect())
+}
+
+/// Runs the terms technique's own probe entry point (`diffraction_probe` of
+/// `shaders/diffraction_scene.wgsl`) on this table through [`TECHNIQUE_ADAPTER`]
+/// ([`compose_scene`]): for each (ω_i, ω_r) in the grating frame, `diffraction_colour(ω_i,
+/// ω_r)` and `diffraction_specular_order_colour(ω_r.z)` with the uniform's F². This is the
+/// scene pipeline's source, run on the device: what the renderer gets when it binds this
+/// table at group 1 instead of a terms table.
+///
+/// # Errors
+/// As [`run_probe`].
+pub fn run_scene_probe(
+    ctx: &GpuContext,
+    technique: &DiffractionIntegrated,
+    pairs: &[([f32; 3], [f32; 3])],
+) -> Result<Vec<ProbeOutput>> {
+    let input: Vec<[f32; 4]> = pairs
+        .iter()
+        .flat_map(|(i, r)| [[i[0], i[1], i[2], 0.0], [r[0], r[1], r[2], 0.0]])
+        .collect();
+    let values = dispatch(
+        ctx,
+        technique,
+        &compose_scene(),
+        "diffraction_probe",
+        &input,
+        pairs.len(),
+    )?;
+    Ok(values
+        .chunks_exact(2)
+        .map(|c| ProbeOutput {
+            colour: [c[0][0], c[0][1], c[0][2]],
+            specular: [c[1][0], c[1][1], c[1][2]],
+        })
+        .collect())
+}
+
+/// One compute dispatch of `entry` in `source` (64 invocations per workgroup, one per
+/// case): group 0 empty, group 1 the technique, group 2 (binding 0 `input`, read-only;
+/// binding 1 two vec4 outputs per case); returns the outputs.
+fn dispatch(
+    ctx: &GpuContext,
+    technique: &DiffractionIntegrated,
+    source: &str,
+    entry: &str,
+    input: &[[f32; 4]],
+    cases: usize,
+) -> Result<Vec<[f32; 4]>> {
+    if cases == 0 {
+        return Ok(Vec::new());
+    }
+    let groups = u32::try_from(cases.div_ceil(64))
+        .ok()
+        .filter(|g| *g <= ctx.device.limits().max_compute_workgroups_per_dimension)
+        .ok_or_else(|| Error::Invalid {
+            context: "integrated diffraction probe".into(),
+            message: format!("{cases} cases are too many for one dispatch"),
+        })?;
+    let out_bytes = (cases * 2 * 16) as u64;
+    let device = &ctx.device;
+    let readback = ctx.checked("running the integrated diffraction probe", || {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("diffraction integrated probe"),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        });
+        let storage = |binding, read_only| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let io_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("diffraction integrated probe io"),
+            entries: &[storage(0, true), storage(1, false)],
+        });
+        let empty = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("diffraction integrated probe (no view)"),
+            entries: &[],
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("diffraction integrated probe"),
+            bind_group_layouts: &[
+                Some(&empty),
+                Some(technique.bind_group_layout()),
+                Some(&io_layout),
+            ],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("diffraction integrated probe"),
+            layout: Some(&layout),
+            module: &module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        let inputs = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("diffraction integrated probe inputs"),
+            contents: bytemuck::cast_slice(input),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let outputs = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("diffraction integrated probe outputs"),
+            size: out_bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("diffraction integrated probe readback"),
+            size: out_bytes,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let empty_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("diffraction integrated probe (no view)"),
+            layout: &empty,
+            entries: &[],
+        });
+        let io = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("diffraction integrated probe io"),
+            layout: &io_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: inputs.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: outputs.as_entire_binding(),
+                },
+            ],
+        });
+        let mut encoder = device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&pipeline);
+            pass.set_bind_group(0, &empty_group, &[]);
+            pass.set_bind_group(1, technique.bind_group(), &[]);
+            pass.set_bind_group(2, &io, &[]);
+            pass.dispatch_workgroups(groups, 1, 1);
+        }
+        encoder.copy_buffer_to_buffer(&outputs, 0, &readback, 0, out_bytes);
+        ctx.queue.submit([encoder.finish()]);
+        readback
+    })?;
+    map_buffer(ctx, &readback)
+}
+
+/// Maps a `MAP_READ` buffer of vec4<f32> and copies it out.
+fn map_buffer(ctx: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<[f32; 4]>> {
+    let (sender, receiver) = std::sync::mpsc::channel();
+    buffer.map_async(wgpu::MapMode::Read, .., move |r| {
+        let _ = sender.send(r);
+    });
+    ctx.wait("reading the integrated diffraction probe back")?;
+    let gpu = |message: String| Error::Gpu {
+        context: "mapping the integrated diffraction probe buffer".into(),
+        message,
+    };
+    receiver
+        .recv()
+        .map_err(|e| e.to_string())
+        .and_then(|r| r.map_err(|e| e.to_string()))
+        .map_err(gpu)?;
+    let view = buffer
+        .get_mapped_range(..)
+        .map_err(|e| gpu(e.to_string()))?;
+    let out = bytemuck::pod_collect_to_vec(&view);
+    drop(view);
+    buffer.unmap();
+    Ok(out)
+}

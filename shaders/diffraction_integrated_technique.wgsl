@@ -1,0 +1,35 @@
+// nacre · shaders/diffraction_integrated_technique.wgsl
+//
+// Adapter: presents the layout "integrated" module (diffraction_integrated.wgsl, composed
+// before this file) under the names the consumers of the terms technique call
+// (diffraction_scene.wgsl: the cd-disc and snake-skin scenes, the bench pass, the probe),
+// so that `diffraction_integrated.wgsl + this file + diffraction_scene.wgsl` is a complete
+// pipeline source with group 1 = `nacre_runtime::diffraction_integrated::DiffractionIntegrated`
+// instead of the terms table. F² comes from the uniform's `fresnel_kind` and `fresnel_ior`
+// (the host's `FresnelTerm`, as the terms technique's uniform carries it).
+//
+//   diffraction_colour(ω_i, ω_r)              = diffraction_integrated_colour(ω_i, ω_r, F²)
+//   diffraction_specular_order_colour(cos θ)  = diffraction_integrated_specular_colour(cos θ, F²)
+//                                               (the mirror-lobe peak; see its comment)
+//   diffraction_fresnel(cos θ), diffraction_frame(n, t), diffraction_finite3(v)
+//                                             = their diffraction_integrated_* twins
+
+fn diffraction_finite3(v: vec3<f32>) -> bool {
+    return diffraction_integrated_finite3(v);
+}
+
+fn diffraction_frame(n: vec3<f32>, t: vec3<f32>) -> mat3x3<f32> {
+    return diffraction_integrated_frame(n, t);
+}
+
+fn diffraction_fresnel(cos_theta: f32) -> f32 {
+    return diffraction_integrated_fresnel(cos_theta, diffraction_integrated.fresnel_kind, diffraction_integrated.fresnel_ior);
+}
+
+fn diffraction_colour(wi: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
+    return diffraction_integrated_colour(wi, wr, diffraction_integrated.fresnel_kind, diffraction_integrated.fresnel_ior);
+}
+
+fn diffraction_specular_order_colour(cos_theta: f32) -> vec3<f32> {
+    return diffraction_integrated_specular_colour(cos_theta, diffraction_integrated.fresnel_kind, diffraction_integrated.fresnel_ior);
+}
