@@ -275,20 +275,12 @@ impl DiffractionTable {
                 ),
             });
         }
-        let limits = ctx.device.limits();
         let layers = (order + 1).div_ceil(2);
-        for (what, n, limit) in [
-            ("width", record.nx, limits.max_texture_dimension_2d),
-            ("height", record.ny, limits.max_texture_dimension_2d),
-            ("layers", layers, limits.max_texture_array_layers),
-        ] {
-            check_limit(
-                ctx,
-                &format!("diffraction `{}` {what}", manifest.name),
-                n as u64,
-                limit,
-            )?;
-        }
+        check_array_limits(
+            ctx,
+            &format!("diffraction `{}`", manifest.name),
+            [record.nx, record.ny, layers],
+        )?;
         let (loaded, terms) = manifest.load_diffraction(manifest_path)?;
         if (loaded.nx, loaded.ny) != terms.size() || terms.order() != order {
             return Err(Error::Manifest {
@@ -312,40 +304,7 @@ impl DiffractionTable {
             }
             v
         };
-        let name = manifest.name.clone();
-        let texture = ctx.checked("uploading a diffraction table", || {
-            let size = wgpu::Extent3d {
-                width: nx as u32,
-                height: ny as u32,
-                depth_or_array_layers: layers as u32,
-            };
-            let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(&name),
-                size,
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::Rgba32Float,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-                view_formats: &[],
-            });
-            ctx.queue.write_texture(
-                wgpu::TexelCopyTextureInfo {
-                    texture: &texture,
-                    mip_level: 0,
-                    origin: wgpu::Origin3d::ZERO,
-                    aspect: wgpu::TextureAspect::All,
-                },
-                bytemuck::cast_slice(&texels),
-                wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(nx as u32 * 16),
-                    rows_per_image: Some(ny as u32),
-                },
-                size,
-            );
-            texture
-        })?;
+        let texture = upload_rgba32f_array(ctx, &manifest.name, [nx, ny, layers], &texels)?;
         Ok(DiffractionTable {
             name: manifest.name.clone(),
             manifest_path: manifest_path.to_path_buf(),
@@ -524,6 +483,64 @@ pub struct DiffractionBinding {
     pub grid: SpectralGrid,
 }
 
+/// Refuses a 2-D array texture of `[width, height, layers]` beyond the device's limits
+/// (before anything is uploaded), naming `what`.
+pub(crate) fn check_array_limits(ctx: &GpuContext, what: &str, size: [usize; 3]) -> Result<()> {
+    let limits = ctx.device.limits();
+    for (axis, n, limit) in [
+        ("width", size[0], limits.max_texture_dimension_2d),
+        ("height", size[1], limits.max_texture_dimension_2d),
+        ("layers", size[2], limits.max_texture_array_layers),
+    ] {
+        check_limit(ctx, &format!("{what} {axis}"), n as u64, limit)?;
+    }
+    Ok(())
+}
+
+/// Uploads `texels` (RGBA, layer-major, rows of `width`) into a new `Rgba32Float` 2-D array
+/// texture of `[width, height, layers]` named `name`: the storage of both diffraction
+/// layouts, unfilterable and read with `textureLoad`.
+pub(crate) fn upload_rgba32f_array(
+    ctx: &GpuContext,
+    name: &str,
+    [width, height, layers]: [usize; 3],
+    texels: &[f32],
+) -> Result<wgpu::Texture> {
+    ctx.checked(&format!("uploading the diffraction table `{name}`"), || {
+        let size = wgpu::Extent3d {
+            width: width as u32,
+            height: height as u32,
+            depth_or_array_layers: layers as u32,
+        };
+        let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(name),
+            size,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba32Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        ctx.queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            bytemuck::cast_slice(texels),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(width as u32 * 16),
+                rows_per_image: Some(height as u32),
+            },
+            size,
+        );
+        texture
+    })
+}
+
 /// Mesa's llvmpipe (the rasteriser behind lavapipe) ends every shader invocation after
 /// 65,535 loop iterations in all — gallivm's `LP_MAX_TGSI_LOOP_ITERATIONS`, "shared between
 /// every loop in a shader", an infinite-loop guard — and carries on with the loops cut
@@ -687,27 +704,59 @@ pub fn run_probe(
     binding: &DiffractionBinding,
     pairs: &[([f32; 3], [f32; 3])],
 ) -> Result<Vec<ProbeOutput>> {
-    if pairs.is_empty() {
-        return Ok(Vec::new());
-    }
-    let groups = u32::try_from(pairs.len().div_ceil(64))
-        .ok()
-        .filter(|g| *g <= ctx.device.limits().max_compute_workgroups_per_dimension)
-        .ok_or_else(|| Error::Invalid {
-            context: "diffraction probe".into(),
-            message: format!("{} inputs are too many for one dispatch", pairs.len()),
-        })?;
     let input: Vec<[f32; 4]> = pairs
         .iter()
         .flat_map(|(i, r)| [[i[0], i[1], i[2], 0.0], [r[0], r[1], r[2], 0.0]])
         .collect();
-    let bytes = (input.len() * 16) as u64;
+    let values = dispatch_probe(
+        ctx,
+        &compose(),
+        "diffraction_probe",
+        (&binding.layout, &binding.bind_group),
+        &input,
+        pairs.len(),
+    )?;
+    Ok(values
+        .chunks_exact(2)
+        .map(|c| ProbeOutput {
+            colour: [c[0][0], c[0][1], c[0][2]],
+            specular_order: [c[1][0], c[1][1], c[1][2]],
+        })
+        .collect())
+}
+
+/// One compute dispatch of `entry` in `source` (64 invocations per workgroup, one per
+/// case) for the probes of both layouts: group 0 empty, group 1 the technique's
+/// (`technique`: layout and bind group), group 2 binding 0 the `input` (read-only storage),
+/// binding 1 two vec4<f32> outputs per case; returns the outputs.
+///
+/// # Errors
+/// [`Error::Invalid`] for more cases than one dispatch takes; [`Error::Gpu`] or
+/// [`Error::DeviceLost`] from the device.
+pub(crate) fn dispatch_probe(
+    ctx: &GpuContext,
+    source: &str,
+    entry: &str,
+    technique: (&wgpu::BindGroupLayout, &wgpu::BindGroup),
+    input: &[[f32; 4]],
+    cases: usize,
+) -> Result<Vec<[f32; 4]>> {
+    if cases == 0 {
+        return Ok(Vec::new());
+    }
+    let groups = u32::try_from(cases.div_ceil(64))
+        .ok()
+        .filter(|g| *g <= ctx.device.limits().max_compute_workgroups_per_dimension)
+        .ok_or_else(|| Error::Invalid {
+            context: format!("diffraction probe `{entry}`"),
+            message: format!("{cases} cases are too many for one dispatch"),
+        })?;
+    let out_bytes = (cases * 2 * 16) as u64;
     let device = &ctx.device;
-    let source = compose();
-    let readback = ctx.checked("running the diffraction probe", || {
+    let readback = ctx.checked(&format!("running the diffraction probe `{entry}`"), || {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("diffraction probe"),
-            source: wgpu::ShaderSource::Wgsl(source.as_str().into()),
+            label: Some(entry),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
         });
         let storage = |binding, read_only| wgpu::BindGroupLayoutEntry {
             binding,
@@ -719,7 +768,7 @@ pub fn run_probe(
             },
             count: None,
         };
-        let probe_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        let io_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("diffraction probe io"),
             entries: &[storage(0, true), storage(1, false)],
         });
@@ -729,31 +778,31 @@ pub fn run_probe(
         });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("diffraction probe"),
-            bind_group_layouts: &[Some(&empty), Some(&binding.layout), Some(&probe_layout)],
+            bind_group_layouts: &[Some(&empty), Some(technique.0), Some(&io_layout)],
             immediate_size: 0,
         });
         let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("diffraction probe"),
+            label: Some(entry),
             layout: Some(&layout),
             module: &module,
-            entry_point: Some("diffraction_probe"),
+            entry_point: Some(entry),
             compilation_options: Default::default(),
             cache: None,
         });
         let inputs = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("diffraction probe inputs"),
-            contents: bytemuck::cast_slice(&input),
+            contents: bytemuck::cast_slice(input),
             usage: wgpu::BufferUsages::STORAGE,
         });
         let outputs = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("diffraction probe outputs"),
-            size: bytes,
+            size: out_bytes,
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
         let readback = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("diffraction probe readback"),
-            size: bytes,
+            size: out_bytes,
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
@@ -764,7 +813,7 @@ pub fn run_probe(
         });
         let io = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("diffraction probe io"),
-            layout: &probe_layout,
+            layout: &io_layout,
             entries: &[
                 wgpu::BindGroupEntry {
                     binding: 0,
@@ -781,47 +830,16 @@ pub fn run_probe(
             let mut pass = encoder.begin_compute_pass(&Default::default());
             pass.set_pipeline(&pipeline);
             pass.set_bind_group(0, &empty_group, &[]);
-            pass.set_bind_group(1, &binding.bind_group, &[]);
+            pass.set_bind_group(1, technique.1, &[]);
             pass.set_bind_group(2, &io, &[]);
             pass.dispatch_workgroups(groups, 1, 1);
         }
-        encoder.copy_buffer_to_buffer(&outputs, 0, &readback, 0, bytes);
+        encoder.copy_buffer_to_buffer(&outputs, 0, &readback, 0, out_bytes);
         ctx.queue.submit([encoder.finish()]);
         readback
     })?;
-    let values = map_buffer(ctx, &readback)?;
-    Ok(values
-        .chunks_exact(2)
-        .map(|c| ProbeOutput {
-            colour: [c[0][0], c[0][1], c[0][2]],
-            specular_order: [c[1][0], c[1][1], c[1][2]],
-        })
-        .collect())
-}
-
-/// Maps a `MAP_READ` buffer of vec4<f32> and copies it out.
-fn map_buffer(ctx: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<[f32; 4]>> {
-    let (sender, receiver) = std::sync::mpsc::channel();
-    buffer.map_async(wgpu::MapMode::Read, .., move |r| {
-        let _ = sender.send(r);
-    });
-    ctx.wait("reading the diffraction probe back")?;
-    receiver
-        .recv()
-        .map_err(|e| e.to_string())
-        .and_then(|r| r.map_err(|e| e.to_string()))
-        .map_err(|message| Error::Gpu {
-            context: "mapping the diffraction probe buffer".into(),
-            message,
-        })?;
-    let view = buffer.get_mapped_range(..).map_err(|e| Error::Gpu {
-        context: "mapping the diffraction probe buffer".into(),
-        message: e.to_string(),
-    })?;
-    let out = bytemuck::pod_collect_to_vec(&view);
-    drop(view);
-    buffer.unmap();
-    Ok(out)
+    let bytes = crate::readback::read_buffer(ctx, &readback, "reading the diffraction probe back")?;
+    Ok(bytemuck::pod_collect_to_vec(&bytes))
 }
 
 // ─── Scenes ────────────────────────────────────────────────────────────────────────────────

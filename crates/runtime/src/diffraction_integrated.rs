@@ -62,8 +62,9 @@
 //! 6 × 25 × 81 = 12 150 loads).
 
 use crate::context::{BufferInitExt, GpuContext};
+use crate::diffraction::{check_array_limits, dispatch_probe, upload_rgba32f_array};
 use crate::error::{Error, Result};
-use crate::tables::{check_limit, verify_files};
+use crate::tables::verify_files;
 use bytemuck::{Pod, Zeroable};
 use nacre_bake::bake::Manifest;
 use nacre_bake::diffraction::DiffractionRecord;
@@ -201,27 +202,15 @@ impl DiffractionIntegrated {
                 )));
             }
         };
-        let limits = ctx.device.limits();
-        for (what, n, limit) in [
-            (
-                "width",
+        check_array_limits(
+            ctx,
+            &format!("integrated diffraction `{}`", manifest.name),
+            [
                 integrated.samples_u,
-                limits.max_texture_dimension_2d,
-            ),
-            (
-                "height",
                 integrated.samples_v,
-                limits.max_texture_dimension_2d,
-            ),
-            ("layers", integrated.layers, limits.max_texture_array_layers),
-        ] {
-            check_limit(
-                ctx,
-                &format!("integrated diffraction `{}` {what}", manifest.name),
-                n as u64,
-                limit,
-            )?;
-        }
+                integrated.layers,
+            ],
+        )?;
         let (_, table) = manifest.load_diffraction_integrated(manifest_path)?;
         let (cols, rows) = table.size();
         let layers = table.layers();
@@ -253,38 +242,9 @@ impl DiffractionIntegrated {
             .collect();
         let name = manifest.name.clone();
         let device = &ctx.device;
-        let (texture, layout, bind_group) =
-            ctx.checked("uploading an integrated diffraction table", || {
-                let size = wgpu::Extent3d {
-                    width: cols as u32,
-                    height: rows as u32,
-                    depth_or_array_layers: layers as u32,
-                };
-                let texture = device.create_texture(&wgpu::TextureDescriptor {
-                    label: Some(&name),
-                    size,
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
-                    format: wgpu::TextureFormat::Rgba32Float,
-                    usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-                    view_formats: &[],
-                });
-                ctx.queue.write_texture(
-                    wgpu::TexelCopyTextureInfo {
-                        texture: &texture,
-                        mip_level: 0,
-                        origin: wgpu::Origin3d::ZERO,
-                        aspect: wgpu::TextureAspect::All,
-                    },
-                    bytemuck::cast_slice(&texels),
-                    wgpu::TexelCopyBufferLayout {
-                        offset: 0,
-                        bytes_per_row: Some(cols as u32 * 16),
-                        rows_per_image: Some(rows as u32),
-                    },
-                    size,
-                );
+        let texture = upload_rgba32f_array(ctx, &name, [cols, rows, layers], &texels)?;
+        let (layout, bind_group) =
+            ctx.checked("binding an integrated diffraction table", || {
                 let visibility = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
                 let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                     label: Some("diffraction integrated technique"),
@@ -340,7 +300,7 @@ impl DiffractionIntegrated {
                         },
                     ],
                 });
-                (texture, layout, bind_group)
+                (layout, bind_group)
             })?;
         Ok(DiffractionIntegrated {
             name: manifest.name.clone(),
@@ -427,11 +387,11 @@ pub fn run_probe(
             ]
         })
         .collect();
-    let values = dispatch(
+    let values = dispatch_probe(
         ctx,
-        technique,
         &compose_probe(),
         "diffraction_integrated_probe",
+        (technique.bind_group_layout(), technique.bind_group()),
         &input,
         cases.len(),
     )?;
@@ -462,11 +422,11 @@ pub fn run_scene_probe(
         .iter()
         .flat_map(|(i, r)| [[i[0], i[1], i[2], 0.0], [r[0], r[1], r[2], 0.0]])
         .collect();
-    let values = dispatch(
+    let values = dispatch_probe(
         ctx,
-        technique,
         &compose_scene(),
         "diffraction_probe",
+        (technique.bind_group_layout(), technique.bind_group()),
         &input,
         pairs.len(),
     )?;
@@ -477,144 +437,4 @@ pub fn run_scene_probe(
             specular: [c[1][0], c[1][1], c[1][2]],
         })
         .collect())
-}
-
-/// One compute dispatch of `entry` in `source` (64 invocations per workgroup, one per
-/// case): group 0 empty, group 1 the technique, group 2 (binding 0 `input`, read-only;
-/// binding 1 two vec4 outputs per case); returns the outputs.
-fn dispatch(
-    ctx: &GpuContext,
-    technique: &DiffractionIntegrated,
-    source: &str,
-    entry: &str,
-    input: &[[f32; 4]],
-    cases: usize,
-) -> Result<Vec<[f32; 4]>> {
-    if cases == 0 {
-        return Ok(Vec::new());
-    }
-    let groups = u32::try_from(cases.div_ceil(64))
-        .ok()
-        .filter(|g| *g <= ctx.device.limits().max_compute_workgroups_per_dimension)
-        .ok_or_else(|| Error::Invalid {
-            context: "integrated diffraction probe".into(),
-            message: format!("{cases} cases are too many for one dispatch"),
-        })?;
-    let out_bytes = (cases * 2 * 16) as u64;
-    let device = &ctx.device;
-    let readback = ctx.checked("running the integrated diffraction probe", || {
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("diffraction integrated probe"),
-            source: wgpu::ShaderSource::Wgsl(source.into()),
-        });
-        let storage = |binding, read_only| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only },
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
-        let io_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("diffraction integrated probe io"),
-            entries: &[storage(0, true), storage(1, false)],
-        });
-        let empty = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("diffraction integrated probe (no view)"),
-            entries: &[],
-        });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("diffraction integrated probe"),
-            bind_group_layouts: &[
-                Some(&empty),
-                Some(technique.bind_group_layout()),
-                Some(&io_layout),
-            ],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("diffraction integrated probe"),
-            layout: Some(&layout),
-            module: &module,
-            entry_point: Some(entry),
-            compilation_options: Default::default(),
-            cache: None,
-        });
-        let inputs = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("diffraction integrated probe inputs"),
-            contents: bytemuck::cast_slice(input),
-            usage: wgpu::BufferUsages::STORAGE,
-        });
-        let outputs = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("diffraction integrated probe outputs"),
-            size: out_bytes,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        let readback = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("diffraction integrated probe readback"),
-            size: out_bytes,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let empty_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("diffraction integrated probe (no view)"),
-            layout: &empty,
-            entries: &[],
-        });
-        let io = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("diffraction integrated probe io"),
-            layout: &io_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: inputs.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: outputs.as_entire_binding(),
-                },
-            ],
-        });
-        let mut encoder = device.create_command_encoder(&Default::default());
-        {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&pipeline);
-            pass.set_bind_group(0, &empty_group, &[]);
-            pass.set_bind_group(1, technique.bind_group(), &[]);
-            pass.set_bind_group(2, &io, &[]);
-            pass.dispatch_workgroups(groups, 1, 1);
-        }
-        encoder.copy_buffer_to_buffer(&outputs, 0, &readback, 0, out_bytes);
-        ctx.queue.submit([encoder.finish()]);
-        readback
-    })?;
-    map_buffer(ctx, &readback)
-}
-
-/// Maps a `MAP_READ` buffer of vec4<f32> and copies it out.
-fn map_buffer(ctx: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<[f32; 4]>> {
-    let (sender, receiver) = std::sync::mpsc::channel();
-    buffer.map_async(wgpu::MapMode::Read, .., move |r| {
-        let _ = sender.send(r);
-    });
-    ctx.wait("reading the integrated diffraction probe back")?;
-    let gpu = |message: String| Error::Gpu {
-        context: "mapping the integrated diffraction probe buffer".into(),
-        message,
-    };
-    receiver
-        .recv()
-        .map_err(|e| e.to_string())
-        .and_then(|r| r.map_err(|e| e.to_string()))
-        .map_err(gpu)?;
-    let view = buffer
-        .get_mapped_range(..)
-        .map_err(|e| gpu(e.to_string()))?;
-    let out = bytemuck::pod_collect_to_vec(&view);
-    drop(view);
-    buffer.unmap();
-    Ok(out)
 }

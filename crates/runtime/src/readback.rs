@@ -1,4 +1,5 @@
-//! Copying a 2-D texture back to the host (rows padded to 256 bytes on the GPU side).
+//! Copying a 2-D texture (rows padded to 256 bytes on the GPU side) or a buffer back to the
+//! host.
 
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
@@ -42,28 +43,37 @@ pub fn read_texture(
         ctx.queue.submit([encoder.finish()]);
         buffer
     })?;
+    let bytes = read_buffer(ctx, &buffer, "reading a texture back")?;
+    let mut out = Vec::with_capacity((row * height) as usize);
+    for y in 0..height as usize {
+        let start = y * padded as usize;
+        out.extend_from_slice(&bytes[start..start + row as usize]);
+    }
+    Ok(out)
+}
+
+/// Maps a `MAP_READ` `buffer` whose copies have been submitted, waits for the queue and
+/// returns its bytes; `what` names the operation in errors ([`Error::Gpu`], or
+/// [`Error::DeviceLost`] from the wait).
+pub fn read_buffer(ctx: &GpuContext, buffer: &wgpu::Buffer, what: &str) -> Result<Vec<u8>> {
     let (sender, receiver) = std::sync::mpsc::channel();
     buffer.map_async(wgpu::MapMode::Read, .., move |r| {
         let _ = sender.send(r);
     });
-    ctx.wait("reading a texture back")?;
+    ctx.wait(what)?;
+    let gpu = |message: String| Error::Gpu {
+        context: format!("{what}: mapping the buffer"),
+        message,
+    };
     receiver
         .recv()
         .map_err(|e| e.to_string())
         .and_then(|r| r.map_err(|e| e.to_string()))
-        .map_err(|message| Error::Gpu {
-            context: "mapping the readback buffer".into(),
-            message,
-        })?;
-    let view = buffer.get_mapped_range(..).map_err(|e| Error::Gpu {
-        context: "mapping the readback buffer".into(),
-        message: e.to_string(),
-    })?;
-    let mut out = Vec::with_capacity((row * height) as usize);
-    for y in 0..height as usize {
-        let start = y * padded as usize;
-        out.extend_from_slice(&view[start..start + row as usize]);
-    }
+        .map_err(gpu)?;
+    let view = buffer
+        .get_mapped_range(..)
+        .map_err(|e| gpu(e.to_string()))?;
+    let out = view.to_vec();
     drop(view);
     buffer.unmap();
     Ok(out)

@@ -16,7 +16,6 @@
 use nacre_bake::bake::default_baked_dir;
 use nacre_optics::C64;
 use nacre_optics::diffraction::{DiffractionSurface, FresnelTerm, in_plane_directions};
-use nacre_runtime::GpuContext;
 use nacre_runtime::diffraction::{
     DiffractionBinding, DiffractionLayout, DiffractionOptions, DiffractionScene,
     DiffractionSceneOptions, DiffractionTable, DiffractionTables, render_diffraction_scene,
@@ -25,16 +24,8 @@ use nacre_runtime::diffraction::{
 use rayon::prelude::*;
 use std::sync::OnceLock;
 
-fn ctx() -> &'static GpuContext {
-    static CTX: OnceLock<GpuContext> = OnceLock::new();
-    CTX.get_or_init(|| {
-        let ctx = GpuContext::new_headless().unwrap_or_else(|e| {
-            panic!("the GPU tests need an adapter (CI installs mesa-vulkan-drivers): {e}")
-        });
-        eprintln!("adapter: {}", ctx.describe());
-        ctx
-    })
-}
+mod support;
+use support::ctx;
 
 /// A default-set table through the dispatching loader (an integrated one with F² = 1, the
 /// `cd-disc` scene's).

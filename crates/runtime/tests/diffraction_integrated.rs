@@ -26,14 +26,15 @@ use nacre_optics::diffraction::integrated::check_directions;
 use nacre_optics::diffraction::{
     DiffractionSurface, FresnelTerm, SpectralGrid, in_plane_directions,
 };
-use nacre_runtime::GpuContext;
 use nacre_runtime::diffraction_integrated::{
     DiffractionIntegrated, DiffractionIntegratedUniform, ProbeCase, WGSL, compose_probe,
     compose_scene, run_probe, run_scene_probe,
 };
-use naga::valid::{Capabilities, ModuleInfo, ValidationFlags, Validator};
 use rayon::prelude::*;
 use std::sync::OnceLock;
+
+mod support;
+use support::{ctx, translate, validate};
 
 /// Largest GPU − CPU difference allowed, in units of the specular white per channel, scaled
 /// by (1 + |CPU value| / white) so that the large values of grazing directions are compared
@@ -42,17 +43,6 @@ use std::sync::OnceLock;
 /// the warped coordinates (pow in f32) and G/w², and fused multiply-adds. Measured on Mesa
 /// lavapipe (llvmpipe 15, x86-64): 2.7 · 10⁻⁶.
 const TOLERANCE: f64 = 1e-4;
-
-fn ctx() -> &'static GpuContext {
-    static CTX: OnceLock<GpuContext> = OnceLock::new();
-    CTX.get_or_init(|| {
-        let ctx = GpuContext::new_headless().unwrap_or_else(|e| {
-            panic!("the GPU tests need an adapter (CI installs mesa-vulkan-drivers): {e}")
-        });
-        eprintln!("adapter: {}", ctx.describe());
-        ctx
-    })
-}
 
 fn technique() -> &'static DiffractionIntegrated {
     static T: OnceLock<DiffractionIntegrated> = OnceLock::new();
@@ -553,65 +543,10 @@ fn the_loader_checks_kind_layout_and_sha256() {
     );
 }
 
-/// Parses and validates with naga, panicking with the annotated report.
-fn validate(name: &str, source: &str) -> (naga::Module, ModuleInfo) {
-    let module = naga::front::wgsl::parse_str(source)
-        .unwrap_or_else(|e| panic!("{name}: WGSL parse error\n{}", e.emit_to_string(source)));
-    let info = Validator::new(ValidationFlags::all(), Capabilities::default())
-        .validate(&module)
-        .unwrap_or_else(|e| panic!("{name}: validation error\n{}", e.emit_to_string(source)));
-    (module, info)
-}
-
-/// Translates to SPIR-V, MSL, HLSL and GLSL (4.50 core and ES 3.10, per entry point).
-fn translate(name: &str, module: &naga::Module, info: &ModuleInfo) {
-    use naga::back::{glsl, hlsl, msl, spv};
-    spv::write_vec(module, info, &spv::Options::default(), None)
-        .unwrap_or_else(|e| panic!("{name}: SPIR-V: {e}"));
-    let msl_options = msl::Options {
-        lang_version: (2, 0),
-        ..msl::Options::default()
-    };
-    msl::write_string(module, info, &msl_options, &msl::PipelineOptions::default())
-        .unwrap_or_else(|e| panic!("{name}: MSL: {e}"));
-    let mut hlsl_out = String::new();
-    hlsl::Writer::new(
-        &mut hlsl_out,
-        &hlsl::Options::default(),
-        &hlsl::PipelineOptions::default(),
-    )
-    .write(module, info, None)
-    .unwrap_or_else(|e| panic!("{name}: HLSL: {e}"));
-    for version in [glsl::Version::Desktop(450), glsl::Version::new_gles(310)] {
-        for entry in &module.entry_points {
-            let options = glsl::Options {
-                version,
-                ..glsl::Options::default()
-            };
-            let pipeline = glsl::PipelineOptions {
-                shader_stage: entry.stage,
-                entry_point: entry.name.clone(),
-                multiview: None,
-            };
-            let mut out = String::new();
-            glsl::Writer::new(
-                &mut out,
-                module,
-                info,
-                &options,
-                &pipeline,
-                naga::proc::BoundsCheckPolicies::default(),
-            )
-            .and_then(|mut w| w.write())
-            .unwrap_or_else(|e| panic!("{name}: GLSL {version} `{}`: {e}", entry.name));
-        }
-    }
-}
-
 #[test]
 fn the_shaders_validate_and_translate() {
     // The probe.
-    let (module, info) = validate("diffraction_integrated + probe", &compose_probe());
+    let (module, info) = validate("diffraction_integrated + probe", &compose_probe(), "");
     translate("diffraction_integrated + probe", &module, &info);
     assert!(
         module
@@ -635,7 +570,11 @@ fn the_shaders_validate_and_translate() {
     let offsets: Vec<u32> = members.iter().map(|m| m.offset).collect();
     assert_eq!(offsets, [0, 8, 12, 16, 20, 24]);
     // The terms technique's consumers (scenes, bench, probe) through the adapter.
-    let (module, info) = validate("diffraction_integrated + adapter + scene", &compose_scene());
+    let (module, info) = validate(
+        "diffraction_integrated + adapter + scene",
+        &compose_scene(),
+        "",
+    );
     translate("diffraction_integrated + adapter + scene", &module, &info);
     for entry in [
         "diffraction_vs",
@@ -657,7 +596,7 @@ fn fs_bindingless(@builtin(position) p: vec4<f32>) -> @location(0) vec4<f32> {
 }
 ";
     let source = format!("{WGSL}\n{consumer}\n");
-    let (module, info) = validate("diffraction_integrated", &source);
+    let (module, info) = validate("diffraction_integrated", &source, "");
     translate("diffraction_integrated", &module, &info);
     let mut bound = 0;
     for (_, g) in module.global_variables.iter() {

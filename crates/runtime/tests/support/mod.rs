@@ -27,8 +27,10 @@ pub fn repo_root() -> PathBuf {
 }
 
 /// Parses and validates WGSL `source`, panicking with naga's annotated report (line and
-/// column in `source`; `map` says which module a line of a composed source belongs to).
+/// column in `source`; `map` says which module a line of a composed source belongs to, or is
+/// empty).
 pub fn validate(name: &str, source: &str, map: &str) -> (naga::Module, ModuleInfo) {
+    let map = if map.is_empty() { "as given" } else { map };
     let module = naga::front::wgsl::parse_str(source).unwrap_or_else(|e| {
         panic!(
             "{name}: WGSL parse error\n{}\ncomposed source: {map}",
