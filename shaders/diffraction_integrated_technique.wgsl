@@ -11,19 +11,11 @@
 //   diffraction_colour(ω_i, ω_r)              = diffraction_integrated_colour(ω_i, ω_r, F²)
 //   diffraction_specular_order_colour(cos θ)  = diffraction_integrated_specular_colour(cos θ, F²)
 //                                               (the mirror-lobe peak; see its comment)
-//   diffraction_fresnel(cos θ), diffraction_frame(n, t), diffraction_finite3(v)
-//                                             = their diffraction_integrated_* twins
-
-fn diffraction_finite3(v: vec3<f32>) -> bool {
-    return diffraction_integrated_finite3(v);
-}
-
-fn diffraction_frame(n: vec3<f32>, t: vec3<f32>) -> mat3x3<f32> {
-    return diffraction_integrated_frame(n, t);
-}
+//   diffraction_fresnel(cos θ)                = diffraction_fresnel_of(cos θ, the uniform's F²)
+//   (diffraction_frame and diffraction_finite3 come from diffraction_common.wgsl)
 
 fn diffraction_fresnel(cos_theta: f32) -> f32 {
-    return diffraction_integrated_fresnel(cos_theta, diffraction_integrated.fresnel_kind, diffraction_integrated.fresnel_ior);
+    return diffraction_fresnel_of(cos_theta, diffraction_integrated.fresnel_kind, diffraction_integrated.fresnel_ior);
 }
 
 fn diffraction_colour(wi: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {

@@ -55,9 +55,19 @@ use nacre_optics::diffraction::{FresnelTerm, SpectralGrid, TaylorTerms};
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
-/// The technique module (`shaders/diffraction.wgsl`): bind group 1 and the functions
-/// `diffraction_colour`, `diffraction_specular_order_colour`, `diffraction_frame`.
-pub const DIFFRACTION: &str = include_str!("../../../shaders/diffraction.wgsl");
+/// What both layouts share (`shaders/diffraction_common.wgsl`): `diffraction_finite`,
+/// `diffraction_unit`, `diffraction_frame`, `diffraction_fresnel_of`,
+/// `diffraction_geometry_over_w2`; no bindings. [`DIFFRACTION`] and
+/// [`crate::diffraction_integrated::WGSL`] each begin with it.
+pub const DIFFRACTION_COMMON: &str = include_str!("../../../shaders/diffraction_common.wgsl");
+/// The technique module, layout "terms" ([`DIFFRACTION_COMMON`], then
+/// `shaders/diffraction.wgsl`): bind group 1 and the functions `diffraction_colour`,
+/// `diffraction_specular_order_colour`, `diffraction_fresnel`, `diffraction_frame`.
+pub const DIFFRACTION: &str = concat!(
+    include_str!("../../../shaders/diffraction_common.wgsl"),
+    "\n",
+    include_str!("../../../shaders/diffraction.wgsl")
+);
 /// Its consumers (`shaders/diffraction_scene.wgsl`): the scenes, the bench pass and the probe.
 pub const DIFFRACTION_SCENE: &str = include_str!("../../../shaders/diffraction_scene.wgsl");
 

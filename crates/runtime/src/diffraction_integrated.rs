@@ -37,7 +37,7 @@
 //! group 1 of a pipeline layout that has [`DiffractionIntegrated::bind_group_layout`] there:
 //!
 //! ```wgsl
-//! let frame = diffraction_integrated_frame(normal, across_the_lines); // rows x, y, n
+//! let frame = diffraction_frame(normal, across_the_lines); // rows x, y, n
 //! let c = diffraction_integrated_colour(frame * to_light, frame * to_eye,
 //!                                       diffraction_integrated.fresnel_kind,
 //!                                       diffraction_integrated.fresnel_ior);
@@ -74,10 +74,15 @@ use nacre_optics::diffraction::FresnelTerm;
 use nacre_optics::diffraction::integrated::IntegratedTable;
 use std::path::{Path, PathBuf};
 
-/// The technique module (`shaders/diffraction_integrated.wgsl`): bind group 1 and the
-/// functions `diffraction_integrated_colour`, `diffraction_integrated_specular_colour`,
-/// `diffraction_integrated_frame`, `diffraction_integrated_fresnel`.
-pub const WGSL: &str = include_str!("../../../shaders/diffraction_integrated.wgsl");
+/// The technique module, layout "integrated" ([`crate::diffraction::DIFFRACTION_COMMON`],
+/// then `shaders/diffraction_integrated.wgsl`): bind group 1 and the functions
+/// `diffraction_integrated_colour`, `diffraction_integrated_specular_colour`, with
+/// `diffraction_frame` and `diffraction_fresnel_of` from the common module.
+pub const WGSL: &str = concat!(
+    include_str!("../../../shaders/diffraction_common.wgsl"),
+    "\n",
+    include_str!("../../../shaders/diffraction_integrated.wgsl")
+);
 /// `shaders/diffraction_integrated_technique.wgsl`: the names a terms-technique consumer
 /// calls (`diffraction_colour`, …), defined from [`WGSL`] with F² from the uniform.
 pub const TECHNIQUE_ADAPTER: &str =

@@ -590,7 +590,7 @@ fn the_shaders_validate_and_translate() {
     let consumer = "
 @fragment
 fn fs_bindingless(@builtin(position) p: vec4<f32>) -> @location(0) vec4<f32> {
-    let frame = diffraction_integrated_frame(vec3<f32>(0.0, 0.0, 1.0), vec3<f32>(1.0, 0.0, 0.0));
+    let frame = diffraction_frame(vec3<f32>(0.0, 0.0, 1.0), vec3<f32>(1.0, 0.0, 0.0));
     let c = diffraction_integrated_colour(frame * vec3<f32>(-0.3, 0.0, 0.9), vec3<f32>(p.x, 0.0, 1.0), 1u, vec2<f32>(1.5, 0.0));
     return vec4<f32>(c + diffraction_integrated_specular_colour(p.y, 0u, vec2<f32>(1.0, 0.0)), 1.0);
 }
