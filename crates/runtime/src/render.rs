@@ -2190,38 +2190,51 @@ pub(crate) fn check_film_eval(tables: &TableSet, options: &SceneOptions) -> Resu
                 .into(),
         });
     };
-    let axes = &lut.axes;
-    let m = &options.material;
+    let a = &lut.axes;
     let context = format!("rough-film-lut `{}`", lut.name);
+    check_material_in_table(
+        &context,
+        &options.material,
+        a.ambient_index,
+        [a.ior_min, a.ior_max],
+        a.thickness_max_nm,
+    )
+}
+
+/// Checks that a table baked for `ambient_index`, film indices `film_ior` = [min, max] and
+/// thicknesses up to `thickness_max_nm` holds `material` (its ambient, film index and
+/// thickest point), naming the table (`context`) and the value out of range.
+fn check_material_in_table(
+    context: &str,
+    material: &MaterialOptions,
+    ambient_index: f64,
+    [ior_min, ior_max]: [f64; 2],
+    thickness_max_nm: f64,
+) -> Result<()> {
     let tol = 1e-4;
-    if (f64::from(m.ambient_ior) - axes.ambient_index).abs() > tol {
-        return Err(Error::Invalid {
-            context,
-            message: format!(
-                "the table was baked for ambient index {}, the material has {}",
-                axes.ambient_index, m.ambient_ior
-            ),
-        });
+    let invalid = |message: String| {
+        Err(Error::Invalid {
+            context: context.to_string(),
+            message,
+        })
+    };
+    if (f64::from(material.ambient_ior) - ambient_index).abs() > tol {
+        return invalid(format!(
+            "the table was baked for ambient index {ambient_index}, the material has {}",
+            material.ambient_ior
+        ));
     }
-    let n = f64::from(m.film_ior);
-    if n < axes.ior_min - tol || n > axes.ior_max + tol {
-        return Err(Error::Invalid {
-            context,
-            message: format!(
-                "film index {n} lies outside the table's {}–{}",
-                axes.ior_min, axes.ior_max
-            ),
-        });
+    let n = f64::from(material.film_ior);
+    if n < ior_min - tol || n > ior_max + tol {
+        return invalid(format!(
+            "film index {n} lies outside the table's {ior_min}–{ior_max}"
+        ));
     }
-    let d = f64::from(m.max_thickness_nm());
-    if d > axes.thickness_max_nm * (1.0 + tol) {
-        return Err(Error::Invalid {
-            context,
-            message: format!(
-                "the material reaches {d} nm, beyond the table's {} nm",
-                axes.thickness_max_nm
-            ),
-        });
+    let d = f64::from(material.max_thickness_nm());
+    if d > thickness_max_nm * (1.0 + tol) {
+        return invalid(format!(
+            "the material reaches {d} nm, beyond the table's {thickness_max_nm} nm"
+        ));
     }
     Ok(())
 }
@@ -2236,38 +2249,15 @@ pub(crate) fn check_film_lut(tables: &TableSet, material: &MaterialOptions) -> R
             message: "needs a `film-lut` table in the table set".into(),
         });
     };
-    let axes = &lut.axes;
+    let a = &lut.axes;
     let context = format!("film-lut `{}`", lut.name);
-    let tol = 1e-4;
-    if (f64::from(material.ambient_ior) - axes.ambient_index).abs() > tol {
-        return Err(Error::Invalid {
-            context,
-            message: format!(
-                "the table was baked for ambient index {}, the material has {}",
-                axes.ambient_index, material.ambient_ior
-            ),
-        });
-    }
-    let n = f64::from(material.film_ior);
-    if n < axes.ior_min - tol || n > axes.ior_max + tol {
-        return Err(Error::Invalid {
-            context,
-            message: format!(
-                "film index {n} lies outside the table's {}–{}",
-                axes.ior_min, axes.ior_max
-            ),
-        });
-    }
-    let d = f64::from(material.max_thickness_nm());
-    if d > axes.thickness_max_nm * (1.0 + tol) {
-        return Err(Error::Invalid {
-            context,
-            message: format!(
-                "the material reaches {d} nm, beyond the table's {} nm",
-                axes.thickness_max_nm
-            ),
-        });
-    }
+    check_material_in_table(
+        &context,
+        material,
+        a.ambient_index,
+        [a.ior_min, a.ior_max],
+        a.thickness_max_nm,
+    )?;
     if material.transmission && !lut.has_transmittance {
         return Err(Error::Invalid {
             context,
