@@ -59,8 +59,10 @@ Examples:
   # a height field through an integrated table built in memory
   nacre diffraction sine:1.6:0.05 --coherence 16 --layout integrated --color --views -40:40:1";
 
+/// The surface both `nacre diffraction` and `nacre plot diffraction` evaluate: a height
+/// field (file or synthetic spec, and how to read and window it) or a baked table.
 #[derive(Args)]
-pub struct DiffractionArgs {
+pub struct SurfaceArgs {
     /// Height field: a .png/.exr/.csv file or a synthetic spec (see below).
     #[arg(
         value_name = "FILE|SPEC",
@@ -71,30 +73,7 @@ pub struct DiffractionArgs {
     /// Evaluate a baked `diffraction` table (default-set name or manifest path) instead.
     #[arg(long, value_name = "NAME|PATH")]
     table: Option<String>,
-    /// Incidence angle θ_i, degrees, in (-90, 90).
-    #[arg(
-        long,
-        value_name = "DEG",
-        default_value = "0",
-        allow_hyphen_values = true
-    )]
-    incidence: String,
-    /// View angles θ_r, degrees, signed (see below).
-    #[arg(
-        long,
-        value_name = "START:END:STEP",
-        default_value = "-80:80:0.25",
-        allow_hyphen_values = true
-    )]
-    views: String,
-    /// Vacuum wavelengths, nm (the colour grid with --color; within 360-830) [default:
-    /// 380:780:5, or an integrated table's grid].
-    #[arg(long, value_name = "START:END:STEP", allow_hyphen_values = true)]
-    wavelengths: Option<String>,
-    /// Write colours (view_deg,X,Y,Z,R,G,B) instead of spectra.
-    #[arg(long)]
-    color: bool,
-    /// Layout to evaluate a height field through: terms or integrated (needs --color)
+    /// Layout to evaluate a height field through: terms or integrated (colours only)
     /// [default: terms; a --table uses its own].
     #[arg(long, value_name = "terms|integrated")]
     layout: Option<String>,
@@ -118,6 +97,35 @@ pub struct DiffractionArgs {
     /// Coherence diameter 4σ_s of the light, µm [default: 65].
     #[arg(long, value_name = "UM")]
     coherence: Option<String>,
+}
+
+#[derive(Args)]
+pub struct DiffractionArgs {
+    #[command(flatten)]
+    source: SurfaceArgs,
+    /// Incidence angle θ_i, degrees, in (-90, 90).
+    #[arg(
+        long,
+        value_name = "DEG",
+        default_value = "0",
+        allow_hyphen_values = true
+    )]
+    incidence: String,
+    /// View angles θ_r, degrees, signed (see below).
+    #[arg(
+        long,
+        value_name = "START:END:STEP",
+        default_value = "-80:80:0.25",
+        allow_hyphen_values = true
+    )]
+    views: String,
+    /// Vacuum wavelengths, nm (the colour grid with --color; within 360-830) [default:
+    /// 380:780:5, or an integrated table's grid].
+    #[arg(long, value_name = "START:END:STEP", allow_hyphen_values = true)]
+    wavelengths: Option<String>,
+    /// Write colours (view_deg,X,Y,Z,R,G,B) instead of spectra.
+    #[arg(long)]
+    color: bool,
     /// Fresnel factor: the refractive index (n or n+κi) of the bulk material, evaluated at
     /// the half-vector angle [default: F = 1, a perfect reflector].
     #[arg(long, value_name = "INDEX")]
@@ -228,21 +236,15 @@ impl Loaded {
 
 /// The sources and options `load` reads.
 pub struct Source<'a> {
-    pub surface: Option<&'a str>,
-    pub table: Option<&'a str>,
+    /// The height field or table and how to read it.
+    pub surface: &'a SurfaceArgs,
     /// `--wavelengths` as given.
     pub wavelengths: Option<&'a str>,
     /// The grid when `--wavelengths` is not given (terms layout).
     pub default_wavelengths: &'a str,
-    pub pitch: Option<&'a str>,
-    pub samples: Option<usize>,
-    pub height_scale: &'a str,
-    pub coherence: Option<&'a str>,
     pub fresnel: Option<&'a str>,
     /// --observer, --illuminant, --space.
     pub colour: [Option<&'a str>; 3],
-    pub layout: Option<&'a str>,
-    pub integrated_samples: Option<usize>,
 }
 
 fn parse_wavelengths(text: &str) -> Result<Vec<f64>> {
@@ -260,17 +262,26 @@ fn parse_wavelengths(text: &str) -> Result<Vec<f64>> {
 /// Loads the surface or table of `src` for the light/view pairs `directions`, checking
 /// the sampling and the table's range.
 pub fn load(src: &Source, directions: &[([f64; 3], [f64; 3])]) -> Result<Loaded> {
-    let integrated_wanted = match src.layout.map(str::trim) {
+    let a = src.surface;
+    let (surface, table, layout) = (
+        a.surface.as_deref(),
+        a.table.as_deref(),
+        a.layout.as_deref(),
+    );
+    let (pitch, coherence) = (a.pitch.as_deref(), a.coherence.as_deref());
+    let (samples, integrated_samples, height_scale) =
+        (a.samples, a.integrated_samples, a.height_scale.as_str());
+    let integrated_wanted = match layout.map(str::trim) {
         None | Some("terms") => false,
         Some("integrated") => true,
         Some(other) => {
             return Err(flag("--layout", other, "expected `terms` or `integrated`"));
         }
     };
-    if src.integrated_samples.is_some() && !integrated_wanted {
+    if integrated_samples.is_some() && !integrated_wanted {
         return Err(flag(
             "--integrated-samples",
-            &src.integrated_samples.unwrap_or(0).to_string(),
+            &integrated_samples.unwrap_or(0).to_string(),
             "applies to --layout integrated only",
         ));
     }
@@ -313,7 +324,7 @@ pub fn load(src: &Source, directions: &[([f64; 3], [f64; 3])]) -> Result<Loaded>
                 .map_err(|e: nacre_optics::Error| flag("--space", &s, e.to_string()))?,
         ))
     };
-    let (terms, sigma_s, table_colour, context, wavelengths) = match (src.surface, src.table) {
+    let (terms, sigma_s, table_colour, context, wavelengths) = match (surface, table) {
         (_, Some(name)) => {
             let path = bake::resolve_table(name);
             let manifest = bake::Manifest::read(&path)?;
@@ -324,7 +335,7 @@ pub fn load(src: &Source, directions: &[([f64; 3], [f64; 3])]) -> Result<Loaded>
                     manifest.name, manifest.kind
                 ),
             })?;
-            if let Some(l) = src.layout {
+            if let Some(l) = layout {
                 return Err(flag(
                     "--layout",
                     l,
@@ -383,7 +394,7 @@ pub fn load(src: &Source, directions: &[([f64; 3], [f64; 3])]) -> Result<Loaded>
                     ),
                 });
             }
-            if src.coherence.is_some() || src.pitch.is_some() || src.samples.is_some() {
+            if coherence.is_some() || pitch.is_some() || samples.is_some() {
                 return Err(flag(
                     "--table",
                     name,
@@ -450,13 +461,12 @@ pub fn load(src: &Source, directions: &[([f64; 3], [f64; 3])]) -> Result<Loaded>
             let wavelengths =
                 parse_wavelengths(src.wavelengths.unwrap_or(src.default_wavelengths))?;
             let wl_min = wavelengths.iter().copied().fold(f64::INFINITY, f64::min);
-            let coherence_um = match src.coherence {
+            let coherence_um = match coherence {
                 Some(t) => positive("--coherence", t)?,
                 None => DEFAULT_COHERENCE_DIAMETER_UM,
             };
-            let pitch_um = src.pitch.map(|t| positive("--pitch", t)).transpose()?;
-            let scale = src
-                .height_scale
+            let pitch_um = pitch.map(|t| positive("--pitch", t)).transpose()?;
+            let scale = height_scale
                 .trim()
                 .parse::<f64>()
                 .ok()
@@ -464,15 +474,15 @@ pub fn load(src: &Source, directions: &[([f64; 3], [f64; 3])]) -> Result<Loaded>
                 .ok_or_else(|| {
                     flag(
                         "--height-scale",
-                        src.height_scale,
+                        height_scale,
                         "expected a finite non-negative number of micrometres",
                     )
                 })?;
-            if src.samples == Some(0) {
+            if samples == Some(0) {
                 return Err(flag("--samples", "0", "expected at least 1"));
             }
             let source = HeightSource::parse("FILE|SPEC", text)?;
-            let field = source.load(text, "--pitch", coherence_um, pitch_um, src.samples, scale)?;
+            let field = source.load(text, "--pitch", coherence_um, pitch_um, samples, scale)?;
             let x = max_phase(&field, wl_min, w_max);
             let (order, bound) =
                 taylor_order_for(x, TAYLOR_TOLERANCE).map_err(|source| Error::OpticsIn {
@@ -508,7 +518,7 @@ pub fn load(src: &Source, directions: &[([f64; 3], [f64; 3])]) -> Result<Loaded>
         })?;
     let colorimeter = colorimeter_of(table_colour)?;
     let evaluator = if integrated_wanted {
-        let n = src.integrated_samples.unwrap_or(DEFAULT_INTEGRATED_SAMPLES);
+        let n = integrated_samples.unwrap_or(DEFAULT_INTEGRATED_SAMPLES);
         let axis =
             WarpedAxis::new(max_uv.clamp(1e-3, 2.0), 3.0, n).map_err(|source| Error::OpticsIn {
                 context: "--integrated-samples".into(),
@@ -566,7 +576,7 @@ pub fn run(args: &DiffractionArgs) -> Result<()> {
         .iter()
         .map(|&v| nacre_optics::diffraction::in_plane_directions(incidence, v))
         .collect();
-    if args.layout.as_deref().map(str::trim) == Some("integrated") && !args.color {
+    if args.source.layout.as_deref().map(str::trim) == Some("integrated") && !args.color {
         return Err(flag(
             "--layout",
             "integrated",
@@ -575,22 +585,15 @@ pub fn run(args: &DiffractionArgs) -> Result<()> {
     }
     let loaded = load(
         &Source {
-            surface: args.surface.as_deref(),
-            table: args.table.as_deref(),
+            surface: &args.source,
             wavelengths: args.wavelengths.as_deref(),
             default_wavelengths: "380:780:5",
-            pitch: args.pitch.as_deref(),
-            samples: args.samples,
-            height_scale: &args.height_scale,
-            coherence: args.coherence.as_deref(),
             fresnel: args.fresnel.as_deref(),
             colour: [
                 args.observer.as_deref(),
                 args.illuminant.as_deref(),
                 args.space.as_deref(),
             ],
-            layout: args.layout.as_deref(),
-            integrated_samples: args.integrated_samples,
         },
         &directions,
     )?;
@@ -629,16 +632,8 @@ Examples:
 
 #[derive(Args)]
 pub struct MapArgs {
-    /// Height field: a .png/.exr/.csv file or a synthetic spec (as `nacre diffraction`).
-    #[arg(
-        value_name = "FILE|SPEC",
-        required_unless_present = "table",
-        conflicts_with = "table"
-    )]
-    surface: Option<String>,
-    /// A baked `diffraction` table instead (default-set name or manifest path).
-    #[arg(long, value_name = "NAME|PATH")]
-    table: Option<String>,
+    #[command(flatten)]
+    source: SurfaceArgs,
     /// Incidence angle θ_i, degrees, in (-90, 90); the light is on the -x side.
     #[arg(
         long,
@@ -657,28 +652,9 @@ pub struct MapArgs {
     /// table's grid].
     #[arg(long, value_name = "START:END:STEP")]
     wavelengths: Option<String>,
-    /// Layout to evaluate a height field through: terms or integrated [default: terms; a
-    /// --table uses its own].
-    #[arg(long, value_name = "terms|integrated")]
-    layout: Option<String>,
-    /// Texels along v of an in-memory integrated table (even, 4-4096; u gets half).
-    #[arg(long, value_name = "N")]
-    integrated_samples: Option<usize>,
     /// Exposure: a positive factor, or `auto`.
     #[arg(long, default_value = "auto")]
     exposure: String,
-    /// Sample pitch of the height field, µm (required for files).
-    #[arg(long, value_name = "UM")]
-    pitch: Option<String>,
-    /// Samples per axis of a synthetic field.
-    #[arg(long, value_name = "N")]
-    samples: Option<usize>,
-    /// Height of a file's full scale (PNG) or multiplier (EXR, CSV), µm.
-    #[arg(long, value_name = "UM", default_value = "1")]
-    height_scale: String,
-    /// Coherence diameter 4σ_s, µm [default: 65].
-    #[arg(long, value_name = "UM")]
-    coherence: Option<String>,
     /// Output image (.png or .svg).
     #[arg(
         short = 'o',
@@ -743,25 +719,19 @@ pub fn run_map(args: &MapArgs) -> Result<()> {
         .collect();
     let loaded = load(
         &Source {
-            surface: args.surface.as_deref(),
-            table: args.table.as_deref(),
+            surface: &args.source,
             wavelengths: args.wavelengths.as_deref(),
             default_wavelengths: "380:780:10",
-            pitch: args.pitch.as_deref(),
-            samples: args.samples,
-            height_scale: &args.height_scale,
-            coherence: args.coherence.as_deref(),
             fresnel: None,
             colour: [None, None, None],
-            layout: args.layout.as_deref(),
-            integrated_samples: args.integrated_samples,
         },
         &directions,
     )?;
     let name = args
+        .source
         .surface
         .clone()
-        .or_else(|| args.table.clone())
+        .or_else(|| args.source.table.clone())
         .unwrap_or_default();
     let map = match &loaded.evaluator {
         Evaluator::Terms(surface) => {
