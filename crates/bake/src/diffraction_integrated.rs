@@ -276,16 +276,24 @@ fn sig4(v: f64) -> f64 {
 ///
 /// # Errors
 /// [`Error::Invalid`] naming the recipe when the measured error exceeds the tolerance
-/// (nothing written); write errors.
+/// (nothing written) or the recipe is not of the layout "integrated"; write errors.
 pub fn bake(
     recipe: &DiffractionRecipe,
     out_dir: &Path,
     progress: &(dyn Fn() + Sync),
 ) -> Result<PathBuf> {
     let mut r = recipe.record.clone();
-    let mut s = r.integrated.clone().expect("an integrated recipe");
-    let c = &recipe.colorimeter;
     let context = recipe.path.display().to_string();
+    let Some(mut s) = r.integrated.clone() else {
+        return Err(Error::Invalid {
+            context,
+            message: format!(
+                "layout \"{}\": expected a recipe with layout = \"integrated\"",
+                r.layout
+            ),
+        });
+    };
+    let c = &recipe.colorimeter;
     let optics = |source| Error::OpticsIn {
         context: context.clone(),
         source,
