@@ -17,4 +17,6 @@ fuzz_target!(|data: &[u8]| {
     let _ = manifest.embedded_json();
     let _ = manifest.load_table(path, "reflectance");
     let _ = manifest.load_fourier(path);
+    let _ = manifest.load_diffraction(path);
+    let _ = manifest.load_diffraction_integrated(path);
 });
