@@ -269,7 +269,7 @@ impl HeightField {
     ///
     /// # Errors
     /// As [`HeightField::new`]; [`Error::OutOfRange`] when the patch is narrower than one
-    /// track or shorter than one pit and land.
+    /// track or shorter than one pit and land, or the pitch exceeds half a pit's width.
     pub fn cd_tracks(
         nx: usize,
         ny: usize,
@@ -279,6 +279,15 @@ impl HeightField {
     ) -> Result<Self> {
         check_length("height-field pitch (µm)", pitch_um)?;
         check_height("pit depth (µm)", depth_um)?;
+        // Two samples across a pit at least: coarser samples cannot show the pits (and a
+        // patch of millimetres would hold billions of them to rasterise).
+        if pitch_um > 0.5 * CD_PIT_WIDTH_UM {
+            return Err(Error::OutOfRange {
+                what: "CD height-field pitch (µm)",
+                value: pitch_um,
+                expected: "at most 0.25 µm: two samples across a 0.5 µm pit",
+            });
+        }
         let (lx, ly) = (nx as f64 * pitch_um, ny as f64 * pitch_um);
         if lx < CD_TRACK_PITCH_UM || ly < 22.0 * CD_CHANNEL_BIT_UM {
             return Err(Error::OutOfRange {
@@ -332,11 +341,18 @@ impl HeightField {
                 }
                 y += l;
             }
+            // The few columns the track's pits cover.
+            let columns: Vec<(usize, f64)> = cov_x
+                .iter()
+                .enumerate()
+                .filter(|(_, c)| **c != 0.0)
+                .map(|(i, c)| (i, *c))
+                .collect();
             for (iy, cy) in cov_y.iter().enumerate() {
                 if *cy == 0.0 {
                     continue;
                 }
-                for (ix, cx) in cov_x.iter().enumerate() {
+                for &(ix, cx) in &columns {
                     h[iy * nx + ix] -= depth_um * cx * cy;
                 }
             }
@@ -349,8 +365,8 @@ impl HeightField {
     /// H cos²(πρ/(2r)) for ρ < r, summed with periodic wrap-around so that the patch tiles.
     ///
     /// # Errors
-    /// As [`HeightField::new`]; [`Error::OutOfRange`] for a non-positive radius, a negative
-    /// height, or a fill outside (0, 10].
+    /// As [`HeightField::new`]; [`Error::OutOfRange`] for a non-positive radius or one
+    /// below the pitch, a negative height, or a fill outside (0, 10].
     #[allow(clippy::too_many_arguments)]
     pub fn random_bumps(
         nx: usize,
@@ -369,6 +385,15 @@ impl HeightField {
                 what: "bump fill factor",
                 value: fill,
                 expected: "a number in (0, 10]",
+            });
+        }
+        // A bump spans two samples at least: smaller ones are not resolved (and their
+        // count, fill · area / (π r²), would grow without bound).
+        if radius_um < pitch_um {
+            return Err(Error::OutOfRange {
+                what: "bump radius (µm)",
+                value: radius_um,
+                expected: "at least the height-field pitch: a bump must span two samples",
             });
         }
         let (lx, ly) = (nx as f64 * pitch_um, ny as f64 * pitch_um);
