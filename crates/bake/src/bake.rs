@@ -41,7 +41,6 @@ use crate::error::{Error, Result};
 use crate::film_lut::{FilmLut, FilmLutAxes, FilmLutJob, validate_axes};
 use crate::fourier_table::{FourierAxes, FourierTable};
 use crate::materials::resolve;
-use crate::output::write_atomic;
 use crate::rough_lut::{RoughLutAxes, RoughRecipe};
 use crate::stack_spec::{line_of, toml_error};
 use crate::table_io::{self, Precision, Table3};
@@ -835,13 +834,7 @@ pub fn bake_recipe(
         });
     }
     manifest.files = files;
-    let name = format!("{}.json", recipe.name);
-    let json = serde_json::to_string_pretty(&manifest).expect("manifest serialises");
-    write_atomic(&dir.join(&name), |w| {
-        w.write_all(json.as_bytes())?;
-        w.write_all(b"\n")
-    })?;
-    stage.commit(&name, &stale)
+    stage.commit_manifest(&manifest, &stale)
 }
 
 /// The recipes of the default set, sorted by name.
@@ -1079,13 +1072,7 @@ impl FourierRecipe {
             sha256: table_io::sha256_hex(&ktx2_path)?,
         });
         manifest.files = files;
-        let name = format!("{}.json", self.name);
-        let json = serde_json::to_string_pretty(&manifest).expect("manifest serialises");
-        write_atomic(&dir.join(&name), |w| {
-            w.write_all(json.as_bytes())?;
-            w.write_all(b"\n")
-        })?;
-        stage.commit(&name, &[])
+        stage.commit_manifest(&manifest, &[])
     }
 }
 

@@ -56,7 +56,6 @@
 
 use crate::bake::{AxisRecord, FileRecord, Manifest};
 use crate::error::{Error, Result};
-use crate::output::write_atomic;
 use crate::spectrum::fmt_sig;
 use crate::stack_spec::{line_of, toml_error};
 use crate::table_io::{self, Precision, Table3};
@@ -955,13 +954,7 @@ impl DiffractionRecipe {
             sha256: table_io::sha256_hex(&ktx2_path)?,
         });
         manifest.files = files;
-        let name = format!("{}.json", self.name);
-        let json = serde_json::to_string_pretty(&manifest).expect("manifest serialises");
-        write_atomic(&out_dir.join(&name), |w| {
-            w.write_all(json.as_bytes())?;
-            w.write_all(b"\n")
-        })?;
-        stage.commit(&name, &[])
+        stage.commit_manifest(&manifest, &[])
     }
 }
 

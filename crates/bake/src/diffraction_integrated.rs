@@ -62,7 +62,6 @@
 use crate::bake::{AxisRecord, FileRecord, Manifest};
 use crate::diffraction::{DiffractionRecipe, DiffractionRecord};
 use crate::error::{Error, Result};
-use crate::output::write_atomic;
 use crate::table_io::{self, Precision, Table3};
 use nacre_optics::diffraction::integrated::{
     IntegratedTable, MAX_INTEGRATED_SAMPLES, WarpedAxis, check_directions,
@@ -495,13 +494,7 @@ fn write_files(
         sha256: table_io::sha256_hex(&ktx2_path)?,
     });
     manifest.files = files;
-    let name = format!("{}.json", recipe.name);
-    let json = serde_json::to_string_pretty(&manifest).expect("manifest serialises");
-    write_atomic(&out_dir.join(&name), |w| {
-        w.write_all(json.as_bytes())?;
-        w.write_all(b"\n")
-    })?;
-    stage.commit(&name, &[])
+    stage.commit_manifest(&manifest, &[])
 }
 
 impl Manifest {

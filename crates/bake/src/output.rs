@@ -178,6 +178,25 @@ impl StagedTable {
         self.stage.path()
     }
 
+    /// Writes `manifest` as `NAME.json` (pretty JSON and a newline) into the staging folder
+    /// and [`StagedTable::commit`]s the table with it: the last step of every baker.
+    ///
+    /// # Errors
+    /// As [`StagedTable::commit`]; [`Error::Io`] when the manifest cannot be written.
+    pub fn commit_manifest(
+        self,
+        manifest: &crate::bake::Manifest,
+        stale: &[String],
+    ) -> Result<std::path::PathBuf> {
+        let name = format!("{}.json", manifest.name);
+        let json = serde_json::to_string_pretty(manifest).expect("manifest serialises");
+        write_atomic(&self.path().join(&name), |w| {
+            w.write_all(json.as_bytes())?;
+            w.write_all(b"\n")
+        })?;
+        self.commit(&name, stale)
+    }
+
     /// Moves the staged files into the output folder, the manifest `manifest` (a file name
     /// in the staging folder) last, and removes the files named in `stale` (earlier outputs
     /// the new manifest no longer lists). Returns the manifest's final path.

@@ -133,7 +133,6 @@ use crate::bake::{
 };
 use crate::error::{Error, Result};
 use crate::film_lut::MIN_COS_THETA;
-use crate::output::write_atomic;
 use crate::stack_spec::{line_of, toml_error};
 use crate::table_io::{self, Precision, Table3};
 use nacre_optics::colour::Colorimeter;
@@ -1104,13 +1103,7 @@ impl RoughRecipe {
             files.extend(self.write_quantity(out_dir, quantity, exr, halves, &embedded)?);
         }
         manifest.files = files;
-        let name = format!("{}.json", self.name);
-        let json = serde_json::to_string_pretty(&manifest).expect("manifest serialises");
-        write_atomic(&out_dir.join(&name), |w| {
-            w.write_all(json.as_bytes())?;
-            w.write_all(b"\n")
-        })?;
-        stage.commit(&name, &[])
+        stage.commit_manifest(&manifest, &[])
     }
 }
 
