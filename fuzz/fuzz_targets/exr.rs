@@ -7,7 +7,7 @@ use std::path::Path;
 
 fuzz_target!(|data: &[u8]| {
     let path = Path::new("fuzz.exr");
-    if let Ok((atlas, _)) = nacre_bake::table_io::decode_exr_bytes(path, data) {
+    if let Ok((atlas, _)) = nacre_format::table_io::decode_exr_bytes(path, data) {
         assert_eq!(atlas.data.len(), atlas.width * atlas.height * 3);
         assert!(atlas.data.iter().all(|v| v.is_finite()));
     }

@@ -3,8 +3,8 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use nacre_bake::grid::{MAX_AXIS_SAMPLES, parse_range, parse_thickness_nm};
-use nacre_bake::stack_spec::StackSpec;
+use nacre_bake::commands::grid::{MAX_AXIS_SAMPLES, parse_range, parse_thickness_nm};
+use nacre_bake::commands::stack_spec::StackSpec;
 
 fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else {

@@ -3,7 +3,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use nacre_bake::ktx2::Ktx2Image;
+use nacre_format::ktx2::Ktx2Image;
 use std::path::Path;
 
 fuzz_target!(|data: &[u8]| {

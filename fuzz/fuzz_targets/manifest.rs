@@ -10,7 +10,7 @@ fuzz_target!(|data: &[u8]| {
     };
     // A folder that does not exist: any file the manifest names is missing.
     let path = Path::new("/nonexistent-nacre-fuzz/table.json");
-    let Ok(manifest) = nacre_bake::bake::Manifest::parse(path, text) else {
+    let Ok(manifest) = nacre_format::Manifest::parse(path, text) else {
         return;
     };
     let _ = manifest.colorimeter(path);

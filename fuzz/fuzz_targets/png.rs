@@ -15,7 +15,7 @@ fuzz_target!(|data: &[u8]| {
         usize::from(*z) + 1,
     );
     let path = Path::new("fuzz.png");
-    if let Ok(table) = nacre_bake::table_io::decode_png16_table(path, file, nx, ny, nz) {
+    if let Ok(table) = nacre_format::table_io::decode_png16_table(path, file, nx, ny, nz) {
         assert_eq!(table.data.len(), nx * ny * nz * 3);
         assert!(table.data.iter().all(|v| (0.0..=1.0).contains(v)));
     }

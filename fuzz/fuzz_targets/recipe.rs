@@ -12,9 +12,9 @@ fuzz_target!(|data: &[u8]| {
     // A name no test folder holds: relative material paths in the recipe resolve against
     // the current folder and are not found.
     let path = Path::new("fuzz-recipe.toml");
-    if let Err(e) = nacre_bake::bake::AnyRecipe::parse(path, text.to_string()) {
+    if let Err(e) = nacre_bake::kinds::parse_recipe(path, text.to_string()) {
         let message = e.to_string();
         assert!(!message.is_empty());
     }
-    let _ = nacre_bake::stack_spec::StackRecipe::parse(path, text);
+    let _ = nacre_bake::commands::stack_spec::StackRecipe::parse(path, text);
 });

@@ -4,9 +4,10 @@
 //! Targets (issue: colorimetry and film-lut tables): ΔE2000 95th percentile ≤ 0.3, maximum
 //! ≤ 1.5, and each default table ≤ 16 MiB.
 
-use nacre_bake::bake::{Manifest, default_baked_dir};
-use nacre_bake::color::{self, LoadedLut, Method, Point, Quantity};
-use nacre_bake::materials::resolve;
+use nacre_format::Manifest;
+use nacre_format::set::default_baked_dir;
+use nacre_bake::commands::color::{self, LoadedLut, Method, Point, Quantity};
+use nacre_format::materials::resolve;
 use nacre_optics::colour::{delta_e_2000, xyz_to_lab};
 use nacre_optics::{C64, Material};
 
@@ -39,7 +40,7 @@ fn default_tables_meet_the_accuracy_targets() {
             .sum();
         assert!(bytes <= 16 << 20, "{name}: {bytes} bytes");
         let lut = LoadedLut::load(&path).unwrap();
-        let a = manifest.film_lut.as_ref().unwrap();
+        let a = manifest.film_lut().unwrap();
         let ambient = resolve(&manifest.ambient, "test", None).unwrap();
         let base = resolve(&manifest.base, "test", None).unwrap();
         let film = Material::constant("film", C64::new(a.ior_min, 0.0)).unwrap();

@@ -9,8 +9,9 @@
 //! raises the number of points for a longer sweep (the README's figures use 1000);
 //! `NACRE_BAKED_DIR` measures an experimental bake.
 
-use nacre_bake::bake::{Manifest, default_baked_dir};
-use nacre_bake::rough_lut::{LoadedRoughLut, RoughFilmLut};
+use nacre_format::Manifest;
+use nacre_format::set::default_baked_dir;
+use nacre_format::rough_film_lut::{LoadedRoughLut, RoughFilmLut};
 use nacre_optics::colour::{delta_e_2000, xyz_to_lab};
 use nacre_optics::microfacet::{FilmTerm, directional_albedo_with};
 use nacre_optics::{Layer, Material, Stack};
@@ -134,7 +135,7 @@ fn default_rough_table_matches_monte_carlo() {
 /// White furnace (issue 6): every entry of the default table, a lossless stack (air, a
 /// non-absorbing film, glass), reflects plus transmits at most all the light — single
 /// scattering loses what the microfacets mask. Exactly, on the stored half floats: the bake
-/// rounds each pair so that it holds (`nacre_bake::rough_lut::store_albedo_pair`).
+/// rounds each pair so that it holds (`nacre_bake::kinds::rough_film_lut::store_albedo_pair`).
 #[test]
 fn default_rough_table_passes_the_white_furnace() {
     let dir = std::env::var_os("NACRE_BAKED_DIR")

@@ -4,7 +4,7 @@
 //!
 //! Target (issue: optics core): |ΔR| and |ΔT| ≤ 1e-10 for every polarisation and point.
 
-use nacre_bake::stack_spec::{MaterialRef, StackSpec};
+use nacre_bake::commands::stack_spec::{MaterialRef, StackSpec};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 

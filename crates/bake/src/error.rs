@@ -7,6 +7,9 @@ use std::path::PathBuf;
 /// writing tables. Each message names the flag, file and line concerned.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
+    /// An error from the table format (reading or writing tables, resolving materials).
+    #[error(transparent)]
+    Format(#[from] nacre_format::Error),
     /// An error from the physics core.
     #[error(transparent)]
     Optics(#[from] nacre_optics::Error),

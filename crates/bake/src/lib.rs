@@ -1,30 +1,22 @@
 //! # nacre-bake
 //!
-//! The front end of nacre: material library and recipes, table generators and writers,
-//! and the `nacre` command-line tool (`src/main.rs`). The physics lives in
-//! [`nacre_optics`]; this crate parses, resolves, calls the core and writes files
-//! atomically.
+//! The front end of nacre: table recipes and their bakers, and the commands behind the
+//! `nacre` command-line tool. The physics lives in [`nacre_optics`]; the table format
+//! (manifests, file readers and writers, atomic writes, material references) in
+//! [`nacre_format`]. This crate parses recipes and flags, calls the core and writes tables
+//! through the format.
+//!
+//! - [`kinds`]: one module per table kind behind [`kinds::TableRecipe`] and
+//!   [`kinds::REGISTRY`];
+//! - [`recipe`]: the recipe sections every kind shares (`[colour]`, `[stack]`, `[output]`);
+//! - [`commands`]: `color`, `compare`, `conformance`, `spectrum`, `plot` and their inputs.
 
 // `!(x > 0.0)` is how this crate rejects NaN together with out-of-range values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-pub mod bake;
-pub mod color;
-pub mod compare;
-pub mod conformance;
-pub mod diffraction;
-pub mod diffraction_integrated;
+pub mod commands;
 pub mod error;
-pub mod film_lut;
-pub mod fourier_table;
-pub mod grid;
-pub mod ktx2;
-pub mod materials;
-pub mod output;
-pub mod plot;
-pub mod rough_lut;
-pub mod spectrum;
-pub mod stack_spec;
-pub mod table_io;
+pub mod kinds;
+pub mod recipe;
 
 pub use error::{Error, Result};

@@ -2,8 +2,8 @@
 //! each must now be refused with an error naming the file, quickly and without a large
 //! allocation.
 
-use nacre_bake::ktx2::Ktx2Image;
-use nacre_bake::table_io::decode_exr_bytes;
+use nacre_format::ktx2::Ktx2Image;
+use nacre_format::table_io::decode_exr_bytes;
 use std::path::{Path, PathBuf};
 
 fn inputs(target: &str) -> Vec<(PathBuf, Vec<u8>)> {
@@ -58,7 +58,7 @@ fn recipe_regressions_are_refused_quickly() {
     for (path, bytes) in inputs("recipe") {
         let start = std::time::Instant::now();
         let text = String::from_utf8(bytes).unwrap();
-        let e = nacre_bake::bake::AnyRecipe::parse(&path, text)
+        let e = nacre_bake::kinds::parse_recipe(&path, text)
             .err()
             .unwrap_or_else(|| panic!("{} parsed", path.display()));
         let message = e.to_string();

@@ -4,9 +4,11 @@
 //! files' (half floats bit for bit, full floats bit for bit).
 
 use half::f16;
-use nacre_bake::bake::{FOURIER_KTX2_QUANTITY, Manifest, default_baked_dir};
-use nacre_bake::ktx2::{MANIFEST_KEY, WRITER_KEY};
-use nacre_bake::table_io::{read_exr_table, sha256_hex};
+use nacre_format::Manifest;
+use nacre_format::manifest::FOURIER_KTX2_QUANTITY;
+use nacre_format::set::default_baked_dir;
+use nacre_format::ktx2::{MANIFEST_KEY, WRITER_KEY};
+use nacre_format::table_io::{read_exr_table, sha256_hex};
 
 fn manifests() -> Vec<std::path::PathBuf> {
     let mut v: Vec<_> = std::fs::read_dir(default_baked_dir())
@@ -76,7 +78,7 @@ fn every_baked_ktx2_parses_with_the_ktx2_crate_and_matches_its_exr() {
             match m.kind.as_str() {
                 // A rough-film-lut is laid out like a film-lut with depth = α blocks × indices.
                 "film-lut" | "rough-film-lut" => {
-                    let (nx, ny, nz) = match (&m.film_lut, &m.rough_film_lut) {
+                    let (nx, ny, nz) = match (&m.film_lut(), &m.rough_film_lut()) {
                         (Some(a), _) => (a.cos_theta_count, a.opd_count, a.ior_count),
                         (None, Some(a)) => (a.cos_theta_count, a.opd_count, a.depth()),
                         _ => panic!("{what}: no axes"),
@@ -116,7 +118,7 @@ fn every_baked_ktx2_parses_with_the_ktx2_crate_and_matches_its_exr() {
                     }
                 }
                 "fourier" => {
-                    let a = m.fourier.as_ref().unwrap();
+                    let a = m.fourier().unwrap();
                     let reader = open(&bytes, &m, ktx2::Format::R32G32B32A32_SFLOAT, what);
                     let h = reader.header();
                     assert_eq!(
@@ -148,9 +150,9 @@ fn every_baked_ktx2_parses_with_the_ktx2_crate_and_matches_its_exr() {
                         }
                     }
                 }
-                "diffraction" if m.diffraction.as_ref().unwrap().layout == "integrated" => {
+                "diffraction" if m.diffraction().unwrap().layout == "integrated" => {
                     // 2-D array RGBA32F n/2 × n, layer p = (I_p, 0), the EXR atlas's values.
-                    let d = m.diffraction.as_ref().unwrap();
+                    let d = m.diffraction().unwrap();
                     let s = d.integrated.as_ref().unwrap();
                     let reader = open(&bytes, &m, ktx2::Format::R32G32B32A32_SFLOAT, what);
                     let h = reader.header();
@@ -179,7 +181,7 @@ fn every_baked_ktx2_parses_with_the_ktx2_crate_and_matches_its_exr() {
                 }
                 "diffraction" => {
                     // 2-D array RGBA32F: layer l = (Re T_2l, Im T_2l, Re T_2l+1, Im T_2l+1).
-                    let d = m.diffraction.as_ref().unwrap();
+                    let d = m.diffraction().unwrap();
                     let terms = d.taylor_order + 1;
                     let reader = open(&bytes, &m, ktx2::Format::R32G32B32A32_SFLOAT, what);
                     let h = reader.header();
@@ -268,7 +270,7 @@ fn manifest_loads_tables_from_ktx2_when_no_exr_is_listed() {
                     );
                 }
             }
-            "diffraction" if m.diffraction.as_ref().unwrap().layout == "integrated" => assert_eq!(
+            "diffraction" if m.diffraction().unwrap().layout == "integrated" => assert_eq!(
                 m.load_diffraction_integrated(&copy).unwrap(),
                 full.load_diffraction_integrated(&path).unwrap()
             ),
@@ -277,7 +279,7 @@ fn manifest_loads_tables_from_ktx2_when_no_exr_is_listed() {
                 full.load_diffraction(&path).unwrap()
             ),
             "rough-film-lut" => {
-                use nacre_bake::rough_lut::LoadedRoughLut;
+                use nacre_format::rough_film_lut::LoadedRoughLut;
                 assert_eq!(
                     LoadedRoughLut::load(&copy).unwrap().lut,
                     LoadedRoughLut::load(&path).unwrap().lut,
@@ -316,8 +318,8 @@ png = false
 transmittance = "auto"
 "#;
     std::fs::write(&recipe_path, text).unwrap();
-    let recipe = nacre_bake::bake::Recipe::read(&recipe_path).unwrap();
-    let manifest_path = nacre_bake::bake::bake_recipe(&recipe, out.path(), &|| {}).unwrap();
+    let recipe = nacre_bake::kinds::film_lut::FilmLutRecipe::read(&recipe_path).unwrap();
+    let manifest_path = nacre_bake::kinds::film_lut::bake_recipe(&recipe, out.path(), &|| {}).unwrap();
     let manifest = Manifest::read(&manifest_path).unwrap();
     let mut seen = 0;
     for f in manifest.files.iter().filter(|f| f.format == "ktx2") {

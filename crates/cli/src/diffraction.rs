@@ -1,15 +1,15 @@
 //! `nacre diffraction`: relative reflectance and colour of a diffracting surface over view
 //! angles in the plane of incidence (Stam 1999; Dhillon et al. 2014), from a height field
 //! (file or synthetic spec) or a baked `diffraction` table. The physics is
-//! [`nacre_optics::diffraction`], the sources and CSV writers [`nacre_bake::diffraction`].
+//! [`nacre_optics::diffraction`], the sources and CSV writers [`nacre_bake::kinds::diffraction`].
 
 use clap::Args;
 use nacre_bake::bake;
-use nacre_bake::diffraction::{HeightSource, ViewSweep, par_map_pairs, write_colour_csv};
-use nacre_bake::diffraction_integrated::DEFAULT_INTEGRATED_SAMPLES;
+use nacre_bake::kinds::diffraction::{HeightSource, ViewSweep, par_map_pairs, write_colour_csv};
+use nacre_bake::kinds::diffraction_integrated::DEFAULT_INTEGRATED_SAMPLES;
 use nacre_bake::error::{Error, Result};
-use nacre_bake::grid::parse_range;
-use nacre_bake::output::write_atomic;
+use nacre_bake::commands::grid::parse_range;
+use nacre_format::atomic::write_atomic;
 use nacre_optics::C64;
 use nacre_optics::colour::Colorimeter;
 use nacre_optics::diffraction::integrated::{IntegratedTable, WarpedAxis};
@@ -328,7 +328,7 @@ pub fn load(src: &Source, directions: &[([f64; 3], [f64; 3])]) -> Result<Loaded>
         (_, Some(name)) => {
             let path = bake::resolve_table(name);
             let manifest = bake::Manifest::read(&path)?;
-            let record = manifest.diffraction.clone().ok_or_else(|| Error::Invalid {
+            let record = manifest.diffraction().cloned().ok_or_else(|| Error::Invalid {
                 context: path.display().to_string(),
                 message: format!(
                     "table `{}` is a `{}` table, not a diffraction table",
@@ -666,7 +666,7 @@ pub struct MapArgs {
 }
 
 pub fn run_map(args: &MapArgs) -> Result<()> {
-    nacre_bake::plot::ImageFormat::from_path(&args.output)?;
+    nacre_bake::commands::plot::ImageFormat::from_path(&args.output)?;
     let incidence = args
         .incidence
         .trim()
@@ -742,7 +742,7 @@ pub fn run_map(args: &MapArgs) -> Result<()> {
                         source,
                     }
                 })?;
-            nacre_bake::diffraction::DiffractionMap::compute(
+            nacre_bake::kinds::diffraction::DiffractionMap::compute(
                 String::new(),
                 surface,
                 incidence,
@@ -754,7 +754,7 @@ pub fn run_map(args: &MapArgs) -> Result<()> {
                 exposure,
             )
         }
-        Evaluator::Integrated(table) => nacre_bake::diffraction::DiffractionMap::compute_with(
+        Evaluator::Integrated(table) => nacre_bake::kinds::diffraction::DiffractionMap::compute_with(
             String::new(),
             &|wi, wr| table.colour(wi, wr, loaded.fresnel),
             incidence,
@@ -768,6 +768,6 @@ pub fn run_map(args: &MapArgs) -> Result<()> {
         "diffraction map of {name}: light at {incidence}°, views to {max_view}°, exposure {:.3}",
         map.exposure
     );
-    let map = nacre_bake::diffraction::DiffractionMap { title, ..map };
-    nacre_bake::plot::write_figure(&args.output, &map)
+    let map = nacre_bake::kinds::diffraction::DiffractionMap { title, ..map };
+    nacre_bake::commands::plot::write_figure(&args.output, &map)
 }

@@ -5,9 +5,9 @@
 
 use clap::{Args, Parser, Subcommand};
 use nacre_bake::error::Result;
-use nacre_bake::grid::parse_range;
-use nacre_bake::output::write_atomic;
-use nacre_bake::stack_spec::{StackRecipe, StackSpec};
+use nacre_bake::commands::grid::parse_range;
+use nacre_format::atomic::write_atomic;
+use nacre_bake::commands::stack_spec::{StackRecipe, StackSpec};
 use nacre_bake::{bake, materials, spectrum};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -449,7 +449,7 @@ fn run_spectrum(args: &SpectrumArgs) -> Result<()> {
 }
 
 fn run_color(args: &ColorArgs) -> Result<()> {
-    use nacre_bake::color::{self, LoadedLut, Method, Point, Quantity};
+    use nacre_bake::commands::color::{self, LoadedLut, Method, Point, Quantity};
     use nacre_bake::error::Error;
     use nacre_optics::colour::Colorimeter;
     let (spec, recipe_angles, _) = load_stack(&args.stack)?;
@@ -521,7 +521,7 @@ fn run_color(args: &ColorArgs) -> Result<()> {
     }
     let (lut, colorimeter) = match &method {
         Method::RoughLut { path, alpha, .. } => {
-            let table = nacre_bake::rough_lut::LoadedRoughLut::load(path)?;
+            let table = nacre_format::rough_film_lut::LoadedRoughLut::load(path)?;
             color::check_stack_matches(&table.manifest, path, &stack, "rough-lut")?;
             let m = &table.manifest;
             for (flag, given, baked) in [
@@ -652,7 +652,7 @@ fn run_color(args: &ColorArgs) -> Result<()> {
 fn load_fourier_table(
     given: Option<&str>,
     colorimeter: &nacre_optics::colour::Colorimeter,
-) -> Result<nacre_bake::fourier_table::FourierTable> {
+) -> Result<nacre_format::fourier::FourierTable> {
     use nacre_bake::error::Error;
     let settings = (
         colorimeter.observer().to_string(),
@@ -716,7 +716,7 @@ fn load_fourier_table(
 }
 
 fn run_compare(args: &CompareArgs) -> Result<()> {
-    use nacre_bake::compare;
+    use nacre_bake::commands::compare;
     use nacre_bake::error::Error;
     let case = compare::CASES
         .iter()
@@ -1257,7 +1257,7 @@ struct ConformanceArgs {
 }
 
 fn run_conformance(args: &ConformanceArgs) -> Result<()> {
-    use nacre_bake::conformance::{self, GridSize};
+    use nacre_bake::commands::conformance::{self, GridSize};
     let size = if args.quick {
         GridSize::Quick
     } else if args.fine {
@@ -1279,7 +1279,7 @@ fn run_conformance(args: &ConformanceArgs) -> Result<()> {
 
 /// Sets the material database from --material-db, else from NACRE_MATERIAL_DB.
 fn set_material_db(flag: Option<&std::path::Path>) {
-    use nacre_bake::materials::{MaterialDb, set_database};
+    use nacre_format::materials::{MaterialDb, set_database};
     let db = match flag {
         Some(dir) => Some(MaterialDb::new(dir, "--material-db")),
         None => std::env::var_os("NACRE_MATERIAL_DB")

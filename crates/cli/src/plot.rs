@@ -1,15 +1,15 @@
 //! `nacre plot spectrum|chromaticity|chart|table`: pictures, as PNG or SVG by the output's
-//! extension. The figures and their colour conventions live in [`nacre_bake::plot`]; this
+//! extension. The figures and their colour conventions live in [`nacre_bake::commands::plot`]; this
 //! module parses the flags, computes the data and hands it over.
 
 use super::{StackArgs, load_fourier_table, load_stack};
 use clap::{Args, Subcommand};
-use nacre_bake::color::{self, LoadedLut, Method, Point, Quantity};
-use nacre_bake::compare::CASES;
+use nacre_bake::commands::color::{self, LoadedLut, Method, Point, Quantity};
+use nacre_bake::commands::compare::CASES;
 use nacre_bake::error::{Error, Result};
-use nacre_bake::grid::{parse_range, parse_thickness_nm};
-use nacre_bake::plot::{self, ChartColumns, ImageFormat, SpectrumQuantity};
-use nacre_bake::stack_spec::StackSpec;
+use nacre_bake::commands::grid::{parse_range, parse_thickness_nm};
+use nacre_bake::commands::plot::{self, ChartColumns, ImageFormat, SpectrumQuantity};
+use nacre_bake::commands::stack_spec::StackSpec;
 use nacre_optics::Stack;
 use nacre_optics::colour::{Colorimeter, Illuminant, Observer, OutputSpace, RgbSpace};
 use std::path::PathBuf;

@@ -152,7 +152,7 @@ fn copy_dir(from: &Path, to: &Path) {
 /// The SHA-256 of a file as manifests record it: damaged table files below get manifests
 /// that match them, so that their decoders (not the checksum) must refuse them.
 fn sha(path: &Path) -> String {
-    nacre_bake::table_io::sha256_hex(path).unwrap()
+    nacre_format::table_io::sha256_hex(path).unwrap()
 }
 
 /// Keeps only the `files` entries of the manifest whose format is `format`.

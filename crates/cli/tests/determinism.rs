@@ -35,7 +35,7 @@ fn committed_manifests_list_every_committed_file_with_its_sha256() {
         let m: serde_json::Value = serde_json::from_slice(bytes).unwrap();
         for f in m["files"].as_array().unwrap() {
             let path = f["path"].as_str().unwrap();
-            let sha = nacre_bake::table_io::sha256_hex(&baked.join(path))
+            let sha = nacre_format::table_io::sha256_hex(&baked.join(path))
                 .unwrap_or_else(|e| panic!("{name} lists {path}: {e}"));
             assert_eq!(sha, f["sha256"].as_str().unwrap(), "{name}: {path}");
             listed.insert(path.to_string());

@@ -94,7 +94,7 @@ fn check(out: &Path, reference: &[BTreeMap<String, Vec<u8>>; 2]) -> Vec<Option<u
             let m: serde_json::Value = serde_json::from_slice(bytes).unwrap();
             for f in m["files"].as_array().unwrap() {
                 let path = out.join(f["path"].as_str().unwrap());
-                let sha = nacre_bake::table_io::sha256_hex(&path)
+                let sha = nacre_format::table_io::sha256_hex(&path)
                     .unwrap_or_else(|e| panic!("{manifest} names {}: {e}", path.display()));
                 assert_eq!(sha, f["sha256"].as_str().unwrap(), "{}", path.display());
             }

@@ -14,7 +14,7 @@
 //! software ones included); a host engine instead binds the technique's group 1 and the
 //! material's groups in its own passes.
 
-use nacre_bake::bake::resolve_table;
+use nacre_format::set::resolve_table;
 use nacre_runtime::bindings::TechniqueOptions;
 use nacre_runtime::render::{
     EnvironmentMap, Renderer, SceneKind, SceneOptions, ThicknessMap, procedural_thickness_map,

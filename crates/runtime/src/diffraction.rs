@@ -5,13 +5,13 @@
 //!
 //! # Upload
 //!
-//! A `diffraction` table's Taylor terms Tₙ (`nacre_bake::diffraction` says what every texel
+//! A `diffraction` table's Taylor terms Tₙ (`nacre_bake::kinds::diffraction` says what every texel
 //! holds) become one 2-D array texture, `Rgba32Float`, Mₓ × M_y texels, ⌈(N + 1)/2⌉ layers,
 //! layer l = (Re T₂ₗ, Im T₂ₗ, Re T₂ₗ₊₁, Im T₂ₗ₊₁) — the layout of the table's KTX2 file. Full
 //! float is not filterable everywhere, and the technique needs exact bins anyway: the shader
 //! reads it with `textureLoad` only (integer texel coordinates, texel (s, t) = bin
 //! (s − ⌊Mₓ/2⌋, t − ⌊M_y/2⌋)). The texels come from the EXR file, else the KTX2 file
-//! ([`nacre_bake::bake::Manifest::load_diffraction`]); every file is checked against its
+//! ([`nacre_format::Manifest::load_diffraction`]); every file is checked against its
 //! manifest's SHA-256 and the texture against the device's limits before upload.
 //!
 //! [`DiffractionTables::load`] dispatches on the manifest's `layout` ([`DiffractionLayout`]):
@@ -48,8 +48,8 @@ use crate::readback::read_texture;
 use crate::render::{Camera, EnvironmentMap, Level, Light, MAX_DIMENSION, RenderedImage};
 use crate::tables::{check_limit, verify_files};
 use bytemuck::{Pod, Zeroable};
-use nacre_bake::bake::Manifest;
-use nacre_bake::diffraction::DiffractionRecord;
+use nacre_format::Manifest;
+use nacre_format::diffraction::DiffractionRecord;
 use nacre_optics::colour::Colorimeter;
 use nacre_optics::diffraction::{FresnelTerm, SpectralGrid, TaylorTerms};
 use std::path::{Path, PathBuf};
@@ -217,7 +217,7 @@ impl From<DiffractionIntegrated> for DiffractionTables {
 /// [`Error::Manifest`] for a table of another kind or a manifest without the record.
 fn diffraction_record(manifest_path: &Path) -> Result<(Manifest, DiffractionRecord)> {
     let manifest = Manifest::read(manifest_path)?;
-    if manifest.kind != "diffraction" {
+    if manifest.kind != nacre_format::TableKind::Diffraction {
         return Err(Error::Manifest {
             path: manifest_path.to_path_buf(),
             message: format!(
@@ -227,8 +227,8 @@ fn diffraction_record(manifest_path: &Path) -> Result<(Manifest, DiffractionReco
         });
     }
     let record = manifest
-        .diffraction
-        .clone()
+        .diffraction()
+        .cloned()
         .ok_or_else(|| Error::Manifest {
             path: manifest_path.to_path_buf(),
             message: "a diffraction manifest without its `diffraction` record".into(),

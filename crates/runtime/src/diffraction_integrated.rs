@@ -9,7 +9,7 @@
 //! Iₚ(u, v), p = 0 … 2N, wavelength-integrated colour tables in the manifest's output space
 //! such that colour = F²(θ_h) · G/w² · Σₚ wᵖ Iₚ(u, v), (u, v, w) = −ω_i − ω_r
 //! (Stam 1999; Dhillon et al. 2014; derivation in
-//! [`nacre_optics::diffraction::integrated`], files in [`nacre_bake::diffraction_integrated`]).
+//! [`nacre_optics::diffraction::integrated`], files in [`nacre_bake::kinds::diffraction_integrated`]).
 //! The shader folds u < 0 onto u ≥ 0 ((u, v, w) → (−u, −v, −w), since
 //! Iₚ(−u, −v) = (−1)ᵖ Iₚ(u, v)), maps u and v to texel coordinates on the warped axes,
 //! reads every layer bilinearly from four `textureLoad`s and sums by Horner in w. It is the
@@ -21,7 +21,7 @@
 //! One 2-D array texture, `Rgba32Float`, n/2 × n texels (u ≥ 0 columns, v rows), 2N + 1
 //! layers, layer p = (Iₚ ch 0, ch 1, ch 2, 0) — the layout of the table's KTX2 file. The
 //! texels come from the EXR file, else the KTX2 file
-//! ([`nacre_bake::bake::Manifest::load_diffraction_integrated`]); every file is checked
+//! ([`nacre_format::Manifest::load_diffraction_integrated`]); every file is checked
 //! against its manifest's SHA-256 and the texture against the device's limits first.
 //!
 //! # Bind group (group 1 of a pipeline; fragment and compute)
@@ -66,9 +66,9 @@ use crate::diffraction::{check_array_limits, dispatch_probe, upload_rgba32f_arra
 use crate::error::{Error, Result};
 use crate::tables::verify_files;
 use bytemuck::{Pod, Zeroable};
-use nacre_bake::bake::Manifest;
-use nacre_bake::diffraction::DiffractionRecord;
-use nacre_bake::diffraction_integrated::IntegratedRecord;
+use nacre_format::Manifest;
+use nacre_format::diffraction::DiffractionRecord;
+use nacre_format::diffraction::IntegratedRecord;
 use nacre_optics::colour::Colorimeter;
 use nacre_optics::diffraction::FresnelTerm;
 use nacre_optics::diffraction::integrated::IntegratedTable;
@@ -187,7 +187,7 @@ impl DiffractionIntegrated {
             message,
         };
         let manifest = Manifest::read(manifest_path)?;
-        if manifest.kind != "diffraction" {
+        if manifest.kind != nacre_format::TableKind::Diffraction {
             return Err(bad(format!(
                 "table `{}` is a `{}` table, not a `diffraction` table",
                 manifest.name, manifest.kind
@@ -195,8 +195,8 @@ impl DiffractionIntegrated {
         }
         verify_files(&manifest, manifest_path)?;
         let record = manifest
-            .diffraction
-            .clone()
+            .diffraction()
+            .cloned()
             .ok_or_else(|| bad("a diffraction manifest without its `diffraction` record".into()))?;
         let integrated = match (&record.integrated, record.layout.as_str()) {
             (Some(s), "integrated") => s.clone(),

@@ -18,9 +18,13 @@ pub enum Error {
         /// wgpu's message.
         message: String,
     },
-    /// A table or manifest could not be read or does not describe what was asked for.
+    /// A table or manifest could not be read or does not describe what was asked for, or a
+    /// material it names could not be resolved.
     #[error(transparent)]
-    Table(#[from] nacre_bake::Error),
+    Table(#[from] nacre_format::Error),
+    /// The physics core rejected a value (a material, a stack).
+    #[error(transparent)]
+    Optics(#[from] nacre_optics::Error),
     /// A manifest and its files disagree, or a manifest asks for something the runtime
     /// cannot upload.
     #[error("{path}: {message}")]

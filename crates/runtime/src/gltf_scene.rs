@@ -170,7 +170,7 @@ pub fn rgb_metal(name: &str, index_rgb: [C64; 3]) -> Result<Material> {
         csv.push_str(&format!("{w},{},{}\n", n.re, n.im));
     }
     Material::from_nk_csv(name, name, &csv)
-        .map_err(nacre_bake::Error::from)
+        .map_err(crate::Error::from)
         .map_err(Error::from)
 }
 
@@ -224,7 +224,7 @@ impl GltfMaterial {
                 1.5
             };
             m.base = Material::constant(format!("{ior}"), C64::new(f64::from(ior), 0.0))
-                .map_err(nacre_bake::Error::from)?;
+                .map_err(crate::Error::from)?;
             m.base_kind = BaseKind::Dielectric;
             m.transmission = clamp01(self.transmission) >= 0.5;
             m.base_colour = if m.transmission { [0.0; 3] } else { rgb };

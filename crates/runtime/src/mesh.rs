@@ -229,7 +229,7 @@ fn lut_material(
     };
     let context = format!("{} (base)", lut.manifest_path.display());
     let table_base =
-        nacre_bake::materials::resolve(&lut.manifest.base, &context, lut.manifest_path.parent())
+        nacre_format::materials::resolve(&lut.manifest.base, &context, lut.manifest_path.parent())
             .map_err(|e| e.to_string())?;
     let table_kind = BaseKind::of(&table_base);
     let mut m = material.clone();

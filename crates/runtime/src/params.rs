@@ -66,7 +66,7 @@ pub struct FilmLutParams {
 
 impl FilmLutParams {
     /// From a table's axes.
-    pub fn new(axes: &nacre_bake::film_lut::FilmLutAxes, has_transmittance: bool) -> Self {
+    pub fn new(axes: &nacre_format::film_lut::FilmLutAxes, has_transmittance: bool) -> Self {
         FilmLutParams {
             cos_theta_count: axes.cos_theta_count as u32,
             opd_count: axes.opd_count as u32,
@@ -106,7 +106,7 @@ pub struct FourierParams {
 
 impl FourierParams {
     /// From a table's axes and the harmonics to sum (0: automatic).
-    pub fn new(axes: &nacre_bake::fourier_table::FourierAxes, harmonics: u32) -> Self {
+    pub fn new(axes: &nacre_format::fourier::FourierAxes, harmonics: u32) -> Self {
         FourierParams {
             max_opd_nm: axes.max_opd_nm as f32,
             level_count: axes.level_samples.len() as u32,
@@ -157,7 +157,7 @@ impl SpectralParams {
 }
 
 /// The samples of `film_spectral` for `setup`: the wavelengths and weights of `nacre color
-/// --method samples:N` ([`nacre_bake::color::sample_weights`]) and the base's index at each.
+/// --method samples:N` ([`nacre_optics::spectral::sample_weights`]) and the base's index at each.
 pub fn spectral_samples(
     colorimeter: &nacre_optics::colour::Colorimeter,
     setup: &crate::bindings::SpectralSetup,
@@ -168,12 +168,12 @@ pub fn spectral_samples(
             message: format!("{} wavelengths (expected 1 to 4096)", setup.samples),
         });
     }
-    let (wavelengths, weights) = nacre_bake::color::sample_weights(colorimeter, setup.samples);
+    let (wavelengths, weights) = nacre_optics::spectral::sample_weights(colorimeter, setup.samples);
     wavelengths
         .iter()
         .zip(&weights)
         .map(|(&wl, w)| {
-            let n = setup.base.index_at(wl).map_err(nacre_bake::Error::from)?;
+            let n = setup.base.index_at(wl).map_err(crate::Error::from)?;
             Ok(SpectralSample {
                 wavelength_nm: wl as f32,
                 base_ior: n.re as f32,

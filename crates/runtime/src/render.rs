@@ -670,7 +670,7 @@ impl SceneOptions {
         };
         let dir = lut.manifest_path.parent();
         let context = format!("{} (base)", lut.manifest_path.display());
-        let base = nacre_bake::materials::resolve(&lut.manifest.base, &context, dir)?;
+        let base = nacre_format::materials::resolve(&lut.manifest.base, &context, dir)?;
         self.material.set_base(base);
         self.material.ambient_ior = lut.axes.ambient_index as f32;
         self.material.film_ior = self
@@ -865,7 +865,7 @@ impl MaterialUniform {
             let n = m
                 .base
                 .index_at(wavelengths[j])
-                .map_err(nacre_bake::Error::from)?;
+                .map_err(crate::Error::from)?;
             base_ior[j] = n.re as f32;
             base_kappa[j] = n.im as f32;
         }
@@ -969,7 +969,7 @@ pub struct EnvironmentMap {
 
 /// The committed default environment: `tables/env/studio.exr`.
 pub fn default_environment_path() -> PathBuf {
-    nacre_bake::bake::tables_dir()
+    nacre_format::set::tables_dir()
         .join("env")
         .join("studio.exr")
 }
@@ -1008,7 +1008,7 @@ impl EnvironmentMap {
         if let Some(h) = meta.headers.first() {
             check_image_size(path, "an environment", h.layer_size.0, h.layer_size.1)?;
         }
-        let (atlas, _) = nacre_bake::table_io::read_exr(path)?;
+        let (atlas, _) = nacre_format::table_io::read_exr(path)?;
         check_image_size(path, "an environment", atlas.width, atlas.height)?;
         Ok(EnvironmentMap {
             width: atlas.width,
@@ -1038,16 +1038,16 @@ impl EnvironmentMap {
 
     /// Writes the environment as a half-float, ZIP-compressed OpenEXR file (atomically).
     pub fn write_exr(&self, path: &Path) -> Result<()> {
-        let table = nacre_bake::table_io::Table3 {
+        let table = nacre_format::table_io::Table3 {
             nx: self.width,
             ny: self.height,
             nz: 1,
             data: self.rgb.iter().flatten().copied().collect(),
         };
-        Ok(nacre_bake::table_io::write_exr(
+        Ok(nacre_format::table_io::write_exr(
             path,
             &table,
-            nacre_bake::table_io::Precision::Half,
+            nacre_format::table_io::Precision::Half,
         )?)
     }
 
@@ -1365,7 +1365,7 @@ impl RenderedImage {
     /// Writes [`RenderedImage::encode_png`] to `path` atomically.
     pub fn write_png(&self, path: &Path) -> Result<()> {
         let bytes = self.encode_png()?;
-        Ok(nacre_bake::output::write_atomic(path, |w| {
+        Ok(nacre_format::atomic::write_atomic(path, |w| {
             w.write_all(&bytes)
         })?)
     }
@@ -1449,7 +1449,7 @@ pub fn view_group_layout(device: &wgpu::Device, label: &str) -> wgpu::BindGroupL
 }
 
 /// Mirror of `RoughLutParams` (`shaders/rough_lut_mapping.wgsl`; the axes of
-/// `nacre_bake::rough_lut::RoughLutAxes`): 48 bytes.
+/// `nacre_format::rough_film_lut::RoughLutAxes`): 48 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct RoughLutUniform {

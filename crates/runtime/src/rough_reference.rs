@@ -39,7 +39,7 @@ use crate::render::{
 };
 use crate::shaders::Technique;
 use crate::tables::TableSet;
-use nacre_bake::table_io::{self, Precision, Table3};
+use nacre_format::table_io::{self, Precision, Table3};
 use nacre_optics::colour::{Colorimeter, delta_e_2000, xyz_to_lab};
 use nacre_optics::microfacet::{
     FilmTerm, SplitMix64, radiance_directional, sample_ggx_vndf, smith_g1, smith_g2,
@@ -442,15 +442,15 @@ pub fn film_term_of(options: &SceneOptions, colorimeter: &Colorimeter) -> Result
     };
     let constant = |n: f64| Material::constant(format!("{n}"), C64::new(n, 0.0));
     let stack = Stack::new(
-        constant(f64::from(m.ambient_ior)).map_err(nacre_bake::Error::from)?,
+        constant(f64::from(m.ambient_ior)).map_err(crate::Error::from)?,
         vec![Layer {
-            material: constant(f64::from(m.film_ior)).map_err(nacre_bake::Error::from)?,
+            material: constant(f64::from(m.film_ior)).map_err(crate::Error::from)?,
             thickness_nm: d,
         }],
         m.base.clone(),
     )
-    .map_err(nacre_bake::Error::from)?;
-    Ok(FilmTerm::from_stack(&stack, colorimeter).map_err(nacre_bake::Error::from)?)
+    .map_err(crate::Error::from)?;
+    Ok(FilmTerm::from_stack(&stack, colorimeter).map_err(crate::Error::from)?)
 }
 
 /// The reference of `options` (built by [`comparison_options`] or alike) with `samples`

@@ -7,7 +7,7 @@
 
 /// Constants, complex arithmetic, Fresnel at an interface, NaN guards, `FilmInput`/`FilmOutput`.
 pub const COMMON: &str = include_str!("../../../shaders/common.wgsl");
-/// The film-lut coordinate mappings (mirror of `nacre_bake::film_lut::FilmLutAxes`).
+/// The film-lut coordinate mappings (mirror of `nacre_format::film_lut::FilmLutAxes`).
 pub const LUT_MAPPING: &str = include_str!("../../../shaders/lut_mapping.wgsl");
 /// Technique: trilinear lookup in a baked `film-lut` table.
 pub const FILM_LUT: &str = include_str!("../../../shaders/film_lut.wgsl");
@@ -23,7 +23,7 @@ pub const BENCH: &str = include_str!("../../../shaders/bench.wgsl");
 /// Consumer: the GPU = CPU probe pass.
 pub const PROBE: &str = include_str!("../../../shaders/probe.wgsl");
 /// The rough-film-lut coordinate mappings and two-fetch lookup (mirror of
-/// `nacre_bake::rough_lut`; no bindings of its own).
+/// `nacre_bake::kinds::rough_film_lut`; no bindings of its own).
 pub const ROUGH_LUT_MAPPING: &str = include_str!("../../../shaders/rough_lut_mapping.wgsl");
 /// Consumer: the thin-film microfacet material (GGX + film, environment, light, tone
 /// mapping; groups 0 and 2), preceded by [`ROUGH_LUT_MAPPING`] (its exact split-sum path

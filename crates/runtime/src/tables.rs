@@ -5,7 +5,7 @@
 //!   floats (or 16-bit PNG), so the upload is exact, and a linear, clamp-to-edge sampler at
 //!   the texture coordinates of `lut_mapping.wgsl` reproduces the CPU `lut:` method.
 //! * `rough-film-lut` → two 3-D `Rgba16Float` textures (reflectance, transmittance; a 1×1×1
-//!   zero texture when the base is opaque) in the layout of `nacre_bake::rough_lut`: x =
+//!   zero texture when the base is opaque) in the layout of `nacre_bake::kinds::rough_film_lut`: x =
 //!   cos θ_o, y = Δ, z = i_α · count(n_f) + i_n (α-major blocks); `rough_lut_mapping.wgsl`
 //!   samples it (two trilinear fetches, mixed in α).
 //! * `fourier` → one 2-D array texture, `Rgba32Float`, two layers (0: Re A_j, 1: Im A_j),
@@ -15,7 +15,7 @@
 //!
 //! The texels come from the OpenEXR files when the manifest lists them, else from the KTX2
 //! files baked beside them (`film-lut`: one 3-D `RGBA16F` texture per quantity; `fourier`:
-//! one 2-D array `RGBA32F` texture with every level; see `nacre_bake::ktx2`), so a
+//! one 2-D array `RGBA32F` texture with every level; see `nacre_format::ktx2`), so a
 //! manifest whose `files` list only KTX2 files loads too, into identical textures.
 //!
 //! Every file is checked against its manifest (format, size, SHA-256) before upload, and
@@ -24,11 +24,11 @@
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
 use half::f16;
-use nacre_bake::bake::Manifest;
-use nacre_bake::film_lut::FilmLutAxes;
-use nacre_bake::fourier_table::FourierAxes;
-use nacre_bake::rough_lut::RoughLutAxes;
-use nacre_bake::table_io::{self, Table3};
+use nacre_format::{Manifest, TableKind};
+use nacre_format::film_lut::FilmLutAxes;
+use nacre_format::fourier::FourierAxes;
+use nacre_format::rough_film_lut::RoughLutAxes;
+use nacre_format::table_io::{self, Table3};
 use nacre_optics::colour::Colorimeter;
 use std::path::{Path, PathBuf};
 
@@ -50,7 +50,7 @@ pub struct FilmLutTextures {
     pub has_transmittance: bool,
 }
 
-/// A `rough-film-lut` table on the GPU (`nacre_bake::rough_lut`).
+/// A `rough-film-lut` table on the GPU (`nacre_bake::kinds::rough_film_lut`).
 pub struct RoughFilmLutTextures {
     /// Table name (from the manifest).
     pub name: String,
@@ -105,13 +105,13 @@ impl TableSet {
     pub fn add(&mut self, ctx: &GpuContext, manifest_path: &Path) -> Result<()> {
         let manifest = Manifest::read(manifest_path)?;
         verify_files(&manifest, manifest_path)?;
-        match manifest.kind.as_str() {
-            "film-lut" => self.film_lut = Some(upload_film_lut(ctx, manifest, manifest_path)?),
-            "fourier" => self.fourier = Some(upload_fourier(ctx, manifest, manifest_path)?),
-            "rough-film-lut" => {
+        match manifest.kind {
+            TableKind::FilmLut => self.film_lut = Some(upload_film_lut(ctx, manifest, manifest_path)?),
+            TableKind::Fourier => self.fourier = Some(upload_fourier(ctx, manifest, manifest_path)?),
+            TableKind::RoughFilmLut => {
                 self.rough_film_lut = Some(upload_rough_film_lut(ctx, manifest, manifest_path)?)
             }
-            other => {
+            other @ TableKind::Diffraction => {
                 return Err(Error::Manifest {
                     path: manifest_path.to_path_buf(),
                     message: format!(
@@ -211,7 +211,7 @@ fn upload_film_lut(
     manifest: Manifest,
     manifest_path: &Path,
 ) -> Result<FilmLutTextures> {
-    let axes = manifest.film_lut.clone().ok_or_else(|| Error::Manifest {
+    let axes = manifest.film_lut().cloned().ok_or_else(|| Error::Manifest {
         path: manifest_path.to_path_buf(),
         message: "a film-lut manifest without its `film_lut` axes".into(),
     })?;
@@ -262,8 +262,8 @@ fn upload_rough_film_lut(
     manifest_path: &Path,
 ) -> Result<RoughFilmLutTextures> {
     let axes = manifest
-        .rough_film_lut
-        .clone()
+        .rough_film_lut()
+        .cloned()
         .ok_or_else(|| Error::Manifest {
             path: manifest_path.to_path_buf(),
             message: "a rough-film-lut manifest without its `rough_film_lut` axes".into(),
@@ -282,7 +282,7 @@ fn upload_rough_film_lut(
         )?;
     }
     // The loader of nacre-bake reads the EXR (or KTX2) files in the table's layout.
-    let loaded = nacre_bake::rough_lut::LoadedRoughLut::load(manifest_path)?;
+    let loaded = nacre_format::rough_film_lut::LoadedRoughLut::load(manifest_path)?;
     let label = manifest.name.clone();
     let lut = &loaded.lut;
     let (reflectance, transmittance) = ctx.checked("uploading a rough-film-lut table", || {

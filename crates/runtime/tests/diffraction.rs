@@ -13,7 +13,7 @@
 //!
 //! A missing adapter fails these tests: they never skip.
 
-use nacre_bake::bake::default_baked_dir;
+use nacre_format::set::default_baked_dir;
 use nacre_optics::C64;
 use nacre_optics::diffraction::{DiffractionSurface, FresnelTerm, in_plane_directions};
 use nacre_runtime::diffraction::{

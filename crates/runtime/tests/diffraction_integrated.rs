@@ -20,7 +20,7 @@
 //!
 //! A missing adapter fails the GPU tests: they never skip.
 
-use nacre_bake::bake::default_baked_dir;
+use nacre_format::set::default_baked_dir;
 use nacre_optics::C64;
 use nacre_optics::diffraction::integrated::check_directions;
 use nacre_optics::diffraction::{
@@ -273,7 +273,7 @@ fn the_terms_consumers_run_on_the_integrated_table() {
 fn gpu_matches_the_terms_layout_within_the_baked_tolerance() {
     let t = technique();
     let terms_path = default_baked_dir().join("cd-tracks.json");
-    let m = nacre_bake::bake::Manifest::read(&terms_path).unwrap();
+    let m = nacre_format::Manifest::read(&terms_path).unwrap();
     let (record, terms) = m.load_diffraction(&terms_path).unwrap();
     for (a, b) in [
         (record.sigma_s_um, t.record.sigma_s_um),

@@ -30,7 +30,7 @@ fn updating() -> bool {
 
 /// The tables of `nacre render --gltf`: film-dielectric + fourier-srgb.
 fn tables() -> TableSet {
-    let baked = nacre_bake::bake::default_baked_dir();
+    let baked = nacre_format::set::default_baked_dir();
     let mut tables = TableSet::load(ctx(), &baked.join("film-dielectric.json")).unwrap();
     tables.add(ctx(), &baked.join("fourier-srgb.json")).unwrap();
     tables
@@ -219,7 +219,7 @@ fn gltf_meshes_render_with_the_rough_film_paths() {
         .err()
         .expect("exact without its table");
     assert!(err.to_string().contains("rough-film-lut"), "{err}");
-    let baked = nacre_bake::bake::default_baked_dir();
+    let baked = nacre_format::set::default_baked_dir();
     tables
         .add(ctx, &baked.join("rough-film-dielectric.json"))
         .unwrap();

@@ -5,7 +5,8 @@
 //!
 //! A missing adapter fails these tests: they never skip.
 
-use nacre_bake::bake::{Manifest, default_baked_dir};
+use nacre_format::Manifest;
+use nacre_format::set::default_baked_dir;
 use nacre_optics::C64;
 use nacre_runtime::bindings::{TechniqueBinding, TechniqueOptions};
 use nacre_runtime::probe::run_probe;
@@ -142,7 +143,7 @@ fn broken_ktx2_files_are_errors() {
         ] {
             std::fs::write(&file, &broken).unwrap();
             let mut m = good.clone();
-            m.files[0].sha256 = nacre_bake::table_io::sha256_hex(&file).unwrap();
+            m.files[0].sha256 = nacre_format::table_io::sha256_hex(&file).unwrap();
             std::fs::write(&path, serde_json::to_string_pretty(&m).unwrap()).unwrap();
             let err = match TableSet::load(ctx, &path) {
                 Ok(_) => panic!("{name} {what}: loaded"),

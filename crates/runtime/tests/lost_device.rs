@@ -17,7 +17,7 @@ fn fresh_context() -> GpuContext {
 }
 
 fn manifest(name: &str) -> PathBuf {
-    nacre_bake::bake::default_baked_dir().join(format!("{name}.json"))
+    nacre_format::set::default_baked_dir().join(format!("{name}.json"))
 }
 
 fn small_sphere() -> SceneOptions {

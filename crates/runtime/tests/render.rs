@@ -43,7 +43,7 @@ fn tables_for(scene: SceneKind) -> TableSet {
         SceneKind::Bubble => "soap-film",
         SceneKind::Plane => "oil-slick",
     };
-    let baked = nacre_bake::bake::default_baked_dir();
+    let baked = nacre_format::set::default_baked_dir();
     let mut tables = TableSet::load(ctx(), &baked.join(format!("{lut}.json"))).unwrap();
     tables.add(ctx(), &baked.join("fourier-srgb.json")).unwrap();
     tables
@@ -552,7 +552,7 @@ fn bad_files_and_settings_are_errors() {
     // A bubble needs a transmittance in the lut.
     let gold = TableSet::load(
         ctx,
-        &nacre_bake::bake::default_baked_dir().join("film-gold.json"),
+        &nacre_format::set::default_baked_dir().join("film-gold.json"),
     )
     .unwrap();
     let mut o = SceneOptions::new(SceneKind::Bubble);

@@ -51,7 +51,7 @@ fn updating() -> bool {
 }
 
 fn tables() -> TableSet {
-    let baked = nacre_bake::bake::default_baked_dir();
+    let baked = nacre_format::set::default_baked_dir();
     let mut t = TableSet::load(ctx(), &baked.join("film-dielectric.json")).unwrap();
     // NACRE_ROUGH_TABLE=PATH.json measures another rough-film-lut (e.g. one baked elsewhere).
     let rough = std::env::var_os("NACRE_ROUGH_TABLE")
@@ -63,9 +63,9 @@ fn tables() -> TableSet {
 }
 
 fn colorimeter() -> nacre_optics::colour::Colorimeter {
-    let baked = nacre_bake::bake::default_baked_dir();
+    let baked = nacre_format::set::default_baked_dir();
     let path = baked.join("film-dielectric.json");
-    nacre_bake::bake::Manifest::read(&path)
+    nacre_format::Manifest::read(&path)
         .unwrap()
         .colorimeter(&path)
         .unwrap()
@@ -230,7 +230,7 @@ struct LobeEstimator {
 /// Mean ΔE2000 of [`LobeEstimator`] + the directional light (closed form, as the reference)
 /// against the committed reference at `alpha`.
 fn twin_delta_e(estimator: &LobeEstimator, alpha: f64) -> f64 {
-    use nacre_bake::rough_lut::{LoadedRoughLut, RoughFilmLut};
+    use nacre_format::rough_film_lut::{LoadedRoughLut, RoughFilmLut};
     use nacre_optics::microfacet::{ggx_d, radiance_directional, sample_ggx_vndf, smith_lambda};
     use nacre_runtime::ibl::{
         PREFILTER_LEVELS, PrefilteredEnvironment, env_direction_to_uv, sample_level_bilinear,
@@ -239,7 +239,7 @@ fn twin_delta_e(estimator: &LobeEstimator, alpha: f64) -> f64 {
     use nacre_runtime::rough_reference::{COMPARISON_FILM_IOR, COMPARISON_THICKNESS_NM};
     let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     let c = colorimeter();
-    let baked = nacre_bake::bake::default_baked_dir();
+    let baked = nacre_format::set::default_baked_dir();
     let rough = LoadedRoughLut::load(&baked.join("rough-film-dielectric.json")).unwrap();
     let env = comparison_environment();
     let pre = PrefilteredEnvironment::cached(&env);

@@ -59,10 +59,11 @@
 //! ω_i·ω_r)² / (cos θ_i cos θ_r (cos θ_i + cos θ_r)²) · S, F² = 1 or the Fresnel reflectance
 //! of one index at the half-vector angle.
 
-use crate::bake::{AxisRecord, FileRecord, Manifest};
-use crate::diffraction::{DiffractionRecipe, DiffractionRecord};
+use crate::kinds::diffraction::DiffractionRecipe;
+use nacre_format::diffraction::{DiffractionRecord, ERROR_METRIC, IntegratedRecord, MAX_INTEGRATED_BYTES};
+use nacre_format::manifest::{AxisRecord, Encoding, FileFormat, FileRecord, KindRecord, Manifest};
 use crate::error::{Error, Result};
-use crate::table_io::{self, Precision, Table3};
+use nacre_format::table_io::{self, Precision, Table3};
 use nacre_optics::diffraction::integrated::{
     IntegratedTable, MAX_INTEGRATED_SAMPLES, WarpedAxis, check_directions,
 };
@@ -77,12 +78,7 @@ pub const DEFAULT_INTEGRATED_SAMPLES: usize = 256;
 pub const DEFAULT_INTEGRATED_GAMMA: f64 = 3.0;
 /// Default tolerance on the measured reconstruction error, in units of the specular white.
 pub const DEFAULT_INTEGRATED_TOLERANCE: f64 = 1e-2;
-/// Largest integrated table accepted: (2N + 1)·n·n/2 RGBA32F texels, 1 GiB (the KTX2
-/// file; the EXR file is ¾ of it).
-pub const MAX_INTEGRATED_BYTES: u64 = 1 << 30;
 
-/// The error metric recorded in manifests.
-pub const ERROR_METRIC: &str = "max over light/view pairs and output channels c of |colour_integrated,c - colour_terms,c| / white_c, white = the colour of rho = 1 (a flat perfect mirror in its specular direction); colour_integrated as a shader rebuilds it (f32 texels, bilinear in the warped coordinates, f32 Horner sum), colour_terms from the f64 Taylor terms at the same N and wavelength grid, F = 1";
 
 /// The layout "integrated" settings of a recipe.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -95,51 +91,6 @@ pub struct IntegratedSettings {
     pub tolerance: f64,
 }
 
-/// What a manifest records about an integrated table (inside [`DiffractionRecord`]).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct IntegratedRecord {
-    /// Columns n/2 (u ≥ 0).
-    pub samples_u: usize,
-    /// Rows n (v over [−u_max, u_max]).
-    pub samples_v: usize,
-    /// Warp exponent γ.
-    pub gamma: f64,
-    /// u_max = 2 sin θ_max.
-    pub max_uv: f64,
-    /// Layers 2N + 1 (p = 0 … 2N).
-    pub layers: usize,
-    /// What the three channels hold.
-    pub channels: String,
-    /// Column coordinate of u ≥ 0.
-    pub u_forward: String,
-    /// u at the centre of column c.
-    pub u_inverse: String,
-    /// Row coordinate of v.
-    pub v_forward: String,
-    /// v at the centre of row r.
-    pub v_inverse: String,
-    /// How u < 0 is read.
-    pub fold: String,
-    /// [`ERROR_METRIC`].
-    pub error_metric: String,
-    /// The tolerance the bake was held to.
-    pub tolerance: f64,
-    /// The measured error ([`ERROR_METRIC`]).
-    pub reconstruction_error: f64,
-    /// Its mean over the pairs.
-    pub mean_error: f64,
-    /// Light direction of the largest error: (θ, φ), degrees (φ from +x towards +y).
-    pub worst_light_deg: [f64; 2],
-    /// View direction of the largest error: (θ, φ), degrees.
-    pub worst_view_deg: [f64; 2],
-    /// Output channel of the largest error.
-    pub worst_channel: String,
-    /// Light/view pairs measured.
-    pub pairs: usize,
-    /// Error of f32 storage and the f32 sum alone, at texel centres (no interpolation),
-    /// same units: the catastrophic cancellation of tall structures.
-    pub storage_error: f64,
-}
 
 impl IntegratedSettings {
     /// Parses the `integrated_*` keys; `bad` makes a recipe error at a span. Refuses up
@@ -359,7 +310,7 @@ fn write_files(
     table: &IntegratedTable,
     out_dir: &Path,
 ) -> Result<PathBuf> {
-    let stage = crate::output::StagedTable::new(out_dir)?;
+    let stage = nacre_format::atomic::StagedTable::new(out_dir)?;
     let out_dir = stage.path();
     let c = &recipe.colorimeter;
     let (cols, rows, layers) = (s.samples_u, s.samples_v, s.layers);
@@ -407,7 +358,6 @@ fn write_files(
                 inverse: "p".into(),
             },
         ],
-        diffraction: Some(r.clone()),
         texel_centres: format!(
             "column c holds u = {m} ((2 c + 1) / {n})^{g}, row r holds v = {m} sign(t) |t|^{g} with t = (2 r + 1) / {n} - 1 (centres of a {n}-texel warped axis over [-{m}, {m}], of which the columns are the half u >= 0); bilinear interpolation in these texel coordinates by four integer loads",
             m = s.max_uv,
@@ -423,7 +373,7 @@ fn write_files(
         ),
         files: Vec::new(),
         ..Manifest::for_recipe(
-            "diffraction",
+            KindRecord::Diffraction(Box::new(r.clone())),
             &recipe.name,
             &recipe.description,
             &recipe.path,
@@ -444,9 +394,9 @@ fn write_files(
     table_io::write_exr(&out_dir.join(&exr), &atlas, Precision::Float)?;
     let mut files = vec![FileRecord {
         quantity: "integrated".into(),
-        format: "exr".into(),
+        format: FileFormat::Exr,
         path: exr.clone(),
-        encoding: "float".into(),
+        encoding: Encoding::Float,
         channels: vec!["R".into(), "G".into(), "B".into()],
         width: cols,
         height: rows * layers,
@@ -465,10 +415,10 @@ fn write_files(
         v.push(0);
         v
     };
-    crate::ktx2::write_ktx2(
+    nacre_format::ktx2::write_ktx2(
         &ktx2_path,
-        &crate::ktx2::Ktx2Image {
-            format: crate::ktx2::Ktx2Format::Rgba32Float,
+        &nacre_format::ktx2::Ktx2Image {
+            format: nacre_format::ktx2::Ktx2Format::Rgba32Float,
             width: cols as u32,
             height: rows as u32,
             depth: 0,
@@ -476,130 +426,27 @@ fn write_files(
             levels: vec![level],
             key_values: vec![
                 (
-                    crate::ktx2::WRITER_KEY.into(),
+                    nacre_format::ktx2::WRITER_KEY.into(),
                     nul(&format!("nacre {}", env!("CARGO_PKG_VERSION"))),
                 ),
-                (crate::ktx2::MANIFEST_KEY.into(), nul(&embedded)),
+                (nacre_format::ktx2::MANIFEST_KEY.into(), nul(&embedded)),
             ],
         },
     )?;
     files.push(FileRecord {
         quantity: "integrated".into(),
-        format: "ktx2".into(),
+        format: FileFormat::Ktx2,
         path: ktx2,
-        encoding: "float".into(),
+        encoding: Encoding::Float,
         channels: vec!["R".into(), "G".into(), "B".into(), "A".into()],
         width: cols,
         height: rows,
         sha256: table_io::sha256_hex(&ktx2_path)?,
     });
     manifest.files = files;
-    stage.commit_manifest(&manifest, &[])
+    Ok(stage.commit_manifest(&manifest, &[])?)
 }
 
-impl Manifest {
-    /// Loads an integrated `diffraction` table (from its EXR file, else its KTX2 file) as
-    /// stored (f32 values).
-    ///
-    /// # Errors
-    /// [`Error::Invalid`] for another kind or layout, or sizes a bake could not have
-    /// written; file errors.
-    pub fn load_diffraction_integrated(
-        &self,
-        manifest_path: &Path,
-    ) -> Result<(DiffractionRecord, IntegratedTable)> {
-        let invalid = |message: String| Error::Invalid {
-            context: manifest_path.display().to_string(),
-            message,
-        };
-        let r = self.diffraction.clone().ok_or_else(|| {
-            invalid(format!(
-                "table `{}` is a `{}` table, not a diffraction table",
-                self.name, self.kind
-            ))
-        })?;
-        let s = match (&r.integrated, r.layout.as_str()) {
-            (Some(s), "integrated") => s.clone(),
-            _ => {
-                return Err(invalid(format!(
-                    "diffraction table `{}` has the layout \"{}\", not \"integrated\"",
-                    self.name, r.layout
-                )));
-            }
-        };
-        let n = s.samples_v;
-        let bytes = (s.layers as u64)
-            .saturating_mul(n as u64)
-            .saturating_mul(s.samples_u as u64)
-            .saturating_mul(16);
-        if !(4..=MAX_INTEGRATED_SAMPLES).contains(&n)
-            || n % 2 == 1
-            || s.samples_u != n / 2
-            || s.layers != 2 * r.taylor_order + 1
-            || bytes > MAX_INTEGRATED_BYTES
-        {
-            return Err(invalid(format!(
-                "integrated table of {} × {n} texels and {} layers for N = {}: expected n even from 4 to {MAX_INTEGRATED_SAMPLES}, n/2 columns, 2N + 1 layers, at most {MAX_INTEGRATED_BYTES} bytes",
-                s.samples_u, s.layers, r.taylor_order
-            )));
-        }
-        let axis = WarpedAxis::new(s.max_uv, s.gamma, n).map_err(|source| Error::OpticsIn {
-            context: manifest_path.display().to_string(),
-            source,
-        })?;
-        let dir = manifest_path.parent().unwrap_or(Path::new("."));
-        let find = |format: &str| {
-            self.files
-                .iter()
-                .find(|f| f.quantity == "integrated" && f.format == format)
-        };
-        let (cols, layers) = (s.samples_u, s.layers);
-        let mut values = vec![[0.0f32; 3]; layers * n * cols];
-        if let Some(f) = find("exr") {
-            let (t, _) = table_io::read_exr_table(&dir.join(&f.path), cols, n, layers)?;
-            for p in 0..layers {
-                for iv in 0..n {
-                    for c in 0..cols {
-                        values[(p * n + iv) * cols + c] = t.texel(c, iv, p);
-                    }
-                }
-            }
-        } else if let Some(f) = find("ktx2") {
-            let path = dir.join(&f.path);
-            let image = crate::ktx2::read_ktx2(&path)?;
-            if image.format != crate::ktx2::Ktx2Format::Rgba32Float
-                || (
-                    image.width as usize,
-                    image.height as usize,
-                    image.layers as usize,
-                ) != (cols, n, layers)
-                || image.levels.len() != 1
-            {
-                return Err(Error::Table {
-                    path,
-                    message: format!(
-                        "texture is {:?} {}x{} with {} layers; expected Rgba32Float {cols}x{n} with {layers} layers",
-                        image.format, image.width, image.height, image.layers
-                    ),
-                });
-            }
-            let data = image.level_f32(0);
-            for (i, v) in values.iter_mut().enumerate() {
-                *v = [data[4 * i], data[4 * i + 1], data[4 * i + 2]];
-            }
-        } else {
-            return Err(invalid("the manifest lists no integrated file".into()));
-        }
-        let table =
-            IntegratedTable::from_values(axis, r.taylor_order, values).map_err(|source| {
-                Error::OpticsIn {
-                    context: manifest_path.display().to_string(),
-                    source,
-                }
-            })?;
-        Ok((r, table))
-    }
-}
 
 #[cfg(test)]
 mod tests {
@@ -609,7 +456,7 @@ mod tests {
     fn recipe(dir: &Path, name: &str, text: &str) -> Result<crate::bake::AnyRecipe> {
         let path = dir.join(name);
         std::fs::write(&path, text).unwrap();
-        crate::bake::AnyRecipe::read(&path)
+        crate::kinds::read_recipe(&path)
     }
 
     const SINE: &str = "kind = \"diffraction\"

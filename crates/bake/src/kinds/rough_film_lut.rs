@@ -81,60 +81,18 @@
 //! points, 16 indices gave p95 0.51 and 24 give 0.27; 24 view angles or 16 roughnesses with
 //! 16 indices instead did not lower it).
 //!
-//! # Axes and mappings (forward and inverse: [`RoughLutAxes`])
-//!
-//! | axis | count | t from the physical value | inverse |
-//! |---|---|---|---|
-//! | x: cos θ_o | `cos_theta_count` | t = √cos θ_o | cos θ_o = t² |
-//! | y: Δ, nm | `opd_count` | t = Δ / Δ_max, Δ = 2 d q(n_f, c_ref(cos θ_o, α)), Δ_max = 2 d_max n_max | Δ = t Δ_max |
-//! | film index | `film_ior_count` | t = √((n_f − n_min)/(n_max − n_min)) | n_f = n_min + t² (n_max − n_min) |
-//! | roughness α | `alpha_count` | t = ln(α/α_min) / ln(α_max/α_min) | α = α_min (α_max/α_min)^t |
-//!
-//! q(n, cos θ) = √(n² − n₀² sin²θ) is the film's normal wave-vector component (as in
-//! film-lut). Δ is the optical path difference at the kernel's mean microfacet cosine,
-//! c_ref(cos θ_o, α) = cos θ_o + (2α − α²)(0.7 − 0.8 cos θ_o) ([`RoughLutAxes::reference_cos`],
-//! a fit within ±0.05 of the kernel mean): the specular path (c_ref = cos θ_o) for smooth
-//! films, where film-lut showed that at fixed Δ the colour varies slowly with index and
-//! angle, moving to c ≈ 0.7–0.9 at α = 1 whatever the view. Referring Δ to the view cosine at
-//! every α instead left errors of ΔE2000 1.7 at α ≈ 1 (neighbouring view-angle texels at the
-//! same Δ then hold films of different thickness as the normal microfacets see them). Each α
-//! block refers Δ to its own α, so a lookup computes t_y per block. Unlike film-lut's index axis,
-//! this one does not depend on θ_o, so the film colours of step 2 are shared by every view
-//! angle. The square root crowds texels near n_min, where a film nearly index-matched to the
-//! ambient changes fastest; the logarithm in α spreads them over 0.02–0.3, where roughness
-//! washes the fringes out (the spread of microfacet optical paths grows linearly with α).
-//! Values outside the ranges clamp to them.
-//!
-//! # Texture layout and texel centres
-//!
-//! Per quantity one 3-D texture: width = count(cos θ_o), height = count(Δ), depth =
-//! count(α) × count(n_f) in α-major blocks, slice z = i_α · count(n_f) + i_n. On every axis
-//! texel i of `count` holds t = i / (count − 1), reached at texture coordinate
-//! u = (t (count − 1) + 0.5) / count. Within one α block a linear sampler filters x, y and
-//! the film index (the index coordinate w = (i_α count(n_f) + t_n (count(n_f) − 1) + 0.5) /
-//! depth stays between the block's first and last texel centres, so filtering never mixes
-//! blocks); the two α blocks around t_α are fetched separately and mixed:
-//!
-//! ```text
-//! t  = forward(cos θ_o, α, d, n_f)                  // (t_x, t_y, t_n, t_α)
-//! s  = t_α (count(α) − 1);  a₀ = min(⌊s⌋, count(α) − 2);  f = s − a₀
-//! E  = mix(sample(a₀), sample(a₀ + 1), f)           // sample(a): trilinear within block a
-//! environment specular = prefiltered_env(R, α) × E_r;  transmitted = … × E_t
-//! ```
-//!
-//! `shaders/rough_lut_mapping.wgsl` mirrors this and [`RoughFilmLut::lookup`] does the same
-//! on the CPU. The files: OpenEXR atlas (width = count(cos θ_o), height = count(Δ) × depth,
-//! slice z at rows [z count(Δ), (z + 1) count(Δ)), [`crate::table_io`]) and KTX 2.0 3-D
-//! `RGBA16F` textures with alpha 1 ([`crate::ktx2::film_lut_image`]).
-
-use crate::bake::{
-    AxisRecord, FileRecord, MAX_TEXELS, Manifest, RawColour, RawOutput, RawStack, RecipeStack,
-    Toggle, is_transparent, parse_colour, table_name,
+use crate::kinds::{KindEntry, TableRecipe};
+use crate::recipe::{
+    OutputSettings, RawColour, RawOutput, RawStack, RecipeStack, line_of, parse_colour,
+    table_name, toml_error,
 };
+use nacre_format::manifest::{
+    AxisRecord, Encoding, FileFormat, FileRecord, KindRecord, MAX_TEXELS, Manifest, TableKind,
+};
+use nacre_format::rough_film_lut::{RoughFilmLut, RoughLutAxes, validate_axes};
 use crate::error::{Error, Result};
-use crate::film_lut::MIN_COS_THETA;
-use crate::stack_spec::{line_of, toml_error};
-use crate::table_io::{self, Precision, Table3};
+use nacre_format::film_lut::MIN_COS_THETA;
+use nacre_format::table_io::{self, Precision, Table3};
 use nacre_optics::colour::Colorimeter;
 use nacre_optics::microfacet::{REFRACTION_WAVELENGTH_NM, refract, sample_ggx_vndf, smith_lambda};
 use nacre_optics::{C64, Layer, Material, SpectralRule, Stack};
@@ -161,156 +119,6 @@ pub const FINE_OPD_STEP_NM: f64 = 24.0;
 /// the Δ axis at grazing views of low-index films hold thicker films than d_max, and the
 /// interpolation near the physical range's edge reads them.
 pub const THICKNESS_EXTENSION: f64 = 1.5;
-
-/// Axes of a rough-film LUT, with the forward (physical → t ∈ [0, 1]) and inverse mappings.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct RoughLutAxes {
-    /// Texels along cos θ_o (x, the texture width).
-    pub cos_theta_count: usize,
-    /// Texels along the optical path difference Δ at the reference cosine (y, the height).
-    pub opd_count: usize,
-    /// Texels along the film index within one α block.
-    pub ior_count: usize,
-    /// α blocks (the texture depth is `alpha_count * ior_count`).
-    pub alpha_count: usize,
-    /// Smallest film thickness, nm (the table covers Δ from 0).
-    pub thickness_min_nm: f64,
-    /// Largest film thickness d_max, nm.
-    pub thickness_max_nm: f64,
-    /// Smallest film index.
-    pub ior_min: f64,
-    /// Largest film index.
-    pub ior_max: f64,
-    /// Smallest GGX roughness α.
-    pub alpha_min: f64,
-    /// Largest GGX roughness α.
-    pub alpha_max: f64,
-    /// The (real, constant) ambient index n₀.
-    pub ambient_index: f64,
-    /// Relative index η = n_base / n₀ at 560 nm used to refract into the base, when the
-    /// transmittance table is baked.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub base_eta: Option<f64>,
-}
-
-impl RoughLutAxes {
-    /// Δ_max = 2 d_max n_max, nm.
-    pub fn opd_max_nm(&self) -> f64 {
-        2.0 * self.thickness_max_nm * self.ior_max
-    }
-
-    /// Normal component q = √(n² − n₀² sin²θ) of a film of index `film_ior` seen at
-    /// `cos_theta`.
-    pub fn film_q(&self, cos_theta: f64, film_ior: f64) -> f64 {
-        let sin2 = (1.0 - cos_theta * cos_theta).max(0.0);
-        (film_ior * film_ior - self.ambient_index * self.ambient_index * sin2)
-            .max(0.0)
-            .sqrt()
-    }
-
-    /// The microfacet cosine the Δ axis of an α block refers to:
-    /// c_ref(cos θ_o, α) = cos θ_o + (2α − α²)(0.7 − 0.8 cos θ_o), a fit (within ±0.05)
-    /// of the mean of c = ω_o·h under the reflection kernel (c_ref → cos θ_o as α → 0, the
-    /// specular direction; 0.7–0.9 at α = 1 whatever the view). Clamped to [0, 1].
-    pub fn reference_cos(cos_theta_o: f64, alpha: f64) -> f64 {
-        let c = cos_theta_o.clamp(0.0, 1.0);
-        let s = alpha.clamp(0.0, 1.0) * (2.0 - alpha.clamp(0.0, 1.0));
-        (c + s * (0.7 - 0.8 * c)).clamp(0.0, 1.0)
-    }
-
-    /// Optical path difference of the Δ axis, Δ = 2 d q(n, c_ref(cos θ_o, α)), nm: the film's
-    /// path at the kernel's mean microfacet, so that at fixed Δ the albedo varies slowly
-    /// with view angle and index at every roughness.
-    pub fn opd_nm(&self, cos_theta: f64, alpha: f64, thickness_nm: f64, film_ior: f64) -> f64 {
-        2.0 * thickness_nm * self.film_q(Self::reference_cos(cos_theta, alpha), film_ior)
-    }
-
-    /// t of roughness α: ln(α/α_min) / ln(α_max/α_min) (0 when the range is one value).
-    pub fn alpha_t(&self, alpha: f64) -> f64 {
-        let span = (self.alpha_max / self.alpha_min).ln();
-        if span > 0.0 {
-            (alpha / self.alpha_min).ln() / span
-        } else {
-            0.0
-        }
-    }
-
-    /// Forward mapping: physical (cos θ_o, α, d nm, n_f) → (t_x, t_y, t_n, t_α), each clamped
-    /// to [0, 1]; non-finite values become 0.
-    pub fn forward(
-        &self,
-        cos_theta: f64,
-        alpha: f64,
-        thickness_nm: f64,
-        film_ior: f64,
-    ) -> [f64; 4] {
-        let c = cos_theta.clamp(0.0, 1.0);
-        let tx = c.sqrt();
-        let ty =
-            self.opd_nm(c, alpha.max(self.alpha_min), thickness_nm, film_ior) / self.opd_max_nm();
-        let span = self.ior_max - self.ior_min;
-        let tn = if span > 0.0 {
-            ((film_ior - self.ior_min) / span).max(0.0).sqrt()
-        } else {
-            0.0
-        };
-        let ta = self.alpha_t(alpha.max(self.alpha_min));
-        [tx, ty, tn, ta].map(|t| {
-            if t.is_finite() {
-                t.clamp(0.0, 1.0)
-            } else {
-                0.0
-            }
-        })
-    }
-
-    /// Inverse mapping: t → (cos θ_o, Δ nm, n_f, α).
-    pub fn inverse(&self, t: [f64; 4]) -> (f64, f64, f64, f64) {
-        (
-            t[0] * t[0],
-            t[1] * self.opd_max_nm(),
-            self.ior_min + t[2] * t[2] * (self.ior_max - self.ior_min),
-            self.alpha_min * (self.alpha_max / self.alpha_min).powf(t[3]),
-        )
-    }
-
-    /// t of texel `i` on an axis of `count` texels: i / (count − 1) (0 when count = 1).
-    pub fn texel_t(i: usize, count: usize) -> f64 {
-        crate::film_lut::FilmLutAxes::texel_t(i, count)
-    }
-
-    /// Texture depth: `alpha_count * ior_count`.
-    pub fn depth(&self) -> usize {
-        self.alpha_count * self.ior_count
-    }
-
-    /// cos θ_o of texel column `x` (at least [`MIN_COS_THETA`]).
-    pub fn texel_cos_theta(&self, x: usize) -> f64 {
-        let t = Self::texel_t(x, self.cos_theta_count);
-        (t * t).max(MIN_COS_THETA)
-    }
-
-    /// Film index of index texel `k`.
-    pub fn texel_ior(&self, k: usize) -> f64 {
-        self.inverse([0.0, 0.0, Self::texel_t(k, self.ior_count), 0.0])
-            .2
-    }
-
-    /// Roughness of α block `a`.
-    pub fn texel_alpha(&self, a: usize) -> f64 {
-        self.inverse([0.0, 0.0, 0.0, Self::texel_t(a, self.alpha_count)])
-            .3
-    }
-
-    /// Film thickness (nm) of texel (x, y, k) of α block `a`:
-    /// d = Δ_y / (2 q(n_k, c_ref(cos θ_x, α_a))) (0 at Δ = 0).
-    pub fn texel_thickness_nm(&self, x: usize, y: usize, k: usize, a: usize) -> f64 {
-        let opd = Self::texel_t(y, self.opd_count) * self.opd_max_nm();
-        let c_ref = Self::reference_cos(self.texel_cos_theta(x), self.texel_alpha(a));
-        let q = self.film_q(c_ref, self.texel_ior(k));
-        if opd > 0.0 { opd / (2.0 * q) } else { 0.0 }
-    }
-}
 
 /// One kernel pair: K_r and K_t on the c grid of [`KERNEL_COS_NODES`] nodes.
 #[derive(Clone, Debug, PartialEq)]
@@ -473,110 +281,29 @@ pub fn kernels_with(
     k
 }
 
-/// A rough-film LUT in memory.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RoughFilmLut {
-    /// The axes.
-    pub axes: RoughLutAxes,
-    /// Reflected albedo E_r per texel (width × height × depth, see the module docs).
-    pub reflectance: Table3,
-    /// Transmitted albedo E_t per texel, when the base transmits.
-    pub transmittance: Option<Table3>,
-}
 
-impl RoughFilmLut {
-    /// The albedo colour at physical (cos θ_o, α, d nm, n_f) from `table` (one quantity),
-    /// exactly as the shader samples it: trilinear within the two α blocks around α, mixed
-    /// linearly (module docs).
-    pub fn lookup(
-        axes: &RoughLutAxes,
-        table: &Table3,
-        cos_theta: f64,
-        alpha: f64,
-        thickness_nm: f64,
-        film_ior: f64,
-    ) -> [f64; 3] {
-        let t = axes.forward(cos_theta, alpha, thickness_nm, film_ior);
-        let (a0, f) = lerp_index(t[3], axes.alpha_count);
-        // Each block's Δ axis refers to its own α (texel_alpha), as it was baked.
-        let block = |a: usize| {
-            let t_block = axes.forward(cos_theta, axes.texel_alpha(a), thickness_nm, film_ior);
-            trilinear(
-                table,
-                [t[0], t_block[1], t[2]],
-                a * axes.ior_count,
-                axes.ior_count,
-            )
-        };
-        let lo = block(a0);
-        if f == 0.0 {
-            return lo;
+/// The tables as the half-float files store them: each (E_r, E_t) pair rounded by
+/// [`store_albedo_pair`] (so that E_r + E_t ≤ 1 holds for the stored halves), E_r alone
+/// rounded to the nearest half where nothing is transmitted. Values are `f32`s that are
+/// exactly half floats.
+pub fn rounded_to_half(lut: &RoughFilmLut) -> (Table3, Option<Table3>) {
+    let Some(t) = &lut.transmittance else {
+        let mut r = lut.reflectance.clone();
+        for v in &mut r.data {
+            *v = half::f16::from_f32(*v).to_f32();
         }
-        let hi = block(a0 + 1);
-        std::array::from_fn(|c| lo[c] + f * (hi[c] - lo[c]))
+        return (r, None);
+    };
+    let (mut r_out, mut t_out) = (lut.reflectance.clone(), t.clone());
+    for ((r, t), (r_in, t_in)) in r_out
+        .data
+        .iter_mut()
+        .zip(t_out.data.iter_mut())
+        .zip(lut.reflectance.data.iter().zip(&t.data))
+    {
+        (*r, *t) = store_albedo_pair(f64::from(*r_in), f64::from(*t_in), Precision::Half);
     }
-}
-
-impl RoughFilmLut {
-    /// The tables as the half-float files store them: each (E_r, E_t) pair rounded by
-    /// [`store_albedo_pair`] (so that E_r + E_t ≤ 1 holds for the stored halves), E_r alone
-    /// rounded to the nearest half where nothing is transmitted. Values are `f32`s that are
-    /// exactly half floats.
-    pub fn rounded_to_half(&self) -> (Table3, Option<Table3>) {
-        let Some(t) = &self.transmittance else {
-            let mut r = self.reflectance.clone();
-            for v in &mut r.data {
-                *v = half::f16::from_f32(*v).to_f32();
-            }
-            return (r, None);
-        };
-        let (mut r_out, mut t_out) = (self.reflectance.clone(), t.clone());
-        for ((r, t), (r_in, t_in)) in r_out
-            .data
-            .iter_mut()
-            .zip(t_out.data.iter_mut())
-            .zip(self.reflectance.data.iter().zip(&t.data))
-        {
-            (*r, *t) = store_albedo_pair(f64::from(*r_in), f64::from(*t_in), Precision::Half);
-        }
-        (r_out, Some(t_out))
-    }
-}
-
-/// Lower texel and fraction of linear interpolation at t on `count` texels.
-fn lerp_index(t: f64, count: usize) -> (usize, f64) {
-    if count <= 1 {
-        return (0, 0.0);
-    }
-    let pos = t.clamp(0.0, 1.0) * (count - 1) as f64;
-    let i = (pos.floor() as usize).min(count - 2);
-    (i, pos - i as f64)
-}
-
-/// Trilinear interpolation at normalised t (x, y, index) inside the block of `block_count`
-/// slices starting at slice `z0`.
-fn trilinear(table: &Table3, t: [f64; 3], z0: usize, block_count: usize) -> [f64; 3] {
-    let (x0, fx) = lerp_index(t[0], table.nx);
-    let (y0, fy) = lerp_index(t[1], table.ny);
-    let (k0, fk) = lerp_index(t[2], block_count);
-    let mut out = [0.0; 3];
-    for corner in 0..8 {
-        let (ux, uy, uk) = (corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
-        let w = [(1.0 - fx, fx), (1.0 - fy, fy), (1.0 - fk, fk)];
-        let weight = [ux, uy, uk]
-            .iter()
-            .zip(w)
-            .map(|(&u, (a, b))| if u == 1 { b } else { a })
-            .product::<f64>();
-        if weight == 0.0 {
-            continue;
-        }
-        let v = table.texel(x0 + ux, y0 + uy, z0 + k0 + uk);
-        for c in 0..3 {
-            out[c] += weight * f64::from(v[c]);
-        }
-    }
-    out
+    (r_out, Some(t_out))
 }
 
 /// Everything needed to bake one rough-film LUT.
@@ -789,79 +516,6 @@ fn f16_round_down(v: f64) -> half::f16 {
     }
 }
 
-/// Checks the axes of a recipe; `context` names the recipe's `[axes]` table.
-pub fn validate_axes(axes: &RoughLutAxes, context: &str, max_texels: u64) -> Result<()> {
-    let err = |message: String| Error::Invalid {
-        context: context.to_string(),
-        message,
-    };
-    for (name, count, least) in [
-        ("cos_theta_count", axes.cos_theta_count, 2),
-        ("opd_count", axes.opd_count, 2),
-        ("film_ior_count", axes.ior_count, 1),
-        ("alpha_count", axes.alpha_count, 1),
-    ] {
-        if count < least {
-            return Err(err(format!(
-                "{name} = {count}: needs at least {least} texel(s)"
-            )));
-        }
-    }
-    if !(axes.thickness_max_nm > 0.0 && axes.thickness_max_nm <= 1e5) {
-        return Err(err(format!(
-            "thickness_nm maximum {} must be positive and at most 100000 nm",
-            axes.thickness_max_nm
-        )));
-    }
-    if !(axes.thickness_min_nm >= 0.0 && axes.thickness_min_nm < axes.thickness_max_nm) {
-        return Err(err(format!(
-            "thickness_nm range [{}, {}] must satisfy 0 ≤ min < max",
-            axes.thickness_min_nm, axes.thickness_max_nm
-        )));
-    }
-    if !(axes.ior_min > 0.0 && axes.ior_max >= axes.ior_min && axes.ior_max <= 10.0) {
-        return Err(err(format!(
-            "film_ior range [{}, {}] must satisfy 0 < min ≤ max ≤ 10",
-            axes.ior_min, axes.ior_max
-        )));
-    }
-    if axes.ior_min < axes.ambient_index {
-        return Err(err(format!(
-            "film_ior minimum {} is below the ambient index {}: the film would be evanescent at grazing angles",
-            axes.ior_min, axes.ambient_index
-        )));
-    }
-    if (axes.ior_max > axes.ior_min) != (axes.ior_count > 1) {
-        return Err(err(format!(
-            "film_ior = [{}, {}] with film_ior_count = {}: a range needs at least 2 texels, a single index exactly 1",
-            axes.ior_min, axes.ior_max, axes.ior_count
-        )));
-    }
-    if !(axes.alpha_min >= 1e-3 && axes.alpha_max >= axes.alpha_min && axes.alpha_max <= 1.0) {
-        return Err(err(format!(
-            "alpha range [{}, {}] must satisfy 0.001 ≤ min ≤ max ≤ 1",
-            axes.alpha_min, axes.alpha_max
-        )));
-    }
-    if (axes.alpha_max > axes.alpha_min) != (axes.alpha_count > 1) {
-        return Err(err(format!(
-            "alpha = [{}, {}] with alpha_count = {}: a range needs at least 2 texels, a single roughness exactly 1",
-            axes.alpha_min, axes.alpha_max, axes.alpha_count
-        )));
-    }
-    let texels = axes.cos_theta_count as u64
-        * axes.opd_count as u64
-        * axes.ior_count as u64
-        * axes.alpha_count as u64;
-    if texels > max_texels {
-        return Err(Error::TooLarge {
-            what: format!("{context}: texels (cos_theta × opd × film_ior × alpha)"),
-            count: texels,
-            limit: max_texels,
-        });
-    }
-    Ok(())
-}
 
 // ---------------------------------------------------------------------------------------
 // Recipes
@@ -953,29 +607,8 @@ impl RoughRecipe {
             under,
             under_specs,
         } = RecipeStack::parse(path, &text, &raw.stack, "rough-film-lut")?;
-        let output = raw.output.unwrap_or(RawOutput {
-            precision: None,
-            png: None,
-            transmittance: None,
-        });
-        let transmits = under
-            .iter()
-            .map(|l| &l.material)
-            .chain(std::iter::once(&base))
-            .all(is_transparent);
-        let transmittance = match output.transmittance {
-            None => transmits,
-            Some(Toggle::Bool(b)) => b,
-            Some(Toggle::Word(w)) if w == "auto" => transmits,
-            Some(Toggle::Word(w)) => {
-                return Err(Error::Invalid {
-                    context: path.display().to_string(),
-                    message: format!(
-                        "[output] transmittance = \"{w}\": expected \"auto\", true or false"
-                    ),
-                });
-            }
-        };
+        let output = OutputSettings::parse(path, raw.output, &under, &base, false)?;
+        let transmittance = output.transmittance;
         let base_eta = if transmittance {
             let nb = base.index_at(REFRACTION_WAVELENGTH_NM)?;
             if nb.im != 0.0 || !(nb.re > 0.0) {
@@ -1023,8 +656,8 @@ impl RoughRecipe {
                 colorimeter,
                 transmittance,
             },
-            precision: output.precision.unwrap_or(Precision::Half),
-            png: output.png.unwrap_or(false),
+            precision: output.precision,
+            png: output.png,
             text,
         })
     }
@@ -1038,8 +671,8 @@ impl RoughRecipe {
     pub fn bake(&self, out_dir: &Path, progress: &(dyn Fn() + Sync)) -> Result<PathBuf> {
         let lut = self.job.bake(progress)?;
         // Every file goes to a staging folder first; `commit` moves them into `out_dir`,
-        // the manifest last (crate::output::StagedTable).
-        let stage = crate::output::StagedTable::new(out_dir)?;
+        // the manifest last (nacre_format::atomic::StagedTable).
+        let stage = nacre_format::atomic::StagedTable::new(out_dir)?;
         let out_dir = stage.path();
         let a = &lut.axes;
         let c = &self.job.colorimeter;
@@ -1067,16 +700,12 @@ impl RoughRecipe {
             under: self.under_specs.clone(),
             base: self.base_spec.clone(),
             axes: axis_records(a),
-            film_lut: None,
-            fourier: None,
-            diffraction: None,
-            rough_film_lut: Some(a.clone()),
             texel_centres: "texel i of an axis with count n holds t = i / (n - 1); a sampler reaches t at u = (t * (n - 1) + 0.5) / n; clamp to edge. The film_ior coordinate of alpha block a is w = (a * count(film_ior) + t_ior * (count(film_ior) - 1) + 0.5) / (count(alpha) * count(film_ior)), which stays inside the block".into(),
             atlas: "per quantity one 3-D texture: width = count(cos_theta_o), height = count(opd_nm), depth = count(alpha) * count(film_ior) in alpha-major blocks, slice z = i_alpha * count(film_ior) + i_ior. EXR: an atlas of width = count(cos_theta_o), height = count(opd_nm) * depth, slice z at rows [z * count(opd_nm), (z + 1) * count(opd_nm)), row j of the slice is opd_nm index j, top row first; KTX2: the same texels as a 3-D RGBA16F texture, alpha 1".into(),
             reconstruction: "cos_o = dot(N, V); q(n) = sqrt(n^2 - n0^2 (1 - cos_o^2)); c_ref(alpha) = clamp(cos_o + (2 alpha - alpha^2) (0.7 - 0.8 cos_o), 0, 1); t = (sqrt(cos_o), t_y, sqrt((n_f - ior_min) / (ior_max - ior_min)), ln(alpha / alpha_min) / ln(alpha_max / alpha_min)), each clamped to [0, 1]; s = t_alpha (count(alpha) - 1), a0 = min(floor(s), count(alpha) - 2), f = s - a0; alpha_a = alpha_min (alpha_max / alpha_min)^(a / (count(alpha) - 1)) is block a's roughness and t_y(a) = 2 d q(n_f, c_ref(alpha_a)) / opd_max; E = mix(trilinear(block a0), trilinear(block a0 + 1), f) with trilinear(block a) = linear sample at (u(t_x), u(t_y(a)), (a count(ior) + t_ior (count(ior) - 1) + 0.5) / depth); environment specular = prefiltered_env(R, alpha) * E_reflectance, transmitted energy = E_transmittance (shaders/rough_lut_mapping.wgsl)".into(),
             files: Vec::new(),
             ..Manifest::for_recipe(
-                "rough-film-lut",
+                KindRecord::RoughFilmLut(a.clone()),
                 &self.name,
                 &self.description,
                 &self.path,
@@ -1088,7 +717,7 @@ impl RoughRecipe {
         let mut files = Vec::new();
         // The half-float files (the KTX2 textures always, the EXR atlases at
         // `precision = "half"`) hold the pairs rounded by `store_albedo_pair`.
-        let (half_r, half_t) = lut.rounded_to_half();
+        let (half_r, half_t) = rounded_to_half(&lut);
         for (quantity, table, halves) in [
             ("reflectance", Some(&lut.reflectance), Some(&half_r)),
             ("transmittance", lut.transmittance.as_ref(), half_t.as_ref()),
@@ -1103,7 +732,7 @@ impl RoughRecipe {
             files.extend(self.write_quantity(out_dir, quantity, exr, halves, &embedded)?);
         }
         manifest.files = files;
-        stage.commit_manifest(&manifest, &[])
+        Ok(stage.commit_manifest(&manifest, &[])?)
     }
 }
 
@@ -1126,12 +755,8 @@ impl RoughRecipe {
         table_io::write_exr(&out_dir.join(&exr), table, self.precision)?;
         files.push(FileRecord {
             quantity: quantity.into(),
-            format: "exr".into(),
-            encoding: match self.precision {
-                Precision::Half => "half",
-                Precision::Float => "float",
-            }
-            .into(),
+            format: FileFormat::Exr,
+            encoding: Encoding::from(self.precision),
             channels: rgb.clone(),
             width: table.nx,
             height: table.ny * table.nz,
@@ -1142,8 +767,8 @@ impl RoughRecipe {
         if self.png && table_io::write_png16(&out_dir.join(&png), table)? {
             files.push(FileRecord {
                 quantity: quantity.into(),
-                format: "png16".into(),
-                encoding: "unorm16".into(),
+                format: FileFormat::Png16,
+                encoding: Encoding::Unorm16,
                 channels: rgb,
                 width: table.nx,
                 height: table.ny * table.nz,
@@ -1156,15 +781,15 @@ impl RoughRecipe {
         }
         let ktx2 = format!("{}.{quantity}.ktx2", self.name);
         let ktx2_path = out_dir.join(&ktx2);
-        crate::ktx2::write_ktx2(
+        nacre_format::ktx2::write_ktx2(
             &ktx2_path,
-            &crate::ktx2::film_lut_image(&ktx2_path, halves, embedded_manifest)?,
+            &nacre_format::ktx2::film_lut_image(&ktx2_path, halves, embedded_manifest)?,
         )?;
         files.push(FileRecord {
             quantity: quantity.into(),
-            format: "ktx2".into(),
+            format: FileFormat::Ktx2,
             path: ktx2,
-            encoding: "half".into(),
+            encoding: Encoding::Half,
             channels: vec!["R".into(), "G".into(), "B".into(), "A".into()],
             width: table.nx,
             height: table.ny,
@@ -1244,69 +869,28 @@ fn axis_records(a: &RoughLutAxes) -> Vec<AxisRecord> {
     ]
 }
 
-/// A rough-film LUT loaded through its manifest, for CPU lookups (`nacre color --method
-/// rough-lut:`).
-#[derive(Clone, Debug, PartialEq)]
-pub struct LoadedRoughLut {
-    /// The manifest.
-    pub manifest: Manifest,
-    /// The table.
-    pub lut: RoughFilmLut,
-    /// The table's colorimeter.
-    pub colorimeter: Colorimeter,
-}
 
-impl LoadedRoughLut {
-    /// Loads the table at `path` (a manifest), from its EXR files or else its KTX2 files.
-    pub fn load(path: &Path) -> Result<Self> {
-        let manifest = Manifest::read(path)?;
-        let axes = manifest
-            .rough_film_lut
-            .clone()
-            .ok_or_else(|| Error::Invalid {
-                context: path.display().to_string(),
-                message: format!(
-                    "table `{}` is a `{}` table, not a rough-film-lut",
-                    manifest.name, manifest.kind
-                ),
-            })?;
-        let dir = path.parent().unwrap_or(Path::new("."));
-        let (nx, ny, nz) = (axes.cos_theta_count, axes.opd_count, axes.depth());
-        let load = |quantity: &str| -> Result<Option<Table3>> {
-            let find = |format: &str| {
-                manifest
-                    .files
-                    .iter()
-                    .find(|f| f.quantity == quantity && f.format == format)
-            };
-            match (find("exr"), find("ktx2")) {
-                (Some(f), _) => Ok(Some(
-                    table_io::read_exr_table(&dir.join(&f.path), nx, ny, nz)?.0,
-                )),
-                (None, Some(f)) => Ok(Some(crate::ktx2::read_film_lut_ktx2(
-                    &dir.join(&f.path),
-                    nx,
-                    ny,
-                    nz,
-                )?)),
-                (None, None) => Ok(None),
-            }
-        };
-        let reflectance = load("reflectance")?.ok_or_else(|| Error::Invalid {
-            context: path.display().to_string(),
-            message: "the manifest lists no reflectance EXR or KTX2 file".into(),
-        })?;
-        let transmittance = load("transmittance")?;
-        let colorimeter = manifest.colorimeter(path)?;
-        Ok(LoadedRoughLut {
-            lut: RoughFilmLut {
-                axes,
-                reflectance,
-                transmittance,
-            },
-            manifest,
-            colorimeter,
-        })
+/// The registry entry of `rough-film-lut` ([`crate::kinds::REGISTRY`]).
+pub const ENTRY: KindEntry = KindEntry {
+    kind: TableKind::RoughFilmLut,
+    parse: |path, text| Ok(Box::new(RoughRecipe::parse(path, text)?)),
+};
+
+impl TableRecipe for RoughRecipe {
+    fn kind(&self) -> TableKind {
+        TableKind::RoughFilmLut
+    }
+
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn work(&self) -> u64 {
+        RoughRecipe::work(self)
+    }
+
+    fn bake(&self, out_dir: &Path, progress: &(dyn Fn() + Sync)) -> Result<PathBuf> {
+        RoughRecipe::bake(self, out_dir, progress)
     }
 }
 
@@ -1499,7 +1083,7 @@ mod tests {
         }
         // Linear sRGB channels of saturated film colours may be negative (a violet
         // residual reflection), so the law is on the sum, channel by channel: R + T ≤ 1.
-        let (half_r, half_t) = lut.rounded_to_half();
+        let (half_r, half_t) = rounded_to_half(&lut);
         let half_t = half_t.unwrap();
         for (r_table, t_table) in [(&lut.reflectance, t), (&half_r, &half_t)] {
             for (i, (r, t)) in r_table.data.iter().zip(&t_table.data).enumerate() {
@@ -1648,7 +1232,7 @@ mod tests {
             "{e}"
         );
         // The kind dispatch reaches this parser.
-        let any = crate::bake::AnyRecipe::parse(path, good.to_string()).unwrap();
+        let any = crate::kinds::parse_recipe(path, good.to_string()).unwrap();
         assert_eq!(any.name(), "rough");
     }
 }

@@ -49,7 +49,7 @@
 //! and values and never panic on malformed or truncated files; every error names the file.
 
 use crate::error::{Error, Result};
-use crate::output::write_atomic;
+use crate::atomic::write_atomic;
 use half::f16;
 use std::io::{Cursor, Read};
 use std::path::Path;

@@ -7,10 +7,11 @@
 //! `film-lut` baked in memory for the case (24 × 384 texels over cos θ × optical path,
 //! half-float values, as the default tables).
 
-use crate::color::{self, Method, Point, Quantity};
+use crate::commands::color::{self, Method, Point, Quantity};
 use crate::error::{Error, Result};
-use crate::film_lut::{FilmLut, FilmLutAxes, FilmLutJob};
-use crate::output::write_atomic;
+use crate::kinds::film_lut::FilmLutJob;
+use nacre_format::film_lut::{FilmLut, FilmLutAxes};
+use nacre_format::atomic::write_atomic;
 use nacre_optics::colour::{Colorimeter, Illuminant, Observer, OutputSpace, RgbSpace};
 use nacre_optics::colour::{delta_e_2000, xyz_to_lab};
 use nacre_optics::fourier::Harmonics;
@@ -93,7 +94,7 @@ pub fn compare(
         OutputSpace::Rgb(RgbSpace::Srgb),
     );
     let air = Material::constant("1.0", C64::new(1.0, 0.0))?;
-    let base = crate::materials::resolve(case.base, "--case", None)?;
+    let base = nacre_format::materials::resolve(case.base, "--case", None)?;
     let film = Material::constant(format!("{}", case.film_ior), C64::new(case.film_ior, 0.0))?;
     let stack = Stack::new(
         air.clone(),
@@ -187,7 +188,7 @@ pub fn write_csv(
     thicknesses_nm: &[f64],
     results: &[MethodResult],
 ) -> Result<()> {
-    write_atomic(path, |w| {
+    Ok(write_atomic(path, |w| {
         writeln!(w, "method,angle_deg,thickness_nm,delta_e_2000")?;
         for r in results {
             let mut it = r.delta_e.iter();
@@ -199,7 +200,7 @@ pub fn write_csv(
             }
         }
         Ok(())
-    })
+    })?)
 }
 
 /// The colour of ΔE2000 `v` on a perceptual ramp (dark blue 0 → yellow ≥ `max`).
@@ -231,7 +232,7 @@ pub fn write_png(
     thicknesses_nm: &[f64],
     results: &[MethodResult],
 ) -> Result<()> {
-    static FONT: &[u8] = include_bytes!("../../../tables/fonts/DejaVuSans.ttf");
+    static FONT: &[u8] = include_bytes!("../../../../tables/fonts/DejaVuSans.ttf");
     // Registering twice is harmless; a failure only means no text.
     let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
     let (w, h) = (1400u32, 900u32);
@@ -303,7 +304,7 @@ pub fn write_png(
         }
         root.present().map_err(|e| draw_err(e.to_string()))?;
     }
-    write_atomic(path, |out| {
+    Ok(write_atomic(path, |out| {
         let mut enc = png::Encoder::new(out, w, h);
         enc.set_color(png::ColorType::Rgb);
         enc.set_depth(png::BitDepth::Eight);
@@ -312,5 +313,5 @@ pub fn write_png(
             .write_image_data(&buf)
             .map_err(std::io::Error::other)?;
         writer.finish().map_err(std::io::Error::other)
-    })
+    })?)
 }

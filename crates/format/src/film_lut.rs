@@ -48,9 +48,6 @@
 
 use crate::error::{Error, Result};
 use crate::table_io::Table3;
-use nacre_optics::colour::Colorimeter;
-use nacre_optics::{C64, Layer, Material, SpectralRule, Stack};
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// Cosines below this are evaluated at this value (θ → 90°, where every stack reflects
@@ -221,75 +218,6 @@ impl FilmLut {
     }
 }
 
-/// Everything needed to bake one film LUT.
-pub struct FilmLutJob {
-    /// Axes.
-    pub axes: FilmLutAxes,
-    /// Ambient medium (constant real index).
-    pub ambient: Material,
-    /// Fixed layers under the film, top first.
-    pub under: Vec<Layer>,
-    /// Base (substrate).
-    pub base: Material,
-    /// Colour conversion.
-    pub colorimeter: Colorimeter,
-    /// Whether to bake transmittance.
-    pub transmittance: bool,
-}
-
-impl FilmLutJob {
-    /// Bakes the table: rows of constant (cos θ, n) in parallel, each a thickness sweep
-    /// integrated spectrally; `progress` is called once per finished row.
-    pub fn bake(&self, progress: &(dyn Fn() + Sync)) -> Result<FilmLut> {
-        let a = &self.axes;
-        let under_opd: f64 = {
-            let probe = Stack::new(self.ambient.clone(), self.under.clone(), self.base.clone())?;
-            probe.max_opd_nm(None)
-        };
-        let rule = SpectralRule::new(&self.colorimeter, a.opd_max_nm() + under_opd);
-        let rows: Vec<(usize, usize)> = (0..a.ior_count)
-            .flat_map(|z| (0..a.cos_theta_count).map(move |x| (x, z)))
-            .collect();
-        let results: Vec<nacre_optics::FilmColours> = rows
-            .par_iter()
-            .map(|&(x, z)| {
-                let (cos_theta, _, n) = a.texel_parameters(x, 0, z);
-                let thicknesses: Vec<f64> = (0..a.opd_count)
-                    .map(|y| a.texel_parameters(x, y, z).1)
-                    .collect();
-                let film = Material::constant(format!("{n}"), C64::new(n, 0.0))?;
-                let mut layers = vec![Layer {
-                    material: film,
-                    thickness_nm: 0.0,
-                }];
-                layers.extend(self.under.iter().cloned());
-                let stack = Stack::new(self.ambient.clone(), layers, self.base.clone())?;
-                let angle_deg = cos_theta.acos().to_degrees();
-                let colours = stack.colours_over_thickness(1, angle_deg, &rule, &thicknesses)?;
-                progress();
-                Ok(colours)
-            })
-            .collect::<Result<_>>()?;
-        let mut reflectance = Table3::new(a.cos_theta_count, a.opd_count, a.ior_count);
-        let mut transmittance = self
-            .transmittance
-            .then(|| Table3::new(a.cos_theta_count, a.opd_count, a.ior_count));
-        for (&(x, z), colours) in rows.iter().zip(&results) {
-            for y in 0..a.opd_count {
-                reflectance.set(x, y, z, colours.reflectance[y].map(|v| v as f32));
-                if let Some(t) = transmittance.as_mut() {
-                    t.set(x, y, z, colours.transmittance[y].map(|v| v as f32));
-                }
-            }
-        }
-        Ok(FilmLut {
-            axes: a.clone(),
-            reflectance,
-            transmittance,
-        })
-    }
-}
-
 /// Checks the axes of a recipe; `context` names the recipe.
 pub fn validate_axes(axes: &FilmLutAxes, context: &str, max_texels: u64) -> Result<()> {
     let err = |message: String| Error::Invalid {
@@ -341,92 +269,4 @@ pub fn validate_axes(axes: &FilmLutAxes, context: &str, max_texels: u64) -> Resu
         });
     }
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn axes() -> FilmLutAxes {
-        FilmLutAxes {
-            cos_theta_count: 17,
-            opd_count: 33,
-            ior_count: 9,
-            thickness_min_nm: 0.0,
-            thickness_max_nm: 1200.0,
-            ior_min: 1.0,
-            ior_max: 2.5,
-            ambient_index: 1.0,
-        }
-    }
-
-    #[test]
-    fn forward_and_inverse_round_trip() {
-        let a = axes();
-        for &(c, d, n) in &[
-            (1.0, 0.0, 1.0),
-            (0.5, 300.0, 1.7),
-            (0.01, 1200.0, 2.5),
-            (0.9, 17.0, 1.2),
-        ] {
-            let t = a.forward(c, d, n);
-            let (c2, opd, n2) = a.inverse(t);
-            assert!((c2 - c).abs() < 1e-12 && (n2 - n).abs() < 1e-12);
-            assert!((opd - a.opd_nm(c, d, n)).abs() < 1e-9);
-        }
-        // Texel centres: t_i = i/(n−1) is sampled at u = (i + 0.5)/n.
-        for i in 0..17 {
-            let t = FilmLutAxes::texel_t(i, 17);
-            assert!(
-                (FilmLutAxes::texture_coordinate(t, 17) - (i as f64 + 0.5) / 17.0).abs() < 1e-15
-            );
-        }
-        // Texel parameters map back to their own t.
-        for (x, y, z) in [(0, 0, 0), (16, 32, 8), (3, 7, 5)] {
-            let (c, d, n) = a.texel_parameters(x, y, z);
-            let t = a.forward(c, d, n);
-            let want = [
-                FilmLutAxes::texel_t(x, 17),
-                FilmLutAxes::texel_t(y, 33),
-                FilmLutAxes::texel_t(z, 9),
-            ];
-            for k in 0..3 {
-                // x = 0 is evaluated at cos θ = 1e-6 (t = 1e-3).
-                assert!(
-                    (t[k] - want[k]).abs() < 2e-3,
-                    "{x},{y},{z}: {t:?} vs {want:?}"
-                );
-                if x > 0 {
-                    assert!(
-                        (t[k] - want[k]).abs() < 1e-12,
-                        "{x},{y},{z}: {t:?} vs {want:?}"
-                    );
-                }
-            }
-        }
-    }
-
-    #[test]
-    fn lookup_is_exact_at_texels_and_linear_between() {
-        let a = axes();
-        let mut table = Table3::new(17, 33, 9);
-        for z in 0..9 {
-            for y in 0..33 {
-                for x in 0..17 {
-                    let v = (x + 100 * y + 10_000 * z) as f32;
-                    table.set(x, y, z, [v, 2.0 * v, -v]);
-                }
-            }
-        }
-        let (c, d, n) = a.inverse([0.5, 0.25, 0.5]);
-        let d = d / (2.0 * (n * n - (1.0 - c * c)).sqrt());
-        let v = FilmLut::lookup(&a, &table, c, d, n);
-        assert!((v[0] - (8.0 + 800.0 + 40_000.0)).abs() < 1e-6, "{v:?}");
-        // Half-way between texels x = 8 and 9 (t = 8.5/16) in the t domain.
-        let tx: f64 = 8.5 / 16.0;
-        let (c, _, n) = a.inverse([tx, 0.25, 0.5]);
-        let d = 0.25 * a.opd_max_nm() / a.opd_nm(c, 1.0, n);
-        let v = FilmLut::lookup(&a, &table, c, d, n);
-        assert!((v[0] - (8.5 + 800.0 + 40_000.0)).abs() < 1e-6, "{v:?}");
-    }
 }

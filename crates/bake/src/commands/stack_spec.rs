@@ -18,8 +18,9 @@
 //! Relative material paths are resolved from the recipe's folder. Unknown keys are errors.
 
 use crate::error::{Error, Result};
-use crate::grid::parse_thickness_nm;
-use crate::materials::resolve;
+use crate::recipe::{line_of, toml_error};
+use crate::commands::grid::parse_thickness_nm;
+use nacre_format::materials::resolve;
 use nacre_optics::{Layer, Stack};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -152,24 +153,6 @@ pub struct StackRecipe {
     pub angles: Option<String>,
     /// `wavelengths` range text, if given.
     pub wavelengths: Option<String>,
-}
-
-/// 1-based line of byte offset `at` in `text`.
-pub fn line_of(text: &str, at: usize) -> usize {
-    text.as_bytes()[..at.min(text.len())]
-        .iter()
-        .filter(|&&b| b == b'\n')
-        .count()
-        + 1
-}
-
-/// Converts a `toml` error into a recipe error with its line.
-pub fn toml_error(path: &Path, text: &str, e: &toml::de::Error) -> Error {
-    Error::Recipe {
-        path: path.to_path_buf(),
-        line: e.span().map_or(1, |s| line_of(text, s.start)),
-        message: e.message().trim().to_string(),
-    }
 }
 
 impl StackRecipe {

@@ -6,7 +6,7 @@
 //! factor), and absorptance A = 1 − R − T. One row per (angle, wavelength), angle-major.
 
 use crate::error::{Error, Result};
-use crate::grid::MAX_AXIS_SAMPLES;
+use crate::commands::grid::MAX_AXIS_SAMPLES;
 use nacre_optics::{Power, Stack};
 use std::io::Write;
 

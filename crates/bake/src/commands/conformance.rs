@@ -5,11 +5,11 @@
 //! thickness 0–1200 nm (`iridescenceThicknessMinimum`/`Maximum`), dielectric bases of index
 //! 1.0–2.5 (`KHR_materials_ior`) and four metals, incidence 0–89° — the exact colour of
 //! the unpolarised reflectance of ambient 1.0 | film | base, integrated with the `spectral`
-//! method ([`crate::color::Method::Spectral`]), as XYZ (CIE 1931 2°, D65, perfect
+//! method ([`crate::commands::color::Method::Spectral`]), as XYZ (CIE 1931 2°, D65, perfect
 //! reflector Y = 1) and linear sRGB. Beside it, the glTF reference approximation
-//! ([`crate::color::Method::GaussianFitBelcour2017`]) at every point with its ΔE2000, and
+//! ([`crate::commands::color::Method::GaussianFitBelcour2017`]) at every point with its ΔE2000, and
 //! swatch charts. [`Conformance::files`] renders every file in memory; the CLI writes them
-//! with [`crate::output::write_files_atomic`].
+//! with [`nacre_format::atomic::write_files_atomic`].
 //!
 //! Three grids ([`GridSize`]); each is a subset of the next larger one, so that the
 //! `quick` rows of a run are byte-identical to the same rows of the committed default set:
@@ -20,10 +20,10 @@
 //! | default | 0–80 step 10, 85, 89 | 0–1200 step 25 | 1.0, 1.2, 1.3, 1.4, 1.5, 1.6, 1.8, 2.0, 2.333 | 48 510 |
 //! | fine | 0–85 step 5, 89 | 0–1200 step 12.5 | 1.0–1.8 step 0.1, 2.0, 2.333 | 202 730 |
 
-use crate::color::{self, Method, Point, Quantity};
+use crate::commands::color::{self, Method, Point, Quantity};
 use crate::error::{Error, Result};
-use crate::output::write_files_atomic;
-use crate::spectrum::fmt_sig;
+use nacre_format::atomic::write_files_atomic;
+use crate::commands::spectrum::fmt_sig;
 use nacre_optics::colour::{Colorimeter, Illuminant, Observer, OutputSpace, RgbSpace};
 use nacre_optics::colour::{delta_e_2000, xyz_to_lab};
 use nacre_optics::fourier::gltf_iridescence;
@@ -263,7 +263,7 @@ pub fn compute(grid: Grid) -> Result<Conformance> {
     let mut bases = Vec::with_capacity(BASES.len());
     for base in BASES {
         let context = format!("conformance base `{}`", base.label);
-        let material = crate::materials::resolve(base.label, &context, None)?;
+        let material = nacre_format::materials::resolve(base.label, &context, None)?;
         let stack = Stack::new(
             air.clone(),
             vec![Layer {
@@ -398,7 +398,7 @@ impl Conformance {
     /// each of [`SWATCH_ANGLES_DEG`]), thickness rows (0 at the top) × film-index columns,
     /// sRGB-encoded with each channel clipped to [0, 1].
     fn swatch_png(&self, b: &BaseResult, name: &str) -> Result<Vec<u8>> {
-        static FONT: &[u8] = include_bytes!("../../../tables/fonts/DejaVuSans.ttf");
+        static FONT: &[u8] = include_bytes!("../../../../tables/fonts/DejaVuSans.ttf");
         // Registering twice is harmless; a failure only means no text.
         let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
         let g = &self.grid;
@@ -844,7 +844,7 @@ mod tests {
             .iter()
             .filter(|b| ["1.5", "au", "1"].contains(&b.base.label))
         {
-            let base = crate::materials::resolve(b.base.label, "test", None).unwrap();
+            let base = nacre_format::materials::resolve(b.base.label, "test", None).unwrap();
             let stack = color::film_stack(
                 Material::constant("1.0", C64::new(1.0, 0.0)).unwrap(),
                 Material::constant("1.0", C64::new(1.0, 0.0)).unwrap(),

@@ -34,14 +34,15 @@
 //!   is drawn thick and black. Line style tells polarisation (solid: unpolarised,
 //!   dashed: s, dotted: p) or gamut (sRGB solid, Display P3 dashed, Rec. 2020 dotted).
 
-use crate::bake::{Manifest, default_baked_dir, resolve_table};
-use crate::color::{LoadedLut, Quantity};
+use nacre_format::Manifest;
+use nacre_format::set::{default_baked_dir, resolve_table};
+use crate::commands::color::{LoadedLut, Quantity};
 use crate::error::{Error, Result};
-use crate::film_lut::{FilmLut, FilmLutAxes, MIN_COS_THETA};
-use crate::fourier_table::FourierTable;
-use crate::grid::parse_range;
-use crate::output::write_atomic;
-use crate::table_io::Table3;
+use nacre_format::film_lut::{FilmLut, FilmLutAxes, MIN_COS_THETA};
+use nacre_format::fourier::FourierTable;
+use crate::commands::grid::parse_range;
+use nacre_format::atomic::write_atomic;
+use nacre_format::table_io::Table3;
 use nacre_optics::Stack;
 use nacre_optics::colour::{Colorimeter, Observer, OutputSpace, RgbSpace, xy_to_xyz, xyz_to_xy};
 use plotters::coord::Shift;
@@ -65,7 +66,7 @@ pub const MAX_CHART_CELLS: (usize, usize) = (400, 40);
 pub const MAX_SLICES: usize = 8;
 
 /// The font every figure uses (registered as `sans-serif`).
-static FONT: &[u8] = include_bytes!("../../../tables/fonts/DejaVuSans.ttf");
+static FONT: &[u8] = include_bytes!("../../../../tables/fonts/DejaVuSans.ttf");
 
 /// What a figure's `draw` returns: plotters' error of the backend in use.
 pub type DrawResult<DB> =
@@ -170,7 +171,7 @@ pub fn render(figure: &impl Figure, format: ImageFormat) -> Result<Vec<u8>> {
 pub fn write_figure(path: &Path, figure: &impl Figure) -> Result<()> {
     let format = ImageFormat::from_path(path)?;
     let bytes = render(figure, format)?;
-    write_atomic(path, |w| w.write_all(&bytes))
+    Ok(write_atomic(path, |w| w.write_all(&bytes))?)
 }
 
 // ---------------------------------------------------------------------------------------
@@ -583,7 +584,7 @@ pub enum SpectrumQuantity {
 }
 
 impl SpectrumQuantity {
-    /// In the column order of [`crate::spectrum::HEADER`] (after the angle and wavelength).
+    /// In the column order of [`crate::commands::spectrum::HEADER`] (after the angle and wavelength).
     pub const ALL: [SpectrumQuantity; 7] = [
         SpectrumQuantity::Rs,
         SpectrumQuantity::Rp,
@@ -666,7 +667,7 @@ pub fn spectrum_curves(
     angles_deg: &[f64],
     wavelengths_nm: &[f64],
 ) -> Result<Vec<SpectrumCurve>> {
-    let powers = crate::spectrum::compute(stack, angles_deg, wavelengths_nm)?;
+    let powers = crate::commands::spectrum::compute(stack, angles_deg, wavelengths_nm)?;
     Ok(angles_deg
         .iter()
         .zip(powers.chunks(wavelengths_nm.len().max(1)))
@@ -681,7 +682,7 @@ pub fn spectrum_curves(
         .collect())
 }
 
-/// Reads a `nacre spectrum` CSV (header [`crate::spectrum::HEADER`], then 9 numbers a
+/// Reads a `nacre spectrum` CSV (header [`crate::commands::spectrum::HEADER`], then 9 numbers a
 /// row; blank lines and `#` comments skipped) into one curve per angle, in the order the
 /// angles first appear, each sorted by wavelength. Errors name `path` and the line.
 pub fn read_spectrum_csv(path: &Path, text: &str) -> Result<Vec<SpectrumCurve>> {
@@ -690,7 +691,7 @@ pub fn read_spectrum_csv(path: &Path, text: &str) -> Result<Vec<SpectrumCurve>> 
         line,
         message,
     };
-    let names: Vec<&str> = crate::spectrum::HEADER.split(',').collect();
+    let names: Vec<&str> = crate::commands::spectrum::HEADER.split(',').collect();
     let mut header = false;
     let mut curves: Vec<SpectrumCurve> = Vec::new();
     for (i, raw) in text.lines().enumerate() {
@@ -705,7 +706,7 @@ pub fn read_spectrum_csv(path: &Path, text: &str) -> Result<Vec<SpectrumCurve>> 
                     i + 1,
                     format!(
                         "expected the `nacre spectrum` header `{}`, found `{line}`",
-                        crate::spectrum::HEADER
+                        crate::commands::spectrum::HEADER
                     ),
                 ));
             }
@@ -761,7 +762,7 @@ pub fn read_spectrum_csv(path: &Path, text: &str) -> Result<Vec<SpectrumCurve>> 
             1,
             format!(
                 "empty: expected the `nacre spectrum` header `{}`",
-                crate::spectrum::HEADER
+                crate::commands::spectrum::HEADER
             ),
         ));
     }
@@ -1745,7 +1746,7 @@ pub fn load_table_plot(name_or_path: &str, options: &TableOptions) -> Result<Tab
         });
     }
     let manifest = Manifest::read(&path)?;
-    if manifest.fourier.is_some() {
+    if manifest.fourier().is_some() {
         let table = manifest.load_fourier(&path)?;
         let colorimeter = manifest.colorimeter(&path)?;
         let max_opd_nm = match options.max_opd_nm {
@@ -1770,7 +1771,7 @@ pub fn load_table_plot(name_or_path: &str, options: &TableOptions) -> Result<Tab
         })));
     }
     let lut = LoadedLut::load(&path)?;
-    let axes = lut.manifest.film_lut.clone().expect("checked by LoadedLut");
+    let axes = lut.manifest.film_lut().cloned().expect("checked by LoadedLut");
     let (table, what) = match options.quantity {
         Quantity::Reflectance => (lut.reflectance, "reflectance"),
         Quantity::Transmittance => (
@@ -1920,7 +1921,7 @@ mod tests {
         let path = Path::new("s.csv");
         let good = format!(
             "{}\n0,400,0.1,0.1,0.1,0.9,0.9,0.9,0\n",
-            crate::spectrum::HEADER
+            crate::commands::spectrum::HEADER
         );
         let curves = read_spectrum_csv(path, &good).unwrap();
         assert_eq!(curves.len(), 1);
@@ -1931,7 +1932,7 @@ mod tests {
             (format!("\n{good}0,410,0.1\n"), 4),
             (format!("{good}95,410,0.1,0.1,0.1,0.9,0.9,0.9,0\n"), 3),
             (String::new(), 1),
-            (format!("{}\n", crate::spectrum::HEADER), 1),
+            (format!("{}\n", crate::commands::spectrum::HEADER), 1),
         ] {
             let e = read_spectrum_csv(path, &text).unwrap_err().to_string();
             assert!(e.starts_with(&format!("s.csv:{line}: ")), "{e}");

@@ -4,10 +4,11 @@
 //!
 //! A missing adapter fails these tests: they never skip.
 
-use nacre_bake::bake::{Manifest, default_baked_dir};
-use nacre_bake::color::{self, Method, Point, Quantity};
-use nacre_bake::film_lut::FilmLut;
-use nacre_bake::materials;
+use nacre_format::Manifest;
+use nacre_format::set::default_baked_dir;
+use nacre_bake::commands::color::{self, Method, Point, Quantity};
+use nacre_format::film_lut::FilmLut;
+use nacre_format::materials;
 use nacre_optics::fourier::Harmonics;
 use nacre_optics::{C64, Material};
 use nacre_runtime::bindings::{SpectralSetup, TechniqueBinding, TechniqueOptions};
@@ -15,6 +16,7 @@ use nacre_runtime::probe::run_probe;
 use nacre_runtime::{FilmInput, TableSet, Technique};
 use std::sync::Arc;
 
+#[path = "../../crates/runtime/tests/support/mod.rs"]
 mod support;
 use support::ctx;
 
@@ -67,7 +69,7 @@ fn film_lut_matches_the_cpu_lookup() {
         let path = manifest(name);
         let tables = TableSet::load(ctx, &path).unwrap();
         let m = Manifest::read(&path).unwrap();
-        let axes = m.film_lut.clone().unwrap();
+        let axes = m.film_lut().cloned().unwrap();
         let refl = m.load_table(&path, "reflectance").unwrap().unwrap();
         let trans = m.load_table(&path, "transmittance").unwrap();
         let binding = TechniqueBinding::new(

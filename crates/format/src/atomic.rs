@@ -185,7 +185,7 @@ impl StagedTable {
     /// As [`StagedTable::commit`]; [`Error::Io`] when the manifest cannot be written.
     pub fn commit_manifest(
         self,
-        manifest: &crate::bake::Manifest,
+        manifest: &crate::manifest::Manifest,
         stale: &[String],
     ) -> Result<std::path::PathBuf> {
         let name = format!("{}.json", manifest.name);

@@ -48,8 +48,8 @@
 //! truncated or malformed file is an [`Error::Table`] naming the file, never a panic.
 
 use crate::error::{Error, Result};
-use crate::fourier_table::{FourierAxes, FourierTable};
-use crate::output::write_atomic;
+use crate::fourier::{FourierAxes, FourierTable};
+use crate::atomic::write_atomic;
 use crate::table_io::{MAX_TEXELS, Table3};
 use half::f16;
 use nacre_optics::C64;

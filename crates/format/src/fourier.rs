@@ -35,9 +35,8 @@
 use crate::error::{Error, Result};
 use crate::table_io::{self, Precision, Table3};
 use nacre_optics::C64;
-use nacre_optics::colour::Colorimeter;
 use nacre_optics::fourier::SensitivitySpectrum;
-use rayon::prelude::*;
+use nacre_optics::colour::Colorimeter;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 use std::path::Path;
@@ -109,33 +108,6 @@ pub struct FourierTable {
 }
 
 impl FourierTable {
-    /// Computes every level (texels in parallel; each texel independent, so the result
-    /// does not depend on the thread count).
-    pub fn bake(colorimeter: &Colorimeter, axes: FourierAxes) -> Self {
-        let spectrum = SensitivitySpectrum::new(colorimeter);
-        let levels = axes
-            .level_samples
-            .iter()
-            .zip(&axes.level_sigma_nm)
-            .map(|(&n, &sigma)| {
-                (0..n)
-                    .into_par_iter()
-                    .map(|i| {
-                        let mu = (i as f64 + 0.5) * axes.max_opd_nm / n as f64;
-                        let s = spectrum.transform(mu, sigma);
-                        std::array::from_fn(|j| {
-                            let a = s[j]
-                                * C64::from_polar(1.0, 2.0 * PI * mu * axes.carrier_nu_per_nm[j]);
-                            // Stored as f32: round here so that CPU lookups see the file's values.
-                            C64::new(f64::from(a.re as f32), f64::from(a.im as f32))
-                        })
-                    })
-                    .collect()
-            })
-            .collect();
-        FourierTable { axes, levels }
-    }
-
     /// Ŝ_j(μ) prefiltered at σ_μ, sampled exactly as a GPU sampler with linear filtering
     /// between texels and levels and clamp-to-edge addressing (module docs).
     pub fn sample(&self, mu_nm: f64, sigma_mu_nm: f64) -> [C64; 3] {
@@ -209,37 +181,3 @@ impl FourierTable {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use nacre_optics::colour::{Illuminant, Observer, OutputSpace, RgbSpace};
-
-    #[test]
-    fn sampled_transform_matches_the_exact_one() {
-        let c = Colorimeter::new(
-            Observer::Cie1931_2Deg,
-            Illuminant::D65,
-            OutputSpace::Rgb(RgbSpace::Srgb),
-        );
-        let table = FourierTable::bake(&c, FourierAxes::new(&c, 8192, 160_000.0, 8));
-        let spectrum = SensitivitySpectrum::new(&c);
-        let mut worst: f64 = 0.0;
-        for k in 0..400 {
-            let mu = 37.3 + 123.7 * k as f64;
-            let (a, b) = (table.sample(mu, 0.0), spectrum.transform(mu, 0.0));
-            for j in 0..3 {
-                worst = worst.max((a[j] - b[j]).norm());
-            }
-        }
-        assert!(worst < 2e-4, "{worst:e}");
-        // At a level's own σ the level is exact up to interpolation.
-        let sigma = table.axes.level_sigma_nm[3];
-        let (a, b) = (
-            table.sample(5000.0, sigma),
-            spectrum.transform(5000.0, sigma),
-        );
-        for j in 0..3 {
-            assert!((a[j] - b[j]).norm() < 2e-4, "{a:?} {b:?}");
-        }
-    }
-}

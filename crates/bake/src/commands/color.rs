@@ -5,7 +5,7 @@
 //! * `spectral` — the reference: exact spectral integration ([`nacre_optics::SpectralRule`],
 //!   within ΔE2000 0.01 of a 0.1 nm integration for films up to 10 µm);
 //! * `lut:NAME|PATH` — a baked `film-lut` table, with the trilinear interpolation the GPU
-//!   uses ([`crate::film_lut::FilmLut::lookup`]); the table must have been baked for the
+//!   uses ([`nacre_format::film_lut::FilmLut::lookup`]); the table must have been baked for the
 //!   same ambient, base and fixed layers, and its colour settings are used;
 //! * `rgb3` — one wavelength per channel (R at 650, 510 and 475 nm, taken as linear RGB of
 //!   the output space): the common real-time shortcut;
@@ -19,7 +19,7 @@
 //!   thickness distribution of standard deviation SIGMA_NM (one film on a base; reflectance);
 //! * `rough-lut:NAME|PATH` (with a roughness α) — the directional albedo of the rough
 //!   (GGX) iridescent lobe from a baked `rough-film-lut` table, looked up as the shader does
-//!   ([`crate::rough_lut::RoughFilmLut::lookup`]); `rough-mc[:N]` — the Monte Carlo reference
+//!   ([`nacre_format::rough_film_lut::RoughFilmLut::lookup`]); `rough-mc[:N]` — the Monte Carlo reference
 //!   for the same albedo ([`nacre_optics::microfacet::directional_albedo_with`], N
 //!   visible-normal samples per point, default [`ROUGH_MC_SAMPLES`], seed = the point's index);
 //! * `gaussian` — the Gaussian-fit closed form with Schlick Fresnel and m ≤ 2 of glTF's
@@ -30,12 +30,13 @@
 //! with a perfect reflector at Y = 1; R, G, B linear in the output space, equal to X, Y, Z
 //! for `--space xyz`).
 
-use crate::bake::{Manifest, resolve_table};
+use nacre_format::Manifest;
+use nacre_format::set::resolve_table;
 use crate::error::{Error, Result};
-use crate::film_lut::FilmLut;
-use crate::fourier_table::FourierTable;
-use crate::spectrum::fmt_sig;
-use crate::table_io::Table3;
+use nacre_format::film_lut::FilmLut;
+use nacre_format::fourier::FourierTable;
+use crate::commands::spectrum::fmt_sig;
+use nacre_format::table_io::Table3;
 use nacre_optics::colour::{Colorimeter, OutputSpace, RgbSpace};
 use nacre_optics::fourier::{FilmOnBase, Harmonics, gltf_iridescence};
 use nacre_optics::{C64, Layer, Material, SpectralRule, Stack};
@@ -97,7 +98,7 @@ pub enum Method {
 }
 
 /// A loaded `rough-film-lut` table.
-pub type RoughTable = crate::rough_lut::LoadedRoughLut;
+pub type RoughTable = nacre_format::rough_film_lut::LoadedRoughLut;
 
 impl Method {
     /// True for the methods that need a roughness (`rough-lut:`, `rough-mc`).
@@ -373,7 +374,7 @@ impl LoadedLut {
     /// Loads a table through its manifest.
     pub fn load(path: &Path) -> Result<Self> {
         let manifest = Manifest::read(path)?;
-        if manifest.film_lut.is_none() {
+        if manifest.film_lut().is_none() {
             return Err(Error::Invalid {
                 context: path.display().to_string(),
                 message: format!(
@@ -438,7 +439,7 @@ impl LoadedLut {
         };
         let cos_theta = point.angle_deg.to_radians().cos();
         Ok(FilmLut::lookup(
-            self.manifest.film_lut.as_ref().expect("checked at load"),
+            self.manifest.film_lut().expect("checked at load"),
             table,
             cos_theta,
             d,
@@ -458,7 +459,7 @@ pub fn check_stack_matches(m: &Manifest, path: &Path, stack: &Stack, method: &st
     };
     let base_dir = path.parent();
     let same = |a: &Material, spec: &str| -> Result<bool> {
-        let b = crate::materials::resolve(spec, &context, base_dir)?;
+        let b = nacre_format::materials::resolve(spec, &context, base_dir)?;
         Ok((0..=20).all(|i| {
             let wl = 380.0 + 20.0 * f64::from(i);
             match (a.index_at(wl), b.index_at(wl)) {
@@ -633,7 +634,7 @@ pub fn evaluate(
                             })?
                         }
                     };
-                    Ok(crate::rough_lut::RoughFilmLut::lookup(
+                    Ok(nacre_format::rough_film_lut::RoughFilmLut::lookup(
                         &t.lut.axes,
                         table,
                         point.angle_deg.to_radians().cos(),

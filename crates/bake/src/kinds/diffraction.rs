@@ -1,6 +1,6 @@
 //! Diffraction gratings: height-field sources (files and synthetic specs), the table kind
 //! `diffraction` (layout "terms" here, layout "integrated" in
-//! [`crate::diffraction_integrated`]), and the CPU evaluation behind `nacre diffraction`.
+//! [`crate::kinds::diffraction_integrated`]), and the CPU evaluation behind `nacre diffraction`.
 //! The physics is [`nacre_optics::diffraction`] (Stam 1999; Dhillon et al. 2014).
 //!
 //! # Height-field sources
@@ -29,7 +29,7 @@
 //! pitch_um = 0.125                # required with `file`; synthetic: optional
 //! height_scale_um = 0.1           # `file` only: full scale of a PNG, multiplier of EXR/CSV
 //! [diffraction]
-//! layout = "terms"                # or "integrated" (crate::diffraction_integrated)
+//! layout = "terms"                # or "integrated" (crate::kinds::diffraction_integrated)
 //! coherence_diameter_um = 65.0    # 4σ_s; default 65 (Dhillon et al. 2014)
 //! wavelengths = "380:780:5"       # range (and colour step) the table serves
 //! max_angle_deg = 45.0            # light and view polar angles the table serves
@@ -52,13 +52,15 @@
 //! ([`nacre_optics::diffraction::SpectralGrid`]). The layout "integrated" (the
 //! wavelength-integrated fast path, `layout = "integrated"` with the keys
 //! `integrated_samples`, `integrated_gamma`, `integrated_tolerance`) is documented in
-//! [`crate::diffraction_integrated`].
+//! [`crate::kinds::diffraction_integrated`].
 
-use crate::bake::{AxisRecord, FileRecord, Manifest};
+use crate::kinds::{KindEntry, TableRecipe};
+use crate::recipe::{RawColour, line_of, parse_colour, table_name, toml_error};
+use nacre_format::diffraction::{DiffractionRecord, SIGN_CONVENTION};
+use nacre_format::manifest::{AxisRecord, Encoding, FileFormat, FileRecord, KindRecord, Manifest, TableKind};
 use crate::error::{Error, Result};
-use crate::spectrum::fmt_sig;
-use crate::stack_spec::{line_of, toml_error};
-use crate::table_io::{self, Precision, Table3};
+use crate::commands::spectrum::fmt_sig;
+use nacre_format::table_io::{self, Precision, Table3};
 use nacre_optics::C64;
 use nacre_optics::colour::Colorimeter;
 use nacre_optics::diffraction::{
@@ -71,8 +73,6 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
-/// The sign convention recorded in manifests and printed by the CLI.
-pub const SIGN_CONVENTION: &str = "P(ku, kv) = ∬ exp(+i k (u x + v y + w h(x, y))) dx dy with (u, v, w) = −ω_i − ω_r (ω_i towards the light, ω_r towards the viewer; time dependence exp(−iωt)); T_n[j] = (1/M) Σ_m (i h_m)^n exp(+i κ_j·x_m), κ_j = 2π j / L; P_j = Σ_n (k w)^n / n! T_n[j]; x runs across the grating lines";
 
 /// Largest pitch the automatic sampling of synthetic specs uses, µm: the Nyquist limit of
 /// 380 nm light at |u| = 2 is 0.095 µm.
@@ -528,58 +528,6 @@ impl HeightSource {
     }
 }
 
-/// Everything a `diffraction` manifest records about the table (beside the common fields).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct DiffractionRecord {
-    /// `terms` or `integrated`.
-    pub layout: String,
-    /// The height field: a synthetic spec or the file name as written in the recipe.
-    pub source: String,
-    /// Samples (bins) along x.
-    pub nx: usize,
-    /// Samples (bins) along y.
-    pub ny: usize,
-    /// Sample spacing Δ, µm.
-    pub pitch_um: f64,
-    /// Patch size (Lₓ, L_y), µm.
-    pub patch_um: [f64; 2],
-    /// The mean height removed (a global phase), µm.
-    pub mean_removed_um: f64,
-    /// Largest |h| after removing the mean, µm.
-    pub max_abs_height_um: f64,
-    /// Coherence diameter 4σ_s, µm.
-    pub coherence_diameter_um: f64,
-    /// σ_s, µm.
-    pub sigma_s_um: f64,
-    /// Shortest wavelength served, nm.
-    pub wavelength_min_nm: f64,
-    /// Longest wavelength served, nm.
-    pub wavelength_max_nm: f64,
-    /// Wavelength step of the colour sums, nm.
-    pub wavelength_step_nm: f64,
-    /// Largest polar angle of light and view served, degrees.
-    pub max_angle_deg: f64,
-    /// 2 sin(max_angle): the largest |u|, |v|.
-    pub max_uv: f64,
-    /// Taylor order N (terms T₀ … T_N).
-    pub taylor_order: usize,
-    /// Tolerance asked for on the remainder bound.
-    pub taylor_tolerance: f64,
-    /// max |k w h| at the shortest wavelength with |w| ≤ 2.
-    pub max_phase: f64,
-    /// The remainder bound |kwh|^{N+1}/(N+1)! at max_phase.
-    pub taylor_bound: f64,
-    /// Bound on the error of the Taylor sum from storing Tₙ as f32: 2⁻²⁴ e^{max_phase}.
-    pub f32_rounding_bound: f64,
-    /// Texel of the DC bin, (⌊Mₓ/2⌋, ⌊M_y/2⌋).
-    pub dc_texel: [usize; 2],
-    /// [`SIGN_CONVENTION`].
-    pub sign_convention: String,
-    /// Layout "integrated" only: its axes, settings and measured reconstruction error
-    /// ([`crate::diffraction_integrated`]).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub integrated: Option<crate::diffraction_integrated::IntegratedRecord>,
-}
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -721,7 +669,7 @@ impl DiffractionRecipe {
             Some(s) => (format!("{} wavelengths", at(s.span())), s.get_ref().clone()),
             None => ("wavelengths".into(), "380:780:5".into()),
         };
-        let wavelengths = crate::grid::parse_range(&wl_context, &wl_text)?;
+        let wavelengths = crate::commands::grid::parse_range(&wl_context, &wl_text)?;
         SpectralGrid::new(&colorimeter, &wavelengths).map_err(|source| Error::OpticsIn {
             context: wl_context.clone(),
             source,
@@ -816,7 +764,7 @@ impl DiffractionRecipe {
             source,
         })?;
         if integrated_layout {
-            let settings = crate::diffraction_integrated::IntegratedSettings::parse(
+            let settings = crate::kinds::diffraction_integrated::IntegratedSettings::parse(
                 &bad,
                 d.integrated_samples.as_ref(),
                 d.integrated_gamma.as_ref(),
@@ -848,17 +796,17 @@ impl DiffractionRecipe {
     }
 
     /// Computes the terms and writes `NAME.terms.exr`, `NAME.terms.ktx2` and `NAME.json`
-    /// (layout "integrated": [`crate::diffraction_integrated::bake`]); returns the
+    /// (layout "integrated": [`crate::kinds::diffraction_integrated::bake`]); returns the
     /// manifest path.
     pub fn bake(&self, out_dir: &Path, progress: &(dyn Fn() + Sync)) -> Result<PathBuf> {
         if self.record.integrated.is_some() {
-            return crate::diffraction_integrated::bake(self, out_dir, progress);
+            return crate::kinds::diffraction_integrated::bake(self, out_dir, progress);
         }
         let terms = TaylorTerms::compute(&self.field, self.record.taylor_order);
         progress();
         // Every file goes to a staging folder first; `commit` moves them into `out_dir`,
-        // the manifest last (crate::output::StagedTable).
-        let stage = crate::output::StagedTable::new(out_dir)?;
+        // the manifest last (nacre_format::atomic::StagedTable).
+        let stage = nacre_format::atomic::StagedTable::new(out_dir)?;
         let out_dir = stage.path();
         let r = &self.record;
         let c = &self.colorimeter;
@@ -900,7 +848,6 @@ impl DiffractionRecipe {
                     inverse: "n".into(),
                 },
             ],
-            diffraction: Some(r.clone()),
             texel_centres: "texel (s, t) holds the DFT bin of frequency kappa = 2 pi (s - floor(nx/2), t - floor(ny/2)) / L exactly (integer texel loads; no filtering)".into(),
             atlas: format!(
                 "EXR: width nx = {}, height ny * (N + 1) = {} * {}; term n occupies rows [n ny, (n + 1) ny), R = Re T_n, G = Im T_n, B = 0, full float. KTX2: 2-D array RGBA32F texture nx x ny with ceil((N + 1) / 2) = {} layers, layer l = (Re T_2l, Im T_2l, Re T_2l+1, Im T_2l+1), zero beyond T_N",
@@ -912,7 +859,7 @@ impl DiffractionRecipe {
             ),
             files: Vec::new(),
             ..Manifest::for_recipe(
-                "diffraction",
+                KindRecord::Diffraction(Box::new(r.clone())),
                 &self.name,
                 &self.description,
                 &self.path,
@@ -932,9 +879,9 @@ impl DiffractionRecipe {
         table_io::write_exr(&out_dir.join(&exr), &table, Precision::Float)?;
         let mut files = vec![FileRecord {
             quantity: "terms".into(),
-            format: "exr".into(),
+            format: FileFormat::Exr,
             path: exr.clone(),
-            encoding: "float".into(),
+            encoding: Encoding::Float,
             channels: vec!["R".into(), "G".into(), "B".into()],
             width: r.nx,
             height: r.ny * layers,
@@ -942,19 +889,19 @@ impl DiffractionRecipe {
         }];
         let ktx2 = format!("{}.terms.ktx2", self.name);
         let ktx2_path = out_dir.join(&ktx2);
-        crate::ktx2::write_ktx2(&ktx2_path, &terms_image(&layer_data, r.nx, r.ny, &embedded))?;
+        nacre_format::ktx2::write_ktx2(&ktx2_path, &terms_image(&layer_data, r.nx, r.ny, &embedded))?;
         files.push(FileRecord {
             quantity: "terms".into(),
-            format: "ktx2".into(),
+            format: FileFormat::Ktx2,
             path: ktx2,
-            encoding: "float".into(),
+            encoding: Encoding::Float,
             channels: vec!["R".into(), "G".into(), "B".into(), "A".into()],
             width: r.nx,
             height: r.ny,
             sha256: table_io::sha256_hex(&ktx2_path)?,
         });
         manifest.files = files;
-        stage.commit_manifest(&manifest, &[])
+        Ok(stage.commit_manifest(&manifest, &[])?)
     }
 }
 
@@ -964,7 +911,7 @@ fn terms_image(
     nx: usize,
     ny: usize,
     manifest_json: &str,
-) -> crate::ktx2::Ktx2Image {
+) -> nacre_format::ktx2::Ktx2Image {
     let pairs = layers.len().div_ceil(2);
     let mut level = Vec::with_capacity(pairs * nx * ny * 16);
     for l in 0..pairs {
@@ -981,8 +928,8 @@ fn terms_image(
         v.push(0);
         v
     };
-    crate::ktx2::Ktx2Image {
-        format: crate::ktx2::Ktx2Format::Rgba32Float,
+    nacre_format::ktx2::Ktx2Image {
+        format: nacre_format::ktx2::Ktx2Format::Rgba32Float,
         width: nx as u32,
         height: ny as u32,
         depth: 0,
@@ -990,10 +937,10 @@ fn terms_image(
         levels: vec![level],
         key_values: vec![
             (
-                crate::ktx2::WRITER_KEY.into(),
+                nacre_format::ktx2::WRITER_KEY.into(),
                 nul(&format!("nacre {}", env!("CARGO_PKG_VERSION"))),
             ),
-            (crate::ktx2::MANIFEST_KEY.into(), nul(manifest_json)),
+            (nacre_format::ktx2::MANIFEST_KEY.into(), nul(manifest_json)),
         ],
     }
 }
@@ -1062,92 +1009,6 @@ pub fn plan(
     })
 }
 
-impl Manifest {
-    /// Loads the Taylor terms of a `diffraction` table (from its EXR file, else its KTX2
-    /// file) as stored (f32 values).
-    pub fn load_diffraction(
-        &self,
-        manifest_path: &Path,
-    ) -> Result<(DiffractionRecord, TaylorTerms)> {
-        let r = self.diffraction.clone().ok_or_else(|| Error::Invalid {
-            context: manifest_path.display().to_string(),
-            message: format!(
-                "table `{}` is a `{}` table, not a diffraction table",
-                self.name, self.kind
-            ),
-        })?;
-        if r.layout != "terms" {
-            return Err(Error::Invalid {
-                context: manifest_path.display().to_string(),
-                message: format!(
-                    "diffraction table `{}` has the layout \"{}\", which stores colours summed over wavelengths, not the Taylor terms",
-                    self.name, r.layout
-                ),
-            });
-        }
-        let dir = manifest_path.parent().unwrap_or(Path::new("."));
-        let layers = r.taylor_order + 1;
-        let find = |format: &str| {
-            self.files
-                .iter()
-                .find(|f| f.quantity == "terms" && f.format == format)
-        };
-        let mut terms = vec![vec![C64::new(0.0, 0.0); r.nx * r.ny]; layers];
-        if let Some(f) = find("exr") {
-            let (t, _) = table_io::read_exr_table(&dir.join(&f.path), r.nx, r.ny, layers)?;
-            for (n, layer) in terms.iter_mut().enumerate() {
-                for (i, v) in layer.iter_mut().enumerate() {
-                    let [re, im, _] = t.texel(i % r.nx, i / r.nx, n);
-                    *v = C64::new(f64::from(re), f64::from(im));
-                }
-            }
-        } else if let Some(f) = find("ktx2") {
-            let path = dir.join(&f.path);
-            let image = crate::ktx2::read_ktx2(&path)?;
-            if image.format != crate::ktx2::Ktx2Format::Rgba32Float
-                || (
-                    image.width as usize,
-                    image.height as usize,
-                    image.layers as usize,
-                ) != (r.nx, r.ny, layers.div_ceil(2))
-                || image.levels.len() != 1
-            {
-                return Err(Error::Table {
-                    path,
-                    message: format!(
-                        "texture is {:?} {}x{} with {} layers; expected Rgba32Float {}x{} with {} layers",
-                        image.format,
-                        image.width,
-                        image.height,
-                        image.layers,
-                        r.nx,
-                        r.ny,
-                        layers.div_ceil(2)
-                    ),
-                });
-            }
-            let data = image.level_f32(0);
-            for (n, layer) in terms.iter_mut().enumerate() {
-                for (i, v) in layer.iter_mut().enumerate() {
-                    let at = ((n / 2) * r.nx * r.ny + i) * 4 + 2 * (n % 2);
-                    *v = C64::new(f64::from(data[at]), f64::from(data[at + 1]));
-                }
-            }
-        } else {
-            return Err(Error::Invalid {
-                context: manifest_path.display().to_string(),
-                message: "the manifest lists no terms file".into(),
-            });
-        }
-        let t = TaylorTerms::from_terms(r.nx, r.ny, r.pitch_um, &terms).map_err(|source| {
-            Error::OpticsIn {
-                context: manifest_path.display().to_string(),
-                source,
-            }
-        })?;
-        Ok((r, t))
-    }
-}
 
 /// A `nacre diffraction` evaluation: one incidence, a list of in-plane view angles.
 pub struct ViewSweep<'a> {
@@ -1330,7 +1191,7 @@ impl DiffractionMap {
     ) -> Self {
         let radius = max_view_deg.to_radians().sin();
         let (omega_i, _) = in_plane_directions(incidence_deg, 0.0);
-        let display = crate::plot::DisplayConverter::new(colorimeter);
+        let display = crate::commands::plot::DisplayConverter::new(colorimeter);
         let colours: Vec<Option<[f64; 3]>> = (0..cells)
             .into_par_iter()
             .flat_map_iter(|iy| {
@@ -1362,7 +1223,7 @@ impl DiffractionMap {
     }
 }
 
-impl crate::plot::Figure for DiffractionMap {
+impl crate::commands::plot::Figure for DiffractionMap {
     fn size(&self) -> (u32, u32) {
         (760, 800)
     }
@@ -1370,8 +1231,8 @@ impl crate::plot::Figure for DiffractionMap {
     fn draw<DB: plotters::prelude::DrawingBackend>(
         &self,
         root: &plotters::prelude::DrawingArea<DB, plotters::coord::Shift>,
-        format: crate::plot::ImageFormat,
-    ) -> crate::plot::DrawResult<DB> {
+        format: crate::commands::plot::ImageFormat,
+    ) -> crate::commands::plot::DrawResult<DB> {
         use plotters::prelude::*;
         let area = root.titled(&self.title, ("sans-serif", 17))?;
         let r = self.radius;
@@ -1393,7 +1254,7 @@ impl crate::plot::Figure for DiffractionMap {
             BLACK.filled(),
         )))?;
         // SVG: coarser cells (every other one) to keep files small.
-        let stride = if format == crate::plot::ImageFormat::Png {
+        let stride = if format == crate::commands::plot::ImageFormat::Png {
             1
         } else {
             2
@@ -1407,7 +1268,7 @@ impl crate::plot::Figure for DiffractionMap {
                     let span = step * stride as f64;
                     rects.push(Rectangle::new(
                         [(x0, y0), (x0 + span, y0 + span)],
-                        crate::plot::srgb8(c.map(|v| v * self.exposure)).filled(),
+                        crate::commands::plot::srgb8(c.map(|v| v * self.exposure)).filled(),
                     ));
                 }
             }
@@ -1419,6 +1280,45 @@ impl crate::plot::Figure for DiffractionMap {
             WHITE.stroke_width(1),
         )))?;
         Ok(())
+    }
+}
+
+
+/// The registry entry of `diffraction` ([`crate::kinds::REGISTRY`]).
+pub const ENTRY: KindEntry = KindEntry {
+    kind: TableKind::Diffraction,
+    parse: |path, text| {
+        #[derive(Deserialize)]
+        struct ColourOnly {
+            colour: Option<RawColour>,
+        }
+        let c: ColourOnly = toml::from_str(&text).map_err(|e| toml_error(path, &text, &e))?;
+        let colorimeter = parse_colour(path, &text, c.colour)?;
+        let name = table_name(path)?;
+        Ok(Box::new(DiffractionRecipe::parse(
+            path,
+            text,
+            name,
+            colorimeter,
+        )?))
+    },
+};
+
+impl TableRecipe for DiffractionRecipe {
+    fn kind(&self) -> TableKind {
+        TableKind::Diffraction
+    }
+
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn work(&self) -> u64 {
+        1
+    }
+
+    fn bake(&self, out_dir: &Path, progress: &(dyn Fn() + Sync)) -> Result<PathBuf> {
+        DiffractionRecipe::bake(self, out_dir, progress)
     }
 }
 
@@ -1467,7 +1367,7 @@ mod tests {
     fn recipe(dir: &Path, name: &str, text: &str) -> Result<crate::bake::AnyRecipe> {
         let path = dir.join(name);
         std::fs::write(&path, text).unwrap();
-        crate::bake::AnyRecipe::read(&path)
+        crate::kinds::read_recipe(&path)
     }
 
     #[test]

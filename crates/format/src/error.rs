@@ -1,0 +1,124 @@
+//! The error type of `nacre-format`: reading and writing table files and manifests, and
+//! resolving material references. Each variant carries the values that went wrong; only the
+//! `nacre` binary turns it into a message and an exit status.
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong while reading or writing tables and resolving materials.
+/// Each message names the file (and line) concerned.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// An error from the physics core.
+    #[error(transparent)]
+    Optics(#[from] nacre_optics::Error),
+    /// The physics core rejected something that came from a named flag or recipe key.
+    #[error("{context}: {source}")]
+    OpticsIn {
+        /// Flag or `file:line` the value came from.
+        context: String,
+        /// What the core said.
+        source: nacre_optics::Error,
+    },
+    /// A text file (manifest, material data) is malformed at a line.
+    #[error("{}:{line}: {message}", path.display())]
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line.
+        line: usize,
+        /// What was wrong and what was expected.
+        message: String,
+    },
+    /// A material name that is neither a number, a bundled material nor a data file.
+    #[error(
+        "{context}: unknown material `{name}`: expected a number (`1.5`), a complex index (`0.27+2.9i`), a bundled material ({bundled}), a path to a `.yml`/`.csv` file or a refractiveindex.info page SHELF/BOOK/PAGE (with --material-db)"
+    )]
+    UnknownMaterial {
+        /// Flag or `file:line` the name came from.
+        context: String,
+        /// The name given.
+        name: String,
+        /// The bundled names, comma-separated.
+        bundled: String,
+    },
+    /// A refractiveindex.info page (`shelf/book/page`) that the material database does not
+    /// have, or that was asked for with no database set.
+    #[error("{context}: {message}")]
+    MaterialDb {
+        /// Flag or `file:line` the spec came from.
+        context: String,
+        /// The spec given.
+        spec: String,
+        /// The paths looked at, in order.
+        tried: Vec<PathBuf>,
+        /// What was wrong, with the paths tried and how to set the database.
+        message: String,
+    },
+    /// Reading or writing a file failed.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The operating-system error.
+        source: std::io::Error,
+    },
+    /// A request larger than the documented limits.
+    #[error("{what}: {count} exceeds the limit of {limit}")]
+    TooLarge {
+        /// What was counted.
+        what: String,
+        /// The requested count.
+        count: u64,
+        /// The limit.
+        limit: u64,
+    },
+    /// A lookup-table image (OpenEXR or PNG atlas) is malformed, does not match the
+    /// expected dimensions, or a table cannot be written in the requested format.
+    #[error("{}: {message}", path.display())]
+    Table {
+        /// The image file.
+        path: PathBuf,
+        /// What was wrong and what was expected.
+        message: String,
+    },
+    /// A table file whose SHA-256 differs from the one its manifest records: replaced or
+    /// damaged after the bake.
+    #[error(
+        "{}: does not match its manifest {} (SHA-256 {actual}, the manifest says {expected}): re-bake the table or restore the file",
+        path.display(),
+        manifest.display()
+    )]
+    Checksum {
+        /// The table file.
+        path: PathBuf,
+        /// The manifest that lists it.
+        manifest: PathBuf,
+        /// The file's SHA-256.
+        actual: String,
+        /// The SHA-256 the manifest records.
+        expected: String,
+    },
+    /// A manifest of another table kind (or diffraction layout) than the reader expects.
+    #[error("{}: table `{name}` is a `{kind}` table, not {expected}", manifest.display())]
+    WrongKind {
+        /// The manifest.
+        manifest: PathBuf,
+        /// The table's name.
+        name: String,
+        /// Its kind.
+        kind: crate::manifest::TableKind,
+        /// What the reader expected, e.g. "a film-lut".
+        expected: &'static str,
+    },
+    /// A value (usually from a recipe or manifest) that is well-formed but not acceptable.
+    #[error("{context}: {message}")]
+    Invalid {
+        /// File, `file:line`, flag or table name concerned.
+        context: String,
+        /// What was wrong and what was expected.
+        message: String,
+    },
+}
+
+/// Shorthand for `Result<T, nacre_format::Error>`.
+pub type Result<T, E = Error> = std::result::Result<T, E>;

@@ -1,0 +1,513 @@
+//! The JSON manifest written beside every table: the runtime and engine integrations load
+//! tables only through it. Its keys are stable (`nacre-table/1`): every manifest the
+//! default set ships loads unchanged.
+//!
+//! A manifest names its [`TableKind`]; the kind's own axes are one [`KindRecord`] (the JSON
+//! key `film_lut`, `fourier`, `rough_film_lut` or `diffraction`); its files are
+//! [`FileRecord`]s with a SHA-256 checked before any file is read.
+
+use crate::diffraction::DiffractionRecord;
+use crate::error::{Error, Result};
+use crate::film_lut::{FilmLutAxes, validate_axes};
+use crate::fourier::{FourierAxes, FourierTable};
+use crate::rough_film_lut::RoughLutAxes;
+use crate::table_io::{self, Table3};
+use nacre_optics::colour::Colorimeter;
+use serde::{Deserialize, Serialize};
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// Most texels one table may have (2²⁴ ≈ 16.8 million: 96 MiB of half-float RGB per
+/// quantity). Larger recipes are refused before any work.
+pub const MAX_TEXELS: u64 = 1 << 24;
+
+/// Manifest format identifier.
+pub const MANIFEST_FORMAT: &str = "nacre-table/1";
+
+/// The `quantity` of a `fourier` table's KTX2 file (every level in one file).
+pub const FOURIER_KTX2_QUANTITY: &str = "all levels";
+
+/// The kinds of table nacre bakes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum TableKind {
+    /// Pre-integrated film colour over cos θ × optical path × film index
+    /// ([`crate::film_lut`]).
+    FilmLut,
+    /// Fourier transforms of the colour sensitivities, mip-mapped ([`crate::fourier`]).
+    Fourier,
+    /// Directional albedo of the iridescent GGX lobe ([`crate::rough_film_lut`]).
+    RoughFilmLut,
+    /// Stam's diffraction terms or their wavelength-integrated colours
+    /// ([`crate::diffraction`]).
+    Diffraction,
+}
+
+impl TableKind {
+    /// Every kind.
+    pub const ALL: [TableKind; 4] = [
+        TableKind::FilmLut,
+        TableKind::Fourier,
+        TableKind::RoughFilmLut,
+        TableKind::Diffraction,
+    ];
+
+    /// The name recipes and manifests use (`film-lut`, …).
+    pub fn name(self) -> &'static str {
+        match self {
+            TableKind::FilmLut => "film-lut",
+            TableKind::Fourier => "fourier",
+            TableKind::RoughFilmLut => "rough-film-lut",
+            TableKind::Diffraction => "diffraction",
+        }
+    }
+
+    /// The kind named `name`, if any.
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|k| k.name() == name)
+    }
+}
+
+impl fmt::Display for TableKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The axes and records of one table kind, as the manifest stores them (flattened: the
+/// variant's JSON key sits beside the common fields).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum KindRecord {
+    /// Machine-readable axes of a `film-lut`.
+    #[serde(rename = "film_lut")]
+    FilmLut(FilmLutAxes),
+    /// Machine-readable axes of a `fourier` table.
+    #[serde(rename = "fourier")]
+    Fourier(FourierAxes),
+    /// Machine-readable axes of a `rough-film-lut`.
+    #[serde(rename = "rough_film_lut")]
+    RoughFilmLut(RoughLutAxes),
+    /// Sampling, Taylor order and conventions of a `diffraction` table.
+    #[serde(rename = "diffraction")]
+    Diffraction(Box<DiffractionRecord>),
+}
+
+impl KindRecord {
+    /// The kind this record belongs to.
+    pub fn kind(&self) -> TableKind {
+        match self {
+            KindRecord::FilmLut(_) => TableKind::FilmLut,
+            KindRecord::Fourier(_) => TableKind::Fourier,
+            KindRecord::RoughFilmLut(_) => TableKind::RoughFilmLut,
+            KindRecord::Diffraction(_) => TableKind::Diffraction,
+        }
+    }
+}
+
+/// The format of one table file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum FileFormat {
+    /// OpenEXR atlas ([`crate::table_io`]).
+    #[serde(rename = "exr")]
+    Exr,
+    /// 16-bit PNG atlas, values in [0, 1] ([`crate::table_io`]).
+    #[serde(rename = "png16")]
+    Png16,
+    /// KTX 2.0 texture ([`crate::ktx2`]).
+    #[serde(rename = "ktx2")]
+    Ktx2,
+}
+
+/// How a table file stores its values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Encoding {
+    /// IEEE half floats.
+    Half,
+    /// IEEE single floats.
+    Float,
+    /// 16-bit unsigned normalised integers.
+    Unorm16,
+}
+
+impl From<table_io::Precision> for Encoding {
+    fn from(p: table_io::Precision) -> Self {
+        match p {
+            table_io::Precision::Half => Encoding::Half,
+            table_io::Precision::Float => Encoding::Float,
+        }
+    }
+}
+
+/// One axis as the manifest describes it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AxisRecord {
+    /// Axis name.
+    pub name: String,
+    /// Unit.
+    pub unit: String,
+    /// Texels.
+    pub count: usize,
+    /// Smallest value (at t = 0).
+    pub min: f64,
+    /// Largest value (at t = 1).
+    pub max: f64,
+    /// Mapping name.
+    pub mapping: String,
+    /// Physical value → t.
+    pub forward: String,
+    /// t → physical value.
+    pub inverse: String,
+}
+
+/// One file of a table.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FileRecord {
+    /// `reflectance` or `transmittance` (film-lut); `level K` or, for the KTX2 file,
+    /// [`FOURIER_KTX2_QUANTITY`] (fourier).
+    pub quantity: String,
+    /// The file's format.
+    pub format: FileFormat,
+    /// File name, relative to the manifest.
+    pub path: String,
+    /// How its values are stored.
+    pub encoding: Encoding,
+    /// Channel names.
+    pub channels: Vec<String>,
+    /// Atlas width in pixels (KTX2: the texture's level-0 width).
+    pub width: usize,
+    /// Atlas height in pixels (KTX2: the texture's level-0 height; its depth, layers and
+    /// levels follow from the axes).
+    pub height: usize,
+    /// SHA-256 of the file.
+    pub sha256: String,
+}
+
+/// The JSON manifest written beside every table: the runtime loads tables only through it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Manifest {
+    /// [`MANIFEST_FORMAT`].
+    pub format: String,
+    /// Do-not-edit notice with the command that regenerates the table.
+    pub generated_by: String,
+    /// Table name.
+    pub name: String,
+    /// Table kind.
+    pub kind: TableKind,
+    /// Description from the recipe.
+    pub description: String,
+    /// nacre version that baked it.
+    pub nacre_version: String,
+    /// Recipe file name (no folder).
+    pub recipe_file: String,
+    /// SHA-256 of the recipe text.
+    pub recipe_sha256: String,
+    /// The recipe text.
+    pub recipe: String,
+    /// Observer (`1931` or `1964`).
+    pub observer: String,
+    /// Illuminant (`d65`, `d50`, `a`, `e`).
+    pub illuminant: String,
+    /// Output space (`xyz`, `srgb`, …), linear.
+    pub space: String,
+    /// Convention of the colour values.
+    pub colour_convention: String,
+    /// Ambient material spec (film-lut).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub ambient: String,
+    /// Film label (film-lut).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub film: String,
+    /// Fixed layers under the film: (material spec, thickness nm) (film-lut).
+    #[serde(default)]
+    pub under: Vec<(String, f64)>,
+    /// Base material spec (film-lut).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub base: String,
+    /// The axes in x, y, z order.
+    pub axes: Vec<AxisRecord>,
+    /// The kind's own axes and records (JSON key `film_lut`, `fourier`, `rough_film_lut`
+    /// or `diffraction`).
+    #[serde(flatten)]
+    pub record: KindRecord,
+    /// Texel-centre convention.
+    pub texel_centres: String,
+    /// Atlas layout of the files.
+    pub atlas: String,
+    /// How a shader rebuilds the result from the channels.
+    pub reconstruction: String,
+    /// The files.
+    pub files: Vec<FileRecord>,
+}
+
+impl Manifest {
+    /// The fields every table's manifest shares — format, provenance (the recipe's file
+    /// name, SHA-256 and text) and colour settings — for a table of `kind` baked from the
+    /// recipe at `recipe_path`, with the kind's `record`; the baker fills in the rest
+    /// (left empty here).
+    pub fn for_recipe(
+        record: KindRecord,
+        name: &str,
+        description: &str,
+        recipe_path: &Path,
+        recipe_text: &str,
+        colorimeter: &Colorimeter,
+    ) -> Manifest {
+        let file_name = recipe_path
+            .file_name()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        Manifest {
+            format: MANIFEST_FORMAT.into(),
+            generated_by: format!(
+                "generated by `nacre bake` from the recipe {file_name} (in tables/recipes/ for the default set, which `nacre bake` with no arguments regenerates); do not edit"
+            ),
+            name: name.to_string(),
+            kind: record.kind(),
+            description: description.to_string(),
+            nacre_version: env!("CARGO_PKG_VERSION").into(),
+            recipe_file: file_name,
+            recipe_sha256: sha256_text(recipe_text),
+            recipe: recipe_text.to_string(),
+            observer: colorimeter.observer().to_string(),
+            illuminant: colorimeter.illuminant().to_string(),
+            space: colorimeter.space().to_string(),
+            colour_convention: String::new(),
+            ambient: String::new(),
+            film: String::new(),
+            under: Vec::new(),
+            base: String::new(),
+            axes: Vec::new(),
+            record,
+            texel_centres: String::new(),
+            atlas: String::new(),
+            reconstruction: String::new(),
+            files: Vec::new(),
+        }
+    }
+
+    /// Reads and validates a manifest file.
+    pub fn read(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::parse(path, &text)
+    }
+
+    /// Parses and validates manifest text; `path` names it in errors.
+    pub fn parse(path: &Path, text: &str) -> Result<Self> {
+        let m: Manifest = serde_json::from_str(text).map_err(|e| Error::Parse {
+            path: path.to_path_buf(),
+            line: e.line(),
+            message: format!("not a nacre table manifest: {e}"),
+        })?;
+        if m.format != MANIFEST_FORMAT {
+            return Err(Error::Invalid {
+                context: path.display().to_string(),
+                message: format!("manifest format `{}` is not `{MANIFEST_FORMAT}`", m.format),
+            });
+        }
+        if m.record.kind() != m.kind {
+            return Err(Error::Invalid {
+                context: path.display().to_string(),
+                message: format!(
+                    "a `{}` table whose manifest holds the axes of a `{}` table",
+                    m.kind,
+                    m.record.kind()
+                ),
+            });
+        }
+        // Axes a bake could not have written are refused here, before any file is sized
+        // from them.
+        if let Some(a) = m.film_lut() {
+            validate_axes(a, &format!("{}: film_lut", path.display()), MAX_TEXELS)?;
+        }
+        if let Some(f) = m.fourier() {
+            let consistent = f.level_samples.first() == Some(&f.samples)
+                && f.level_samples.len() == f.level_sigma_nm.len()
+                && f.level_samples
+                    .iter()
+                    .all(|n| (1..=MAX_FOURIER_SAMPLES).contains(n))
+                && f.max_opd_nm > 0.0
+                && f.max_opd_nm.is_finite();
+            if !consistent {
+                return Err(Error::Invalid {
+                    context: format!("{}: fourier", path.display()),
+                    message: format!(
+                        "samples = {}, level_samples = {:?}, {} level_sigma_nm, max_opd_nm = {}: expected level 0 of `samples` texels, every level 1 to {MAX_FOURIER_SAMPLES} texels with one sigma each, and a positive finite max_opd_nm",
+                        f.samples,
+                        f.level_samples,
+                        f.level_sigma_nm.len(),
+                        f.max_opd_nm
+                    ),
+                });
+            }
+        }
+        Ok(m)
+    }
+
+    /// The manifest as embedded in its KTX2 files (key [`crate::ktx2::MANIFEST_KEY`]):
+    /// pretty JSON without `files`, whose checksums would include the KTX2 files themselves.
+    pub fn embedded_json(&self) -> String {
+        let mut v = serde_json::to_value(self).expect("manifest serialises");
+        if let Some(o) = v.as_object_mut() {
+            o.remove("files");
+        }
+        serde_json::to_string_pretty(&v).expect("manifest serialises")
+    }
+
+    /// Loads the table of `quantity` listed by this manifest (at `manifest_path`): from its
+    /// EXR file when the manifest lists one, else from its KTX2 file; `None` when neither
+    /// is listed.
+    pub fn load_table(&self, manifest_path: &Path, quantity: &str) -> Result<Option<Table3>> {
+        let Some(f) = self
+            .file(quantity, FileFormat::Exr)
+            .or_else(|| self.file(quantity, FileFormat::Ktx2))
+        else {
+            return Ok(None);
+        };
+        let a = self
+            .film_lut()
+            .ok_or_else(|| self.wrong_kind(manifest_path, "a film-lut"))?;
+        let path = self.dir(manifest_path).join(&f.path);
+        verify_sha256(manifest_path, &path, f)?;
+        let (nx, ny, nz) = (a.cos_theta_count, a.opd_count, a.ior_count);
+        if f.format == FileFormat::Ktx2 {
+            return crate::ktx2::read_film_lut_ktx2(&path, nx, ny, nz).map(Some);
+        }
+        let (table, _) = table_io::read_exr_table(&path, nx, ny, nz)?;
+        Ok(Some(table))
+    }
+
+    /// The axes of a `film-lut`, `None` for another kind.
+    pub fn film_lut(&self) -> Option<&FilmLutAxes> {
+        match &self.record {
+            KindRecord::FilmLut(a) => Some(a),
+            _ => None,
+        }
+    }
+
+    /// The axes of a `fourier` table, `None` for another kind.
+    pub fn fourier(&self) -> Option<&FourierAxes> {
+        match &self.record {
+            KindRecord::Fourier(a) => Some(a),
+            _ => None,
+        }
+    }
+
+    /// The axes of a `rough-film-lut`, `None` for another kind.
+    pub fn rough_film_lut(&self) -> Option<&RoughLutAxes> {
+        match &self.record {
+            KindRecord::RoughFilmLut(a) => Some(a),
+            _ => None,
+        }
+    }
+
+    /// The record of a `diffraction` table, `None` for another kind.
+    pub fn diffraction(&self) -> Option<&DiffractionRecord> {
+        match &self.record {
+            KindRecord::Diffraction(r) => Some(r),
+            _ => None,
+        }
+    }
+
+    /// The file of `quantity` in `format`, if the manifest lists one.
+    pub fn file(&self, quantity: &str, format: FileFormat) -> Option<&FileRecord> {
+        self.files
+            .iter()
+            .find(|f| f.quantity == quantity && f.format == format)
+    }
+
+    /// The folder of the manifest at `manifest_path`, against which file paths resolve.
+    pub fn dir(&self, manifest_path: &Path) -> PathBuf {
+        manifest_path
+            .parent()
+            .unwrap_or(Path::new("."))
+            .to_path_buf()
+    }
+
+    /// The error for a reader that expected `expected` (e.g. "a film-lut").
+    pub fn wrong_kind(&self, manifest_path: &Path, expected: &'static str) -> Error {
+        Error::WrongKind {
+            manifest: manifest_path.to_path_buf(),
+            name: self.name.clone(),
+            kind: self.kind,
+            expected,
+        }
+    }
+
+    /// The colorimeter the table was baked with.
+    pub fn colorimeter(&self, manifest_path: &Path) -> Result<Colorimeter> {
+        let bad = |e: nacre_optics::Error| Error::Invalid {
+            context: manifest_path.display().to_string(),
+            message: e.to_string(),
+        };
+        Ok(Colorimeter::new(
+            self.observer.parse().map_err(bad)?,
+            self.illuminant.parse().map_err(bad)?,
+            self.space.parse().map_err(bad)?,
+        ))
+    }
+}
+
+/// Checks that the file at `path`, listed in the manifest at `manifest_path` as `f`, has
+/// the SHA-256 the manifest records: a table whose files were replaced or damaged after the
+/// bake is refused rather than read.
+pub fn verify_sha256(manifest_path: &Path, path: &Path, f: &FileRecord) -> Result<()> {
+    let sha = table_io::sha256_hex(path)?;
+    if sha != f.sha256 {
+        return Err(Error::Checksum {
+            path: path.to_path_buf(),
+            manifest: manifest_path.to_path_buf(),
+            actual: sha,
+            expected: f.sha256.clone(),
+        });
+    }
+    Ok(())
+}
+
+/// SHA-256 of a text, as lower-case hex.
+pub fn sha256_text(text: &str) -> String {
+    use sha2::{Digest, Sha256};
+    Sha256::digest(text.as_bytes())
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
+/// Most texels of level 0 of a `fourier` table.
+pub const MAX_FOURIER_SAMPLES: usize = 1 << 20;
+
+impl Manifest {
+    /// Loads the `fourier` table this manifest (at `manifest_path`) describes: from its
+    /// per-level EXR files when the manifest lists them all, else from its KTX2 file.
+    pub fn load_fourier(&self, manifest_path: &Path) -> Result<FourierTable> {
+        let axes = self
+            .fourier()
+            .cloned()
+            .ok_or_else(|| self.wrong_kind(manifest_path, "a fourier table"))?;
+        let dir = self.dir(manifest_path);
+        let levels = axes.level_samples.len();
+        let exr_level = |k: usize| self.file(&format!("level {k}"), FileFormat::Exr);
+        if (0..levels).any(|k| exr_level(k).is_none())
+            && let Some(f) = self.files.iter().find(|f| f.format == FileFormat::Ktx2)
+        {
+            let path = dir.join(&f.path);
+            verify_sha256(manifest_path, &path, f)?;
+            return crate::ktx2::read_fourier_ktx2(&path, axes);
+        }
+        let paths: Vec<PathBuf> = (0..levels)
+            .map(|k| {
+                let f = exr_level(k).ok_or_else(|| Error::Invalid {
+                    context: manifest_path.display().to_string(),
+                    message: format!("the manifest lists no file for level {k}"),
+                })?;
+                let path = dir.join(&f.path);
+                verify_sha256(manifest_path, &path, f)?;
+                Ok(path)
+            })
+            .collect::<Result<_>>()?;
+        FourierTable::read(axes, &paths)
+    }
+}
