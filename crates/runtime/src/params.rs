@@ -157,7 +157,7 @@ impl SpectralParams {
 }
 
 /// The samples of `film_spectral` for `setup`: the wavelengths and weights of `nacre color
-/// --method samples:N` ([`nacre_bake::color::sample_weights`]) and the base's index at each.
+/// --method samples:N` ([`nacre_optics::spectral::sample_weights`]) and the base's index at each.
 pub fn spectral_samples(
     colorimeter: &nacre_optics::colour::Colorimeter,
     setup: &crate::bindings::SpectralSetup,
@@ -168,7 +168,7 @@ pub fn spectral_samples(
             message: format!("{} wavelengths (expected 1 to 4096)", setup.samples),
         });
     }
-    let (wavelengths, weights) = nacre_bake::color::sample_weights(colorimeter, setup.samples);
+    let (wavelengths, weights) = nacre_optics::spectral::sample_weights(colorimeter, setup.samples);
     wavelengths
         .iter()
         .zip(&weights)
