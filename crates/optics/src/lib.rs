@@ -29,6 +29,7 @@ pub mod fourier;
 pub mod fresnel;
 pub mod material;
 pub mod microfacet;
+pub mod quadrature;
 pub mod spectral;
 pub mod stack;
 
