@@ -2,7 +2,7 @@
 //
 // Thin-film colour by brute force: the exact Airy reflectance and transmittance of one film on
 // a base at each of N wavelengths, weighted per output channel and summed. The GPU twin of
-// `nacre color --method samples:N` (crates/bake/src/color.rs: `sample_weights` supplies the
+// `nacre color --method samples:N` (crates/optics/src/spectral.rs: `sample_weights` supplies the
 // wavelengths and weights, the stack recurrence of crates/optics/src/stack.rs evaluates the
 // stack, which for one film is the Airy formula of common.wgsl). Needs common.wgsl.
 //

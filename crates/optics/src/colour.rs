@@ -89,43 +89,46 @@ fn lerp(a: f64, b: f64, t: f64) -> f64 {
     (1.0 - t) * a + t * b
 }
 
-/// Parses a bundled CIE CSV: `#` comments, the header `columns`, then rows of
-/// `columns.len()` numbers whose first, the wavelength in nm, starts at an integer and
-/// steps by exactly 1 nm. Returns the first wavelength and the remaining columns.
+/// Parses a bundled CIE CSV, read with the `csv` crate as material CSVs are (`#` comment
+/// and blank lines, a UTF-8 BOM, CRLF, quoted fields and spaces accepted): the header
+/// `columns`, then rows of `columns.len()` numbers whose first, the wavelength in nm,
+/// starts at an integer and steps by exactly 1 nm. Returns the first wavelength and the
+/// remaining columns.
 fn parse_table(file: &str, text: &str, columns: &[&str]) -> Result<(f64, Vec<Vec<f64>>)> {
     let perr = |line: usize, message: String| Error::Parse {
         source_name: format!("tables/cie/{file}"),
         line,
         message,
     };
-    let mut header_seen = false;
+    let mut records = crate::csv_rows::rows(&format!("tables/cie/{file}"), text)?.into_iter();
+    let Some(header) = records.next() else {
+        return Err(perr(0, "no header or fewer than two rows".into()));
+    };
+    if header.fields != columns {
+        return Err(perr(
+            header.line,
+            format!(
+                "expected the header `{}`, found `{}`",
+                columns.join(","),
+                header.text()
+            ),
+        ));
+    }
     let mut start_nm = f64::NAN;
     let mut rows = Vec::new();
-    for (i, raw) in text.lines().enumerate() {
-        let line_no = i + 1;
-        let line = raw.trim();
-        if line.is_empty() || line.starts_with('#') {
-            continue;
-        }
-        if !header_seen {
-            let cols: Vec<&str> = line.split(',').map(str::trim).collect();
-            if cols != columns {
-                return Err(perr(
-                    line_no,
-                    format!(
-                        "expected the header `{}`, found `{line}`",
-                        columns.join(",")
-                    ),
-                ));
-            }
-            header_seen = true;
-            continue;
-        }
-        let v = line
-            .split(',')
-            .map(|f| f.trim().parse::<f64>().ok().filter(|v| v.is_finite()))
+    for record in records {
+        let line_no = record.line;
+        let v = record
+            .fields
+            .iter()
+            .map(|f| f.parse::<f64>().ok().filter(|v| v.is_finite()))
             .collect::<Option<Vec<f64>>>()
-            .ok_or_else(|| perr(line_no, format!("`{line}` is not a row of finite numbers")))?;
+            .ok_or_else(|| {
+                perr(
+                    line_no,
+                    format!("`{}` is not a row of finite numbers", record.text()),
+                )
+            })?;
         if v.len() != columns.len() {
             return Err(perr(
                 line_no,
@@ -148,7 +151,7 @@ fn parse_table(file: &str, text: &str, columns: &[&str]) -> Result<(f64, Vec<Vec
         }
         rows.push(v[1..].to_vec());
     }
-    if !header_seen || rows.len() < 2 {
+    if rows.len() < 2 {
         return Err(perr(0, "no header or fewer than two rows".into()));
     }
     Ok((start_nm, rows))
@@ -1038,6 +1041,26 @@ pub fn delta_e_2000(lab1: [f64; 3], lab2: [f64; 3]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn cie_tables_parse_the_same_with_bom_and_crlf_and_name_bad_lines() {
+        let text = include_str!("../../../tables/cie/illuminant-a.csv");
+        let plain = SpdTable::parse("illuminant-a.csv", text).unwrap();
+        let crlf = format!("\u{feff}{}", text.replace('\n', "\r\n"));
+        assert_eq!(SpdTable::parse("illuminant-a.csv", &crlf).unwrap(), plain);
+        let (line, row) = text
+            .lines()
+            .enumerate()
+            .find(|(_, l)| l.starts_with("400,"))
+            .unwrap();
+        let bad = text.replace(row, &row.replace("400,", "400,x"));
+        let e = SpdTable::parse("illuminant-a.csv", &bad).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with(&format!("tables/cie/illuminant-a.csv:{}: `400,x", line + 1)),
+            "{e}"
+        );
+    }
 
     fn close(a: f64, b: f64, tol: f64) -> bool {
         (a - b).abs() <= tol

@@ -22,12 +22,14 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod colour;
+mod csv_rows;
 pub mod diffraction;
 pub mod error;
 pub mod fourier;
 pub mod fresnel;
 pub mod material;
 pub mod microfacet;
+pub mod quadrature;
 pub mod spectral;
 pub mod stack;
 

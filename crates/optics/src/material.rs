@@ -8,8 +8,8 @@
 //!   `tabulated nk` (rows `λ n κ`), `tabulated n`, `tabulated k`, or `formula 1` … `formula 9`
 //!   with `coefficients` and `wavelength_range`; wavelengths in micrometres. n comes from the
 //!   entry that gives n, κ from `tabulated nk`/`tabulated k` (κ = 0 when none does);
-//! * a plain CSV ([`Material::from_nk_csv`]): `#` comment lines, a header line
-//!   `wavelength_nm,n,k`, then rows in nanometres.
+//! * a plain CSV ([`Material::from_nk_csv`], read with the `csv` crate): `#` comment lines,
+//!   a header line `wavelength_nm,n,k`, then rows in nanometres.
 //!
 //! Tabulated values are linearly interpolated in wavelength, n and κ separately. A
 //! wavelength outside the data (or outside a formula's `wavelength_range`) is an
@@ -172,8 +172,10 @@ impl Material {
     }
 
     /// Reads a plain CSV: `#` comment lines and blank lines anywhere, one header line
-    /// `wavelength_nm,n,k`, then rows of three numbers with strictly increasing
-    /// wavelength (nm), n > 0 and κ ≥ 0. `source_name` labels errors (`file:line`).
+    /// `wavelength_nm,n,k` (any case), then rows of three numbers with strictly increasing
+    /// wavelength (nm), n > 0 and κ ≥ 0. A UTF-8 byte-order mark, CRLF line ends, quoted
+    /// fields and spaces around fields are accepted. `source_name` labels errors
+    /// (`file:line`, the 1-based line the row starts on).
     pub fn from_nk_csv(name: impl Into<String>, source_name: &str, text: &str) -> Result<Self> {
         let name = name.into();
         let perr = |line: usize, message: String| Error::Parse {
@@ -181,26 +183,24 @@ impl Material {
             line,
             message,
         };
-        let mut header_seen = false;
+        let mut records = crate::csv_rows::rows(source_name, text)?.into_iter();
+        let Some(header) = records.next() else {
+            return Err(perr(0, "no header line `wavelength_nm,n,k` found".into()));
+        };
+        let cols: Vec<String> = header.fields.iter().map(|c| c.to_lowercase()).collect();
+        if cols != ["wavelength_nm", "n", "k"] {
+            return Err(perr(
+                header.line,
+                format!(
+                    "expected the header `wavelength_nm,n,k`, found `{}`",
+                    header.text()
+                ),
+            ));
+        }
         let mut rows = Vec::new();
-        for (i, raw) in text.lines().enumerate() {
-            let line_no = i + 1;
-            let line = raw.trim();
-            if line.is_empty() || line.starts_with('#') {
-                continue;
-            }
-            if !header_seen {
-                let cols: Vec<String> = line.split(',').map(|c| c.trim().to_lowercase()).collect();
-                if cols != ["wavelength_nm", "n", "k"] {
-                    return Err(perr(
-                        line_no,
-                        format!("expected the header `wavelength_nm,n,k`, found `{line}`"),
-                    ));
-                }
-                header_seen = true;
-                continue;
-            }
-            let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+        for record in records {
+            let line_no = record.line;
+            let fields = &record.fields;
             if fields.len() != 3 {
                 return Err(perr(
                     line_no,
@@ -220,9 +220,6 @@ impl Material {
                 })?;
             }
             rows.push((line_no, v));
-        }
-        if !header_seen {
-            return Err(perr(0, "no header line `wavelength_nm,n,k` found".into()));
         }
         Material::from_rows(name, source_name, rows)
     }
@@ -859,6 +856,35 @@ DATA:
         let e =
             Material::from_nk_csv("c", "c.csv", "wavelength_nm,n,k\n400,1.5,nan\n").unwrap_err();
         assert!(e.to_string().starts_with("c.csv:2: k `nan`"), "{e}");
+    }
+
+    #[test]
+    fn csv_accepts_bom_crlf_comments_quotes_and_spaces() {
+        let plain = "wavelength_nm,n,k\n400,1.5,0\n500,1.6,0.1\n650,1.7,0.25\n";
+        let fancy = "\u{feff}# measured by hand\r\n\r\n  Wavelength_nm , \"n\", k \r\n\
+                     # visible\r\n400, 1.5 ,0\r\n  # indented comment\r\n\
+                     \"500\",\"1.6\" , \"0.1\"\r\n   \r\n 650 ,1.7,\t0.25";
+        let a = Material::from_nk_csv("c", "c.csv", plain).unwrap();
+        let b = Material::from_nk_csv("c", "c.csv", fancy).unwrap();
+        assert_eq!(a, b);
+        // Errors name the line the row is on, past the BOM, comments and CRLF.
+        let e = Material::from_nk_csv("c", "c.csv", &fancy.replace("1.7", "1.7x")).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "c.csv:9: n `1.7x` is not a finite number",
+            "{fancy:?}"
+        );
+        let e = Material::from_nk_csv("c", "c.csv", &fancy.replace("1.6", "-1.6")).unwrap_err();
+        assert!(e.to_string().starts_with("c.csv:7: n = -1.6"), "{e}");
+        let e = Material::from_nk_csv("c", "c.csv", "\u{feff}#\r\nlambda,n,k\r\n").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "c.csv:2: expected the header `wavelength_nm,n,k`, found `lambda,n,k`"
+        );
+        let e = Material::from_nk_csv("c", "c.csv", "# nothing\n\n").unwrap_err();
+        assert!(e.to_string().starts_with("c.csv:0: no header"), "{e}");
+        let e = Material::from_nk_csv("c", "c.csv", "wavelength_nm,n,k\n# none\n").unwrap_err();
+        assert!(e.to_string().starts_with("c.csv:0: no data rows"), "{e}");
     }
 
     #[test]

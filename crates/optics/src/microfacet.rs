@@ -63,6 +63,9 @@
 //! 1/η² radiance factor appears. Light that single scattering masks is lost in both lobes
 //! (Smith single scattering), so with a lossless stack reflected + transmitted ≤ 1.
 //!
+//! The same integrals as deterministic quadrature kernels over the microfacet cosine
+//! (Heitz's disk spread onto cosine nodes, for the pre-integrated tables): [`kernel`].
+//!
 //! # Determinism
 //!
 //! Samples are split into fixed chunks of [`CHUNK_SAMPLES`]; chunk k draws from its own
@@ -110,6 +113,8 @@ use crate::spectral::SpectralRule;
 use crate::stack::Stack;
 use rayon::prelude::*;
 use std::f64::consts::PI;
+
+pub mod kernel;
 
 /// Samples per deterministic chunk (one RNG stream each).
 pub const CHUNK_SAMPLES: usize = 4096;

@@ -109,6 +109,51 @@ fn sum3(it: impl Iterator<Item = [f64; 3]>) -> [f64; 3] {
     it.fold([0.0; 3], |a, w| [a[0] + w[0], a[1] + w[1], a[2] + w[2]])
 }
 
+/// Wavelengths and weights of the N-sample shortcut (`nacre color --method samples:N`, the
+/// GPU's `film_spectral` technique): N wavelengths spread uniformly over 400–700 nm,
+/// λₖ = 400 + 300 k/(N − 1) nm (550 nm for N = 1), weighted by the output-space
+/// sensitivities there, s(λₖ) ([`Colorimeter::sensitivity_at`]), normalised per channel so
+/// that Σₖ wₖ equals the colorimeter's white (the sum of its 1 nm weights,
+/// [`Colorimeter::weights_1nm`]), i.e. R ≡ 1 is white:
+///
+/// ```text
+/// wₖ[c] = s(λₖ)[c] · Σᵢ wᵢ[c] / Σₖ s(λₖ)[c]        (0 where Σₖ s(λₖ)[c] = 0)
+/// ```
+///
+/// A colour is then Σₖ R(λₖ) wₖ. This is the point-sampling shortcut of real-time thin-film
+/// rendering (Sussenbach 2013, §4.3), not an exact integral: a film's fringes alias once
+/// they are finer than the sample spacing ([`SpectralRule`] is the exact rule).
+pub fn sample_weights(colorimeter: &Colorimeter, n: usize) -> (Vec<f64>, Vec<[f64; 3]>) {
+    let wl: Vec<f64> = if n == 1 {
+        vec![550.0]
+    } else {
+        (0..n)
+            .map(|k| 400.0 + 300.0 * k as f64 / (n - 1) as f64)
+            .collect()
+    };
+    let raw: Vec<[f64; 3]> = wl.iter().map(|&l| colorimeter.sensitivity_at(l)).collect();
+    let white = colorimeter
+        .weights_1nm()
+        .iter()
+        .fold([0.0; 3], |a, w| [a[0] + w[0], a[1] + w[1], a[2] + w[2]]);
+    let sum = raw
+        .iter()
+        .fold([0.0; 3], |a, w| [a[0] + w[0], a[1] + w[1], a[2] + w[2]]);
+    let w = raw
+        .iter()
+        .map(|r| {
+            std::array::from_fn(|k| {
+                if sum[k] != 0.0 {
+                    r[k] * white[k] / sum[k]
+                } else {
+                    0.0
+                }
+            })
+        })
+        .collect();
+    (wl, w)
+}
+
 /// Reflectance and transmittance colours (unpolarised) over a thickness sweep.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct FilmColours {
@@ -209,6 +254,41 @@ mod tests {
             Illuminant::D65,
             OutputSpace::Rgb(RgbSpace::Srgb),
         )
+    }
+
+    #[test]
+    fn sample_weights_span_400_to_700_nm_and_sum_to_white() {
+        let c = srgb();
+        let white = sum3(c.weights_1nm().iter().copied());
+        for n in [1, 2, 3, 16, 64] {
+            let (wl, w) = sample_weights(&c, n);
+            assert_eq!((wl.len(), w.len()), (n, n));
+            if n == 1 {
+                assert_eq!(wl, [550.0]);
+            } else {
+                assert_eq!((wl[0], wl[n - 1]), (400.0, 700.0));
+                let step = 300.0 / (n - 1) as f64;
+                assert!(wl.windows(2).all(|p| (p[1] - p[0] - step).abs() < 1e-12));
+            }
+            let got = sum3(w.iter().copied());
+            for k in 0..3 {
+                assert!(
+                    (got[k] - white[k]).abs() <= 1e-12 * white[k].abs(),
+                    "{n}: {got:?}"
+                );
+            }
+            // Each weight is the sensitivity there, scaled per channel.
+            for (l, wk) in wl.iter().zip(&w) {
+                let s = c.sensitivity_at(*l);
+                for k in 0..3 {
+                    if s[k] != 0.0 {
+                        let ratio = wk[k] / s[k];
+                        let first = w[0][k] / c.sensitivity_at(wl[0])[k];
+                        assert!((ratio - first).abs() <= 1e-12 * first.abs(), "{n} {l}");
+                    }
+                }
+            }
+        }
     }
 
     fn film_stack(n_film: f64, d: f64, n_base: C64) -> Stack {

@@ -39,6 +39,7 @@ use crate::commands::spectrum::fmt_sig;
 use nacre_format::table_io::Table3;
 use nacre_optics::colour::{Colorimeter, OutputSpace, RgbSpace};
 use nacre_optics::fourier::{FilmOnBase, Harmonics, gltf_iridescence};
+use nacre_optics::spectral::sample_weights;
 use nacre_optics::{C64, Layer, Material, SpectralRule, Stack};
 use rayon::prelude::*;
 use std::io::Write;
@@ -835,39 +836,6 @@ fn film_on_base(
         point.angle_deg.to_radians().cos(),
         point.thickness_nm.unwrap_or(film.thickness_nm),
     ))
-}
-
-/// Wavelengths and weights of `samples:N`: λₖ = 400 + 300 k/(N − 1) nm (550 nm for N = 1),
-/// weights s(λₖ) normalised per channel so that Σₖ wₖ equals the colorimeter's white.
-pub fn sample_weights(colorimeter: &Colorimeter, n: usize) -> (Vec<f64>, Vec<[f64; 3]>) {
-    let wl: Vec<f64> = if n == 1 {
-        vec![550.0]
-    } else {
-        (0..n)
-            .map(|k| 400.0 + 300.0 * k as f64 / (n - 1) as f64)
-            .collect()
-    };
-    let raw: Vec<[f64; 3]> = wl.iter().map(|&l| colorimeter.sensitivity_at(l)).collect();
-    let white = colorimeter
-        .weights_1nm()
-        .iter()
-        .fold([0.0; 3], |a, w| [a[0] + w[0], a[1] + w[1], a[2] + w[2]]);
-    let sum = raw
-        .iter()
-        .fold([0.0; 3], |a, w| [a[0] + w[0], a[1] + w[1], a[2] + w[2]]);
-    let w = raw
-        .iter()
-        .map(|r| {
-            std::array::from_fn(|k| {
-                if sum[k] != 0.0 {
-                    r[k] * white[k] / sum[k]
-                } else {
-                    0.0
-                }
-            })
-        })
-        .collect();
-    (wl, w)
 }
 
 /// Writes the CSV.

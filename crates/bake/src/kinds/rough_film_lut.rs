@@ -40,9 +40,10 @@
 //! the visible normals, weighted by G₂/G₁. The kernels do not depend on the film, so the
 //! bake computes them once per (cos θ_o, α) and the film colours once per (c, d, n_f):
 //!
-//! 1. **Kernels** ([`kernels`]). The visible-normal domain is Heitz's unit disk (Heitz,
-//!    "Sampling the GGX Distribution of Visible Normals", JCGT 7(4), 2018, Listing 1: the map
-//!    (u₁, u₂) ∈ [0, 1]² → h of [`sample_ggx_vndf`] has constant density on the disk), so
+//! 1. **Kernels** ([`nacre_optics::microfacet::kernel`]). The visible-normal domain is
+//!    Heitz's unit disk (Heitz, "Sampling the GGX Distribution of Visible Normals", JCGT
+//!    7(4), 2018, Listing 1: the map (u₁, u₂) ∈ [0, 1]² → h of
+//!    [`nacre_optics::microfacet::sample_ggx_vndf`] has constant density on the disk), so
 //!    E = ∫∫ F(ω_o·h(u₁, u₂)) g(u₁, u₂) du₁ du₂ with g = G₂/G₁ (0 below the horizon). The
 //!    integral is taken by a deterministic product rule: [`KERNEL_RADIAL_NODES`]-point
 //!    Gauss–Legendre in v, u₁ = r² = 1 − (1 − v)² (nodes crowd the rim, where GGX's tail
@@ -72,14 +73,14 @@
 //! inside the thickness range, |dΔ/dc| = 2 d c/q ≤ 2 d) keep it below 6·10⁻⁴ of the fringe
 //! amplitude (a film reflects a few per cent: ≲ 3·10⁻⁵ absolute). With F ≡ 1 the
 //! reflection kernel's mass is GGX's single-scattering albedo; it matches the Monte Carlo
-//! reference of [`nacre_optics::microfacet`] at 2²² samples within its noise (test
-//! `furnace_kernel_matches_monte_carlo`). The table's own interpolation error dominates:
-//! the default `rough-film-dielectric` (16 × 256 × 12 α × 24 n) is off by ΔE2000 0.112 /
-//! 0.297 / 0.66 (mean / p95 / max) in reflection and 0.055 / 0.119 / 0.30 in transmission
-//! against the Monte Carlo reference at 1000 random points (`tests/tests/rough_lut_accuracy.rs`
-//! with `NACRE_ROUGH_POINTS=1000`); the film-index axis is the one that matters most (at 160
-//! points, 16 indices gave p95 0.51 and 24 give 0.27; 24 view angles or 16 roughnesses with
-//! 16 indices instead did not lower it).
+//! reference of [`nacre_optics::microfacet`] at 2²² samples within its noise (nacre-optics
+//! test `microfacet::kernel::tests::furnace_kernel_matches_monte_carlo`). The table's own
+//! interpolation error dominates: the default `rough-film-dielectric` (16 × 256 × 12 α ×
+//! 24 n) is off by ΔE2000 0.112 / 0.297 / 0.66 (mean / p95 / max) in reflection and 0.055 /
+//! 0.119 / 0.30 in transmission against the Monte Carlo reference at 1000 random points
+//! (`tests/tests/rough_lut_accuracy.rs` with `NACRE_ROUGH_POINTS=1000`); the film-index
+//! axis is the one that matters most (at 160 points, 16 indices gave p95 0.51 and 24 give
+//! 0.27; 24 view angles or 16 roughnesses with 16 indices instead did not lower it).
 //!
 use crate::kinds::{KindEntry, TableRecipe};
 use crate::recipe::{
@@ -94,23 +95,16 @@ use crate::error::{Error, Result};
 use nacre_format::film_lut::MIN_COS_THETA;
 use nacre_format::table_io::{self, Precision, Table3};
 use nacre_optics::colour::Colorimeter;
-use nacre_optics::microfacet::{REFRACTION_WAVELENGTH_NM, refract, sample_ggx_vndf, smith_lambda};
+use nacre_optics::microfacet::REFRACTION_WAVELENGTH_NM;
+use nacre_optics::microfacet::kernel::{
+    KERNEL_AZIMUTH_NODES, KERNEL_COS_NODES, KERNEL_RADIAL_NODES, Kernel, kernel_cos, kernels,
+};
+use nacre_optics::quadrature::cubic_stencil;
 use nacre_optics::{C64, Layer, Material, SpectralRule, Stack};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use toml::Spanned;
-
-/// Nodes of the uniform grid of microfacet cosines c = ω_o·h on which the kernels are
-/// tabulated and the film colours evaluated.
-pub const KERNEL_COS_NODES: usize = 128;
-
-/// Gauss–Legendre nodes in v, u₁ = 1 − (1 − v)² (u₁ the squared radius on Heitz's
-/// visible-normal disk).
-pub const KERNEL_RADIAL_NODES: usize = 128;
-
-/// Midpoint nodes in u₂ (the azimuth on the disk).
-pub const KERNEL_AZIMUTH_NODES: usize = 384;
 
 /// Largest optical path advance between nodes of the fine thickness grid, nm.
 pub const FINE_OPD_STEP_NM: f64 = 24.0;
@@ -119,167 +113,6 @@ pub const FINE_OPD_STEP_NM: f64 = 24.0;
 /// the Δ axis at grazing views of low-index films hold thicker films than d_max, and the
 /// interpolation near the physical range's edge reads them.
 pub const THICKNESS_EXTENSION: f64 = 1.5;
-
-/// One kernel pair: K_r and K_t on the c grid of [`KERNEL_COS_NODES`] nodes.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Kernel {
-    /// Reflection kernel weights K_r(c_j).
-    pub reflection: Vec<f64>,
-    /// Transmission kernel weights K_t(c_j) (all 0 without a base index).
-    pub transmission: Vec<f64>,
-}
-
-impl Kernel {
-    /// First and one-past-last node with a nonzero weight in either kernel.
-    fn support(&self) -> (usize, usize) {
-        let nz = |v: &f64| *v != 0.0;
-        let lo = self
-            .reflection
-            .iter()
-            .position(nz)
-            .into_iter()
-            .chain(self.transmission.iter().position(nz))
-            .min()
-            .unwrap_or(0);
-        let hi = self
-            .reflection
-            .iter()
-            .rposition(nz)
-            .into_iter()
-            .chain(self.transmission.iter().rposition(nz))
-            .max()
-            .map_or(0, |i| i + 1);
-        (lo, hi.max(lo))
-    }
-}
-
-/// The cosine of node j of an `n`-node c grid: j / (n − 1).
-pub fn kernel_cos(j: usize, n: usize) -> f64 {
-    j as f64 / (n - 1) as f64
-}
-
-/// Gauss–Legendre nodes and weights on [0, 1] (Newton iteration on P_n from the
-/// Chebyshev-like initial guesses cos(π(i + 3/4)/(n + 1/2)); Abramowitz & Stegun 25.4.29).
-pub fn gauss_legendre_01(n: usize) -> (Vec<f64>, Vec<f64>) {
-    let mut nodes = vec![0.0; n];
-    let mut weights = vec![0.0; n];
-    for i in 0..n {
-        let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-        let mut dp = 1.0;
-        for _ in 0..100 {
-            // P_n(x) and P_n'(x) by the three-term recurrence.
-            let (mut p0, mut p1) = (1.0, x);
-            for k in 2..=n {
-                let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
-                p0 = p1;
-                p1 = p2;
-            }
-            let p = if n == 0 { 1.0 } else { p1 };
-            let pm1 = if n <= 1 { 1.0 } else { p0 };
-            dp = n as f64 * (x * p - pm1) / (x * x - 1.0);
-            let dx = p / dp;
-            x -= dx;
-            if dx.abs() < 1e-16 {
-                break;
-            }
-        }
-        nodes[i] = 0.5 * (1.0 - x);
-        weights[i] = 1.0 / ((1.0 - x * x) * dp * dp);
-    }
-    (nodes, weights)
-}
-
-/// 4-point Lagrange (cubic) interpolation stencil at fractional position `pos` on a grid of
-/// `n` ≥ 4 uniform nodes: the first node and the weights, exact for cubics; the stencil is
-/// shifted inwards at the ends. `pos` is clamped to [0, n − 1].
-#[inline]
-pub fn cubic_stencil(pos: f64, n: usize) -> (usize, [f64; 4]) {
-    let pos = pos.clamp(0.0, (n - 1) as f64);
-    let start = ((pos.floor() as isize) - 1).clamp(0, n as isize - 4) as usize;
-    let x = pos - start as f64 - 1.0;
-    (
-        start,
-        [
-            -x * (x - 1.0) * (x - 2.0) / 6.0,
-            (x + 1.0) * (x - 1.0) * (x - 2.0) / 2.0,
-            -(x + 1.0) * x * (x - 2.0) / 2.0,
-            (x + 1.0) * x * (x - 1.0) / 6.0,
-        ],
-    )
-}
-
-/// The reflection and transmission kernels of view cosine `cos_theta_o` and roughness
-/// `alpha` on an `n_c`-node c grid (see the module docs), with relative base index `eta`
-/// for transmission. Deterministic: the nodes are summed in a fixed order.
-pub fn kernels(cos_theta_o: f64, alpha: f64, eta: Option<f64>, n_c: usize) -> Kernel {
-    kernels_with(
-        cos_theta_o,
-        alpha,
-        eta,
-        n_c,
-        KERNEL_RADIAL_NODES,
-        KERNEL_AZIMUTH_NODES,
-    )
-}
-
-/// [`kernels`] with explicit quadrature orders (radial Gauss–Legendre nodes, azimuthal
-/// midpoint nodes).
-pub fn kernels_with(
-    cos_theta_o: f64,
-    alpha: f64,
-    eta: Option<f64>,
-    n_c: usize,
-    radial: usize,
-    azimuth: usize,
-) -> Kernel {
-    let c_o = cos_theta_o.clamp(MIN_COS_THETA, 1.0);
-    let wo = [(1.0 - c_o * c_o).max(0.0).sqrt(), 0.0, c_o];
-    let lambda_o = smith_lambda(wo, alpha);
-    let g1_o = 1.0 / (1.0 + lambda_o);
-    // Gauss–Legendre in v with u₁ = 1 − (1 − v)² (du₁ = 2(1 − v) dv): nodes crowd the disk's
-    // rim, where GGX's long tail lives (a mass ≈ α² beyond 45° at normal view) and where
-    // N_z = √(1 − r²) has its square-root edge, which the substitution makes linear in v.
-    let (vs, wvs) = gauss_legendre_01(radial);
-    let (u1s, w1s): (Vec<f64>, Vec<f64>) = vs
-        .iter()
-        .zip(&wvs)
-        .map(|(&v, &w)| (1.0 - (1.0 - v) * (1.0 - v), 2.0 * (1.0 - v) * w))
-        .unzip();
-    let mut k = Kernel {
-        reflection: vec![0.0; n_c],
-        transmission: vec![0.0; n_c],
-    };
-    let scale = (n_c - 1) as f64;
-    for (&u1, &w1) in u1s.iter().zip(&w1s) {
-        let w = w1 / azimuth as f64;
-        for i in 0..azimuth {
-            let u2 = (i as f64 + 0.5) / azimuth as f64;
-            let h = sample_ggx_vndf(wo, alpha, u1, u2);
-            let cos_d = wo[0] * h[0] + wo[1] * h[1] + wo[2] * h[2];
-            if cos_d <= 0.0 {
-                continue;
-            }
-            let (start, lw) = cubic_stencil(cos_d * scale, n_c);
-            let wi = std::array::from_fn(|c| 2.0 * cos_d * h[c] - wo[c]);
-            if wi[2] > 0.0 {
-                let g = w / (1.0 + lambda_o + smith_lambda(wi, alpha)) / g1_o;
-                for (slot, w) in k.reflection[start..start + 4].iter_mut().zip(lw) {
-                    *slot += g * w;
-                }
-            }
-            if let Some(eta) = eta
-                && let Some(wt) = refract(wo, h, cos_d, eta)
-                && wt[2] < 0.0
-            {
-                let g = w / (1.0 + lambda_o + smith_lambda(wt, alpha)) / g1_o;
-                for (slot, w) in k.transmission[start..start + 4].iter_mut().zip(lw) {
-                    *slot += g * w;
-                }
-            }
-        }
-    }
-    k
-}
 
 
 /// The tables as the half-float files store them: each (E_r, E_t) pair rounded by
@@ -951,26 +784,6 @@ mod tests {
     }
 
     #[test]
-    fn gauss_legendre_integrates_polynomials_exactly() {
-        let (x, w) = gauss_legendre_01(12);
-        assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-14);
-        for p in 0..24 {
-            let got: f64 = x.iter().zip(&w).map(|(x, w)| w * x.powi(p)).sum();
-            assert!((got - 1.0 / (p as f64 + 1.0)).abs() < 1e-14, "x^{p}: {got}");
-        }
-    }
-
-    #[test]
-    fn cubic_stencil_reproduces_cubics() {
-        let f = |x: f64| 2.0 - x + 0.3 * x * x - 0.05 * x * x * x;
-        for &pos in &[0.0, 0.3, 1.0, 2.5, 7.9, 9.0] {
-            let (s, w) = cubic_stencil(pos, 10);
-            let v: f64 = (0..4).map(|m| w[m] * f((s + m) as f64)).sum();
-            assert!((v - f(pos)).abs() < 1e-12, "{pos}: {v}");
-        }
-    }
-
-    #[test]
     fn lookup_is_exact_at_texels_and_linear_between_alpha_blocks() {
         let a = axes();
         let mut table = Table3::new(9, 17, a.depth());
@@ -997,21 +810,6 @@ mod tests {
         assert!((v[0] - want).abs() < 1e-6, "{v:?} vs {want}");
     }
 
-    #[test]
-    fn kernel_of_a_smooth_surface_is_a_spike_at_the_view_cosine() {
-        // α → 0: every visible normal is n, c = cos θ_o, G₂/G₁ → 1.
-        let k = kernels_with(0.6, 1e-4, None, 256, 16, 16);
-        let mass: f64 = k.reflection.iter().sum();
-        assert!((mass - 1.0).abs() < 1e-6, "{mass}");
-        let mean: f64 = k
-            .reflection
-            .iter()
-            .enumerate()
-            .map(|(j, w)| w * kernel_cos(j, 256))
-            .sum();
-        assert!((mean - 0.6).abs() < 1e-4, "{mean}");
-    }
-
     fn srgb() -> Colorimeter {
         use nacre_optics::colour::{Illuminant, Observer, OutputSpace, RgbSpace};
         Colorimeter::new(
@@ -1019,30 +817,6 @@ mod tests {
             Illuminant::D65,
             OutputSpace::Rgb(RgbSpace::Srgb),
         )
-    }
-
-    /// (c) With F ≡ 1 the reflection kernel's mass is GGX's single-scattering albedo: the
-    /// deterministic quadrature against the Monte Carlo reference at 2²² samples.
-    #[test]
-    fn furnace_kernel_matches_monte_carlo() {
-        use nacre_optics::microfacet::{FilmTerm, directional_albedo_with};
-        let mirror = FilmTerm::perfect_mirror(&srgb());
-        for &(cos_o, alpha) in &[(1.0, 0.02), (0.9, 0.5), (0.3, 0.5), (0.9, 1.0), (0.1, 1.0)] {
-            let mass: f64 = kernels(cos_o, alpha, None, KERNEL_COS_NODES)
-                .reflection
-                .iter()
-                .sum();
-            let mc = directional_albedo_with(&mirror, alpha, cos_o, 1 << 22, 11).unwrap();
-            let (e, se) = (mc.reflection.colour[1], mc.reflection.standard_error[1]);
-            eprintln!(
-                "cos θ_o {cos_o} α {alpha}: quadrature {mass:.6}, Monte Carlo {e:.6} ± {se:.1e}"
-            );
-            assert!(
-                (mass - e).abs() <= 4.0 * se + 1e-4,
-                "{cos_o} {alpha}: {mass} vs {e} ± {se}"
-            );
-            assert!(mass <= 1.0 + 1e-9);
-        }
     }
 
     fn tiny_job(base: &str) -> RoughLutJob {
