@@ -7,10 +7,10 @@
 //! * prefiltered, σ_d 5–200 nm: `fourier:3:σ` against the brute-force average of spectral
 //!   colours over the Gaussian thickness distribution, p95 ≤ 0.5.
 
-use nacre_format::Manifest;
-use nacre_format::set::default_baked_dir;
 use nacre_bake::commands::color::{self, Method, Point, Quantity};
+use nacre_format::Manifest;
 use nacre_format::fourier::FourierTable;
+use nacre_format::set::default_baked_dir;
 use nacre_optics::colour::{
     Colorimeter, Illuminant, Observer, OutputSpace, RgbSpace, delta_e_2000, xyz_to_lab,
 };

@@ -4,11 +4,11 @@
 //!
 //! A missing adapter fails these tests: they never skip.
 
-use nacre_format::Manifest;
-use nacre_format::set::default_baked_dir;
 use nacre_bake::commands::color::{self, Method, Point, Quantity};
+use nacre_format::Manifest;
 use nacre_format::film_lut::FilmLut;
 use nacre_format::materials;
+use nacre_format::set::default_baked_dir;
 use nacre_optics::fourier::Harmonics;
 use nacre_optics::{C64, Material};
 use nacre_runtime::bindings::{SpectralSetup, TechniqueBinding, TechniqueOptions};

@@ -4,10 +4,10 @@
 //! Targets (issue: colorimetry and film-lut tables): ΔE2000 95th percentile ≤ 0.3, maximum
 //! ≤ 1.5, and each default table ≤ 16 MiB.
 
-use nacre_format::Manifest;
-use nacre_format::set::default_baked_dir;
 use nacre_bake::commands::color::{self, LoadedLut, Method, Point, Quantity};
+use nacre_format::Manifest;
 use nacre_format::materials::resolve;
+use nacre_format::set::default_baked_dir;
 use nacre_optics::colour::{delta_e_2000, xyz_to_lab};
 use nacre_optics::{C64, Material};
 

@@ -35,7 +35,6 @@ pub(crate) struct RawStack {
     pub(crate) under: Vec<RawLayer>,
 }
 
-
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields, untagged)]
 pub(crate) enum Toggle {
@@ -107,8 +106,6 @@ impl OutputSettings {
     }
 }
 
-
-
 fn parse_name<T: std::str::FromStr<Err = nacre_optics::Error>>(
     path: &Path,
     text: &str,
@@ -127,7 +124,6 @@ fn parse_name<T: std::str::FromStr<Err = nacre_optics::Error>>(
             }),
     }
 }
-
 
 /// The materials of a table recipe's `[stack]` (shared by the `film-lut` and
 /// `rough-film-lut` kinds): ambient, base and the layers under the film, resolved.
@@ -205,12 +201,6 @@ pub(crate) fn is_transparent(m: &Material) -> bool {
             .is_ok_and(|n| n.im <= 1e-3)
     })
 }
-
-
-
-
-
-
 
 /// Parses the `[colour]` section shared by every kind.
 pub(crate) fn parse_colour(

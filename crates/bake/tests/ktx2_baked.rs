@@ -5,9 +5,9 @@
 
 use half::f16;
 use nacre_format::Manifest;
+use nacre_format::ktx2::{MANIFEST_KEY, WRITER_KEY};
 use nacre_format::manifest::FOURIER_KTX2_QUANTITY;
 use nacre_format::set::default_baked_dir;
-use nacre_format::ktx2::{MANIFEST_KEY, WRITER_KEY};
 use nacre_format::table_io::{read_exr_table, sha256_hex};
 
 fn manifests() -> Vec<std::path::PathBuf> {
@@ -68,14 +68,18 @@ fn every_baked_ktx2_parses_with_the_ktx2_crate_and_matches_its_exr() {
     for path in manifests() {
         let m = Manifest::read(&path).unwrap();
         let dir = path.parent().unwrap();
-        let ktx2_files: Vec<_> = m.files.iter().filter(|f| f.format == "ktx2").collect();
+        let ktx2_files: Vec<_> = m
+            .files
+            .iter()
+            .filter(|f| f.format == nacre_format::FileFormat::Ktx2)
+            .collect();
         assert!(!ktx2_files.is_empty(), "{}: no KTX2 file", m.name);
         for f in ktx2_files {
             let file = dir.join(&f.path);
             let what = f.path.as_str();
             assert_eq!(sha256_hex(&file).unwrap(), f.sha256, "{what}");
             let bytes = std::fs::read(&file).unwrap();
-            match m.kind.as_str() {
+            match m.kind.name() {
                 // A rough-film-lut is laid out like a film-lut with depth = α blocks × indices.
                 "film-lut" | "rough-film-lut" => {
                     let (nx, ny, nz) = match (&m.film_lut(), &m.rough_film_lut()) {
@@ -91,11 +95,16 @@ fn every_baked_ktx2_parses_with_the_ktx2_crate_and_matches_its_exr() {
                         "{what}"
                     );
                     assert_eq!((h.layer_count, h.level_count), (0, 1), "{what}");
-                    assert_eq!((f.width, f.height, f.encoding.as_str()), (nx, ny, "half"));
+                    assert_eq!(
+                        (f.width, f.height, f.encoding),
+                        (nx, ny, nacre_format::Encoding::Half)
+                    );
                     let exr = m
                         .files
                         .iter()
-                        .find(|e| e.format == "exr" && e.quantity == f.quantity)
+                        .find(|e| {
+                            e.format == nacre_format::FileFormat::Exr && e.quantity == f.quantity
+                        })
                         .unwrap();
                     let (table, _) = read_exr_table(&dir.join(&exr.path), nx, ny, nz).unwrap();
                     let level = reader.levels().next().unwrap().data;
@@ -163,7 +172,9 @@ fn every_baked_ktx2_parses_with_the_ktx2_crate_and_matches_its_exr() {
                     );
                     assert_eq!(h.level_count, 1, "{what}");
                     let mut ktx2_only = m.clone();
-                    ktx2_only.files.retain(|f| f.format == "ktx2");
+                    ktx2_only
+                        .files
+                        .retain(|f| f.format == nacre_format::FileFormat::Ktx2);
                     let copy = tempfile::tempdir().unwrap();
                     let json = copy.path().join("m.json");
                     std::fs::write(&json, serde_json::to_string(&ktx2_only).unwrap()).unwrap();
@@ -196,7 +207,9 @@ fn every_baked_ktx2_parses_with_the_ktx2_crate_and_matches_its_exr() {
                     let exr = m
                         .files
                         .iter()
-                        .find(|e| e.format == "exr" && e.quantity == "terms")
+                        .find(|e| {
+                            e.format == nacre_format::FileFormat::Exr && e.quantity == "terms"
+                        })
                         .unwrap();
                     let (table, _) =
                         read_exr_table(&dir.join(&exr.path), d.nx, d.ny, terms).unwrap();
@@ -254,12 +267,13 @@ fn manifest_loads_tables_from_ktx2_when_no_exr_is_listed() {
         let dir = path.parent().unwrap();
         let copy = out.path().join(path.file_name().unwrap());
         let full = m.clone();
-        m.files.retain(|f| f.format == "ktx2");
+        m.files
+            .retain(|f| f.format == nacre_format::FileFormat::Ktx2);
         for f in &m.files {
             std::fs::copy(dir.join(&f.path), out.path().join(&f.path)).unwrap();
         }
         std::fs::write(&copy, serde_json::to_string_pretty(&m).unwrap()).unwrap();
-        match m.kind.as_str() {
+        match m.kind.name() {
             "film-lut" => {
                 for q in ["reflectance", "transmittance"] {
                     assert_eq!(
@@ -319,11 +333,16 @@ transmittance = "auto"
 "#;
     std::fs::write(&recipe_path, text).unwrap();
     let recipe = nacre_bake::kinds::film_lut::FilmLutRecipe::read(&recipe_path).unwrap();
-    let manifest_path = nacre_bake::kinds::film_lut::bake_recipe(&recipe, out.path(), &|| {}).unwrap();
+    let manifest_path =
+        nacre_bake::kinds::film_lut::bake_recipe(&recipe, out.path(), &|| {}).unwrap();
     let manifest = Manifest::read(&manifest_path).unwrap();
     let mut seen = 0;
-    for f in manifest.files.iter().filter(|f| f.format == "ktx2") {
-        assert_eq!(f.encoding, "float", "{}", f.path);
+    for f in manifest
+        .files
+        .iter()
+        .filter(|f| f.format == nacre_format::FileFormat::Ktx2)
+    {
+        assert_eq!(f.encoding, nacre_format::Encoding::Float, "{}", f.path);
         let bytes = std::fs::read(out.path().join(&f.path)).unwrap();
         let reader = open(
             &bytes,
@@ -347,7 +366,7 @@ transmittance = "auto"
         let exr = manifest
             .files
             .iter()
-            .find(|e| e.format == "exr" && e.quantity == f.quantity)
+            .find(|e| e.format == nacre_format::FileFormat::Exr && e.quantity == f.quantity)
             .unwrap();
         let (table, _) = read_exr_table(&out.path().join(&exr.path), 5, 7, 3).unwrap();
         assert_eq!(texels.len(), table.data.len() / 3 * 4);
@@ -362,7 +381,9 @@ transmittance = "auto"
             assert_eq!(t[3], 1.0);
         }
         let mut only_ktx2 = manifest.clone();
-        only_ktx2.files.retain(|g| g.format == "ktx2");
+        only_ktx2
+            .files
+            .retain(|g| g.format == nacre_format::FileFormat::Ktx2);
         assert_eq!(
             only_ktx2.load_table(&manifest_path, &f.quantity).unwrap(),
             Some(table)

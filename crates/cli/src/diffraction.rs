@@ -4,12 +4,12 @@
 //! [`nacre_optics::diffraction`], the sources and CSV writers [`nacre_bake::kinds::diffraction`].
 
 use clap::Args;
-use nacre_bake::bake;
+use nacre_bake::commands::grid::parse_range;
+use nacre_bake::error::{Error, Result};
 use nacre_bake::kinds::diffraction::{HeightSource, ViewSweep, par_map_pairs, write_colour_csv};
 use nacre_bake::kinds::diffraction_integrated::DEFAULT_INTEGRATED_SAMPLES;
-use nacre_bake::error::{Error, Result};
-use nacre_bake::commands::grid::parse_range;
 use nacre_format::atomic::write_atomic;
+use nacre_format::{Manifest, set};
 use nacre_optics::C64;
 use nacre_optics::colour::Colorimeter;
 use nacre_optics::diffraction::integrated::{IntegratedTable, WarpedAxis};
@@ -326,15 +326,18 @@ pub fn load(src: &Source, directions: &[([f64; 3], [f64; 3])]) -> Result<Loaded>
     };
     let (terms, sigma_s, table_colour, context, wavelengths) = match (surface, table) {
         (_, Some(name)) => {
-            let path = bake::resolve_table(name);
-            let manifest = bake::Manifest::read(&path)?;
-            let record = manifest.diffraction().cloned().ok_or_else(|| Error::Invalid {
-                context: path.display().to_string(),
-                message: format!(
-                    "table `{}` is a `{}` table, not a diffraction table",
-                    manifest.name, manifest.kind
-                ),
-            })?;
+            let path = set::resolve_table(name);
+            let manifest = Manifest::read(&path)?;
+            let record = manifest
+                .diffraction()
+                .cloned()
+                .ok_or_else(|| Error::Invalid {
+                    context: path.display().to_string(),
+                    message: format!(
+                        "table `{}` is a `{}` table, not a diffraction table",
+                        manifest.name, manifest.kind
+                    ),
+                })?;
             if let Some(l) = layout {
                 return Err(flag(
                     "--layout",
@@ -599,7 +602,9 @@ pub fn run(args: &DiffractionArgs) -> Result<()> {
     )?;
     if args.color {
         let colours = loaded.colours(&directions)?;
-        return write_atomic(&args.output, |w| write_colour_csv(w, &views, &colours));
+        return Ok(write_atomic(&args.output, |w| {
+            write_colour_csv(w, &views, &colours)
+        })?);
     }
     let Evaluator::Terms(surface) = &loaded.evaluator else {
         return Err(Error::Invalid {
@@ -615,7 +620,9 @@ pub fn run(args: &DiffractionArgs) -> Result<()> {
         fresnel: loaded.fresnel,
     };
     let rho = sweep.reflectance();
-    write_atomic(&args.output, |w| sweep.write_reflectance_csv(w, &rho))
+    Ok(write_atomic(&args.output, |w| {
+        sweep.write_reflectance_csv(w, &rho)
+    })?)
 }
 
 pub const MAP_EXAMPLES: &str = "\
@@ -754,15 +761,17 @@ pub fn run_map(args: &MapArgs) -> Result<()> {
                 exposure,
             )
         }
-        Evaluator::Integrated(table) => nacre_bake::kinds::diffraction::DiffractionMap::compute_with(
-            String::new(),
-            &|wi, wr| table.colour(wi, wr, loaded.fresnel),
-            incidence,
-            max_view,
-            args.cells,
-            &loaded.colorimeter,
-            exposure,
-        ),
+        Evaluator::Integrated(table) => {
+            nacre_bake::kinds::diffraction::DiffractionMap::compute_with(
+                String::new(),
+                &|wi, wr| table.colour(wi, wr, loaded.fresnel),
+                incidence,
+                max_view,
+                args.cells,
+                &loaded.colorimeter,
+                exposure,
+            )
+        }
     };
     let title = format!(
         "diffraction map of {name}: light at {incidence}°, views to {max_view}°, exposure {:.3}",

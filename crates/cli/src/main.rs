@@ -4,11 +4,13 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 use clap::{Args, Parser, Subcommand};
-use nacre_bake::error::Result;
 use nacre_bake::commands::grid::parse_range;
-use nacre_format::atomic::write_atomic;
+use nacre_bake::commands::spectrum;
 use nacre_bake::commands::stack_spec::{StackRecipe, StackSpec};
-use nacre_bake::{bake, materials, spectrum};
+use nacre_bake::error::Result;
+use nacre_bake::kinds;
+use nacre_format::atomic::write_atomic;
+use nacre_format::{Manifest, materials, set};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -443,9 +445,9 @@ fn run_spectrum(args: &SpectrumArgs) -> Result<()> {
     )?;
     let stack = spec.build()?;
     let powers = spectrum::compute(&stack, &angles, &wavelengths)?;
-    write_atomic(&args.output, |w| {
+    Ok(write_atomic(&args.output, |w| {
         spectrum::write_csv(w, &angles, &wavelengths, &powers)
-    })
+    })?)
 }
 
 fn run_color(args: &ColorArgs) -> Result<()> {
@@ -642,9 +644,9 @@ fn run_color(args: &ColorArgs) -> Result<()> {
             lut.as_ref(),
         )?,
     };
-    write_atomic(&args.output, |w| {
+    Ok(write_atomic(&args.output, |w| {
         color::write_csv(w, &stack, &points, &colours, &colorimeter)
-    })
+    })?)
 }
 
 /// The `fourier` table named by `--fourier-table`, or the default-set one baked for the same
@@ -660,9 +662,9 @@ fn load_fourier_table(
         colorimeter.space().to_string(),
     );
     let path = match given {
-        Some(name) => bake::resolve_table(name),
+        Some(name) => set::resolve_table(name),
         None => {
-            let dir = bake::default_baked_dir();
+            let dir = set::default_baked_dir();
             let mut found = None;
             if let Ok(entries) = std::fs::read_dir(&dir) {
                 let mut paths: Vec<PathBuf> = entries
@@ -671,8 +673,8 @@ fn load_fourier_table(
                     .collect();
                 paths.sort();
                 for p in paths {
-                    if let Ok(m) = bake::Manifest::read(&p)
-                        && m.kind == "fourier"
+                    if let Ok(m) = Manifest::read(&p)
+                        && m.kind == nacre_format::TableKind::Fourier
                         && (m.observer.clone(), m.illuminant.clone(), m.space.clone()) == settings
                     {
                         found = Some(p);
@@ -692,7 +694,7 @@ fn load_fourier_table(
             })?
         }
     };
-    let manifest = bake::Manifest::read(&path)?;
+    let manifest = Manifest::read(&path)?;
     if (
         manifest.observer.clone(),
         manifest.illuminant.clone(),
@@ -712,7 +714,7 @@ fn load_fourier_table(
             ),
         });
     }
-    manifest.load_fourier(&path)
+    Ok(manifest.load_fourier(&path)?)
 }
 
 fn run_compare(args: &CompareArgs) -> Result<()> {
@@ -788,15 +790,15 @@ fn run_compare(args: &CompareArgs) -> Result<()> {
 fn run_bake(args: &BakeArgs) -> Result<()> {
     use indicatif::{ProgressBar, ProgressStyle};
     let paths = if args.recipes.is_empty() {
-        bake::default_recipes()?
+        set::default_recipes()?
     } else {
         args.recipes.clone()
     };
-    let out = args.out.clone().unwrap_or_else(bake::default_baked_dir);
+    let out = args.out.clone().unwrap_or_else(set::default_baked_dir);
     // Parse and validate every recipe before baking any.
     let recipes = paths
         .iter()
-        .map(|p| bake::AnyRecipe::read(p))
+        .map(|p| kinds::read_recipe(p))
         .collect::<Result<Vec<_>>>()?;
     for recipe in &recipes {
         let bar = ProgressBar::new(recipe.work()).with_style(
@@ -822,7 +824,8 @@ fn run_bake(args: &BakeArgs) -> Result<()> {
 fn runtime_error(e: nacre_runtime::Error) -> nacre_bake::error::Error {
     use nacre_bake::error::Error;
     match e {
-        nacre_runtime::Error::Table(e) => e,
+        nacre_runtime::Error::Table(e) => Error::Format(e),
+        nacre_runtime::Error::Optics(e) => Error::Optics(e),
         nacre_runtime::Error::Io { path, source } => Error::Io { path, source },
         other => Error::Invalid {
             context: "render".into(),
@@ -881,7 +884,7 @@ fn run_render(args: &RenderArgs) -> Result<()> {
     // Check the settings and read every input before starting the GPU: bad input fails fast.
     options.validate().map_err(runtime_error)?;
     for name in &names {
-        bake::Manifest::read(&bake::resolve_table(name))?;
+        Manifest::read(&set::resolve_table(name))?;
     }
     if let Some(path) = &options.environment {
         nacre_runtime::render::EnvironmentMap::load(path).map_err(runtime_error)?;
@@ -900,7 +903,7 @@ fn run_render(args: &RenderArgs) -> Result<()> {
     let mut tables = TableSet::default();
     for name in &names {
         tables
-            .add(&ctx, &bake::resolve_table(name))
+            .add(&ctx, &set::resolve_table(name))
             .map_err(runtime_error)?;
     }
     if let Some(scene) = &gltf {
@@ -971,20 +974,21 @@ fn run_render_diffraction(
     options.env_samples = args.env_samples;
     // Check the settings and read every input before starting the GPU: bad input fails fast.
     options.validate().map_err(runtime_error)?;
-    let path = bake::resolve_table(&name);
-    let manifest = bake::Manifest::read(&path)?;
-    let record = manifest
-        .diffraction
-        .clone()
-        .ok_or_else(|| nacre_bake::error::Error::Invalid {
-            context: path.display().to_string(),
-            message: format!(
-                "table `{}` is a `{}` table; the {} scene needs a diffraction table",
-                manifest.name,
-                manifest.kind,
-                scene.name()
-            ),
-        })?;
+    let path = set::resolve_table(&name);
+    let manifest = Manifest::read(&path)?;
+    let record =
+        manifest
+            .diffraction()
+            .cloned()
+            .ok_or_else(|| nacre_bake::error::Error::Invalid {
+                context: path.display().to_string(),
+                message: format!(
+                    "table `{}` is a `{}` table; the {} scene needs a diffraction table",
+                    manifest.name,
+                    manifest.kind,
+                    scene.name()
+                ),
+            })?;
     let layout = DiffractionLayout::of(&record, &path).map_err(runtime_error)?;
     let sum = match layout {
         DiffractionLayout::Terms { .. } => {
@@ -1037,11 +1041,7 @@ const DEFAULT_WAVELENGTH_STEP_NM: f64 = 10.0;
 
 /// An integrated `diffraction` table's wavelength sum was done at bake time: refuses `flag`
 /// when it was given for one.
-fn refuse_step_for_integrated(
-    flag: &str,
-    step_nm: Option<f64>,
-    manifest: &bake::Manifest,
-) -> Result<()> {
+fn refuse_step_for_integrated(flag: &str, step_nm: Option<f64>, manifest: &Manifest) -> Result<()> {
     match step_nm {
         None => Ok(()),
         Some(step_nm) => Err(nacre_bake::error::Error::Invalid {
@@ -1079,7 +1079,7 @@ fn run_render_rough_row(args: &RenderArgs) -> Result<()> {
         args.tables.clone()
     };
     for name in &names {
-        bake::Manifest::read(&bake::resolve_table(name))?;
+        Manifest::read(&set::resolve_table(name))?;
     }
     let options = RoughRowOptions {
         samples_per_pixel: args.reference_samples,
@@ -1092,7 +1092,7 @@ fn run_render_rough_row(args: &RenderArgs) -> Result<()> {
     let mut tables = TableSet::default();
     for name in &names {
         tables
-            .add(&ctx, &bake::resolve_table(name))
+            .add(&ctx, &set::resolve_table(name))
             .map_err(runtime_error)?;
     }
     let row = render_rough_row(&ctx, &tables, technique, &options).map_err(runtime_error)?;
@@ -1126,15 +1126,14 @@ fn run_bench_gpu(args: &BenchGpuArgs) -> Result<()> {
         args.tables.clone()
     };
     for name in &names {
-        bake::Manifest::read(&bake::resolve_table(name))?;
+        Manifest::read(&set::resolve_table(name))?;
     }
-    let diffraction_path = bake::resolve_table(&args.diffraction);
-    let diffraction_manifest = bake::Manifest::read(&diffraction_path)?;
+    let diffraction_path = set::resolve_table(&args.diffraction);
+    let diffraction_manifest = Manifest::read(&diffraction_path)?;
     let mut diffraction_options = DiffractionOptions::default();
     // The sum the diffraction pass does, for the report.
     let diffraction_sum = match diffraction_manifest
-        .diffraction
-        .as_ref()
+        .diffraction()
         .map(|record| DiffractionLayout::of(record, &diffraction_path).map_err(runtime_error))
     {
         Some(Ok(DiffractionLayout::Integrated { .. })) => {
@@ -1170,7 +1169,7 @@ fn run_bench_gpu(args: &BenchGpuArgs) -> Result<()> {
     let mut tables = TableSet::default();
     for name in &names {
         tables
-            .add(&ctx, &bake::resolve_table(name))
+            .add(&ctx, &set::resolve_table(name))
             .map_err(runtime_error)?;
     }
     let diffraction = DiffractionTables::load(&ctx, &diffraction_path, diffraction_options.fresnel)
@@ -1302,8 +1301,8 @@ fn run(cli: Cli) -> Result<()> {
         Command::Render(args) => run_render(&args),
         Command::BenchGpu(args) => run_bench_gpu(&args),
         Command::Info { table } => {
-            let path = bake::resolve_table(&table);
-            let manifest = bake::Manifest::read(&path)?;
+            let path = set::resolve_table(&table);
+            let manifest = Manifest::read(&path)?;
             println!(
                 "{}",
                 serde_json::to_string_pretty(&manifest).expect("manifest serialises")

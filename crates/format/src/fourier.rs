@@ -35,8 +35,8 @@
 use crate::error::{Error, Result};
 use crate::table_io::{self, Precision, Table3};
 use nacre_optics::C64;
-use nacre_optics::fourier::SensitivitySpectrum;
 use nacre_optics::colour::Colorimeter;
+use nacre_optics::fourier::SensitivitySpectrum;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 use std::path::Path;
@@ -180,4 +180,3 @@ impl FourierTable {
         Ok(FourierTable { axes, levels })
     }
 }
-

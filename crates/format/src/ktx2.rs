@@ -47,9 +47,9 @@
 //! length and size against the file and the header before touching texel data, so a
 //! truncated or malformed file is an [`Error::Table`] naming the file, never a panic.
 
+use crate::atomic::write_atomic;
 use crate::error::{Error, Result};
 use crate::fourier::{FourierAxes, FourierTable};
-use crate::atomic::write_atomic;
 use crate::table_io::{MAX_TEXELS, Table3};
 use half::f16;
 use nacre_optics::C64;

@@ -56,7 +56,6 @@ use nacre_optics::colour::Colorimeter;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
-
 /// Axes of a rough-film LUT, with the forward (physical → t ∈ [0, 1]) and inverse mappings.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RoughLutAxes {
@@ -417,4 +416,3 @@ impl LoadedRoughLut {
         })
     }
 }
-

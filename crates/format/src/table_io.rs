@@ -48,8 +48,8 @@
 //! one and is left untouched when writing fails. Readers validate the dimensions, channels
 //! and values and never panic on malformed or truncated files; every error names the file.
 
-use crate::error::{Error, Result};
 use crate::atomic::write_atomic;
+use crate::error::{Error, Result};
 use half::f16;
 use std::io::{Cursor, Read};
 use std::path::Path;
@@ -818,11 +818,11 @@ mod tests {
         struct W {
             p: Precision,
         }
-        let w: W = toml::from_str("p = \"float\"").unwrap();
+        let w: W = serde_json::from_str(r#"{"p": "float"}"#).unwrap();
         assert_eq!(w.p, Precision::Float);
-        let w: W = toml::from_str("p = \"half\"").unwrap();
+        let w: W = serde_json::from_str(r#"{"p": "half"}"#).unwrap();
         assert_eq!(w.p, Precision::Half);
-        assert!(toml::from_str::<W>("p = \"Half\"").is_err());
+        assert!(serde_json::from_str::<W>(r#"{"p": "Half"}"#).is_err());
     }
 
     #[test]

@@ -24,11 +24,11 @@
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
 use half::f16;
-use nacre_format::{Manifest, TableKind};
 use nacre_format::film_lut::FilmLutAxes;
 use nacre_format::fourier::FourierAxes;
 use nacre_format::rough_film_lut::RoughLutAxes;
 use nacre_format::table_io::{self, Table3};
+use nacre_format::{Manifest, TableKind};
 use nacre_optics::colour::Colorimeter;
 use std::path::{Path, PathBuf};
 
@@ -106,8 +106,12 @@ impl TableSet {
         let manifest = Manifest::read(manifest_path)?;
         verify_files(&manifest, manifest_path)?;
         match manifest.kind {
-            TableKind::FilmLut => self.film_lut = Some(upload_film_lut(ctx, manifest, manifest_path)?),
-            TableKind::Fourier => self.fourier = Some(upload_fourier(ctx, manifest, manifest_path)?),
+            TableKind::FilmLut => {
+                self.film_lut = Some(upload_film_lut(ctx, manifest, manifest_path)?)
+            }
+            TableKind::Fourier => {
+                self.fourier = Some(upload_fourier(ctx, manifest, manifest_path)?)
+            }
             TableKind::RoughFilmLut => {
                 self.rough_film_lut = Some(upload_rough_film_lut(ctx, manifest, manifest_path)?)
             }
@@ -211,10 +215,13 @@ fn upload_film_lut(
     manifest: Manifest,
     manifest_path: &Path,
 ) -> Result<FilmLutTextures> {
-    let axes = manifest.film_lut().cloned().ok_or_else(|| Error::Manifest {
-        path: manifest_path.to_path_buf(),
-        message: "a film-lut manifest without its `film_lut` axes".into(),
-    })?;
+    let axes = manifest
+        .film_lut()
+        .cloned()
+        .ok_or_else(|| Error::Manifest {
+            path: manifest_path.to_path_buf(),
+            message: "a film-lut manifest without its `film_lut` axes".into(),
+        })?;
     let limit = ctx.device.limits().max_texture_dimension_3d;
     for (name, n) in [
         ("cos θ axis", axes.cos_theta_count),

@@ -25,7 +25,8 @@ fn manifest(name: &str) -> PathBuf {
 fn ktx2_only(name: &str, dir: &Path) -> PathBuf {
     let path = manifest(name);
     let mut m = Manifest::read(&path).unwrap();
-    m.files.retain(|f| f.format == "ktx2");
+    m.files
+        .retain(|f| f.format == nacre_format::FileFormat::Ktx2);
     assert!(!m.files.is_empty(), "{name} lists no KTX2 file");
     for f in &m.files {
         std::fs::copy(default_baked_dir().join(&f.path), dir.join(&f.path)).unwrap();
@@ -84,7 +85,13 @@ fn ktx2_only_manifests_give_the_same_probe_results_as_exr() {
         &ktx2.film_lut.as_ref().unwrap().manifest,
         &ktx2.fourier.as_ref().unwrap().manifest,
     ] {
-        assert!(t.files.iter().all(|f| f.format == "ktx2"), "{}", t.name);
+        assert!(
+            t.files
+                .iter()
+                .all(|f| f.format == nacre_format::FileFormat::Ktx2),
+            "{}",
+            t.name
+        );
     }
     assert!(ktx2.film_lut.as_ref().unwrap().has_transmittance);
     let colorimeter = exr.colorimeter().unwrap();

@@ -30,12 +30,12 @@
 //! with a perfect reflector at Y = 1; R, G, B linear in the output space, equal to X, Y, Z
 //! for `--space xyz`).
 
-use nacre_format::Manifest;
-use nacre_format::set::resolve_table;
+use crate::commands::spectrum::fmt_sig;
 use crate::error::{Error, Result};
+use nacre_format::Manifest;
 use nacre_format::film_lut::FilmLut;
 use nacre_format::fourier::FourierTable;
-use crate::commands::spectrum::fmt_sig;
+use nacre_format::set::resolve_table;
 use nacre_format::table_io::Table3;
 use nacre_optics::colour::{Colorimeter, OutputSpace, RgbSpace};
 use nacre_optics::fourier::{FilmOnBase, Harmonics, gltf_iridescence};

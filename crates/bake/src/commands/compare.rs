@@ -10,8 +10,8 @@
 use crate::commands::color::{self, Method, Point, Quantity};
 use crate::error::{Error, Result};
 use crate::kinds::film_lut::FilmLutJob;
-use nacre_format::film_lut::{FilmLut, FilmLutAxes};
 use nacre_format::atomic::write_atomic;
+use nacre_format::film_lut::{FilmLut, FilmLutAxes};
 use nacre_optics::colour::{Colorimeter, Illuminant, Observer, OutputSpace, RgbSpace};
 use nacre_optics::colour::{delta_e_2000, xyz_to_lab};
 use nacre_optics::fourier::Harmonics;

@@ -21,9 +21,9 @@
 //! | fine | 0–85 step 5, 89 | 0–1200 step 12.5 | 1.0–1.8 step 0.1, 2.0, 2.333 | 202 730 |
 
 use crate::commands::color::{self, Method, Point, Quantity};
+use crate::commands::spectrum::fmt_sig;
 use crate::error::{Error, Result};
 use nacre_format::atomic::write_files_atomic;
-use crate::commands::spectrum::fmt_sig;
 use nacre_optics::colour::{Colorimeter, Illuminant, Observer, OutputSpace, RgbSpace};
 use nacre_optics::colour::{delta_e_2000, xyz_to_lab};
 use nacre_optics::fourier::gltf_iridescence;

@@ -34,14 +34,14 @@
 //!   is drawn thick and black. Line style tells polarisation (solid: unpolarised,
 //!   dashed: s, dotted: p) or gamut (sRGB solid, Display P3 dashed, Rec. 2020 dotted).
 
-use nacre_format::Manifest;
-use nacre_format::set::{default_baked_dir, resolve_table};
 use crate::commands::color::{LoadedLut, Quantity};
+use crate::commands::grid::parse_range;
 use crate::error::{Error, Result};
+use nacre_format::Manifest;
+use nacre_format::atomic::write_atomic;
 use nacre_format::film_lut::{FilmLut, FilmLutAxes, MIN_COS_THETA};
 use nacre_format::fourier::FourierTable;
-use crate::commands::grid::parse_range;
-use nacre_format::atomic::write_atomic;
+use nacre_format::set::{default_baked_dir, resolve_table};
 use nacre_format::table_io::Table3;
 use nacre_optics::Stack;
 use nacre_optics::colour::{Colorimeter, Observer, OutputSpace, RgbSpace, xy_to_xyz, xyz_to_xy};
@@ -1771,7 +1771,11 @@ pub fn load_table_plot(name_or_path: &str, options: &TableOptions) -> Result<Tab
         })));
     }
     let lut = LoadedLut::load(&path)?;
-    let axes = lut.manifest.film_lut().cloned().expect("checked by LoadedLut");
+    let axes = lut
+        .manifest
+        .film_lut()
+        .cloned()
+        .expect("checked by LoadedLut");
     let (table, what) = match options.quantity {
         Quantity::Reflectance => (lut.reflectance, "reflectance"),
         Quantity::Transmittance => (

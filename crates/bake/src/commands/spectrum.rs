@@ -5,8 +5,8 @@
 //! transmittance into the substrate (Byrnes' `tmm` convention, with the Re(ñ cos θ)
 //! factor), and absorptance A = 1 − R − T. One row per (angle, wavelength), angle-major.
 
-use crate::error::{Error, Result};
 use crate::commands::grid::MAX_AXIS_SAMPLES;
+use crate::error::{Error, Result};
 use nacre_optics::{Power, Stack};
 use std::io::Write;
 

@@ -17,9 +17,9 @@
 //!
 //! Relative material paths are resolved from the recipe's folder. Unknown keys are errors.
 
+use crate::commands::grid::parse_thickness_nm;
 use crate::error::{Error, Result};
 use crate::recipe::{line_of, toml_error};
-use crate::commands::grid::parse_thickness_nm;
 use nacre_format::materials::resolve;
 use nacre_optics::{Layer, Stack};
 use serde::Deserialize;

@@ -54,12 +54,14 @@
 //! `integrated_samples`, `integrated_gamma`, `integrated_tolerance`) is documented in
 //! [`crate::kinds::diffraction_integrated`].
 
+use crate::commands::spectrum::fmt_sig;
+use crate::error::{Error, Result};
 use crate::kinds::{KindEntry, TableRecipe};
 use crate::recipe::{RawColour, line_of, parse_colour, table_name, toml_error};
 use nacre_format::diffraction::{DiffractionRecord, SIGN_CONVENTION};
-use nacre_format::manifest::{AxisRecord, Encoding, FileFormat, FileRecord, KindRecord, Manifest, TableKind};
-use crate::error::{Error, Result};
-use crate::commands::spectrum::fmt_sig;
+use nacre_format::manifest::{
+    AxisRecord, Encoding, FileFormat, FileRecord, KindRecord, Manifest, TableKind,
+};
 use nacre_format::table_io::{self, Precision, Table3};
 use nacre_optics::C64;
 use nacre_optics::colour::Colorimeter;
@@ -68,11 +70,10 @@ use nacre_optics::diffraction::{
     FresnelTerm, HeightField, SpectralGrid, TaylorTerms, in_plane_directions, taylor_order_for,
 };
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
+use serde::Deserialize;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
-
 
 /// Largest pitch the automatic sampling of synthetic specs uses, µm: the Nyquist limit of
 /// 380 nm light at |u| = 2 is 0.095 µm.
@@ -528,7 +529,6 @@ impl HeightSource {
     }
 }
 
-
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawHeightField {
@@ -889,7 +889,10 @@ impl DiffractionRecipe {
         }];
         let ktx2 = format!("{}.terms.ktx2", self.name);
         let ktx2_path = out_dir.join(&ktx2);
-        nacre_format::ktx2::write_ktx2(&ktx2_path, &terms_image(&layer_data, r.nx, r.ny, &embedded))?;
+        nacre_format::ktx2::write_ktx2(
+            &ktx2_path,
+            &terms_image(&layer_data, r.nx, r.ny, &embedded),
+        )?;
         files.push(FileRecord {
             quantity: "terms".into(),
             format: FileFormat::Ktx2,
@@ -1008,7 +1011,6 @@ pub fn plan(
         integrated: None,
     })
 }
-
 
 /// A `nacre diffraction` evaluation: one incidence, a list of in-plane view angles.
 pub struct ViewSweep<'a> {
@@ -1283,7 +1285,6 @@ impl crate::commands::plot::Figure for DiffractionMap {
     }
 }
 
-
 /// The registry entry of `diffraction` ([`crate::kinds::REGISTRY`]).
 pub const ENTRY: KindEntry = KindEntry {
     kind: TableKind::Diffraction,
@@ -1364,7 +1365,7 @@ mod tests {
         }
     }
 
-    fn recipe(dir: &Path, name: &str, text: &str) -> Result<crate::bake::AnyRecipe> {
+    fn recipe(dir: &Path, name: &str, text: &str) -> Result<Box<dyn crate::kinds::TableRecipe>> {
         let path = dir.join(name);
         std::fs::write(&path, text).unwrap();
         crate::kinds::read_recipe(&path)
@@ -1378,7 +1379,7 @@ mod tests {
         let out = dir.path().join("out");
         let manifest_path = r.bake(&out, &|| {}).unwrap();
         let m = Manifest::read(&manifest_path).unwrap();
-        assert_eq!(m.kind, "diffraction");
+        assert_eq!(m.kind, TableKind::Diffraction);
         let (record, terms) = m.load_diffraction(&manifest_path).unwrap();
         assert_eq!((record.nx, record.ny), (terms.size().0, 1));
         assert!(record.taylor_bound <= 1e-4);

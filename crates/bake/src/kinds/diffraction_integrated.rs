@@ -59,16 +59,17 @@
 //! ω_i·ω_r)² / (cos θ_i cos θ_r (cos θ_i + cos θ_r)²) · S, F² = 1 or the Fresnel reflectance
 //! of one index at the half-vector angle.
 
-use crate::kinds::diffraction::DiffractionRecipe;
-use nacre_format::diffraction::{DiffractionRecord, ERROR_METRIC, IntegratedRecord, MAX_INTEGRATED_BYTES};
-use nacre_format::manifest::{AxisRecord, Encoding, FileFormat, FileRecord, KindRecord, Manifest};
 use crate::error::{Error, Result};
+use crate::kinds::diffraction::DiffractionRecipe;
+use nacre_format::diffraction::{
+    DiffractionRecord, ERROR_METRIC, IntegratedRecord, MAX_INTEGRATED_BYTES,
+};
+use nacre_format::manifest::{AxisRecord, Encoding, FileFormat, FileRecord, KindRecord, Manifest};
 use nacre_format::table_io::{self, Precision, Table3};
 use nacre_optics::diffraction::integrated::{
     IntegratedTable, MAX_INTEGRATED_SAMPLES, WarpedAxis, check_directions,
 };
 use nacre_optics::diffraction::{DiffractionSurface, SpectralGrid, TaylorTerms};
-use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
@@ -78,7 +79,6 @@ pub const DEFAULT_INTEGRATED_SAMPLES: usize = 256;
 pub const DEFAULT_INTEGRATED_GAMMA: f64 = 3.0;
 /// Default tolerance on the measured reconstruction error, in units of the specular white.
 pub const DEFAULT_INTEGRATED_TOLERANCE: f64 = 1e-2;
-
 
 /// The layout "integrated" settings of a recipe.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -90,7 +90,6 @@ pub struct IntegratedSettings {
     /// Tolerance on the measured error.
     pub tolerance: f64,
 }
-
 
 impl IntegratedSettings {
     /// Parses the `integrated_*` keys; `bad` makes a recipe error at a span. Refuses up
@@ -447,13 +446,12 @@ fn write_files(
     Ok(stage.commit_manifest(&manifest, &[])?)
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use nacre_optics::diffraction::HeightField;
 
-    fn recipe(dir: &Path, name: &str, text: &str) -> Result<crate::bake::AnyRecipe> {
+    fn recipe(dir: &Path, name: &str, text: &str) -> Result<Box<dyn crate::kinds::TableRecipe>> {
         let path = dir.join(name);
         std::fs::write(&path, text).unwrap();
         crate::kinds::read_recipe(&path)
@@ -493,9 +491,7 @@ integrated_samples = 256
             s.reconstruction_error, s.mean_error, s.storage_error
         );
         // The files hold what the core computes, rounded to f32 (EXR and KTX2 alike).
-        let crate::bake::AnyRecipe::Diffraction(d) = &r else {
-            panic!()
-        };
+        let d = r.downcast_ref::<DiffractionRecipe>().unwrap();
         let field = HeightField::sine_grating(1.6, 0.05, 0.04, 400).unwrap();
         assert_eq!(field, d.field);
         let surface =
@@ -505,7 +501,9 @@ integrated_samples = 256
         let exact = IntegratedTable::compute(&surface, &grid, &d.colorimeter, table.axis());
         assert_eq!(table, exact);
         let mut ktx_only = m.clone();
-        ktx_only.files.retain(|f| f.format == "ktx2");
+        ktx_only
+            .files
+            .retain(|f| f.format == nacre_format::FileFormat::Ktx2);
         let copy = out.join("ktx-only.json");
         std::fs::write(&copy, serde_json::to_string(&ktx_only).unwrap()).unwrap();
         let (_, from_ktx2) = Manifest::read(&copy)

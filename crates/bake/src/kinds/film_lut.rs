@@ -42,8 +42,8 @@
 use crate::error::{Error, Result};
 use crate::kinds::{KindEntry, TableRecipe};
 use crate::recipe::{
-    OutputSettings, RawColour, RawOutput, RawStack, RecipeStack, line_of, parse_colour,
-    table_name, toml_error,
+    OutputSettings, RawColour, RawOutput, RawStack, RecipeStack, line_of, parse_colour, table_name,
+    toml_error,
 };
 use nacre_format::film_lut::{FilmLut, FilmLutAxes, validate_axes};
 use nacre_format::manifest::{
@@ -394,8 +394,6 @@ impl FilmLutJob {
         })
     }
 }
-
-
 
 /// The registry entry of `film-lut` ([`crate::kinds::REGISTRY`]).
 pub const ENTRY: KindEntry = KindEntry {

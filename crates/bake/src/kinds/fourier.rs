@@ -6,12 +6,12 @@
 use crate::error::{Error, Result};
 use crate::kinds::{KindEntry, TableRecipe};
 use crate::recipe::{RawColour, line_of, parse_colour, table_name, toml_error};
-use nacre_format::table_io;
 use nacre_format::fourier::{FourierAxes, FourierTable};
 use nacre_format::manifest::{
     AxisRecord, Encoding, FOURIER_KTX2_QUANTITY, FileFormat, FileRecord, KindRecord,
     MAX_FOURIER_SAMPLES, Manifest, TableKind,
 };
+use nacre_format::table_io;
 use nacre_optics::C64;
 use nacre_optics::colour::Colorimeter;
 use nacre_optics::fourier::SensitivitySpectrum;
@@ -195,7 +195,6 @@ impl FourierRecipe {
     }
 }
 
-
 /// Computes every level (texels in parallel; each texel independent, so the result
 /// does not depend on the thread count).
 pub fn bake_table(colorimeter: &Colorimeter, axes: FourierAxes) -> FourierTable {
@@ -211,8 +210,8 @@ pub fn bake_table(colorimeter: &Colorimeter, axes: FourierAxes) -> FourierTable 
                     let mu = (i as f64 + 0.5) * axes.max_opd_nm / n as f64;
                     let s = spectrum.transform(mu, sigma);
                     std::array::from_fn(|j| {
-                        let a = s[j]
-                            * C64::from_polar(1.0, 2.0 * PI * mu * axes.carrier_nu_per_nm[j]);
+                        let a =
+                            s[j] * C64::from_polar(1.0, 2.0 * PI * mu * axes.carrier_nu_per_nm[j]);
                         // Stored as f32: round here so that CPU lookups see the file's values.
                         C64::new(f64::from(a.re as f32), f64::from(a.im as f32))
                     })
@@ -222,8 +221,6 @@ pub fn bake_table(colorimeter: &Colorimeter, axes: FourierAxes) -> FourierTable 
         .collect();
     FourierTable { axes, levels }
 }
-
-
 
 /// The registry entry of `fourier` ([`crate::kinds::REGISTRY`]).
 pub const ENTRY: KindEntry = KindEntry {

@@ -41,6 +41,12 @@ impl dyn TableRecipe {
     }
 }
 
+impl std::fmt::Debug for dyn TableRecipe {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} recipe `{}`", self.kind(), self.name())
+    }
+}
+
 /// One registry entry: a kind and the parser of its recipes.
 pub struct KindEntry {
     /// The kind.

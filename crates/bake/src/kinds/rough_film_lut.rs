@@ -82,17 +82,17 @@
 //! axis is the one that matters most (at 160 points, 16 indices gave p95 0.51 and 24 give
 //! 0.27; 24 view angles or 16 roughnesses with 16 indices instead did not lower it).
 //!
+use crate::error::{Error, Result};
 use crate::kinds::{KindEntry, TableRecipe};
 use crate::recipe::{
-    OutputSettings, RawColour, RawOutput, RawStack, RecipeStack, line_of, parse_colour,
-    table_name, toml_error,
+    OutputSettings, RawColour, RawOutput, RawStack, RecipeStack, line_of, parse_colour, table_name,
+    toml_error,
 };
+use nacre_format::film_lut::MIN_COS_THETA;
 use nacre_format::manifest::{
     AxisRecord, Encoding, FileFormat, FileRecord, KindRecord, MAX_TEXELS, Manifest, TableKind,
 };
 use nacre_format::rough_film_lut::{RoughFilmLut, RoughLutAxes, validate_axes};
-use crate::error::{Error, Result};
-use nacre_format::film_lut::MIN_COS_THETA;
 use nacre_format::table_io::{self, Precision, Table3};
 use nacre_optics::colour::Colorimeter;
 use nacre_optics::microfacet::REFRACTION_WAVELENGTH_NM;
@@ -102,7 +102,7 @@ use nacre_optics::microfacet::kernel::{
 use nacre_optics::quadrature::cubic_stencil;
 use nacre_optics::{C64, Layer, Material, SpectralRule, Stack};
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
+use serde::Deserialize;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
@@ -113,7 +113,6 @@ pub const FINE_OPD_STEP_NM: f64 = 24.0;
 /// the Δ axis at grazing views of low-index films hold thicker films than d_max, and the
 /// interpolation near the physical range's edge reads them.
 pub const THICKNESS_EXTENSION: f64 = 1.5;
-
 
 /// The tables as the half-float files store them: each (E_r, E_t) pair rounded by
 /// [`store_albedo_pair`] (so that E_r + E_t ≤ 1 holds for the stored halves), E_r alone
@@ -348,7 +347,6 @@ fn f16_round_down(v: f64) -> half::f16 {
         half::f16::from_bits(bits + 1)
     }
 }
-
 
 // ---------------------------------------------------------------------------------------
 // Recipes
@@ -701,7 +699,6 @@ fn axis_records(a: &RoughLutAxes) -> Vec<AxisRecord> {
         },
     ]
 }
-
 
 /// The registry entry of `rough-film-lut` ([`crate::kinds::REGISTRY`]).
 pub const ENTRY: KindEntry = KindEntry {
