@@ -9,14 +9,14 @@
 //! E_t = ∫ D_ωo(h) F_T(ω_o·h) G₂(ω_o, ω_t)/G₁(ω_o) χ⁻(ω_t·n) dh = ∫₀¹ K_t(c; cos θ_o, α, η) F_T(c) dc
 //! ```
 //!
-//! with ω_i = 2(ω_o·h)h − ω_o, ω_t = [`refract`](super::refract)(ω_o, h, η) and the
+//! with ω_i = 2(ω_o·h)h − ω_o, ω_t = [`refract`](ω_o, h, η) and the
 //! height-correlated G₂ of [`super`]. The kernels do not depend on the film term F.
 //!
 //! # Quadrature (Heitz's disk spread onto cosine nodes)
 //!
 //! The visible-normal domain is Heitz's unit disk (Heitz, "Sampling the GGX Distribution of
 //! Visible Normals", JCGT 7(4), 2018, Listing 1: the map (u₁, u₂) ∈ [0, 1]² → h of
-//! [`sample_ggx_vndf`](super::sample_ggx_vndf) has constant density on the disk), so
+//! [`sample_ggx_vndf`] has constant density on the disk), so
 //! E = ∫∫ F(ω_o·h(u₁, u₂)) g(u₁, u₂) du₁ du₂ with g = G₂/G₁ (0 below the horizon). The
 //! integral is taken by a deterministic product rule: [`KERNEL_RADIAL_NODES`]-point
 //! Gauss–Legendre ([`gauss_legendre_01`]) in v, u₁ = r² = 1 − (1 − v)² (nodes crowd the
