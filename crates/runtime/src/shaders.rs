@@ -373,6 +373,25 @@ pub struct Composed {
     pub map: SourceMap,
 }
 
+impl Composed {
+    /// The module, line and column of byte `offset` of [`Self::source`] (naga's
+    /// `SourceLocation::offset`, `Span::to_range().start`).
+    pub fn locate_offset(&self, offset: usize) -> Option<Location> {
+        let span = self
+            .map
+            .spans
+            .iter()
+            .find(|s| offset >= s.bytes.start && offset <= s.bytes.end)?;
+        let before = self.source.get(span.bytes.start..offset)?;
+        let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+        Some(Location {
+            file: span.file.clone(),
+            line: before.matches('\n').count() as u32 + 1,
+            column: Some((before.len() - line_start) as u32 + 1),
+        })
+    }
+}
+
 impl From<Composed> for String {
     fn from(c: Composed) -> String {
         c.source
@@ -881,6 +900,30 @@ mod tests {
         );
     }
 
+    /// The files a host gets (shaders/README.md lists them).
+    #[test]
+    fn flattened_techniques() {
+        let expected: &[(&str, &[&str])] = &[
+            ("film_lut", &["common", "lut_mapping", "film_lut"]),
+            ("film_fourier", &["common", "film_fourier"]),
+            ("film_spectral", &["common", "film_spectral"]),
+            ("plain", &["common", "plain"]),
+            ("diffraction", &["diffraction_common", "diffraction"]),
+            (
+                "diffraction_integrated",
+                &["diffraction_common", "diffraction_integrated"],
+            ),
+        ];
+        let names: Vec<&str> = expected.iter().map(|e| e.0).collect();
+        assert_eq!(names, TECHNIQUE_MODULES);
+        for (name, modules) in expected {
+            let composed = flatten(name).unwrap();
+            let files: Vec<String> = composed.map.spans.iter().map(|s| s.file.clone()).collect();
+            let wanted: Vec<String> = modules.iter().map(|m| format!("{m}.wgsl")).collect();
+            assert_eq!(files, wanted, "{name}");
+        }
+    }
+
     #[test]
     fn source_map_places_lines() {
         let a = src("a.wgsl", "// a\nfn a() {}");
@@ -898,6 +941,13 @@ mod tests {
         assert_eq!(at(3).as_deref(), Some("b.wgsl:1"));
         assert_eq!(at(5).as_deref(), Some("b.wgsl:3"));
         assert_eq!(at(8), None);
+        let offset = composed.source.find("b() {").unwrap();
+        assert_eq!(
+            composed.locate_offset(offset).unwrap().to_string(),
+            "b.wgsl:3:4"
+        );
+        assert_eq!(composed.locate_offset(0).unwrap().to_string(), "a.wgsl:1:1");
+        assert_eq!(composed.locate_offset(composed.source.len()), None);
         let line5 = composed.source.lines().nth(4).unwrap();
         assert_eq!(line5, "fn b() {");
         assert_eq!(composed.map.locate(5, 4).unwrap().to_string(), "b.wgsl:3:4");

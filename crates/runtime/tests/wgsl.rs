@@ -511,6 +511,8 @@ fn naga_error_positions_map_to_module_lines() {
         at.line_number > 100,
         "the composed line is not the module's"
     );
+    let by_offset = composed.locate_offset(at.offset as usize).unwrap();
+    assert_eq!(by_offset, place);
 
     // A validation error (a vec2 returned as f32) in the function that begins on line 4 of
     // "wrong.wgsl" (where naga places it), composed before probe.wgsl.
