@@ -1,4 +1,5 @@
 // bench.wgsl — consumer module of `nacre bench-gpu`: a full-screen pass that shades every
+// import: common, <technique>
 // pixel with one GGX microfacet material whose Fresnel term is the technique's
 // `film_colour` (plain.wgsl: Schlick), so that the passes differ only in the film term.
 //

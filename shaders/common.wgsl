@@ -1,4 +1,5 @@
 // nacre · shaders/common.wgsl
+// import: (none)
 //
 // Constants, complex arithmetic, Snell's law and the Fresnel amplitudes of one interface,
 // the exact Airy reflectance/transmittance of one film at one wavelength, NaN guards, and

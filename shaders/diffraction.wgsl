@@ -1,4 +1,5 @@
 // nacre · shaders/diffraction.wgsl
+// import: diffraction_common
 //
 // Technique `diffraction`: Stam's diffraction BRDF (Stam 1999) from the Taylor terms of a
 // height field (Dhillon et al. 2014), layout "terms" of a baked `diffraction` table

@@ -1,4 +1,5 @@
 // nacre · shaders/diffraction_common.wgsl
+// import: (none)
 //
 // What both layouts of the technique `diffraction` share (diffraction.wgsl, layout
 // "terms"; diffraction_integrated.wgsl, layout "integrated"; each composed after this

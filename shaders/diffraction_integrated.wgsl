@@ -1,4 +1,5 @@
 // nacre · shaders/diffraction_integrated.wgsl
+// import: diffraction_common
 //
 // Technique `diffraction`, layout "integrated" (the fast path of issue 7): Stam's
 // diffraction BRDF (Stam 1999) with the Taylor expansion of Dhillon et al. 2014, summed over

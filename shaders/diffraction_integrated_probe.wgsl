@@ -1,4 +1,5 @@
 // nacre · shaders/diffraction_integrated_probe.wgsl
+// import: diffraction_integrated
 //
 // The GPU = CPU probe of the layout "integrated" (compute; composed after
 // diffraction_integrated.wgsl by `nacre_runtime::diffraction_integrated::run_probe`).

@@ -1,4 +1,5 @@
 // nacre · shaders/diffraction_integrated_technique.wgsl
+// import: diffraction_integrated
 //
 // Adapter: presents the layout "integrated" module (diffraction_integrated.wgsl, composed
 // before this file) under the names the consumers of the terms technique call

@@ -1,4 +1,5 @@
 // nacre · shaders/diffraction_scene.wgsl
+// import: diffraction_common, <technique>
 //
 // Consumers of the `diffraction` technique (composed after diffraction.wgsl by
 // `nacre_runtime::diffraction`): the ray-cast scenes of `nacre render --scene cd-disc |

@@ -1,4 +1,5 @@
 // nacre · shaders/film_fourier.wgsl — technique `film_fourier`
+// import: common
 //
 // Thin-film colour by Belcour & Barla 2017, "A Practical Extension to Microfacet Theory for
 // the Modeling of Varying Iridescence", Eq. 10, with exact Fresnel amplitudes and phases per

@@ -1,4 +1,5 @@
 // nacre · shaders/film_lut.wgsl — technique `film_lut`
+// import: common, lut_mapping
 //
 // Thin-film colour by one trilinear lookup in a baked `film-lut` table
 // (crates/bake/src/film_lut.rs): texel (x, y, z) holds the colour of the unpolarised

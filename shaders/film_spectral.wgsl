@@ -1,4 +1,5 @@
 // nacre · shaders/film_spectral.wgsl — technique `film_spectral`
+// import: common
 //
 // Thin-film colour by brute force: the exact Airy reflectance and transmittance of one film on
 // a base at each of N wavelengths, weighted per output channel and summed. The GPU twin of

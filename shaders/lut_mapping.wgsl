@@ -1,4 +1,5 @@
 // nacre · shaders/lut_mapping.wgsl
+// import: common
 //
 // The film-lut axis mappings, forward (physical → t ∈ [0, 1]³) and inverse, mirroring
 // `nacre_bake::film_lut::FilmLutAxes` (crates/bake/src/film_lut.rs, whose module docs derive

@@ -1,11 +1,12 @@
 // nacre · shaders/material.wgsl — consumer: a thin-film microfacet material
+// import: common, <technique>, rough_lut_mapping
 //
 // A GGX specular lobe whose Fresnel term is the technique's film colour, over a Lambertian
 // (dielectric) or metallic base, lit by one directional light and by an equirectangular HDR
 // environment, with optional transmission through a thin transparent shell (soap bubble),
 // exposure, the Khronos PBR Neutral tone mapper and an sRGB encoding. Composed after
 // common.wgsl, lut_mapping.wgsl, one technique module (which supplies `film_colour`) and
-// rough_lut_mapping.wgsl (nacre_runtime::shaders::MATERIAL includes it), and before
+// rough_lut_mapping.wgsl (its import line above: `nacre_runtime::shaders` resolves them), and before
 // scene.wgsl or mesh.wgsl, which ray-casts the geometry and calls `material_shade`
 // (crates/runtime/src/render.rs; shaders/README.md).
 //

@@ -1,4 +1,5 @@
 // nacre · shaders/mesh.wgsl — consumer: rasterised triangle meshes (glTF scenes)
+// import: material
 //
 // A vertex shader (`mesh_vs`) that projects world-space vertices (position, normal, uv; the
 // runtime applies the glTF node transforms on the CPU) with MeshParams.view_proj, and a

@@ -1,4 +1,5 @@
 // plain.wgsl — the baseline "technique" of `nacre bench-gpu`: no film, Schlick's Fresnel
+// import: common
 // approximation for a dielectric base, so that a consumer shades exactly the same GGX
 // material with and without a film term and the cost ratio isolates the film.
 //

@@ -1,4 +1,5 @@
 // probe.wgsl — consumer module of the GPU = CPU tests (crates/runtime/src/probe.rs).
+// import: common, <technique>
 //
 // Renders one FilmInput per pixel of a full-screen triangle: pixel (x, y) evaluates
 // probe_inputs[y * width + x] with the technique's `film_colour` and writes reflectance to

@@ -1,4 +1,5 @@
 // nacre · shaders/rough_lut_mapping.wgsl
+// import: (none)
 //
 // The rough-film-lut axis mappings, forward (physical → t ∈ [0, 1]⁴) and inverse, and the
 // two-fetch lookup of the pre-integrated directional albedo, mirroring

@@ -1,4 +1,5 @@
 // nacre · shaders/scene.wgsl — consumer: analytic scenes ray-cast in a fragment shader
+// import: material
 //
 // A full-screen triangle (`scene_vs`) whose fragment shader (`scene_fs`) casts one camera ray
 // per pixel into an analytic scene chosen by ViewParams.scene, shades the hit with

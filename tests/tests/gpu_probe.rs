@@ -347,3 +347,24 @@ fn every_technique_is_finite_for_hostile_inputs() {
         }
     }
 }
+
+/// A source the device rejects is reported at the module and line the error lies in, not at
+/// the composed source's line.
+#[test]
+fn shader_errors_name_the_module_and_line() {
+    use nacre_runtime::shaders::{self, Part};
+    // Line 4 of "broken.wgsl" lacks an operand.
+    let broken = "// broken.wgsl\n// import: common, <technique>\nfn broken() -> f32 {\n    return 1.0 +;\n}\n";
+    let composed = shaders::resolve(
+        &[Part::Source {
+            label: "broken.wgsl",
+            source: broken,
+        }],
+        Some(Part::Module("film_lut")),
+    )
+    .unwrap();
+    let error = shaders::create_module(ctx(), "broken", &composed).expect_err("rejected");
+    let message = error.to_string();
+    assert!(message.contains("broken.wgsl:4:"), "{message}");
+    assert!(message.contains("lines 1–"), "{message}");
+}

@@ -239,21 +239,18 @@ pub fn run_bench_with_diffraction(
         };
         let (source, table_layout, table_group) = match (&binding, pass) {
             (Some(b), BenchPass::Film(t)) => (
-                shaders::compose(t, &[shaders::BENCH]),
+                shaders::film_pipeline(t.module(), &["bench"])?,
                 &b.layout,
                 &b.bind_group,
             ),
             _ => (
-                shaders::compose_source(shaders::PLAIN, &[shaders::BENCH]),
+                shaders::film_pipeline("plain", &["bench"])?,
                 &empty_layout,
                 &empty_group,
             ),
         };
+        let module = shaders::create_module(ctx, pass.name(), &source)?;
         let pipeline = ctx.checked("building a bench pipeline", || {
-            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some(pass.name()),
-                source: wgpu::ShaderSource::Wgsl(source.as_str().into()),
-            });
             let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some(pass.name()),
                 bind_group_layouts: &[Some(&view_layout), Some(table_layout)],

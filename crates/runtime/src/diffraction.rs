@@ -46,6 +46,7 @@ use crate::error::{Error, Result};
 use crate::fullscreen;
 use crate::readback::read_texture;
 use crate::render::{Camera, EnvironmentMap, Level, Light, MAX_DIMENSION, RenderedImage};
+use crate::shaders;
 use crate::tables::{check_limit, verify_files};
 use bytemuck::{Pod, Zeroable};
 use nacre_format::Manifest;
@@ -61,7 +62,8 @@ use std::str::FromStr;
 /// [`crate::diffraction_integrated::WGSL`] each begin with it.
 pub const DIFFRACTION_COMMON: &str = include_str!("../../../shaders/diffraction_common.wgsl");
 /// The technique module, layout "terms" ([`DIFFRACTION_COMMON`], then
-/// `shaders/diffraction.wgsl`): bind group 1 and the functions `diffraction_colour`,
+/// `shaders/diffraction.wgsl`, which imports it; `shaders::flatten("diffraction")` plus a
+/// newline): bind group 1 and the functions `diffraction_colour`,
 /// `diffraction_specular_order_colour`, `diffraction_fresnel`, `diffraction_frame`.
 pub const DIFFRACTION: &str = concat!(
     include_str!("../../../shaders/diffraction_common.wgsl"),
@@ -80,9 +82,17 @@ pub const MAX_ENV_SAMPLES: usize = 8;
 /// Most wavelengths of the spectral sum.
 pub const MAX_WAVELENGTHS: usize = 4096;
 
-/// The composed source of a pipeline: the technique, then the consumers.
+/// The composed source of a pipeline: the technique, then the consumers
+/// ([`composition`]'s source).
 pub fn compose() -> String {
-    format!("{DIFFRACTION}\n{DIFFRACTION_SCENE}\n")
+    composition().source
+}
+
+/// `shaders/diffraction_scene.wgsl` with its imports, `<technique>` = `diffraction`
+/// (diffraction_common, diffraction, diffraction_scene), and its source map.
+pub fn composition() -> shaders::Composed {
+    shaders::flatten_with("diffraction_scene", "diffraction")
+        .expect("the diffraction modules resolve (tested)")
 }
 
 /// How a `diffraction` table stores the surface (the manifest's `layout`).
@@ -720,7 +730,7 @@ pub fn run_probe(
         .collect();
     let values = dispatch_probe(
         ctx,
-        &compose(),
+        &composition(),
         "diffraction_probe",
         (&binding.layout, &binding.bind_group),
         &input,
@@ -745,7 +755,7 @@ pub fn run_probe(
 /// [`Error::DeviceLost`] from the device.
 pub(crate) fn dispatch_probe(
     ctx: &GpuContext,
-    source: &str,
+    source: &shaders::Composed,
     entry: &str,
     technique: (&wgpu::BindGroupLayout, &wgpu::BindGroup),
     input: &[[f32; 4]],
@@ -763,11 +773,8 @@ pub(crate) fn dispatch_probe(
         })?;
     let out_bytes = (cases * 2 * 16) as u64;
     let device = &ctx.device;
+    let module = shaders::create_module(ctx, entry, source)?;
     let readback = ctx.checked(&format!("running the diffraction probe `{entry}`"), || {
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some(entry),
-            source: wgpu::ShaderSource::Wgsl(source.into()),
-        });
         let storage = |binding, read_only| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::COMPUTE,
@@ -1219,7 +1226,7 @@ impl ScenePass {
         let (technique, source) = match table {
             DiffractionTables::Terms(t) => (
                 SceneTechnique::Terms(DiffractionBinding::new(ctx, t, technique)?),
-                compose(),
+                composition(),
             ),
             DiffractionTables::Integrated(t) => {
                 let wanted = diffraction_integrated::fresnel_parameters(technique.fresnel)?;
@@ -1237,7 +1244,7 @@ impl ScenePass {
                         layout: t.bind_group_layout().clone(),
                         bind_group: t.bind_group().clone(),
                     },
-                    diffraction_integrated::compose_scene(),
+                    diffraction_integrated::scene_composition(),
                 )
             }
         };
@@ -1247,11 +1254,8 @@ impl ScenePass {
         };
         let view = view_group(ctx, uniform, env)?;
         let device = &ctx.device;
+        let module = shaders::create_module(ctx, "diffraction scene", &source)?;
         let pipeline = ctx.checked("building the diffraction pipeline", || {
-            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some("diffraction scene"),
-                source: wgpu::ShaderSource::Wgsl(source.as_str().into()),
-            });
             let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("diffraction scene"),
                 bind_group_layouts: &[Some(&view.layout), Some(technique_layout)],

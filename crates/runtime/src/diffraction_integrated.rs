@@ -64,6 +64,7 @@
 use crate::context::{BufferInitExt, GpuContext};
 use crate::diffraction::{check_array_limits, dispatch_probe, upload_rgba32f_array};
 use crate::error::{Error, Result};
+use crate::shaders;
 use crate::tables::verify_files;
 use bytemuck::{Pod, Zeroable};
 use nacre_format::Manifest;
@@ -75,7 +76,8 @@ use nacre_optics::diffraction::integrated::IntegratedTable;
 use std::path::{Path, PathBuf};
 
 /// The technique module, layout "integrated" ([`crate::diffraction::DIFFRACTION_COMMON`],
-/// then `shaders/diffraction_integrated.wgsl`): bind group 1 and the functions
+/// then `shaders/diffraction_integrated.wgsl`, which imports it;
+/// `shaders::flatten("diffraction_integrated")` plus a newline): bind group 1 and the functions
 /// `diffraction_integrated_colour`, `diffraction_integrated_specular_colour`, with
 /// `diffraction_frame` and `diffraction_fresnel_of` from the common module.
 pub const WGSL: &str = concat!(
@@ -91,18 +93,31 @@ pub const TECHNIQUE_ADAPTER: &str =
 /// `diffraction_integrated_probe`; group 2 its buffers).
 pub const PROBE: &str = include_str!("../../../shaders/diffraction_integrated_probe.wgsl");
 
-/// The probe pipeline's source: [`WGSL`] then [`PROBE`].
+/// The probe pipeline's source: [`WGSL`] then [`PROBE`] ([`probe_composition`]'s source).
 pub fn compose_probe() -> String {
-    format!("{WGSL}\n{PROBE}\n")
+    probe_composition().source
+}
+
+/// `shaders/diffraction_integrated_probe.wgsl` with its imports (diffraction_common,
+/// diffraction_integrated, diffraction_integrated_probe) and its source map.
+pub fn probe_composition() -> shaders::Composed {
+    shaders::flatten("diffraction_integrated_probe")
+        .expect("the diffraction modules resolve (tested)")
 }
 
 /// The scene pipeline's source: [`WGSL`], [`TECHNIQUE_ADAPTER`], then the terms technique's
-/// consumers ([`crate::diffraction::DIFFRACTION_SCENE`]: scenes, bench pass, probe).
+/// consumers ([`crate::diffraction::DIFFRACTION_SCENE`]: scenes, bench pass, probe)
+/// ([`scene_composition`]'s source).
 pub fn compose_scene() -> String {
-    format!(
-        "{WGSL}\n{TECHNIQUE_ADAPTER}\n{}\n",
-        crate::diffraction::DIFFRACTION_SCENE
-    )
+    scene_composition().source
+}
+
+/// `shaders/diffraction_scene.wgsl` with its imports, `<technique>` =
+/// `diffraction_integrated_technique` (diffraction_common, diffraction_integrated, the
+/// adapter, diffraction_scene), and its source map.
+pub fn scene_composition() -> shaders::Composed {
+    shaders::flatten_with("diffraction_scene", "diffraction_integrated_technique")
+        .expect("the diffraction modules resolve (tested)")
 }
 
 /// Mirror of `DiffractionIntegratedParams` (shaders/diffraction_integrated.wgsl, 32 bytes).
@@ -394,7 +409,7 @@ pub fn run_probe(
         .collect();
     let values = dispatch_probe(
         ctx,
-        &compose_probe(),
+        &probe_composition(),
         "diffraction_integrated_probe",
         (technique.bind_group_layout(), technique.bind_group()),
         &input,
@@ -429,7 +444,7 @@ pub fn run_scene_probe(
         .collect();
     let values = dispatch_probe(
         ctx,
-        &compose_scene(),
+        &scene_composition(),
         "diffraction_probe",
         (technique.bind_group_layout(), technique.bind_group()),
         &input,

@@ -25,7 +25,7 @@ use crate::render::{
     TARGET_FORMAT, ThicknessMap, ViewUniform, check_film_lut, group_layout, uniform_texture_group,
     upload_mips,
 };
-use crate::shaders::{self, MATERIAL, MESH, Technique};
+use crate::shaders::{self, Technique};
 use crate::tables::TableSet;
 use bytemuck::{Pod, Zeroable};
 
@@ -160,12 +160,9 @@ fn mesh_pipeline(
     mesh_layout: &wgpu::BindGroupLayout,
 ) -> Result<wgpu::RenderPipeline> {
     let device = &ctx.device;
-    let source = shaders::compose(technique, &[MATERIAL, MESH]);
+    let source = shaders::film_pipeline(technique.module(), &["material", "mesh"])?;
+    let module = shaders::create_module(ctx, "mesh", &source)?;
     ctx.checked("creating the mesh pipeline", || {
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("mesh"),
-            source: wgpu::ShaderSource::Wgsl(source.as_str().into()),
-        });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("mesh"),
             bind_group_layouts: &[

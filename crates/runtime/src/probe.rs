@@ -9,7 +9,7 @@ use crate::error::{Error, Result};
 use crate::fullscreen;
 use crate::params::{FilmInput, FilmOutput};
 use crate::readback::read_texture;
-use crate::shaders::{self, PROBE};
+use crate::shaders;
 
 /// Pixels per row of the probe target (64 × 16 bytes: rows already 256-byte aligned).
 const WIDTH: u32 = 64;
@@ -37,12 +37,9 @@ pub fn run_probe(
     })?;
     let height = count.div_ceil(WIDTH);
     let device = &ctx.device;
-    let source = shaders::compose(binding.technique, &[PROBE]);
+    let source = shaders::film_pipeline(binding.technique.module(), &["probe"])?;
+    let module = shaders::create_module(ctx, "probe", &source)?;
     let (reflectance, transmittance) = ctx.checked("running the probe pass", || {
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("probe"),
-            source: wgpu::ShaderSource::Wgsl(source.as_str().into()),
-        });
         let view_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("probe view (empty)"),
             entries: &[],

@@ -8,7 +8,8 @@
 //! GGX-prefiltered layers, the E₁ table and the `rough-film-lut` of the split-sum paths:
 //! [`FilmEval`], [`crate::ibl`]), 1 = the technique's tables ([`TechniqueBinding`]), 2 = the material
 //! ([`MaterialUniform`], the thickness map and its sampler). The pipeline's source is
-//! `shaders::compose(technique, &[MATERIAL, SCENE])`.
+//! `shaders::film_pipeline(technique.module(), &["material", "scene"])` (= `shaders::compose(technique,
+//! &[MATERIAL, SCENE])`).
 //!
 //! CPU-side inputs:
 //!
@@ -40,7 +41,7 @@ use crate::context::BufferInitExt;
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
 use crate::readback::read_texture;
-use crate::shaders::{self, MATERIAL, SCENE, Technique};
+use crate::shaders::{self, Technique};
 use crate::tables::TableSet;
 use bytemuck::{Pod, Zeroable};
 use half::f16;
@@ -1867,8 +1868,8 @@ pub(crate) fn linear_sampler(device: &wgpu::Device, label: &str, repeat_v: bool)
 }
 
 impl Renderer {
-    /// Compiles the scene pipeline of `technique` (`shaders::compose(technique, &[MATERIAL,
-    /// SCENE])`) and builds its group-1 tables from `tables` with `options`.
+    /// Compiles the scene pipeline of `technique` (`shaders::film_pipeline(technique.module(),
+    /// &["material", "scene"])`) and builds its group-1 tables from `tables` with `options`.
     pub fn new(
         ctx: &GpuContext,
         tables: &TableSet,
@@ -1895,13 +1896,10 @@ impl Renderer {
         let colorimeter = tables.colorimeter()?;
         let binding = TechniqueBinding::new(ctx, tables, technique, options, &colorimeter)?;
         let device = &ctx.device;
-        let source = shaders::compose(technique, &[MATERIAL, SCENE]);
+        let source = shaders::film_pipeline(technique.module(), &["material", "scene"])?;
+        let module = shaders::create_module(ctx, "scene", &source)?;
         let (view_layout, material_layout, pipeline) =
             ctx.checked("creating the scene pipeline", || {
-                let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                    label: Some("scene"),
-                    source: wgpu::ShaderSource::Wgsl(source.as_str().into()),
-                });
                 let view_layout = view_group_layout(device, "scene view");
                 let material_layout = group_layout(device, "scene material");
                 let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

@@ -1,9 +1,31 @@
-//! The WGSL modules under `shaders/` and their composition.
+//! The WGSL modules under `shaders/`, their import headers and their composition.
 //!
-//! WGSL has no `import`: a pipeline's source is the concatenation, in this order, of
-//! [`COMMON`], [`LUT_MAPPING`], one technique module ([`Technique::source`]) and one
-//! consumer module (probe, material + scene, or the plain baseline). See `shaders/README.md`
-//! for the bind-group contract each module follows.
+//! WGSL has no `import`: a pipeline's source is the concatenation of modules, each followed by
+//! a newline. Every module declares what it needs in its comment header, on one line that
+//! [`parse_imports`] reads:
+//!
+//! ```text
+//! // import: common, <technique>, rough_lut_mapping
+//! // import: (none)
+//! ```
+//!
+//! A name is a module of [`MODULES`] (its file name without `.wgsl`); `<technique>` stands for
+//! whichever technique module the host composes the consumer with (`film_lut`, `film_fourier`,
+//! `film_spectral` or `plain` for the film consumers; `diffraction` or
+//! `diffraction_integrated_technique` for `diffraction_scene`). [`resolve`] orders the
+//! modules depth first — each module after its imports, in the order they are declared, each
+//! module once — and reports unknown names and cycles as a [`ComposeError`]. The result,
+//! [`Composed`], carries a [`SourceMap`] from the lines of the composed source back to
+//! `module.wgsl:line`, which the runtime uses when wgpu (naga) rejects a shader.
+//!
+//! [`flatten`] gives a host engine one self-contained file per technique (or per consumer with
+//! [`flatten_with`]); [`compose`] keeps the runtime's historical order for the film pipelines:
+//! [`COMMON`], [`LUT_MAPPING`], one technique module ([`Technique::source`]), then the
+//! consumers with whatever they import. See `shaders/README.md` for the bind-group contract
+//! each module follows.
+
+use std::fmt;
+use std::ops::Range;
 
 /// Constants, complex arithmetic, Fresnel at an interface, NaN guards, `FilmInput`/`FilmOutput`.
 pub const COMMON: &str = include_str!("../../../shaders/common.wgsl");
@@ -26,18 +48,485 @@ pub const PROBE: &str = include_str!("../../../shaders/probe.wgsl");
 /// `nacre_bake::kinds::rough_film_lut`; no bindings of its own).
 pub const ROUGH_LUT_MAPPING: &str = include_str!("../../../shaders/rough_lut_mapping.wgsl");
 /// Consumer: the thin-film microfacet material (GGX + film, environment, light, tone
-/// mapping; groups 0 and 2), preceded by [`ROUGH_LUT_MAPPING`] (its exact split-sum path
-/// samples a `rough-film-lut`). Compose it before [`SCENE`] or [`MESH`].
-pub const MATERIAL: &str = concat!(
-    include_str!("../../../shaders/rough_lut_mapping.wgsl"),
-    "\n",
-    include_str!("../../../shaders/material.wgsl")
-);
+/// mapping; groups 0 and 2). It imports [`ROUGH_LUT_MAPPING`] (its exact split-sum path
+/// samples a `rough-film-lut`), which [`compose`] places before it. Compose it before
+/// [`SCENE`] or [`MESH`] (which import it).
+pub const MATERIAL: &str = include_str!("../../../shaders/material.wgsl");
 /// Consumer: the ray-cast analytic scenes of `nacre render` (sphere, bubble, plane).
 pub const SCENE: &str = include_str!("../../../shaders/scene.wgsl");
 /// Consumer: rasterised triangle meshes (glTF scenes of `nacre render --gltf`; group 3 holds
 /// the view-projection). Compose it after [`MATERIAL`].
 pub const MESH: &str = include_str!("../../../shaders/mesh.wgsl");
+
+/// The placeholder of an import header for the technique module chosen by the host.
+pub const TECHNIQUE_SLOT: &str = "<technique>";
+
+/// One WGSL module of `shaders/`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Module {
+    /// The file name without `.wgsl`: what import headers name.
+    pub name: &'static str,
+    /// The file's text.
+    pub source: &'static str,
+}
+
+impl Module {
+    /// The module's imports, from its header.
+    ///
+    /// # Errors
+    /// [`ComposeError::BadImport`] for a malformed import line.
+    pub fn imports(&self) -> Result<Vec<Import<'static>>, ComposeError> {
+        parse_imports(self.name, self.source)
+    }
+}
+
+macro_rules! modules {
+    ($($name:literal),* $(,)?) => {
+        &[$(Module {
+            name: $name,
+            source: include_str!(concat!("../../../shaders/", $name, ".wgsl")),
+        }),*]
+    };
+}
+
+/// Every module of `shaders/` (a test checks that the list matches the directory).
+pub const MODULES: &[Module] = modules![
+    "common",
+    "lut_mapping",
+    "film_lut",
+    "film_fourier",
+    "film_spectral",
+    "plain",
+    "rough_lut_mapping",
+    "material",
+    "scene",
+    "mesh",
+    "probe",
+    "bench",
+    "diffraction_common",
+    "diffraction",
+    "diffraction_integrated",
+    "diffraction_integrated_technique",
+    "diffraction_scene",
+    "diffraction_integrated_probe",
+];
+
+/// The technique modules a host can flatten on their own ([`flatten`]): one file each.
+pub const TECHNIQUE_MODULES: &[&str] = &[
+    "film_lut",
+    "film_fourier",
+    "film_spectral",
+    "plain",
+    "diffraction",
+    "diffraction_integrated",
+];
+
+/// The module of [`MODULES`] called `name`.
+pub fn module(name: &str) -> Option<&'static Module> {
+    MODULES.iter().find(|m| m.name == name)
+}
+
+/// One entry of an import header.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Import<'a> {
+    /// A module of [`MODULES`], by name.
+    Module(&'a str),
+    /// [`TECHNIQUE_SLOT`]: the technique module the host composes with.
+    Technique,
+}
+
+impl fmt::Display for Import<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Import::Module(name) => f.write_str(name),
+            Import::Technique => f.write_str(TECHNIQUE_SLOT),
+        }
+    }
+}
+
+/// Why a composition failed.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum ComposeError {
+    /// An import names no module of [`MODULES`].
+    #[error("{importer} imports `{name}`, which is no module of shaders/")]
+    UnknownModule {
+        /// The importing module (or the root asked for).
+        importer: String,
+        /// The unknown name.
+        name: String,
+    },
+    /// The imports form a cycle.
+    #[error("import cycle: {}", cycle.join(" → "))]
+    Cycle {
+        /// The modules of the cycle, the first repeated at the end.
+        cycle: Vec<String>,
+    },
+    /// A module imports `<technique>` but the composition has no technique.
+    #[error("{importer} imports {TECHNIQUE_SLOT}, but no technique was given")]
+    NoTechnique {
+        /// The importing module.
+        importer: String,
+    },
+    /// An import line that is not `// import: name, name, …` (names of letters, digits and
+    /// `_`, or `<technique>`) or `// import: (none)`.
+    #[error("{module} line {line}: bad import header `{text}`")]
+    BadImport {
+        /// The module.
+        module: String,
+        /// 1-based line in the module.
+        line: usize,
+        /// The line.
+        text: String,
+    },
+}
+
+impl From<ComposeError> for crate::error::Error {
+    fn from(e: ComposeError) -> Self {
+        crate::error::Error::Invalid {
+            context: "composing WGSL".into(),
+            message: e.to_string(),
+        }
+    }
+}
+
+/// The imports declared in the leading comment block of `source` (the lines that begin with
+/// `//`, up to the first that does not): every line `// import: a, b, <technique>`, in order;
+/// `// import: (none)` declares none. `module` names the source in errors.
+///
+/// # Errors
+/// [`ComposeError::BadImport`] for a malformed import line.
+pub fn parse_imports<'a>(module: &str, source: &'a str) -> Result<Vec<Import<'a>>, ComposeError> {
+    let mut imports = Vec::new();
+    for (i, line) in source.lines().enumerate() {
+        let Some(comment) = line.strip_prefix("//") else {
+            break;
+        };
+        let Some(list) = comment.trim_start().strip_prefix("import:") else {
+            continue;
+        };
+        let list = list.trim();
+        if list == "(none)" {
+            continue;
+        }
+        let bad = || ComposeError::BadImport {
+            module: module.to_string(),
+            line: i + 1,
+            text: line.to_string(),
+        };
+        for name in list.split(',').map(str::trim) {
+            if name == TECHNIQUE_SLOT {
+                imports.push(Import::Technique);
+            } else if !name.is_empty()
+                && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+            {
+                imports.push(Import::Module(name));
+            } else {
+                return Err(bad());
+            }
+        }
+    }
+    Ok(imports)
+}
+
+/// A root of a composition: a module of [`MODULES`] by name, or a source text of the host's
+/// (its import header is honoured too).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Part<'a> {
+    /// A module of [`MODULES`].
+    Module(&'a str),
+    /// A source that is not in `shaders/`; `label` names it in the [`SourceMap`].
+    Source {
+        /// What errors and the source map call it.
+        label: &'a str,
+        /// The WGSL text.
+        source: &'a str,
+    },
+}
+
+impl<'a> Part<'a> {
+    /// `source` as the module of [`MODULES`] with that exact text, else as a host source
+    /// called `label`.
+    pub fn of_source(label: &'a str, source: &'a str) -> Part<'a> {
+        match MODULES.iter().find(|m| m.source == source) {
+            Some(m) => Part::Module(m.name),
+            None => Part::Source { label, source },
+        }
+    }
+
+    fn label(&self) -> String {
+        match self {
+            Part::Module(name) => format!("{name}.wgsl"),
+            Part::Source { label, .. } => (*label).to_string(),
+        }
+    }
+}
+
+/// Where one module lies in a composed source.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Span {
+    /// `name.wgsl` for a module of [`MODULES`], else the label of the host's source.
+    pub file: String,
+    /// Its bytes in the composed source (without the newline that follows it).
+    pub bytes: Range<usize>,
+    /// The composed source's 1-based line of its first line.
+    pub first_line: u32,
+    /// How many lines it occupies, the newline that follows it included.
+    pub lines: u32,
+}
+
+/// A place in one module.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Location {
+    /// The module's file (see [`Span::file`]).
+    pub file: String,
+    /// 1-based line in the module.
+    pub line: u32,
+    /// 1-based column in bytes, where known.
+    pub column: Option<u32>,
+}
+
+impl fmt::Display for Location {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.column {
+            Some(c) => write!(f, "{}:{}:{c}", self.file, self.line),
+            None => write!(f, "{}:{}", self.file, self.line),
+        }
+    }
+}
+
+/// Which module each line of a composed source came from.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct SourceMap {
+    /// The modules in composition order.
+    pub spans: Vec<Span>,
+}
+
+impl SourceMap {
+    /// The module and its line for 1-based `line` of the composed source (naga's and wgpu's
+    /// `SourceLocation::line_number`).
+    pub fn locate_line(&self, line: u32) -> Option<Location> {
+        let span = self
+            .spans
+            .iter()
+            .find(|s| line >= s.first_line && line < s.first_line + s.lines)?;
+        Some(Location {
+            file: span.file.clone(),
+            line: line - span.first_line + 1,
+            column: None,
+        })
+    }
+
+    /// [`Self::locate_line`] from a 1-based line and column.
+    pub fn locate(&self, line: u32, column: u32) -> Option<Location> {
+        self.locate_line(line).map(|l| Location {
+            column: Some(column),
+            ..l
+        })
+    }
+
+    /// A one-line summary: "lines 1–250 common.wgsl, lines 251–300 lut_mapping.wgsl, …".
+    pub fn describe(&self) -> String {
+        self.spans
+            .iter()
+            .map(|s| {
+                format!(
+                    "lines {}–{} {}",
+                    s.first_line,
+                    s.first_line + s.lines - 1,
+                    s.file
+                )
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
+    /// wgpu's compilation messages with their positions as `module.wgsl:line:column`, one a
+    /// line (messages without a position keep their text).
+    pub fn annotate(&self, info: &wgpu::CompilationInfo) -> String {
+        info.messages
+            .iter()
+            .map(|m| {
+                let kind = match m.message_type {
+                    wgpu::CompilationMessageType::Error => "error",
+                    wgpu::CompilationMessageType::Warning => "warning",
+                    wgpu::CompilationMessageType::Info => "info",
+                };
+                match m
+                    .location
+                    .and_then(|l| self.locate(l.line_number, l.line_position))
+                {
+                    Some(at) => format!("{at}: {kind}: {}", m.message),
+                    None => format!("{kind}: {}", m.message),
+                }
+            })
+            .collect::<Vec<_>>()
+            .join("\n")
+    }
+}
+
+/// A composed WGSL source and where its modules lie.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Composed {
+    /// The source: every module followed by a newline.
+    pub source: String,
+    /// Its modules.
+    pub map: SourceMap,
+}
+
+impl Composed {
+    /// The module, line and column of byte `offset` of [`Self::source`] (naga's
+    /// `SourceLocation::offset`, `Span::to_range().start`).
+    pub fn locate_offset(&self, offset: usize) -> Option<Location> {
+        let span = self
+            .map
+            .spans
+            .iter()
+            .find(|s| offset >= s.bytes.start && offset <= s.bytes.end)?;
+        let before = self.source.get(span.bytes.start..offset)?;
+        let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+        Some(Location {
+            file: span.file.clone(),
+            line: before.matches('\n').count() as u32 + 1,
+            column: Some((before.len() - line_start) as u32 + 1),
+        })
+    }
+}
+
+impl From<Composed> for String {
+    fn from(c: Composed) -> String {
+        c.source
+    }
+}
+
+/// Composes `roots` in order, each after its imports (depth first, in the order of the import
+/// headers; every module once). `technique` fills the `<technique>` imports.
+///
+/// # Errors
+/// [`ComposeError`]: an unknown module, a cycle, a `<technique>` import without a technique,
+/// or a malformed header.
+pub fn resolve(roots: &[Part<'_>], technique: Option<Part<'_>>) -> Result<Composed, ComposeError> {
+    resolve_in(MODULES, roots, technique)
+}
+
+/// [`resolve`] over another table of modules than [`MODULES`].
+///
+/// # Errors
+/// As [`resolve`].
+pub fn resolve_in(
+    modules: &[Module],
+    roots: &[Part<'_>],
+    technique: Option<Part<'_>>,
+) -> Result<Composed, ComposeError> {
+    let mut resolver = Resolver {
+        modules,
+        technique,
+        done: Vec::new(),
+        stack: Vec::new(),
+        out: Composed {
+            source: String::with_capacity(64 * 1024),
+            map: SourceMap::default(),
+        },
+    };
+    for root in roots {
+        resolver.visit(*root, "the composition")?;
+    }
+    Ok(resolver.out)
+}
+
+struct Resolver<'a> {
+    modules: &'a [Module],
+    technique: Option<Part<'a>>,
+    done: Vec<Part<'a>>,
+    stack: Vec<Part<'a>>,
+    out: Composed,
+}
+
+impl<'a> Resolver<'a> {
+    fn visit(&mut self, part: Part<'a>, importer: &str) -> Result<(), ComposeError> {
+        if self.done.contains(&part) {
+            return Ok(());
+        }
+        if let Some(at) = self.stack.iter().position(|p| *p == part) {
+            let mut cycle: Vec<String> = self.stack[at..].iter().map(Part::label).collect();
+            cycle.push(part.label());
+            return Err(ComposeError::Cycle { cycle });
+        }
+        let (label, source) = match part {
+            Part::Module(name) => {
+                let m = self
+                    .modules
+                    .iter()
+                    .find(|m| m.name == name)
+                    .ok_or_else(|| ComposeError::UnknownModule {
+                        importer: importer.to_string(),
+                        name: name.to_string(),
+                    })?;
+                (part.label(), m.source)
+            }
+            Part::Source { label, source } => (label.to_string(), source),
+        };
+        self.stack.push(part);
+        for import in parse_imports(&label, source)? {
+            let next = match import {
+                Import::Module(name) => Part::Module(name),
+                Import::Technique => self.technique.ok_or_else(|| ComposeError::NoTechnique {
+                    importer: label.clone(),
+                })?,
+            };
+            self.visit(next, &label)?;
+        }
+        self.stack.pop();
+        self.done.push(part);
+        let out = &mut self.out;
+        let start = out.source.len();
+        let first_line = out.map.spans.last().map_or(1, |s| s.first_line + s.lines);
+        out.source.push_str(source);
+        out.source.push('\n');
+        out.map.spans.push(Span {
+            file: label,
+            bytes: start..start + source.len(),
+            first_line,
+            lines: source.matches('\n').count() as u32 + 1,
+        });
+        Ok(())
+    }
+}
+
+/// The module `entry` of [`MODULES`] with everything it imports: for a technique of
+/// [`TECHNIQUE_MODULES`], the one file a host engine includes before its own consumer.
+///
+/// # Errors
+/// As [`resolve`]; [`ComposeError::NoTechnique`] when `entry` needs a technique (use
+/// [`flatten_with`]).
+pub fn flatten(entry: &str) -> Result<Composed, ComposeError> {
+    resolve(&[Part::Module(entry)], None)
+}
+
+/// [`flatten`] with `technique` (a module name) for the `<technique>` imports: e.g.
+/// `flatten_with("scene", "film_fourier")` is a complete pipeline source.
+///
+/// # Errors
+/// As [`resolve`].
+pub fn flatten_with(entry: &str, technique: &str) -> Result<Composed, ComposeError> {
+    resolve(&[Part::Module(entry)], Some(Part::Module(technique)))
+}
+
+/// A film pipeline in the runtime's order: [`COMMON`], [`LUT_MAPPING`], the technique module
+/// `technique` (e.g. [`Technique::module`] or `"plain"`), then the modules `consumers` after
+/// their imports, `<technique>` being `technique`.
+///
+/// # Errors
+/// As [`resolve`].
+pub fn film_pipeline(technique: &str, consumers: &[&str]) -> Result<Composed, ComposeError> {
+    let technique = Part::Module(technique);
+    let mut roots = vec![
+        Part::Module("common"),
+        Part::Module("lut_mapping"),
+        technique,
+    ];
+    roots.extend(consumers.iter().map(|&c| Part::Module(c)));
+    resolve(&roots, Some(technique))
+}
 
 /// How the film colour is computed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -63,6 +552,15 @@ impl Technique {
         }
     }
 
+    /// The technique module's name in [`MODULES`] (`film_lut`, …).
+    pub fn module(self) -> &'static str {
+        match self {
+            Technique::Lut => "film_lut",
+            Technique::Fourier => "film_fourier",
+            Technique::Spectral => "film_spectral",
+        }
+    }
+
     /// The name used on the command line and in file names.
     pub fn name(self) -> &'static str {
         match self {
@@ -73,20 +571,408 @@ impl Technique {
     }
 }
 
-/// The full source of a pipeline: common + mapping + `technique` + `consumer`.
+/// The full source of a pipeline: common + mapping + `technique` + `consumer`, each consumer
+/// after its imports (e.g. [`MATERIAL`] brings [`ROUGH_LUT_MAPPING`]). A consumer whose text is
+/// a module of [`MODULES`] is composed as that module; any other text as given, after the
+/// imports of its own header.
+///
+/// # Panics
+/// When a consumer's header names an unknown module or makes a cycle ([`try_compose`] returns
+/// the error; the modules of `shaders/` always resolve, which the tests check).
 pub fn compose(technique: Technique, consumer: &[&str]) -> String {
     compose_source(technique.source(), consumer)
 }
 
 /// [`compose`] with any module that defines `film_colour` (e.g. [`PLAIN`]).
+///
+/// # Panics
+/// As [`compose`].
 pub fn compose_source(technique_source: &str, consumer: &[&str]) -> String {
-    let mut s = String::with_capacity(64 * 1024);
-    for part in [COMMON, LUT_MAPPING, technique_source]
-        .into_iter()
-        .chain(consumer.iter().copied())
-    {
-        s.push_str(part);
-        s.push('\n');
+    try_compose(technique_source, consumer)
+        .unwrap_or_else(|e| panic!("composing WGSL: {e}"))
+        .source
+}
+
+/// [`compose_source`] with its [`SourceMap`], and the error instead of a panic. Host
+/// sources are labelled "technique" and "consumer 1", "consumer 2", … in the map.
+///
+/// # Errors
+/// As [`resolve`].
+pub fn try_compose(technique_source: &str, consumer: &[&str]) -> Result<Composed, ComposeError> {
+    let labels: Vec<String> = (1..=consumer.len())
+        .map(|i| format!("consumer {i}"))
+        .collect();
+    let technique = Part::of_source("technique", technique_source);
+    let mut roots = vec![
+        Part::Module("common"),
+        Part::Module("lut_mapping"),
+        technique,
+    ];
+    roots.extend(
+        consumer
+            .iter()
+            .zip(&labels)
+            .map(|(&source, label)| Part::of_source(label, source)),
+    );
+    resolve(&roots, Some(technique))
+}
+
+/// Creates the shader module of `composed` on `ctx`'s device. When wgpu rejects it, the
+/// [`crate::Error::Gpu`] message leads with naga's messages placed as `module.wgsl:line:column`
+/// ([`SourceMap::annotate`]), then wgpu's own report (whose lines are those of the composed
+/// source, summarised by [`SourceMap::describe`]).
+///
+/// # Errors
+/// [`crate::Error::Gpu`] or [`crate::Error::DeviceLost`].
+///
+/// # Panics
+/// Never: the closure run by [`crate::GpuContext::checked`] always creates the module.
+pub fn create_module(
+    ctx: &crate::GpuContext,
+    label: &str,
+    composed: &Composed,
+) -> crate::error::Result<wgpu::ShaderModule> {
+    let mut module = None;
+    let context = format!("compiling the `{label}` shader");
+    let checked = ctx.checked(&context, || {
+        module = Some(
+            ctx.device
+                .create_shader_module(wgpu::ShaderModuleDescriptor {
+                    label: Some(label),
+                    source: wgpu::ShaderSource::Wgsl(composed.source.as_str().into()),
+                }),
+        );
+    });
+    match (checked, module) {
+        (Ok(()), Some(module)) => Ok(module),
+        (Err(crate::error::Error::Gpu { context, message }), Some(module)) => {
+            let info = pollster::block_on(module.get_compilation_info());
+            Err(crate::error::Error::Gpu {
+                context,
+                message: format!(
+                    "{}\n{message}\n(composed source: {})",
+                    composed.map.annotate(&info),
+                    composed.map.describe()
+                ),
+            })
+        }
+        (Err(e), _) => Err(e),
+        (Ok(()), None) => unreachable!("the closure ran"),
     }
-    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_table_matches_the_directory() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shaders");
+        let mut files: Vec<String> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "wgsl"))
+            .map(|p| p.file_stem().unwrap().to_string_lossy().into_owned())
+            .collect();
+        files.sort();
+        let mut names: Vec<String> = MODULES.iter().map(|m| m.name.to_string()).collect();
+        names.sort();
+        assert_eq!(names, files);
+        for m in MODULES {
+            let text = std::fs::read_to_string(dir.join(format!("{}.wgsl", m.name))).unwrap();
+            assert_eq!(
+                text, m.source,
+                "{}: table source differs from the file",
+                m.name
+            );
+        }
+    }
+
+    /// The declared dependencies of every module, as its header states them.
+    #[test]
+    fn every_header_declares_its_imports() {
+        let expected: &[(&str, &[&str])] = &[
+            ("common", &[]),
+            ("lut_mapping", &["common"]),
+            ("film_lut", &["common", "lut_mapping"]),
+            ("film_fourier", &["common"]),
+            ("film_spectral", &["common"]),
+            ("plain", &["common"]),
+            ("rough_lut_mapping", &[]),
+            ("material", &["common", "<technique>", "rough_lut_mapping"]),
+            ("scene", &["material"]),
+            ("mesh", &["material"]),
+            ("probe", &["common", "<technique>"]),
+            ("bench", &["common", "<technique>"]),
+            ("diffraction_common", &[]),
+            ("diffraction", &["diffraction_common"]),
+            ("diffraction_integrated", &["diffraction_common"]),
+            (
+                "diffraction_integrated_technique",
+                &["diffraction_integrated"],
+            ),
+            ("diffraction_scene", &["diffraction_common", "<technique>"]),
+            ("diffraction_integrated_probe", &["diffraction_integrated"]),
+        ];
+        assert_eq!(expected.len(), MODULES.len());
+        for (name, deps) in expected {
+            let m = module(name).unwrap_or_else(|| panic!("no module {name}"));
+            let header_lines = m
+                .source
+                .lines()
+                .take_while(|l| l.starts_with("//"))
+                .filter(|l| l.starts_with("// import:"))
+                .count();
+            assert_eq!(header_lines, 1, "{name}: one `// import:` line");
+            let imports: Vec<String> = m.imports().unwrap().iter().map(|i| i.to_string()).collect();
+            assert_eq!(imports, *deps, "{name}");
+            for import in m.imports().unwrap() {
+                if let Import::Module(dep) = import {
+                    assert!(module(dep).is_some(), "{name} imports unknown {dep}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn header_syntax() {
+        let src =
+            "// title\n// import: a, <technique>\n//\n// import: b_2\nfn f() {}\n// import: c\n";
+        assert_eq!(
+            parse_imports("x", src).unwrap(),
+            [
+                Import::Module("a"),
+                Import::Technique,
+                Import::Module("b_2")
+            ]
+        );
+        assert_eq!(parse_imports("x", "// import: (none)\n").unwrap(), []);
+        assert_eq!(parse_imports("x", "fn f() {}\n").unwrap(), []);
+        assert_eq!(
+            parse_imports("x", "// t\n// import: a b\n"),
+            Err(ComposeError::BadImport {
+                module: "x".into(),
+                line: 2,
+                text: "// import: a b".into()
+            })
+        );
+        assert!(parse_imports("x", "// import: a,\n").is_err());
+    }
+
+    fn src<'a>(label: &'a str, source: &'a str) -> Part<'a> {
+        Part::Source { label, source }
+    }
+
+    #[test]
+    fn resolver_orders_depth_first_once_each() {
+        let c = src("c", "// import: diffraction_common\nfn c() {}");
+        let roots = [c, Part::Module("diffraction"), c];
+        let composed = resolve(&roots, None).unwrap();
+        let files: Vec<&str> = composed.map.spans.iter().map(|s| s.file.as_str()).collect();
+        assert_eq!(files, ["diffraction_common.wgsl", "c", "diffraction.wgsl"]);
+        let dc = module("diffraction_common").unwrap().source;
+        let d = module("diffraction").unwrap().source;
+        assert_eq!(
+            composed.source,
+            format!("{dc}\n// import: diffraction_common\nfn c() {{}}\n{d}\n")
+        );
+        for s in &composed.map.spans {
+            assert!(composed.source[s.bytes.clone()].ends_with(['}', '\n']));
+        }
+    }
+
+    #[test]
+    fn resolver_reports_cycles_unknown_names_and_missing_techniques() {
+        let table = [
+            Module {
+                name: "x",
+                source: "// import: y\n",
+            },
+            Module {
+                name: "y",
+                source: "// import: <technique>\n",
+            },
+            Module {
+                name: "z",
+                source: "// import: (none)\n",
+            },
+        ];
+        assert_eq!(
+            resolve_in(&table, &[Part::Module("x")], Some(Part::Module("x"))),
+            Err(ComposeError::Cycle {
+                cycle: vec!["x.wgsl".into(), "y.wgsl".into(), "x.wgsl".into()]
+            })
+        );
+        let composed = resolve_in(&table, &[Part::Module("x")], Some(Part::Module("z"))).unwrap();
+        assert_eq!(
+            composed.source,
+            "// import: (none)\n\n// import: <technique>\n\n// import: y\n\n"
+        );
+        let b = src("b", "// import: <technique>\nfn b() {}");
+        assert_eq!(
+            resolve(&[b], Some(b)),
+            Err(ComposeError::Cycle {
+                cycle: vec!["b".into(), "b".into()]
+            })
+        );
+        let u = src("u", "// import: common, nowhere\n");
+        assert_eq!(
+            resolve(&[u], None),
+            Err(ComposeError::UnknownModule {
+                importer: "u".into(),
+                name: "nowhere".into()
+            })
+        );
+        assert_eq!(
+            flatten("scene"),
+            Err(ComposeError::NoTechnique {
+                importer: "material.wgsl".into()
+            })
+        );
+        assert!(matches!(
+            flatten("nope"),
+            Err(ComposeError::UnknownModule { .. })
+        ));
+        let message = ComposeError::Cycle {
+            cycle: vec!["a".into(), "b".into(), "a".into()],
+        }
+        .to_string();
+        assert_eq!(message, "import cycle: a → b → a");
+    }
+
+    /// The compositions the runtime used before the import headers, by hand: each part
+    /// followed by a newline, `MATERIAL` = rough_lut_mapping + material.
+    #[test]
+    fn compositions_are_the_historical_concatenations() {
+        let cat = |parts: &[&str]| parts.iter().map(|p| format!("{p}\n")).collect::<String>();
+        for t in Technique::ALL {
+            let head = [COMMON, LUT_MAPPING, t.source()];
+            let with = |tail: &[&str]| cat(&[&head[..], tail].concat());
+            assert_eq!(compose(t, &[PROBE]), with(&[PROBE]));
+            assert_eq!(compose(t, &[BENCH]), with(&[BENCH]));
+            assert_eq!(
+                compose(t, &[MATERIAL, SCENE]),
+                with(&[ROUGH_LUT_MAPPING, MATERIAL, SCENE])
+            );
+            assert_eq!(
+                compose(t, &[MATERIAL, MESH]),
+                with(&[ROUGH_LUT_MAPPING, MATERIAL, MESH])
+            );
+            assert_eq!(
+                film_pipeline(t.module(), &["scene"]).unwrap().source,
+                with(&[ROUGH_LUT_MAPPING, MATERIAL, SCENE])
+            );
+            assert_eq!(
+                film_pipeline(t.module(), &["mesh"]).unwrap().source,
+                compose(t, &[MATERIAL, MESH])
+            );
+            assert_eq!(
+                film_pipeline(t.module(), &["probe"]).unwrap().source,
+                compose(t, &[PROBE])
+            );
+        }
+        assert_eq!(
+            compose_source(PLAIN, &[BENCH]),
+            cat(&[COMMON, LUT_MAPPING, PLAIN, BENCH])
+        );
+        assert_eq!(
+            film_pipeline("plain", &["bench"]).unwrap().source,
+            compose_source(PLAIN, &[BENCH])
+        );
+        // A host's consumer that is no module is appended as given.
+        let host = "fn host() {}";
+        assert_eq!(
+            compose(Technique::Lut, &[host]),
+            cat(&[COMMON, LUT_MAPPING, FILM_LUT, host])
+        );
+        let m = try_compose(FILM_LUT, &[MATERIAL, host]).unwrap().map;
+        let files: Vec<&str> = m.spans.iter().map(|s| s.file.as_str()).collect();
+        assert_eq!(
+            files,
+            [
+                "common.wgsl",
+                "lut_mapping.wgsl",
+                "film_lut.wgsl",
+                "rough_lut_mapping.wgsl",
+                "material.wgsl",
+                "consumer 2"
+            ]
+        );
+    }
+
+    /// The files a host gets (shaders/README.md lists them).
+    #[test]
+    fn flattened_techniques() {
+        let expected: &[(&str, &[&str])] = &[
+            ("film_lut", &["common", "lut_mapping", "film_lut"]),
+            ("film_fourier", &["common", "film_fourier"]),
+            ("film_spectral", &["common", "film_spectral"]),
+            ("plain", &["common", "plain"]),
+            ("diffraction", &["diffraction_common", "diffraction"]),
+            (
+                "diffraction_integrated",
+                &["diffraction_common", "diffraction_integrated"],
+            ),
+        ];
+        let names: Vec<&str> = expected.iter().map(|e| e.0).collect();
+        assert_eq!(names, TECHNIQUE_MODULES);
+        for (name, modules) in expected {
+            let composed = flatten(name).unwrap();
+            let files: Vec<String> = composed.map.spans.iter().map(|s| s.file.clone()).collect();
+            let wanted: Vec<String> = modules.iter().map(|m| format!("{m}.wgsl")).collect();
+            assert_eq!(files, wanted, "{name}");
+        }
+    }
+
+    #[test]
+    fn source_map_places_lines() {
+        let a = src("a.wgsl", "// a\nfn a() {}");
+        let b = src("b.wgsl", "// b\n\nfn b() {\n}\n");
+        let composed = resolve(&[a, b], None).unwrap();
+        // a: lines 1–2 (+ the newline after it ends line 2); b: lines 3–7 (its trailing
+        // newline, then the composition's, make line 7 empty).
+        assert_eq!(
+            composed.map.describe(),
+            "lines 1–2 a.wgsl, lines 3–7 b.wgsl"
+        );
+        let at = |line| composed.map.locate_line(line).map(|l| l.to_string());
+        assert_eq!(at(1).as_deref(), Some("a.wgsl:1"));
+        assert_eq!(at(2).as_deref(), Some("a.wgsl:2"));
+        assert_eq!(at(3).as_deref(), Some("b.wgsl:1"));
+        assert_eq!(at(5).as_deref(), Some("b.wgsl:3"));
+        assert_eq!(at(8), None);
+        let offset = composed.source.find("b() {").unwrap();
+        assert_eq!(
+            composed.locate_offset(offset).unwrap().to_string(),
+            "b.wgsl:3:4"
+        );
+        assert_eq!(composed.locate_offset(0).unwrap().to_string(), "a.wgsl:1:1");
+        assert_eq!(composed.locate_offset(composed.source.len()), None);
+        let line5 = composed.source.lines().nth(4).unwrap();
+        assert_eq!(line5, "fn b() {");
+        assert_eq!(composed.map.locate(5, 4).unwrap().to_string(), "b.wgsl:3:4");
+        let info = wgpu::CompilationInfo {
+            messages: vec![
+                wgpu::CompilationMessage {
+                    message: "expected `;`".into(),
+                    message_type: wgpu::CompilationMessageType::Error,
+                    location: Some(wgpu::SourceLocation {
+                        line_number: 5,
+                        line_position: 4,
+                        offset: 0,
+                        length: 1,
+                    }),
+                },
+                wgpu::CompilationMessage {
+                    message: "no position".into(),
+                    message_type: wgpu::CompilationMessageType::Warning,
+                    location: None,
+                },
+            ],
+        };
+        assert_eq!(
+            composed.map.annotate(&info),
+            "b.wgsl:3:4: error: expected `;`\nwarning: no position"
+        );
+    }
 }

@@ -3,7 +3,9 @@
 //! checks the bind-group contract of the technique modules, the byte layouts that the Rust
 //! `bytemuck` mirrors rely on, and that every `.wgsl` file opens with a comment header.
 
-use nacre_runtime::shaders::{COMMON, LUT_MAPPING, Technique, compose};
+use nacre_runtime::shaders::{
+    self, ComposeError, MODULES, Part, TECHNIQUE_MODULES, Technique, compose, resolve,
+};
 use std::path::PathBuf;
 
 mod support;
@@ -89,25 +91,21 @@ fn shaders_dir() -> PathBuf {
 /// The composition of `technique` and `consumer`, with a map from its lines to the modules
 /// they came from ("lines 1–250 common.wgsl, …") for error reports.
 fn composition(technique: Technique, consumer: &[(&str, &str)]) -> (String, String) {
-    let source = compose(
-        technique,
-        &consumer.iter().map(|&(_, text)| text).collect::<Vec<_>>(),
-    );
-    let technique_file = format!("film_{}.wgsl", technique.name());
-    let parts = [
-        ("common.wgsl", COMMON),
-        ("lut_mapping.wgsl", LUT_MAPPING),
-        (technique_file.as_str(), technique.source()),
+    let technique_part = Part::Module(technique.module());
+    let mut roots = vec![
+        Part::Module("common"),
+        Part::Module("lut_mapping"),
+        technique_part,
     ];
-    let mut map = Vec::new();
-    let mut line = 1;
-    for (name, text) in parts.into_iter().chain(consumer.iter().copied()) {
-        // `compose` appends a newline to every part.
-        let lines = text.matches('\n').count() + 1;
-        map.push(format!("lines {line}–{} {name}", line + lines - 1));
-        line += lines;
-    }
-    (source, map.join(", "))
+    roots.extend(
+        consumer
+            .iter()
+            .map(|&(name, text)| Part::of_source(name, text)),
+    );
+    let composed = resolve(&roots, Some(technique_part)).expect("the composition resolves");
+    let sources: Vec<&str> = consumer.iter().map(|&(_, text)| text).collect();
+    assert_eq!(composed.source, compose(technique, &sources));
+    (composed.source, composed.map.describe())
 }
 
 #[test]
@@ -323,6 +321,10 @@ fn the_runtimes_own_pipelines_validate_and_translate() {
         &source,
         "common, lut_mapping, plain, bench",
     );
+    assert_eq!(
+        source,
+        shaders::film_pipeline("plain", &["bench"]).unwrap().source
+    );
     translate("plain + bench", &module, &info);
 }
 
@@ -404,4 +406,144 @@ fn fs_bindingless(@builtin(position) p: vec4<f32>) -> @location(0) vec4<f32> {
             );
         }
     }
+}
+
+/// What a host gets: every module of `shaders/` flattened with its imports (those that import
+/// `<technique>` once with each technique of their family) parses, validates and translates,
+/// so that every header declares all that its module needs.
+#[test]
+fn every_flattened_file_validates_and_translates() {
+    let film = ["film_lut", "film_fourier", "film_spectral", "plain"];
+    let diffraction = ["diffraction", "diffraction_integrated_technique"];
+    let mut count = 0;
+    for m in MODULES {
+        let techniques: Vec<Option<&str>> = match shaders::flatten(m.name) {
+            Ok(_) => vec![None],
+            Err(ComposeError::NoTechnique { .. }) if m.name.starts_with("diffraction") => {
+                diffraction.iter().copied().map(Some).collect()
+            }
+            Err(ComposeError::NoTechnique { .. }) => film.iter().copied().map(Some).collect(),
+            Err(e) => panic!("{}: {e}", m.name),
+        };
+        for technique in techniques {
+            let composed = match technique {
+                None => shaders::flatten(m.name),
+                Some(t) => shaders::flatten_with(m.name, t),
+            }
+            .unwrap_or_else(|e| panic!("{}: {e}", m.name));
+            let name = format!("{} ({})", m.name, technique.unwrap_or("no technique"));
+            assert_eq!(
+                composed.map.spans.last().map(|s| s.file.as_str()),
+                Some(format!("{}.wgsl", m.name).as_str()),
+                "{name}: the entry comes last"
+            );
+            let (module, info) = validate(&name, &composed.source, &composed.map.describe());
+            translate(&name, &module, &info);
+            count += 1;
+        }
+    }
+    assert!(count >= MODULES.len());
+    for t in TECHNIQUE_MODULES.iter().filter(|&&t| t != "plain") {
+        let composed = shaders::flatten(t).unwrap_or_else(|e| panic!("{t}: {e}"));
+        assert!(composed.source.contains("@group(1)"), "{t}: binds group 1");
+    }
+    for t in Technique::ALL {
+        assert!(TECHNIQUE_MODULES.contains(&t.module()));
+        assert_eq!(shaders::module(t.module()).unwrap().source, t.source());
+    }
+}
+
+/// The technique constants of the diffraction modules are their flattened files.
+#[test]
+fn diffraction_constants_are_the_flattened_modules() {
+    use nacre_runtime::diffraction::{self, DIFFRACTION, DIFFRACTION_COMMON, DIFFRACTION_SCENE};
+    use nacre_runtime::diffraction_integrated::{
+        self as integrated, PROBE, TECHNIQUE_ADAPTER, WGSL,
+    };
+    let flat = |name: &str| shaders::flatten(name).unwrap().source;
+    assert_eq!(format!("{DIFFRACTION}\n"), flat("diffraction"));
+    assert_eq!(format!("{WGSL}\n"), flat("diffraction_integrated"));
+    assert_eq!(
+        format!("{DIFFRACTION_COMMON}\n"),
+        flat("diffraction_common")
+    );
+    // The historical concatenations of the three pipelines.
+    assert_eq!(
+        diffraction::compose(),
+        format!("{DIFFRACTION}\n{DIFFRACTION_SCENE}\n")
+    );
+    assert_eq!(integrated::compose_probe(), format!("{WGSL}\n{PROBE}\n"));
+    assert_eq!(
+        integrated::compose_scene(),
+        format!("{WGSL}\n{TECHNIQUE_ADAPTER}\n{DIFFRACTION_SCENE}\n")
+    );
+}
+
+/// naga's error positions in a composed source map back to the module and its line: a parse
+/// error and a validation error in a module composed after common.wgsl and a technique.
+#[test]
+fn naga_error_positions_map_to_module_lines() {
+    // Line 4 of "broken.wgsl" lacks an operand.
+    let broken = "// broken.wgsl: a test module\n// import: common, <technique>\nfn broken() -> f32 {\n    return 1.0 +;\n}\n";
+    let technique = Some(Part::Module("film_fourier"));
+    let composed = resolve(
+        &[Part::Source {
+            label: "broken.wgsl",
+            source: broken,
+        }],
+        technique,
+    )
+    .unwrap();
+    let files: Vec<&str> = composed.map.spans.iter().map(|s| s.file.as_str()).collect();
+    assert_eq!(files, ["common.wgsl", "film_fourier.wgsl", "broken.wgsl"]);
+    let error = naga::front::wgsl::parse_str(&composed.source).expect_err("a syntax error");
+    let at = error.location(&composed.source).expect("a position");
+    let place = composed
+        .map
+        .locate(at.line_number, at.line_position)
+        .unwrap();
+    assert_eq!(
+        (place.file.as_str(), place.line),
+        ("broken.wgsl", 4),
+        "{place}"
+    );
+    assert!(
+        at.line_number > 100,
+        "the composed line is not the module's"
+    );
+    let by_offset = composed.locate_offset(at.offset as usize).unwrap();
+    assert_eq!(by_offset, place);
+
+    // A validation error (a vec2 returned as f32) in the function that begins on line 4 of
+    // "wrong.wgsl" (where naga places it), composed before probe.wgsl.
+    let wrong =
+        "// wrong.wgsl\n// import: common\n\nfn wrong() -> f32 {\n    return vec2<f32>(1.0);\n}\n";
+    let composed = resolve(
+        &[
+            Part::Source {
+                label: "wrong.wgsl",
+                source: wrong,
+            },
+            Part::Module("probe"),
+        ],
+        technique,
+    )
+    .unwrap();
+    let module = naga::front::wgsl::parse_str(&composed.source).expect("parses");
+    let error = naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::default(),
+    )
+    .validate(&module)
+    .expect_err("a type error");
+    let at = error.location(&composed.source).expect("a position");
+    let place = composed
+        .map
+        .locate(at.line_number, at.line_position)
+        .unwrap();
+    assert_eq!(
+        (place.file.as_str(), place.line),
+        ("wrong.wgsl", 4),
+        "{place}"
+    );
 }
