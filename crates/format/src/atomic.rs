@@ -3,6 +3,9 @@
 //! failed run leaves no partial output.
 
 use crate::error::{Error, Result};
+use crate::ktx2::{self, Ktx2Format, Ktx2Image};
+use crate::manifest::{Encoding, FileFormat, FileRecord};
+use crate::table_io::{self, Precision, Table3};
 use std::io::{BufWriter, Write};
 use std::path::Path;
 
@@ -176,6 +179,110 @@ impl StagedTable {
     /// The staging folder: write every file of the table here.
     pub fn path(&self) -> &Path {
         self.stage.path()
+    }
+
+    /// Writes `table` into the staging folder as the OpenEXR atlas `file` (channels R, G, B;
+    /// width = `nx`, height = `ny · nz`) and returns its manifest record, checksum included.
+    ///
+    /// # Errors
+    /// As [`table_io::write_exr`] and [`table_io::sha256_hex`].
+    pub fn write_exr(
+        &self,
+        file: &str,
+        quantity: &str,
+        table: &Table3,
+        precision: Precision,
+    ) -> Result<FileRecord> {
+        table_io::write_exr(&self.path().join(file), table, precision)?;
+        self.record(
+            file,
+            quantity,
+            FileFormat::Exr,
+            precision.into(),
+            3,
+            table.nx,
+            table.ny * table.nz,
+        )
+    }
+
+    /// Writes `table` as the 16-bit PNG atlas `file` when every value is in [0, 1] and
+    /// returns its record; `None` (and no file) otherwise.
+    ///
+    /// # Errors
+    /// As [`table_io::write_png16`] and [`table_io::sha256_hex`].
+    pub fn write_png16(
+        &self,
+        file: &str,
+        quantity: &str,
+        table: &Table3,
+    ) -> Result<Option<FileRecord>> {
+        if !table_io::write_png16(&self.path().join(file), table)? {
+            return Ok(None);
+        }
+        let (width, height) = (table.nx, table.ny * table.nz);
+        self.record(
+            file,
+            quantity,
+            FileFormat::Png16,
+            Encoding::Unorm16,
+            3,
+            width,
+            height,
+        )
+        .map(Some)
+    }
+
+    /// Writes `image` as the KTX 2.0 file `file` (channels R, G, B, A; width and height of
+    /// level 0) and returns its record.
+    ///
+    /// # Errors
+    /// As [`ktx2::write_ktx2`] and [`table_io::sha256_hex`].
+    pub fn write_ktx2(&self, file: &str, quantity: &str, image: &Ktx2Image) -> Result<FileRecord> {
+        ktx2::write_ktx2(&self.path().join(file), image)?;
+        let encoding = match image.format {
+            Ktx2Format::Rgba16Float => Encoding::Half,
+            Ktx2Format::Rgba32Float => Encoding::Float,
+        };
+        self.record(
+            file,
+            quantity,
+            FileFormat::Ktx2,
+            encoding,
+            4,
+            image.width as usize,
+            image.height as usize,
+        )
+    }
+
+    /// The record of the staged file `file`: its SHA-256 and the given description
+    /// (`channels` of R, G, B, A in order).
+    ///
+    /// # Errors
+    /// [`Error::Io`] when the file cannot be read.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        file: &str,
+        quantity: &str,
+        format: FileFormat,
+        encoding: Encoding,
+        channels: usize,
+        width: usize,
+        height: usize,
+    ) -> Result<FileRecord> {
+        Ok(FileRecord {
+            quantity: quantity.into(),
+            format,
+            path: file.into(),
+            encoding,
+            channels: ["R", "G", "B", "A"][..channels]
+                .iter()
+                .map(|c| c.to_string())
+                .collect(),
+            width,
+            height,
+            sha256: table_io::sha256_hex(&self.path().join(file))?,
+        })
     }
 
     /// Writes `manifest` as `NAME.json` (pretty JSON and a newline) into the staging folder

@@ -59,10 +59,8 @@ use crate::error::{Error, Result};
 use crate::kinds::{KindEntry, TableRecipe};
 use crate::recipe::{RawColour, line_of, parse_colour, table_name, toml_error};
 use nacre_format::diffraction::{DiffractionRecord, SIGN_CONVENTION};
-use nacre_format::manifest::{
-    AxisRecord, Encoding, FileFormat, FileRecord, KindRecord, Manifest, TableKind,
-};
-use nacre_format::table_io::{self, Precision, Table3};
+use nacre_format::manifest::{AxisRecord, KindRecord, Manifest, TableKind};
+use nacre_format::table_io::{Precision, Table3};
 use nacre_optics::C64;
 use nacre_optics::colour::Colorimeter;
 use nacre_optics::diffraction::{
@@ -807,7 +805,6 @@ impl DiffractionRecipe {
         // Every file goes to a staging folder first; `commit` moves them into `out_dir`,
         // the manifest last (nacre_format::atomic::StagedTable).
         let stage = nacre_format::atomic::StagedTable::new(out_dir)?;
-        let out_dir = stage.path();
         let r = &self.record;
         let c = &self.colorimeter;
         let layers = r.taylor_order + 1;
@@ -876,33 +873,15 @@ impl DiffractionRecipe {
             }
         }
         let exr = format!("{}.terms.exr", self.name);
-        table_io::write_exr(&out_dir.join(&exr), &table, Precision::Float)?;
-        let mut files = vec![FileRecord {
-            quantity: "terms".into(),
-            format: FileFormat::Exr,
-            path: exr.clone(),
-            encoding: Encoding::Float,
-            channels: vec!["R".into(), "G".into(), "B".into()],
-            width: r.nx,
-            height: r.ny * layers,
-            sha256: table_io::sha256_hex(&out_dir.join(&exr))?,
-        }];
         let ktx2 = format!("{}.terms.ktx2", self.name);
-        let ktx2_path = out_dir.join(&ktx2);
-        nacre_format::ktx2::write_ktx2(
-            &ktx2_path,
-            &terms_image(&layer_data, r.nx, r.ny, &embedded),
-        )?;
-        files.push(FileRecord {
-            quantity: "terms".into(),
-            format: FileFormat::Ktx2,
-            path: ktx2,
-            encoding: Encoding::Float,
-            channels: vec!["R".into(), "G".into(), "B".into(), "A".into()],
-            width: r.nx,
-            height: r.ny,
-            sha256: table_io::sha256_hex(&ktx2_path)?,
-        });
+        let files = vec![
+            stage.write_exr(&exr, "terms", &table, Precision::Float)?,
+            stage.write_ktx2(
+                &ktx2,
+                "terms",
+                &terms_image(&layer_data, r.nx, r.ny, &embedded),
+            )?,
+        ];
         manifest.files = files;
         Ok(stage.commit_manifest(&manifest, &[])?)
     }

@@ -64,8 +64,8 @@ use crate::kinds::diffraction::DiffractionRecipe;
 use nacre_format::diffraction::{
     DiffractionRecord, ERROR_METRIC, IntegratedRecord, MAX_INTEGRATED_BYTES,
 };
-use nacre_format::manifest::{AxisRecord, Encoding, FileFormat, FileRecord, KindRecord, Manifest};
-use nacre_format::table_io::{self, Precision, Table3};
+use nacre_format::manifest::{AxisRecord, KindRecord, Manifest};
+use nacre_format::table_io::{Precision, Table3};
 use nacre_optics::diffraction::integrated::{
     IntegratedTable, MAX_INTEGRATED_SAMPLES, WarpedAxis, check_directions,
 };
@@ -310,7 +310,6 @@ fn write_files(
     out_dir: &Path,
 ) -> Result<PathBuf> {
     let stage = nacre_format::atomic::StagedTable::new(out_dir)?;
-    let out_dir = stage.path();
     let c = &recipe.colorimeter;
     let (cols, rows, layers) = (s.samples_u, s.samples_v, s.layers);
     let axis = table.axis();
@@ -390,19 +389,8 @@ fn write_files(
         }
     }
     let exr = format!("{}.integrated.exr", recipe.name);
-    table_io::write_exr(&out_dir.join(&exr), &atlas, Precision::Float)?;
-    let mut files = vec![FileRecord {
-        quantity: "integrated".into(),
-        format: FileFormat::Exr,
-        path: exr.clone(),
-        encoding: Encoding::Float,
-        channels: vec!["R".into(), "G".into(), "B".into()],
-        width: cols,
-        height: rows * layers,
-        sha256: table_io::sha256_hex(&out_dir.join(&exr))?,
-    }];
+    let mut files = vec![stage.write_exr(&exr, "integrated", &atlas, Precision::Float)?];
     let ktx2 = format!("{}.integrated.ktx2", recipe.name);
-    let ktx2_path = out_dir.join(&ktx2);
     let mut level = Vec::with_capacity(table.values().len() * 16);
     for v in table.values() {
         for x in [v[0], v[1], v[2], 0.0] {
@@ -414,34 +402,22 @@ fn write_files(
         v.push(0);
         v
     };
-    nacre_format::ktx2::write_ktx2(
-        &ktx2_path,
-        &nacre_format::ktx2::Ktx2Image {
-            format: nacre_format::ktx2::Ktx2Format::Rgba32Float,
-            width: cols as u32,
-            height: rows as u32,
-            depth: 0,
-            layers: layers as u32,
-            levels: vec![level],
-            key_values: vec![
-                (
-                    nacre_format::ktx2::WRITER_KEY.into(),
-                    nul(&format!("nacre {}", env!("CARGO_PKG_VERSION"))),
-                ),
-                (nacre_format::ktx2::MANIFEST_KEY.into(), nul(&embedded)),
-            ],
-        },
-    )?;
-    files.push(FileRecord {
-        quantity: "integrated".into(),
-        format: FileFormat::Ktx2,
-        path: ktx2,
-        encoding: Encoding::Float,
-        channels: vec!["R".into(), "G".into(), "B".into(), "A".into()],
-        width: cols,
-        height: rows,
-        sha256: table_io::sha256_hex(&ktx2_path)?,
-    });
+    let image = nacre_format::ktx2::Ktx2Image {
+        format: nacre_format::ktx2::Ktx2Format::Rgba32Float,
+        width: cols as u32,
+        height: rows as u32,
+        depth: 0,
+        layers: layers as u32,
+        levels: vec![level],
+        key_values: vec![
+            (
+                nacre_format::ktx2::WRITER_KEY.into(),
+                nul(&format!("nacre {}", env!("CARGO_PKG_VERSION"))),
+            ),
+            (nacre_format::ktx2::MANIFEST_KEY.into(), nul(&embedded)),
+        ],
+    };
+    files.push(stage.write_ktx2(&ktx2, "integrated", &image)?);
     manifest.files = files;
     Ok(stage.commit_manifest(&manifest, &[])?)
 }

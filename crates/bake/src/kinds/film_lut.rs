@@ -46,10 +46,9 @@ use crate::recipe::{
     toml_error,
 };
 use nacre_format::film_lut::{FilmLut, FilmLutAxes, validate_axes};
-use nacre_format::manifest::{
-    AxisRecord, Encoding, FileFormat, FileRecord, KindRecord, MAX_TEXELS, Manifest, TableKind,
-};
-use nacre_format::table_io::{self, Precision, Table3};
+use nacre_format::ktx2::{Ktx2Format, film_lut_image_as};
+use nacre_format::manifest::{AxisRecord, KindRecord, MAX_TEXELS, Manifest, TableKind};
+use nacre_format::table_io::{Precision, Table3};
 use nacre_optics::colour::Colorimeter;
 use nacre_optics::{C64, Layer, Material, SpectralRule, Stack};
 use rayon::prelude::*;
@@ -229,7 +228,6 @@ pub fn bake_recipe(
     let lut: FilmLut = recipe.job.bake(progress)?;
     // Every file goes to a staging folder first; `commit` moves them in, the manifest last.
     let stage = nacre_format::atomic::StagedTable::new(out_dir)?;
-    let dir = stage.path();
     let mut stale = Vec::new();
     let a = &lut.axes;
     let mut files = Vec::new();
@@ -272,55 +270,22 @@ pub fn bake_recipe(
     for (quantity, table) in quantities {
         let Some(table) = table else { continue };
         let exr = format!("{}.{quantity}.exr", recipe.name);
-        table_io::write_exr(&dir.join(&exr), table, recipe.precision)?;
-        files.push(FileRecord {
-            quantity: quantity.into(),
-            format: FileFormat::Exr,
-            path: exr.clone(),
-            encoding: Encoding::from(recipe.precision),
-            channels: vec!["R".into(), "G".into(), "B".into()],
-            width: table.nx,
-            height: table.ny * table.nz,
-            sha256: table_io::sha256_hex(&dir.join(&exr))?,
-        });
+        files.push(stage.write_exr(&exr, quantity, table, recipe.precision)?);
         if recipe.png {
             let png = format!("{}.{quantity}.png", recipe.name);
-            if table_io::write_png16(&dir.join(&png), table)? {
-                files.push(FileRecord {
-                    quantity: quantity.into(),
-                    format: FileFormat::Png16,
-                    path: png.clone(),
-                    encoding: Encoding::Unorm16,
-                    channels: vec!["R".into(), "G".into(), "B".into()],
-                    width: table.nx,
-                    height: table.ny * table.nz,
-                    sha256: table_io::sha256_hex(&dir.join(&png))?,
-                });
-            } else {
+            match stage.write_png16(&png, quantity, table)? {
+                Some(record) => files.push(record),
                 // A stale PNG from an earlier bake would contradict the manifest.
-                stale.push(png);
+                None => stale.push(png),
             }
         }
         let ktx2 = format!("{}.{quantity}.ktx2", recipe.name);
-        let ktx2_path = dir.join(&ktx2);
-        let (ktx2_format, ktx2_encoding) = match recipe.precision {
-            Precision::Half => (nacre_format::ktx2::Ktx2Format::Rgba16Float, Encoding::Half),
-            Precision::Float => (nacre_format::ktx2::Ktx2Format::Rgba32Float, Encoding::Float),
+        let ktx2_format = match recipe.precision {
+            Precision::Half => Ktx2Format::Rgba16Float,
+            Precision::Float => Ktx2Format::Rgba32Float,
         };
-        nacre_format::ktx2::write_ktx2(
-            &ktx2_path,
-            &nacre_format::ktx2::film_lut_image_as(&ktx2_path, table, &embedded, ktx2_format)?,
-        )?;
-        files.push(FileRecord {
-            quantity: quantity.into(),
-            format: FileFormat::Ktx2,
-            path: ktx2,
-            encoding: ktx2_encoding,
-            channels: vec!["R".into(), "G".into(), "B".into(), "A".into()],
-            width: table.nx,
-            height: table.ny,
-            sha256: table_io::sha256_hex(&ktx2_path)?,
-        });
+        let image = film_lut_image_as(&stage.path().join(&ktx2), table, &embedded, ktx2_format)?;
+        files.push(stage.write_ktx2(&ktx2, quantity, &image)?);
     }
     manifest.files = files;
     Ok(stage.commit_manifest(&manifest, &stale)?)

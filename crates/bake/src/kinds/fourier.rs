@@ -7,11 +7,11 @@ use crate::error::{Error, Result};
 use crate::kinds::{KindEntry, TableRecipe};
 use crate::recipe::{RawColour, line_of, parse_colour, table_name, toml_error};
 use nacre_format::fourier::{FourierAxes, FourierTable};
+use nacre_format::ktx2::fourier_image;
 use nacre_format::manifest::{
-    AxisRecord, Encoding, FOURIER_KTX2_QUANTITY, FileFormat, FileRecord, KindRecord,
-    MAX_FOURIER_SAMPLES, Manifest, TableKind,
+    AxisRecord, FOURIER_KTX2_QUANTITY, KindRecord, MAX_FOURIER_SAMPLES, Manifest, TableKind,
 };
-use nacre_format::table_io;
+use nacre_format::table_io::Precision;
 use nacre_optics::C64;
 use nacre_optics::colour::Colorimeter;
 use nacre_optics::fourier::SensitivitySpectrum;
@@ -119,7 +119,6 @@ impl FourierRecipe {
         let table = bake_table(&self.colorimeter, self.axes.clone());
         // Every file goes to a staging folder first; `commit` moves them in, the manifest last.
         let stage = nacre_format::atomic::StagedTable::new(out_dir)?;
-        let dir = stage.path();
         let a = &self.axes;
         let c = &self.colorimeter;
         let mut manifest = Manifest {
@@ -160,36 +159,18 @@ impl FourierRecipe {
         let mut files = Vec::new();
         for k in 0..table.levels.len() {
             let file = format!("{}.level{k}.exr", self.name);
-            let path = dir.join(&file);
-            table.write_level(k, &path)?;
-            files.push(FileRecord {
-                quantity: format!("level {k}"),
-                format: FileFormat::Exr,
-                path: file,
-                encoding: Encoding::Float,
-                channels: vec!["R".into(), "G".into(), "B".into()],
-                width: table.levels[k].len(),
-                height: 2,
-                sha256: table_io::sha256_hex(&path)?,
-            });
+            let quantity = format!("level {k}");
+            files.push(stage.write_exr(
+                &file,
+                &quantity,
+                &table.level_image(k),
+                Precision::Float,
+            )?);
             progress();
         }
         let ktx2 = format!("{}.ktx2", self.name);
-        let ktx2_path = dir.join(&ktx2);
-        nacre_format::ktx2::write_ktx2(
-            &ktx2_path,
-            &nacre_format::ktx2::fourier_image(&ktx2_path, &table, &embedded)?,
-        )?;
-        files.push(FileRecord {
-            quantity: FOURIER_KTX2_QUANTITY.into(),
-            format: FileFormat::Ktx2,
-            path: ktx2,
-            encoding: Encoding::Float,
-            channels: vec!["R".into(), "G".into(), "B".into(), "A".into()],
-            width: a.samples,
-            height: 1,
-            sha256: table_io::sha256_hex(&ktx2_path)?,
-        });
+        let image = fourier_image(&stage.path().join(&ktx2), &table, &embedded)?;
+        files.push(stage.write_ktx2(&ktx2, FOURIER_KTX2_QUANTITY, &image)?);
         manifest.files = files;
         Ok(stage.commit_manifest(&manifest, &[])?)
     }

@@ -88,12 +88,12 @@ use crate::recipe::{
     OutputSettings, RawColour, RawOutput, RawStack, RecipeStack, line_of, parse_colour, table_name,
     toml_error,
 };
+use nacre_format::atomic::StagedTable;
 use nacre_format::film_lut::MIN_COS_THETA;
-use nacre_format::manifest::{
-    AxisRecord, Encoding, FileFormat, FileRecord, KindRecord, MAX_TEXELS, Manifest, TableKind,
-};
+use nacre_format::ktx2::film_lut_image;
+use nacre_format::manifest::{AxisRecord, FileRecord, KindRecord, MAX_TEXELS, Manifest, TableKind};
 use nacre_format::rough_film_lut::{RoughFilmLut, RoughLutAxes, validate_axes};
-use nacre_format::table_io::{self, Precision, Table3};
+use nacre_format::table_io::{Precision, Table3};
 use nacre_optics::colour::Colorimeter;
 use nacre_optics::microfacet::REFRACTION_WAVELENGTH_NM;
 use nacre_optics::microfacet::kernel::{
@@ -504,7 +504,6 @@ impl RoughRecipe {
         // Every file goes to a staging folder first; `commit` moves them into `out_dir`,
         // the manifest last (nacre_format::atomic::StagedTable).
         let stage = nacre_format::atomic::StagedTable::new(out_dir)?;
-        let out_dir = stage.path();
         let a = &lut.axes;
         let c = &self.job.colorimeter;
         let channels: Vec<String> = c
@@ -560,7 +559,7 @@ impl RoughRecipe {
                 Precision::Half => halves,
                 Precision::Float => table,
             };
-            files.extend(self.write_quantity(out_dir, quantity, exr, halves, &embedded)?);
+            files.extend(self.write_quantity(&stage, quantity, exr, halves, &embedded)?);
         }
         manifest.files = files;
         Ok(stage.commit_manifest(&manifest, &[])?)
@@ -574,58 +573,27 @@ impl RoughRecipe {
     /// records.
     fn write_quantity(
         &self,
-        out_dir: &Path,
+        stage: &StagedTable,
         quantity: &str,
         table: &Table3,
         halves: &Table3,
         embedded_manifest: &str,
     ) -> Result<Vec<FileRecord>> {
-        let rgb: Vec<String> = vec!["R".into(), "G".into(), "B".into()];
         let mut files = Vec::new();
         let exr = format!("{}.{quantity}.exr", self.name);
-        table_io::write_exr(&out_dir.join(&exr), table, self.precision)?;
-        files.push(FileRecord {
-            quantity: quantity.into(),
-            format: FileFormat::Exr,
-            encoding: Encoding::from(self.precision),
-            channels: rgb.clone(),
-            width: table.nx,
-            height: table.ny * table.nz,
-            sha256: table_io::sha256_hex(&out_dir.join(&exr))?,
-            path: exr,
-        });
+        files.push(stage.write_exr(&exr, quantity, table, self.precision)?);
         let png = format!("{}.{quantity}.png", self.name);
-        if self.png && table_io::write_png16(&out_dir.join(&png), table)? {
-            files.push(FileRecord {
-                quantity: quantity.into(),
-                format: FileFormat::Png16,
-                encoding: Encoding::Unorm16,
-                channels: rgb,
-                width: table.nx,
-                height: table.ny * table.nz,
-                sha256: table_io::sha256_hex(&out_dir.join(&png))?,
-                path: png,
-            });
+        if self.png
+            && let Some(record) = stage.write_png16(&png, quantity, table)?
+        {
+            files.push(record);
         } else {
             // A stale PNG from an earlier bake would contradict the manifest.
-            let _ = std::fs::remove_file(out_dir.join(&png));
+            let _ = std::fs::remove_file(stage.path().join(&png));
         }
         let ktx2 = format!("{}.{quantity}.ktx2", self.name);
-        let ktx2_path = out_dir.join(&ktx2);
-        nacre_format::ktx2::write_ktx2(
-            &ktx2_path,
-            &nacre_format::ktx2::film_lut_image(&ktx2_path, halves, embedded_manifest)?,
-        )?;
-        files.push(FileRecord {
-            quantity: quantity.into(),
-            format: FileFormat::Ktx2,
-            path: ktx2,
-            encoding: Encoding::Half,
-            channels: vec!["R".into(), "G".into(), "B".into(), "A".into()],
-            width: table.nx,
-            height: table.ny,
-            sha256: table_io::sha256_hex(&ktx2_path)?,
-        });
+        let image = film_lut_image(&stage.path().join(&ktx2), halves, embedded_manifest)?;
+        files.push(stage.write_ktx2(&ktx2, quantity, &image)?);
         Ok(files)
     }
 }
