@@ -545,6 +545,7 @@ impl RoughRecipe {
         };
         let embedded = manifest.embedded_json();
         let mut files = Vec::new();
+        let mut stale = Vec::new();
         // The half-float files (the KTX2 textures always, the EXR atlases at
         // `precision = "half"`) hold the pairs rounded by `store_albedo_pair`.
         let (half_r, half_t) = rounded_to_half(&lut);
@@ -559,10 +560,11 @@ impl RoughRecipe {
                 Precision::Half => halves,
                 Precision::Float => table,
             };
-            files.extend(self.write_quantity(&stage, quantity, exr, halves, &embedded)?);
+            files
+                .extend(self.write_quantity(&stage, quantity, exr, halves, &embedded, &mut stale)?);
         }
         manifest.files = files;
-        Ok(stage.commit_manifest(&manifest, &[])?)
+        Ok(stage.commit_manifest(&manifest, &stale)?)
     }
 }
 
@@ -570,7 +572,8 @@ impl RoughRecipe {
     /// Writes one quantity's files — `NAME.QUANTITY.exr` (atlas, from `table`), `.png` when
     /// asked for and every value is in [0, 1], and `.ktx2` (3-D `RGBA16F`, alpha 1, from
     /// `halves`, values that are already half floats) — each atomically, and returns their
-    /// records.
+    /// records; a PNG not written goes to `stale`, for the commit to remove an earlier
+    /// bake's.
     fn write_quantity(
         &self,
         stage: &StagedTable,
@@ -578,6 +581,7 @@ impl RoughRecipe {
         table: &Table3,
         halves: &Table3,
         embedded_manifest: &str,
+        stale: &mut Vec<String>,
     ) -> Result<Vec<FileRecord>> {
         let mut files = Vec::new();
         let exr = format!("{}.{quantity}.exr", self.name);
@@ -589,7 +593,7 @@ impl RoughRecipe {
             files.push(record);
         } else {
             // A stale PNG from an earlier bake would contradict the manifest.
-            let _ = std::fs::remove_file(stage.path().join(&png));
+            stale.push(png);
         }
         let ktx2 = format!("{}.{quantity}.ktx2", self.name);
         let image = film_lut_image(&stage.path().join(&ktx2), halves, embedded_manifest)?;
@@ -921,6 +925,29 @@ mod tests {
     }
 
     /// (d) Bad recipes: errors name the file and the line.
+    /// A re-bake without PNGs removes the PNGs of an earlier bake from the output folder
+    /// (they were left behind, no longer listed by the manifest).
+    #[test]
+    fn rebake_without_png_removes_the_earlier_pngs() {
+        let dir = tempfile::tempdir().unwrap();
+        let recipe = dir.path().join("tiny.toml");
+        let text = "kind = \"rough-film-lut\"\n[stack]\nambient = \"1.0\"\nbase = \"1.5\"\n[axes]\ncos_theta_count = 3\nthickness_nm = [0.0, 300.0]\nopd_count = 4\nfilm_ior = [1.0, 2.0]\nfilm_ior_count = 2\nalpha = [0.1, 1.0]\nalpha_count = 2\n[output]\ntransmittance = false\n";
+        let out = dir.path().join("out");
+        std::fs::write(&recipe, format!("{text}png = true\n")).unwrap();
+        crate::kinds::read_recipe(&recipe)
+            .unwrap()
+            .bake(&out, &|| {})
+            .unwrap();
+        let png = out.join("tiny.reflectance.png");
+        assert!(png.exists());
+        std::fs::write(&recipe, text).unwrap();
+        crate::kinds::read_recipe(&recipe)
+            .unwrap()
+            .bake(&out, &|| {})
+            .unwrap();
+        assert!(!png.exists(), "the earlier bake's PNG is left behind");
+    }
+
     #[test]
     fn bad_recipes_name_file_and_line() {
         let good = "kind = \"rough-film-lut\"\n[stack]\nambient = \"1.0\"\nbase = \"1.5\"\n[axes]\ncos_theta_count = 4\nthickness_nm = [0.0, 500.0]\nopd_count = 8\nfilm_ior = [1.0, 2.0]\nfilm_ior_count = 3\nalpha = [0.05, 1.0]\nalpha_count = 3\n";
