@@ -10,7 +10,8 @@
 //! `NACRE_BAKED_DIR` measures an experimental bake.
 
 use nacre_format::Manifest;
-use nacre_format::rough_film_lut::{LoadedRoughLut, RoughFilmLut};
+use nacre_format::load::LoadedRoughLut;
+use nacre_format::rough_film_lut::RoughFilmLut;
 use nacre_format::set::default_baked_dir;
 use nacre_optics::colour::{delta_e_2000, xyz_to_lab};
 use nacre_optics::microfacet::{FilmTerm, directional_albedo_with};

@@ -293,7 +293,7 @@ fn manifest_loads_tables_from_ktx2_when_no_exr_is_listed() {
                 full.load_diffraction(&path).unwrap()
             ),
             "rough-film-lut" => {
-                use nacre_format::rough_film_lut::LoadedRoughLut;
+                use nacre_format::load::LoadedRoughLut;
                 assert_eq!(
                     LoadedRoughLut::load(&copy).unwrap().lut,
                     LoadedRoughLut::load(&path).unwrap().lut,

@@ -523,7 +523,7 @@ fn run_color(args: &ColorArgs) -> Result<()> {
     }
     let (lut, colorimeter) = match &method {
         Method::RoughLut { path, alpha, .. } => {
-            let table = nacre_format::rough_film_lut::LoadedRoughLut::load(path)?;
+            let table = nacre_format::load::LoadedRoughLut::load(path)?;
             color::check_stack_matches(&table.manifest, path, &stack, "rough-lut")?;
             let m = &table.manifest;
             for (flag, given, baked) in [

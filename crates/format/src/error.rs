@@ -106,7 +106,7 @@ pub enum Error {
         /// The table's name.
         name: String,
         /// Its kind.
-        kind: crate::manifest::TableKind,
+        kind: crate::kind::TableKind,
         /// What the reader expected, e.g. "a film-lut".
         expected: &'static str,
     },

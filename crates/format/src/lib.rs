@@ -1,11 +1,12 @@
 //! # nacre-format
 //!
 //! The nacre table format, and nothing else: the typed JSON manifest every table ships with
-//! ([`manifest::Manifest`], with a [`manifest::TableKind`] and the kind's axes as
+//! ([`manifest::Manifest`], with a [`kind::TableKind`] and the kind's axes as
 //! [`manifest::KindRecord`]), each kind's forward/inverse axis mappings and CPU lookups
 //! ([`film_lut`], [`fourier`], [`rough_film_lut`], [`diffraction`]), the readers and writers
 //! of table files (OpenEXR atlases and 16-bit PNG in [`table_io`], KTX 2.0 in [`ktx2`]),
-//! atomic writes and staged table commits ([`atomic`]), and the material references that
+//! atomic writes ([`atomic`]) and staged table commits ([`stage`]), the loaders that read a
+//! table through its manifest ([`load`]), and the material references that
 //! manifests and recipes name ([`materials`]: numbers, bundled materials, data files,
 //! refractiveindex.info pages).
 //!
@@ -20,12 +21,16 @@ pub mod diffraction;
 pub mod error;
 pub mod film_lut;
 pub mod fourier;
+pub mod kind;
 pub mod ktx2;
+pub mod load;
 pub mod manifest;
 pub mod materials;
 pub mod rough_film_lut;
 pub mod set;
+pub mod stage;
 pub mod table_io;
 
 pub use error::{Error, Result};
-pub use manifest::{AxisRecord, Encoding, FileFormat, FileRecord, KindRecord, Manifest, TableKind};
+pub use kind::TableKind;
+pub use manifest::{AxisRecord, Encoding, FileFormat, FileRecord, KindRecord, Manifest};

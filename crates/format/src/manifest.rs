@@ -9,12 +9,12 @@
 use crate::diffraction::DiffractionRecord;
 use crate::error::{Error, Result};
 use crate::film_lut::{FilmLutAxes, validate_axes};
-use crate::fourier::{FourierAxes, FourierTable};
+use crate::fourier::FourierAxes;
+pub use crate::kind::TableKind;
 use crate::rough_film_lut::RoughLutAxes;
-use crate::table_io::{self, Table3};
+use crate::table_io;
 use nacre_optics::colour::Colorimeter;
 use serde::{Deserialize, Serialize};
-use std::fmt;
 use std::path::{Path, PathBuf};
 
 /// Most texels one table may have (2²⁴ ≈ 16.8 million: 96 MiB of half-float RGB per
@@ -26,53 +26,6 @@ pub const MANIFEST_FORMAT: &str = "nacre-table/1";
 
 /// The `quantity` of a `fourier` table's KTX2 file (every level in one file).
 pub const FOURIER_KTX2_QUANTITY: &str = "all levels";
-
-/// The kinds of table nacre bakes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum TableKind {
-    /// Pre-integrated film colour over cos θ × optical path × film index
-    /// ([`crate::film_lut`]).
-    FilmLut,
-    /// Fourier transforms of the colour sensitivities, mip-mapped ([`crate::fourier`]).
-    Fourier,
-    /// Directional albedo of the iridescent GGX lobe ([`crate::rough_film_lut`]).
-    RoughFilmLut,
-    /// Stam's diffraction terms or their wavelength-integrated colours
-    /// ([`crate::diffraction`]).
-    Diffraction,
-}
-
-impl TableKind {
-    /// Every kind.
-    pub const ALL: [TableKind; 4] = [
-        TableKind::FilmLut,
-        TableKind::Fourier,
-        TableKind::RoughFilmLut,
-        TableKind::Diffraction,
-    ];
-
-    /// The name recipes and manifests use (`film-lut`, …).
-    pub fn name(self) -> &'static str {
-        match self {
-            TableKind::FilmLut => "film-lut",
-            TableKind::Fourier => "fourier",
-            TableKind::RoughFilmLut => "rough-film-lut",
-            TableKind::Diffraction => "diffraction",
-        }
-    }
-
-    /// The kind named `name`, if any.
-    pub fn from_name(name: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|k| k.name() == name)
-    }
-}
-
-impl fmt::Display for TableKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
 
 /// The axes and records of one table kind, as the manifest stores them (flattened: the
 /// variant's JSON key sits beside the common fields).
@@ -357,29 +310,6 @@ impl Manifest {
         serde_json::to_string_pretty(&v).expect("manifest serialises")
     }
 
-    /// Loads the table of `quantity` listed by this manifest (at `manifest_path`): from its
-    /// EXR file when the manifest lists one, else from its KTX2 file; `None` when neither
-    /// is listed.
-    pub fn load_table(&self, manifest_path: &Path, quantity: &str) -> Result<Option<Table3>> {
-        let Some(f) = self
-            .file(quantity, FileFormat::Exr)
-            .or_else(|| self.file(quantity, FileFormat::Ktx2))
-        else {
-            return Ok(None);
-        };
-        let a = self
-            .film_lut()
-            .ok_or_else(|| self.wrong_kind(manifest_path, "a film-lut"))?;
-        let path = self.dir(manifest_path).join(&f.path);
-        verify_sha256(manifest_path, &path, f)?;
-        let (nx, ny, nz) = (a.cos_theta_count, a.opd_count, a.ior_count);
-        if f.format == FileFormat::Ktx2 {
-            return crate::ktx2::read_film_lut_ktx2(&path, nx, ny, nz).map(Some);
-        }
-        let (table, _) = table_io::read_exr_table(&path, nx, ny, nz)?;
-        Ok(Some(table))
-    }
-
     /// The axes of a `film-lut`, `None` for another kind.
     pub fn film_lut(&self) -> Option<&FilmLutAxes> {
         match &self.record {
@@ -451,22 +381,6 @@ impl Manifest {
     }
 }
 
-/// Checks that the file at `path`, listed in the manifest at `manifest_path` as `f`, has
-/// the SHA-256 the manifest records: a table whose files were replaced or damaged after the
-/// bake is refused rather than read.
-pub fn verify_sha256(manifest_path: &Path, path: &Path, f: &FileRecord) -> Result<()> {
-    let sha = table_io::sha256_hex(path)?;
-    if sha != f.sha256 {
-        return Err(Error::Checksum {
-            path: path.to_path_buf(),
-            manifest: manifest_path.to_path_buf(),
-            actual: sha,
-            expected: f.sha256.clone(),
-        });
-    }
-    Ok(())
-}
-
 /// SHA-256 of a text, as lower-case hex.
 pub fn sha256_text(text: &str) -> String {
     use sha2::{Digest, Sha256};
@@ -478,36 +392,3 @@ pub fn sha256_text(text: &str) -> String {
 
 /// Most texels of level 0 of a `fourier` table.
 pub const MAX_FOURIER_SAMPLES: usize = 1 << 20;
-
-impl Manifest {
-    /// Loads the `fourier` table this manifest (at `manifest_path`) describes: from its
-    /// per-level EXR files when the manifest lists them all, else from its KTX2 file.
-    pub fn load_fourier(&self, manifest_path: &Path) -> Result<FourierTable> {
-        let axes = self
-            .fourier()
-            .cloned()
-            .ok_or_else(|| self.wrong_kind(manifest_path, "a fourier table"))?;
-        let dir = self.dir(manifest_path);
-        let levels = axes.level_samples.len();
-        let exr_level = |k: usize| self.file(&format!("level {k}"), FileFormat::Exr);
-        if (0..levels).any(|k| exr_level(k).is_none())
-            && let Some(f) = self.files.iter().find(|f| f.format == FileFormat::Ktx2)
-        {
-            let path = dir.join(&f.path);
-            verify_sha256(manifest_path, &path, f)?;
-            return crate::ktx2::read_fourier_ktx2(&path, axes);
-        }
-        let paths: Vec<PathBuf> = (0..levels)
-            .map(|k| {
-                let f = exr_level(k).ok_or_else(|| Error::Invalid {
-                    context: manifest_path.display().to_string(),
-                    message: format!("the manifest lists no file for level {k}"),
-                })?;
-                let path = dir.join(&f.path);
-                verify_sha256(manifest_path, &path, f)?;
-                Ok(path)
-            })
-            .collect::<Result<_>>()?;
-        FourierTable::read(axes, &paths)
-    }
-}

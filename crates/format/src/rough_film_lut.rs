@@ -50,11 +50,8 @@
 
 use crate::error::{Error, Result};
 use crate::film_lut::MIN_COS_THETA;
-use crate::manifest::{FileFormat, Manifest};
-use crate::table_io::{self, Table3};
-use nacre_optics::colour::Colorimeter;
+use crate::table_io::Table3;
 use serde::{Deserialize, Serialize};
-use std::path::Path;
 
 /// Axes of a rough-film LUT, with the forward (physical → t ∈ [0, 1]) and inverse mappings.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -358,61 +355,4 @@ pub fn validate_axes(axes: &RoughLutAxes, context: &str, max_texels: u64) -> Res
         });
     }
     Ok(())
-}
-
-/// A rough-film LUT loaded through its manifest, for CPU lookups (`nacre color --method
-/// rough-lut:`).
-#[derive(Clone, Debug, PartialEq)]
-pub struct LoadedRoughLut {
-    /// The manifest.
-    pub manifest: Manifest,
-    /// The table.
-    pub lut: RoughFilmLut,
-    /// The table's colorimeter.
-    pub colorimeter: Colorimeter,
-}
-
-impl LoadedRoughLut {
-    /// Loads the table at `path` (a manifest), from its EXR files or else its KTX2 files.
-    pub fn load(path: &Path) -> Result<Self> {
-        let manifest = Manifest::read(path)?;
-        let axes = manifest
-            .rough_film_lut()
-            .cloned()
-            .ok_or_else(|| manifest.wrong_kind(path, "a rough-film-lut"))?;
-        let dir = path.parent().unwrap_or(Path::new("."));
-        let (nx, ny, nz) = (axes.cos_theta_count, axes.opd_count, axes.depth());
-        let load = |quantity: &str| -> Result<Option<Table3>> {
-            match (
-                manifest.file(quantity, FileFormat::Exr),
-                manifest.file(quantity, FileFormat::Ktx2),
-            ) {
-                (Some(f), _) => Ok(Some(
-                    table_io::read_exr_table(&dir.join(&f.path), nx, ny, nz)?.0,
-                )),
-                (None, Some(f)) => Ok(Some(crate::ktx2::read_film_lut_ktx2(
-                    &dir.join(&f.path),
-                    nx,
-                    ny,
-                    nz,
-                )?)),
-                (None, None) => Ok(None),
-            }
-        };
-        let reflectance = load("reflectance")?.ok_or_else(|| Error::Invalid {
-            context: path.display().to_string(),
-            message: "the manifest lists no reflectance EXR or KTX2 file".into(),
-        })?;
-        let transmittance = load("transmittance")?;
-        let colorimeter = manifest.colorimeter(path)?;
-        Ok(LoadedRoughLut {
-            lut: RoughFilmLut {
-                axes,
-                reflectance,
-                transmittance,
-            },
-            manifest,
-            colorimeter,
-        })
-    }
 }

@@ -289,7 +289,7 @@ fn upload_rough_film_lut(
         )?;
     }
     // The loader of nacre-bake reads the EXR (or KTX2) files in the table's layout.
-    let loaded = nacre_format::rough_film_lut::LoadedRoughLut::load(manifest_path)?;
+    let loaded = nacre_format::load::LoadedRoughLut::load(manifest_path)?;
     let label = manifest.name.clone();
     let lut = &loaded.lut;
     let (reflectance, transmittance) = ctx.checked("uploading a rough-film-lut table", || {

@@ -230,7 +230,8 @@ struct LobeEstimator {
 /// Mean ΔE2000 of [`LobeEstimator`] + the directional light (closed form, as the reference)
 /// against the committed reference at `alpha`.
 fn twin_delta_e(estimator: &LobeEstimator, alpha: f64) -> f64 {
-    use nacre_format::rough_film_lut::{LoadedRoughLut, RoughFilmLut};
+    use nacre_format::load::LoadedRoughLut;
+    use nacre_format::rough_film_lut::RoughFilmLut;
     use nacre_optics::microfacet::{ggx_d, radiance_directional, sample_ggx_vndf, smith_lambda};
     use nacre_runtime::ibl::{
         PREFILTER_LEVELS, PrefilteredEnvironment, env_direction_to_uv, sample_level_bilinear,

@@ -99,7 +99,7 @@ pub enum Method {
 }
 
 /// A loaded `rough-film-lut` table.
-pub type RoughTable = nacre_format::rough_film_lut::LoadedRoughLut;
+pub type RoughTable = nacre_format::load::LoadedRoughLut;
 
 impl Method {
     /// True for the methods that need a roughness (`rough-lut:`, `rough-mc`).

@@ -803,8 +803,8 @@ impl DiffractionRecipe {
         let terms = TaylorTerms::compute(&self.field, self.record.taylor_order);
         progress();
         // Every file goes to a staging folder first; `commit` moves them into `out_dir`,
-        // the manifest last (nacre_format::atomic::StagedTable).
-        let stage = nacre_format::atomic::StagedTable::new(out_dir)?;
+        // the manifest last (nacre_format::stage::StagedTable).
+        let stage = nacre_format::stage::StagedTable::new(out_dir)?;
         let r = &self.record;
         let c = &self.colorimeter;
         let layers = r.taylor_order + 1;

@@ -309,7 +309,7 @@ fn write_files(
     table: &IntegratedTable,
     out_dir: &Path,
 ) -> Result<PathBuf> {
-    let stage = nacre_format::atomic::StagedTable::new(out_dir)?;
+    let stage = nacre_format::stage::StagedTable::new(out_dir)?;
     let c = &recipe.colorimeter;
     let (cols, rows, layers) = (s.samples_u, s.samples_v, s.layers);
     let axis = table.axis();

@@ -227,7 +227,7 @@ pub fn bake_recipe(
 ) -> Result<PathBuf> {
     let lut: FilmLut = recipe.job.bake(progress)?;
     // Every file goes to a staging folder first; `commit` moves them in, the manifest last.
-    let stage = nacre_format::atomic::StagedTable::new(out_dir)?;
+    let stage = nacre_format::stage::StagedTable::new(out_dir)?;
     let mut stale = Vec::new();
     let a = &lut.axes;
     let mut files = Vec::new();

@@ -118,7 +118,7 @@ impl FourierRecipe {
     pub fn bake(&self, out_dir: &Path, progress: &(dyn Fn() + Sync)) -> Result<PathBuf> {
         let table = bake_table(&self.colorimeter, self.axes.clone());
         // Every file goes to a staging folder first; `commit` moves them in, the manifest last.
-        let stage = nacre_format::atomic::StagedTable::new(out_dir)?;
+        let stage = nacre_format::stage::StagedTable::new(out_dir)?;
         let a = &self.axes;
         let c = &self.colorimeter;
         let mut manifest = Manifest {

@@ -88,11 +88,11 @@ use crate::recipe::{
     OutputSettings, RawColour, RawOutput, RawStack, RecipeStack, line_of, parse_colour, table_name,
     toml_error,
 };
-use nacre_format::atomic::StagedTable;
 use nacre_format::film_lut::MIN_COS_THETA;
 use nacre_format::ktx2::film_lut_image;
 use nacre_format::manifest::{AxisRecord, FileRecord, KindRecord, MAX_TEXELS, Manifest, TableKind};
 use nacre_format::rough_film_lut::{RoughFilmLut, RoughLutAxes, validate_axes};
+use nacre_format::stage::StagedTable;
 use nacre_format::table_io::{Precision, Table3};
 use nacre_optics::colour::Colorimeter;
 use nacre_optics::microfacet::REFRACTION_WAVELENGTH_NM;
@@ -502,8 +502,8 @@ impl RoughRecipe {
     pub fn bake(&self, out_dir: &Path, progress: &(dyn Fn() + Sync)) -> Result<PathBuf> {
         let lut = self.job.bake(progress)?;
         // Every file goes to a staging folder first; `commit` moves them into `out_dir`,
-        // the manifest last (nacre_format::atomic::StagedTable).
-        let stage = nacre_format::atomic::StagedTable::new(out_dir)?;
+        // the manifest last (nacre_format::stage::StagedTable).
+        let stage = nacre_format::stage::StagedTable::new(out_dir)?;
         let a = &lut.axes;
         let c = &self.job.colorimeter;
         let channels: Vec<String> = c
