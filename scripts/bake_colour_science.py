@@ -5,7 +5,7 @@ What it measures
 ----------------
 The wall time that vectorised numpy + colour-science 0.4.7 needs to compute the
 table that ``nacre bake tables/recipes/film-dielectric.toml`` computes (the
-definitions are those of the module docs of ``crates/bake/src/film_lut.rs`` and of
+definitions are those of the module docs of ``crates/format/src/film_lut.rs`` and of
 ``nacre_optics::colour::Colorimeter``):
 
 * stack: ambient n0 = 1.0 | one non-dispersive film of real index n | base 1.5;

@@ -47,7 +47,7 @@ const PI: f32 = 3.14159265358979;
 const TWO_PI: f32 = 6.28318530717959;
 
 // Smallest cos θ₁ at which the physics is evaluated (the film-lut bake's
-// `nacre_bake::film_lut::MIN_COS_THETA`): at exactly 90° q₁ = 0 and the power factors divide
+// `nacre_format::film_lut::MIN_COS_THETA`): at exactly 90° q₁ = 0 and the power factors divide
 // by zero; the CPU solver rejects 90° altogether.
 const COS_THETA_MIN: f32 = 1e-6;
 // Largest film thickness (and thickness standard deviation) accepted, nm; larger clamps.

@@ -3,7 +3,7 @@
 //
 // Technique `diffraction`: Stam's diffraction BRDF (Stam 1999) from the Taylor terms of a
 // height field (Dhillon et al. 2014), layout "terms" of a baked `diffraction` table
-// (crates/bake/src/diffraction.rs says what every texel holds). The GPU twin of
+// (crates/bake/src/kinds/diffraction.rs says what every texel holds). The GPU twin of
 // `nacre_optics::diffraction::DiffractionSurface::relative_reflectance` summed over a
 // `SpectralGrid`. Needs diffraction_common.wgsl before it (`nacre_runtime::diffraction::DIFFRACTION`
 // is the two together); declares bind group 1 only.

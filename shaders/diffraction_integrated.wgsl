@@ -6,7 +6,7 @@
 // wavelengths at bake time into colour tables Iₚ(u, v), p = 0 … 2N. The GPU twin of
 // `nacre_optics::diffraction::integrated::IntegratedTable::colour` (derivation, axes and
 // point symmetry in crates/optics/src/diffraction/integrated.rs; what every texel holds in
-// crates/bake/src/diffraction_integrated.rs). Needs diffraction_common.wgsl before it
+// crates/bake/src/kinds/diffraction_integrated.rs). Needs diffraction_common.wgsl before it
 // (`nacre_runtime::diffraction_integrated::WGSL` is the two together); declares bind group
 // 1 only, and every name it defines starts with `diffraction_integrated`.
 //

@@ -6,7 +6,7 @@
 // polarisation and the sensitivities' Fourier transforms Ŝ_j read from a baked, prefiltered,
 // mip-mapped `fourier` table. The GPU twin of `FilmOnBase::fourier_colour_with`
 // (crates/optics/src/fourier.rs) fed by `FourierTable::sample`
-// (crates/bake/src/fourier_table.rs). Needs common.wgsl.
+// (crates/bake/src/kinds/fourier.rs). Needs common.wgsl.
 //
 // Symbols
 //

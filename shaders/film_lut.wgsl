@@ -2,7 +2,7 @@
 // import: common, lut_mapping
 //
 // Thin-film colour by one trilinear lookup in a baked `film-lut` table
-// (crates/bake/src/film_lut.rs): texel (x, y, z) holds the colour of the unpolarised
+// (crates/format/src/film_lut.rs): texel (x, y, z) holds the colour of the unpolarised
 // reflectance (binding 0) and transmittance into the base (binding 1) of
 // `ambient | film(n, d) | fixed layers | base`, integrated exactly over 360–830 nm, at
 // (cos θ, Δ, n) given by the forward mapping of lut_mapping.wgsl. Needs common.wgsl and

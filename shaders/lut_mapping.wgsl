@@ -2,7 +2,7 @@
 // import: common
 //
 // The film-lut axis mappings, forward (physical → t ∈ [0, 1]³) and inverse, mirroring
-// `nacre_bake::film_lut::FilmLutAxes` (crates/bake/src/film_lut.rs, whose module docs derive
+// `nacre_format::film_lut::FilmLutAxes` (crates/format/src/film_lut.rs, whose module docs derive
 // them). Needs common.wgsl; defines no bindings.
 //
 // Symbols
