@@ -1,26 +1,15 @@
 //! `nacre diffraction`: relative reflectance and colour of a diffracting surface over view
 //! angles in the plane of incidence (Stam 1999; Dhillon et al. 2014), from a height field
-//! (file or synthetic spec) or a baked `diffraction` table. The physics is
-//! [`nacre_optics::diffraction`], the sources and CSV writers [`nacre_bake::kinds::diffraction`].
+//! (file or synthetic spec) or a baked `diffraction` table. The evaluation is
+//! [`nacre_bake::commands::diffraction`]; this module holds the flags.
 
 use clap::Args;
-use nacre_bake::commands::grid::parse_range;
-use nacre_bake::error::{Error, Result};
-use nacre_bake::kinds::diffraction::{HeightSource, ViewSweep, par_map_pairs, write_colour_csv};
-use nacre_bake::kinds::diffraction_integrated::DEFAULT_INTEGRATED_SAMPLES;
-use nacre_format::atomic::write_atomic;
-use nacre_format::{Manifest, set};
-use nacre_optics::C64;
-use nacre_optics::colour::Colorimeter;
-use nacre_optics::diffraction::integrated::{IntegratedTable, WarpedAxis};
-use nacre_optics::diffraction::{
-    DEFAULT_COHERENCE_DIAMETER_UM, DiffractionSurface, FresnelTerm, SpectralGrid, TaylorTerms,
-    max_phase, taylor_order_for,
+use nacre_bake::commands::diffraction::{
+    self as lib, MapRequest, Source, SurfaceSpec, ViewsRequest,
 };
+use nacre_bake::error::Result;
+use nacre_format::atomic::write_atomic;
 use std::path::PathBuf;
-
-/// Tolerance on the Taylor remainder bound for fields evaluated directly (f64 terms).
-pub const TAYLOR_TOLERANCE: f64 = 1e-6;
 
 pub const EXAMPLES: &str = "\
 Geometry: x runs across the grating lines and the plane of incidence is x-z. --incidence
@@ -149,446 +138,27 @@ pub struct DiffractionArgs {
     output: PathBuf,
 }
 
-fn flag(flag: &str, value: &str, message: impl Into<String>) -> Error {
-    Error::Flag {
-        flag: flag.into(),
-        value: value.into(),
-        message: message.into(),
-    }
-}
-
-fn positive(name: &str, text: &str) -> Result<f64> {
-    text.trim()
-        .parse::<f64>()
-        .ok()
-        .filter(|v| v.is_finite() && *v > 0.0)
-        .ok_or_else(|| {
-            flag(
-                name,
-                text,
-                "expected a finite positive number of micrometres",
-            )
-        })
-}
-
-fn angles(name: &str, text: &str) -> Result<Vec<f64>> {
-    let v = parse_range(name, text)?;
-    if let Some(a) = v.iter().find(|a| !(a.abs() < 90.0)) {
-        return Err(flag(
-            name,
-            text,
-            format!("angle {a} must lie strictly between -90 and 90 degrees"),
-        ));
-    }
-    Ok(v)
-}
-
-/// How the colour (and, for terms, the spectrum) is evaluated.
-pub enum Evaluator {
-    /// The Taylor terms, per wavelength.
-    Terms(DiffractionSurface),
-    /// An integrated table (colours only).
-    Integrated(IntegratedTable),
-}
-
-/// Everything `nacre diffraction` and `nacre plot diffraction` share: the evaluator, its
-/// colorimeter and the wavelength grid.
-pub struct Loaded {
-    pub evaluator: Evaluator,
-    pub colorimeter: Colorimeter,
-    pub wavelengths: Vec<f64>,
-    pub fresnel: FresnelTerm,
-    /// What the evaluator came from (`--table NAME`, `--layout integrated`), for messages.
-    pub context: String,
-}
-
-impl Loaded {
-    /// (XYZ, output-space colour) for each light/view pair.
-    pub fn colours(
-        &self,
-        directions: &[([f64; 3], [f64; 3])],
-    ) -> Result<Vec<([f64; 3], [f64; 3])>> {
-        let c = &self.colorimeter;
-        match &self.evaluator {
-            Evaluator::Terms(surface) => {
-                let grid =
-                    SpectralGrid::new(c, &self.wavelengths).map_err(|source| Error::OpticsIn {
-                        context: "--wavelengths".into(),
-                        source,
-                    })?;
-                Ok(par_map_pairs(directions, &|wi, wr| {
-                    let rho: Vec<f64> = self
-                        .wavelengths
-                        .iter()
-                        .map(|&l| surface.relative_reflectance(wi, wr, l, self.fresnel))
-                        .collect();
-                    let xyz = grid.xyz(&rho);
-                    (xyz, c.output_from_xyz(xyz))
-                }))
-            }
-            Evaluator::Integrated(table) => Ok(par_map_pairs(directions, &|wi, wr| {
-                let out = table.colour(wi, wr, self.fresnel);
-                (c.xyz_from_output(out), out)
-            })),
+impl SurfaceArgs {
+    /// The surface as the library takes it.
+    fn spec(&self) -> SurfaceSpec {
+        SurfaceSpec {
+            surface: self.surface.clone(),
+            table: self.table.clone(),
+            layout: self.layout.clone(),
+            integrated_samples: self.integrated_samples,
+            pitch: self.pitch.clone(),
+            samples: self.samples,
+            height_scale: self.height_scale.clone(),
+            coherence: self.coherence.clone(),
         }
     }
-}
-
-/// The sources and options `load` reads.
-pub struct Source<'a> {
-    /// The height field or table and how to read it.
-    pub surface: &'a SurfaceArgs,
-    /// `--wavelengths` as given.
-    pub wavelengths: Option<&'a str>,
-    /// The grid when `--wavelengths` is not given (terms layout).
-    pub default_wavelengths: &'a str,
-    pub fresnel: Option<&'a str>,
-    /// --observer, --illuminant, --space.
-    pub colour: [Option<&'a str>; 3],
-}
-
-fn parse_wavelengths(text: &str) -> Result<Vec<f64>> {
-    let wavelengths = parse_range("--wavelengths", text)?;
-    if let Some(l) = wavelengths.iter().find(|l| !(**l >= 360.0 && **l <= 830.0)) {
-        return Err(flag(
-            "--wavelengths",
-            text,
-            format!("wavelength {l} nm is outside 360-830 nm"),
-        ));
-    }
-    Ok(wavelengths)
-}
-
-/// Loads the surface or table of `src` for the light/view pairs `directions`, checking
-/// the sampling and the table's range.
-pub fn load(src: &Source, directions: &[([f64; 3], [f64; 3])]) -> Result<Loaded> {
-    let a = src.surface;
-    let (surface, table, layout) = (
-        a.surface.as_deref(),
-        a.table.as_deref(),
-        a.layout.as_deref(),
-    );
-    let (pitch, coherence) = (a.pitch.as_deref(), a.coherence.as_deref());
-    let (samples, integrated_samples, height_scale) =
-        (a.samples, a.integrated_samples, a.height_scale.as_str());
-    let integrated_wanted = match layout.map(str::trim) {
-        None | Some("terms") => false,
-        Some("integrated") => true,
-        Some(other) => {
-            return Err(flag("--layout", other, "expected `terms` or `integrated`"));
-        }
-    };
-    if integrated_samples.is_some() && !integrated_wanted {
-        return Err(flag(
-            "--integrated-samples",
-            &integrated_samples.unwrap_or(0).to_string(),
-            "applies to --layout integrated only",
-        ));
-    }
-    let fresnel = match src.fresnel {
-        None => FresnelTerm::Unity,
-        Some(text) => {
-            let m = nacre_optics::Material::parse_index(text)
-                .map_err(|e| flag("--fresnel", text, e.to_string()))?;
-            let n: C64 = m
-                .index_at(550.0)
-                .map_err(|e| flag("--fresnel", text, e.to_string()))?;
-            FresnelTerm::Index(n)
-        }
-    };
-    // |u|, |v| and |w| reached by the directions asked for.
-    let max_uv = directions
-        .iter()
-        .map(|(i, r)| (i[0] + r[0]).abs().max((i[1] + r[1]).abs()))
-        .fold(0.0, f64::max);
-    let w_max = directions
-        .iter()
-        .map(|(i, r)| i[2] + r[2])
-        .fold(0.0, f64::max);
-    let pick = |given: Option<&str>, table: &Option<String>, default: &str| {
-        given
-            .map(str::to_string)
-            .or_else(|| table.clone())
-            .unwrap_or_else(|| default.to_string())
-    };
-    let colorimeter_of = |table_colour: [Option<String>; 3]| -> Result<Colorimeter> {
-        let o = pick(src.colour[0], &table_colour[0], "1931");
-        let i = pick(src.colour[1], &table_colour[1], "d65");
-        let s = pick(src.colour[2], &table_colour[2], "srgb");
-        Ok(Colorimeter::new(
-            o.parse()
-                .map_err(|e: nacre_optics::Error| flag("--observer", &o, e.to_string()))?,
-            i.parse()
-                .map_err(|e: nacre_optics::Error| flag("--illuminant", &i, e.to_string()))?,
-            s.parse()
-                .map_err(|e: nacre_optics::Error| flag("--space", &s, e.to_string()))?,
-        ))
-    };
-    let (terms, sigma_s, table_colour, context, wavelengths) = match (surface, table) {
-        (_, Some(name)) => {
-            let path = set::resolve_table(name);
-            let manifest = Manifest::read(&path)?;
-            let record = manifest
-                .diffraction()
-                .cloned()
-                .ok_or_else(|| Error::Invalid {
-                    context: path.display().to_string(),
-                    message: format!(
-                        "table `{}` is a `{}` table, not a diffraction table",
-                        manifest.name, manifest.kind
-                    ),
-                })?;
-            if let Some(l) = layout {
-                return Err(flag(
-                    "--layout",
-                    l,
-                    format!(
-                        "applies to height fields; table `{name}` has the layout \"{}\"",
-                        record.layout
-                    ),
-                ));
-            }
-            let integrated = record.layout == "integrated";
-            let table_grid = format!(
-                "{}:{}:{}",
-                record.wavelength_min_nm, record.wavelength_max_nm, record.wavelength_step_nm
-            );
-            let wavelengths = match (src.wavelengths, integrated) {
-                (Some(text), true) => {
-                    let w = parse_wavelengths(text)?;
-                    if w != parse_range("--wavelengths", &table_grid)? {
-                        return Err(flag(
-                            "--wavelengths",
-                            text,
-                            format!(
-                                "table `{name}` has the integrated layout: its colours are summed over {table_grid} nm (leave --wavelengths out)"
-                            ),
-                        ));
-                    }
-                    w
-                }
-                (None, true) => parse_range("--wavelengths", &table_grid)?,
-                (text, false) => parse_wavelengths(text.unwrap_or(src.default_wavelengths))?,
-            };
-            let wl_min = wavelengths.iter().copied().fold(f64::INFINITY, f64::min);
-            let wl_max = wavelengths.iter().copied().fold(0.0, f64::max);
-            if wl_min < record.wavelength_min_nm - 1e-9 || wl_max > record.wavelength_max_nm + 1e-9
-            {
-                return Err(flag(
-                    "--wavelengths",
-                    src.wavelengths.unwrap_or(src.default_wavelengths),
-                    format!(
-                        "table `{name}` serves {}-{} nm",
-                        record.wavelength_min_nm, record.wavelength_max_nm
-                    ),
-                ));
-            }
-            let max_polar_deg = directions
-                .iter()
-                .map(|(i, r)| i[2].min(r[2]).clamp(-1.0, 1.0).acos().to_degrees())
-                .fold(0.0, f64::max);
-            if max_polar_deg > record.max_angle_deg + 1e-9 || max_uv > record.max_uv * (1.0 + 1e-9)
-            {
-                return Err(Error::Invalid {
-                    context: "--incidence/--views".into(),
-                    message: format!(
-                        "light or view reaches {max_polar_deg:.2}° from the normal; table `{name}` serves light and view within {}° (|u|, |v| ≤ {:.4})",
-                        record.max_angle_deg, record.max_uv
-                    ),
-                });
-            }
-            if coherence.is_some() || pitch.is_some() || samples.is_some() {
-                return Err(flag(
-                    "--table",
-                    name,
-                    "--coherence, --pitch and --samples come from the table",
-                ));
-            }
-            let c = [
-                Some(manifest.observer.clone()),
-                Some(manifest.illuminant.clone()),
-                Some(manifest.space.clone()),
-            ];
-            if integrated {
-                let colorimeter = colorimeter_of(c.clone())?;
-                let baked = manifest.colorimeter(&path)?;
-                for (given, flag_name, same) in [
-                    (
-                        src.colour[0],
-                        "--observer",
-                        colorimeter.observer() == baked.observer(),
-                    ),
-                    (
-                        src.colour[1],
-                        "--illuminant",
-                        colorimeter.illuminant() == baked.illuminant(),
-                    ),
-                    (
-                        src.colour[2],
-                        "--space",
-                        colorimeter.space() == baked.space(),
-                    ),
-                ] {
-                    if let (Some(v), false) = (given, same) {
-                        return Err(flag(
-                            flag_name,
-                            v,
-                            format!(
-                                "table `{name}` has the integrated layout, baked for observer {}, illuminant {} and space {}",
-                                baked.observer(),
-                                baked.illuminant(),
-                                baked.space()
-                            ),
-                        ));
-                    }
-                }
-                let (_, table) = manifest.load_diffraction_integrated(&path)?;
-                return Ok(Loaded {
-                    evaluator: Evaluator::Integrated(table),
-                    colorimeter,
-                    wavelengths,
-                    fresnel,
-                    context: format!("--table {name}"),
-                });
-            }
-            let (record, terms) = manifest.load_diffraction(&path)?;
-            (
-                terms,
-                record.sigma_s_um,
-                c,
-                format!("--table {name}"),
-                wavelengths,
-            )
-        }
-        (Some(text), None) => {
-            let wavelengths =
-                parse_wavelengths(src.wavelengths.unwrap_or(src.default_wavelengths))?;
-            let wl_min = wavelengths.iter().copied().fold(f64::INFINITY, f64::min);
-            let coherence_um = match coherence {
-                Some(t) => positive("--coherence", t)?,
-                None => DEFAULT_COHERENCE_DIAMETER_UM,
-            };
-            let pitch_um = pitch.map(|t| positive("--pitch", t)).transpose()?;
-            let scale = height_scale
-                .trim()
-                .parse::<f64>()
-                .ok()
-                .filter(|v| v.is_finite() && *v >= 0.0)
-                .ok_or_else(|| {
-                    flag(
-                        "--height-scale",
-                        height_scale,
-                        "expected a finite non-negative number of micrometres",
-                    )
-                })?;
-            if samples == Some(0) {
-                return Err(flag("--samples", "0", "expected at least 1"));
-            }
-            let source = HeightSource::parse("FILE|SPEC", text)?;
-            let field = source.load(text, "--pitch", coherence_um, pitch_um, samples, scale)?;
-            let x = max_phase(&field, wl_min, w_max);
-            let (order, bound) =
-                taylor_order_for(x, TAYLOR_TOLERANCE).map_err(|source| Error::OpticsIn {
-                    context: text.to_string(),
-                    source,
-                })?;
-            eprintln!(
-                "nacre: {}x{} samples at {} µm, Taylor order N = {order} (remainder bound {bound:.1e} at max |k w h| = {x:.3}), 4σ_s = {coherence_um} µm",
-                field.nx(),
-                field.ny(),
-                field.pitch_um()
-            );
-            (
-                TaylorTerms::compute(&field, order),
-                coherence_um / 4.0,
-                [None, None, None],
-                text.to_string(),
-                wavelengths,
-            )
-        }
-        (None, None) => unreachable!("clap requires FILE|SPEC or --table"),
-    };
-    let wl_min = wavelengths.iter().copied().fold(f64::INFINITY, f64::min);
-    let surface = DiffractionSurface::new(terms, sigma_s).map_err(|source| Error::OpticsIn {
-        context: context.clone(),
-        source,
-    })?;
-    surface
-        .check_sampling(wl_min, max_uv)
-        .map_err(|source| Error::OpticsIn {
-            context: format!("{context} with --views/--incidence and --wavelengths"),
-            source,
-        })?;
-    let colorimeter = colorimeter_of(table_colour)?;
-    let evaluator = if integrated_wanted {
-        let n = integrated_samples.unwrap_or(DEFAULT_INTEGRATED_SAMPLES);
-        let axis =
-            WarpedAxis::new(max_uv.clamp(1e-3, 2.0), 3.0, n).map_err(|source| Error::OpticsIn {
-                context: "--integrated-samples".into(),
-                source,
-            })?;
-        let grid =
-            SpectralGrid::new(&colorimeter, &wavelengths).map_err(|source| Error::OpticsIn {
-                context: "--wavelengths".into(),
-                source,
-            })?;
-        eprintln!(
-            "nacre: integrated table of {} x {n} texels x {} layers over |u|, |v| <= {:.4}",
-            n / 2,
-            2 * surface.terms().order() + 1,
-            axis.max_uv
-        );
-        Evaluator::Integrated(IntegratedTable::compute(
-            &surface,
-            &grid,
-            &colorimeter,
-            axis,
-        ))
-    } else {
-        Evaluator::Terms(surface)
-    };
-    Ok(Loaded {
-        evaluator,
-        colorimeter,
-        wavelengths,
-        fresnel,
-        context: if integrated_wanted {
-            "--layout integrated".into()
-        } else {
-            context
-        },
-    })
 }
 
 pub fn run(args: &DiffractionArgs) -> Result<()> {
-    let incidence = args
-        .incidence
-        .trim()
-        .parse::<f64>()
-        .ok()
-        .filter(|a| a.abs() < 90.0)
-        .ok_or_else(|| {
-            flag(
-                "--incidence",
-                &args.incidence,
-                "expected an angle in degrees strictly between -90 and 90",
-            )
-        })?;
-    let views = angles("--views", &args.views)?;
-    let directions: Vec<_> = views
-        .iter()
-        .map(|&v| nacre_optics::diffraction::in_plane_directions(incidence, v))
-        .collect();
-    if args.source.layout.as_deref().map(str::trim) == Some("integrated") && !args.color {
-        return Err(flag(
-            "--layout",
-            "integrated",
-            "the integrated layout holds colours summed over wavelengths: add --color, or use the terms layout for per-wavelength reflectance",
-        ));
-    }
-    let loaded = load(
-        &Source {
-            surface: &args.source,
+    let surface = args.source.spec();
+    let output = lib::evaluate_views(&ViewsRequest {
+        source: Source {
+            surface: &surface,
             wavelengths: args.wavelengths.as_deref(),
             default_wavelengths: "380:780:5",
             fresnel: args.fresnel.as_deref(),
@@ -598,31 +168,11 @@ pub fn run(args: &DiffractionArgs) -> Result<()> {
                 args.space.as_deref(),
             ],
         },
-        &directions,
-    )?;
-    if args.color {
-        let colours = loaded.colours(&directions)?;
-        return Ok(write_atomic(&args.output, |w| {
-            write_colour_csv(w, &views, &colours)
-        })?);
-    }
-    let Evaluator::Terms(surface) = &loaded.evaluator else {
-        return Err(Error::Invalid {
-            context: loaded.context.clone(),
-            message: "the integrated layout holds colours summed over wavelengths, not spectra: add --color, or use a terms table for per-wavelength reflectance".into(),
-        });
-    };
-    let sweep = ViewSweep {
-        surface,
-        incidence_deg: incidence,
-        views_deg: &views,
-        wavelengths_nm: &loaded.wavelengths,
-        fresnel: loaded.fresnel,
-    };
-    let rho = sweep.reflectance();
-    Ok(write_atomic(&args.output, |w| {
-        sweep.write_reflectance_csv(w, &rho)
-    })?)
+        incidence: &args.incidence,
+        views: &args.views,
+        color: args.color,
+    })?;
+    Ok(write_atomic(&args.output, |w| output.write_csv(w))?)
 }
 
 pub const MAP_EXAMPLES: &str = "\
@@ -674,109 +224,13 @@ pub struct MapArgs {
 
 pub fn run_map(args: &MapArgs) -> Result<()> {
     nacre_bake::commands::plot::ImageFormat::from_path(&args.output)?;
-    let incidence = args
-        .incidence
-        .trim()
-        .parse::<f64>()
-        .ok()
-        .filter(|a| a.abs() < 90.0)
-        .ok_or_else(|| {
-            flag(
-                "--incidence",
-                &args.incidence,
-                "expected an angle in degrees strictly between -90 and 90",
-            )
-        })?;
-    let max_view = args
-        .max_view
-        .trim()
-        .parse::<f64>()
-        .ok()
-        .filter(|a| *a > 0.0 && *a < 90.0)
-        .ok_or_else(|| {
-            flag(
-                "--max-view",
-                &args.max_view,
-                "expected an angle in degrees strictly between 0 and 90",
-            )
-        })?;
-    if !(16..=1024).contains(&args.cells) {
-        return Err(flag(
-            "--cells",
-            &args.cells.to_string(),
-            "expected 16 to 1024",
-        ));
-    }
-    let exposure = match args.exposure.trim() {
-        "auto" => None,
-        t => Some(
-            t.parse::<f64>()
-                .ok()
-                .filter(|v| v.is_finite() && *v > 0.0)
-                .ok_or_else(|| flag("--exposure", t, "expected a positive number or `auto`"))?,
-        ),
-    };
-    // The extreme view directions: the rim of the disc.
-    let (wi, _) = nacre_optics::diffraction::in_plane_directions(incidence, 0.0);
-    let s = max_view.to_radians().sin();
-    let c = max_view.to_radians().cos();
-    let directions: Vec<_> = [[s, 0.0, c], [-s, 0.0, c], [0.0, s, c], [0.0, -s, c]]
-        .into_iter()
-        .map(|r| (wi, r))
-        .collect();
-    let loaded = load(
-        &Source {
-            surface: &args.source,
-            wavelengths: args.wavelengths.as_deref(),
-            default_wavelengths: "380:780:10",
-            fresnel: None,
-            colour: [None, None, None],
-        },
-        &directions,
-    )?;
-    let name = args
-        .source
-        .surface
-        .clone()
-        .or_else(|| args.source.table.clone())
-        .unwrap_or_default();
-    let map = match &loaded.evaluator {
-        Evaluator::Terms(surface) => {
-            let grid =
-                SpectralGrid::new(&loaded.colorimeter, &loaded.wavelengths).map_err(|source| {
-                    Error::OpticsIn {
-                        context: "--wavelengths".into(),
-                        source,
-                    }
-                })?;
-            nacre_bake::kinds::diffraction::DiffractionMap::compute(
-                String::new(),
-                surface,
-                incidence,
-                max_view,
-                args.cells,
-                &grid,
-                &loaded.colorimeter,
-                loaded.fresnel,
-                exposure,
-            )
-        }
-        Evaluator::Integrated(table) => {
-            nacre_bake::kinds::diffraction::DiffractionMap::compute_with(
-                String::new(),
-                &|wi, wr| table.colour(wi, wr, loaded.fresnel),
-                incidence,
-                max_view,
-                args.cells,
-                &loaded.colorimeter,
-                exposure,
-            )
-        }
-    };
-    let title = format!(
-        "diffraction map of {name}: light at {incidence}°, views to {max_view}°, exposure {:.3}",
-        map.exposure
-    );
-    let map = nacre_bake::kinds::diffraction::DiffractionMap { title, ..map };
+    let map = lib::map(&MapRequest {
+        surface: &args.source.spec(),
+        incidence: &args.incidence,
+        max_view: &args.max_view,
+        cells: args.cells,
+        wavelengths: args.wavelengths.as_deref(),
+        exposure: &args.exposure,
+    })?;
     nacre_bake::commands::plot::write_figure(&args.output, &map)
 }

@@ -7,15 +7,19 @@ use clap::{Args, Parser, Subcommand};
 use nacre_bake::commands::grid::parse_range;
 use nacre_bake::commands::spectrum;
 use nacre_bake::commands::stack_spec::{StackRecipe, StackSpec};
-use nacre_bake::error::Result;
 use nacre_bake::kinds;
 use nacre_format::atomic::write_atomic;
 use nacre_format::{Manifest, materials, set};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+mod choices;
 mod diffraction;
+mod error;
 mod plot;
+
+use choices::{FilmEvalArg, QuantityArg, Scene, SceneArg, TechniqueArg};
+use error::Result;
 
 #[derive(Parser)]
 #[command(
@@ -180,8 +184,8 @@ struct ColorArgs {
     #[arg(long, value_name = "NAME|PATH")]
     fourier_table: Option<String>,
     /// r (reflectance) or t (transmittance into the base).
-    #[arg(long, default_value = "r", value_parser = ["r", "t"])]
-    quantity: String,
+    #[arg(long, value_enum, default_value = "r")]
+    quantity: QuantityArg,
     /// GGX roughness α (0 < α ≤ 1) of the rough-lut: and rough-mc methods.
     #[arg(long, value_name = "ALPHA")]
     roughness: Option<f64>,
@@ -282,15 +286,15 @@ struct RenderArgs {
     /// film-at-n·v shortcut, the exact path and the Monte Carlo reference, three rows), or a
     /// diffraction scene: cd-disc (a CD-like disc with circular tracks; table cd-tracks) or
     /// snake-skin (a curved patch of scales with fanned ridges; table snake-ridges).
-    #[arg(long, default_value = "sphere", value_parser = ["sphere", "bubble", "plane", "rough-row", "cd-disc", "snake-skin"])]
-    scene: String,
+    #[arg(long, value_enum, default_value = "sphere")]
+    scene: SceneArg,
     /// How the film enters the lighting: classic (the film at v·h for the light, at n·v for
     /// a box-filtered environment), nv (the engines' shortcut: the film once at n·v for
     /// every light and the split-sum environment) or exact (the film at each light's half
     /// vector; the split-sum environment with the rough-film-lut table's directional
     /// albedo). nv and exact prefilter the environment with GGX at load.
-    #[arg(long, default_value = "classic", value_parser = ["classic", "nv", "exact"])]
-    film_eval: String,
+    #[arg(long, value_enum, default_value = "classic")]
+    film_eval: FilmEvalArg,
     /// Monte Carlo samples per pixel of the rough-row reference (16 to 1048576).
     #[arg(long, value_name = "N", default_value_t = 1024)]
     reference_samples: usize,
@@ -306,8 +310,8 @@ struct RenderArgs {
     #[arg(long = "tables", value_name = "NAME|PATH")]
     tables: Vec<String>,
     /// Technique: lut, fourier or spectral.
-    #[arg(long, default_value = "lut", value_parser = ["lut", "fourier", "spectral"])]
-    technique: String,
+    #[arg(long, value_enum, default_value = "lut")]
+    technique: TechniqueArg,
     /// Image width, pixels (1 to 8192).
     #[arg(long, default_value_t = 800)]
     width: u32,
@@ -408,7 +412,7 @@ struct SpectrumArgs {
 }
 
 /// The stack and any ranges a recipe supplied.
-fn load_stack(args: &StackArgs) -> Result<(StackSpec, Option<String>, Option<String>)> {
+fn load_stack(args: &StackArgs) -> nacre_bake::Result<(StackSpec, Option<String>, Option<String>)> {
     match &args.recipe {
         Some(path) => {
             let r = StackRecipe::read(path)?;
@@ -451,332 +455,47 @@ fn run_spectrum(args: &SpectrumArgs) -> Result<()> {
 }
 
 fn run_color(args: &ColorArgs) -> Result<()> {
-    use nacre_bake::commands::color::{self, LoadedLut, Method, Point, Quantity};
-    use nacre_bake::error::Error;
-    use nacre_optics::colour::Colorimeter;
+    use nacre_bake::commands::color::{self, Method, Quantity};
+    use nacre_bake::commands::color_request::{self as request, ColorRequest, ColourSettings};
     let (spec, recipe_angles, _) = load_stack(&args.stack)?;
-    let mut method = Method::parse(&args.method)?;
-    let quantity = if args.quantity == "t" {
-        Quantity::Transmittance
-    } else {
-        Quantity::Reflectance
-    };
-    let points: Vec<Point> = match &args.points {
-        Some(path) => {
-            let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-                path: path.clone(),
-                source,
-            })?;
-            color::parse_points(path, &text)?
-        }
-        None => {
-            let text = args
-                .angles
-                .clone()
-                .or(recipe_angles)
-                .unwrap_or_else(|| "0:89:1".into());
-            let angles = parse_range("--angles", &text)?;
-            if let Some(a) = angles.iter().find(|a| !(a.abs() < 90.0)) {
-                return Err(Error::Flag {
-                    flag: "--angles".into(),
-                    value: text,
-                    message: format!("angle {a} must lie strictly between -90 and 90 degrees"),
-                });
-            }
-            angles
-                .into_iter()
-                .map(|angle_deg| Point {
-                    angle_deg,
-                    thickness_nm: None,
-                    film_ior: None,
-                })
-                .collect()
-        }
+    let method = Method::parse(&args.method)?;
+    let quantity = Quantity::from(args.quantity);
+    let points = match &args.points {
+        Some(path) => request::read_points(path)?,
+        None => request::angle_points(args.angles.clone().or(recipe_angles))?,
     };
     let stack = spec.build()?;
-    match (method.is_rough(), args.roughness) {
-        (true, Some(alpha)) => {
-            if !(alpha > 0.0 && alpha <= 1.0) {
-                return Err(Error::Flag {
-                    flag: "--roughness".into(),
-                    value: alpha.to_string(),
-                    message: "GGX roughness α must lie in (0, 1]".into(),
-                });
-            }
-            method = method.with_roughness(alpha);
-        }
-        (true, None) => {
-            return Err(Error::Flag {
-                flag: "--method".into(),
-                value: args.method.clone(),
-                message: "needs --roughness ALPHA (GGX α, 0 < α ≤ 1)".into(),
-            });
-        }
-        (false, Some(alpha)) => {
-            return Err(Error::Flag {
-                flag: "--roughness".into(),
-                value: alpha.to_string(),
-                message: "applies only to --method rough-lut:NAME and rough-mc".into(),
-            });
-        }
-        (false, None) => {}
+    let prepared = request::prepare(
+        &stack,
+        method,
+        &ColorRequest {
+            method: &args.method,
+            roughness: args.roughness,
+            colour: ColourSettings {
+                observer: args.observer.as_deref(),
+                illuminant: args.illuminant.as_deref(),
+                space: args.space.as_deref(),
+            },
+            fourier_table: args.fourier_table.as_deref(),
+        },
+    )?;
+    let out = request::compute(&stack, &points, &prepared, quantity)?;
+    if let Some((samples, worst)) = out.monte_carlo {
+        eprintln!(
+            "rough-mc: {samples} samples per point (seed = point index); largest standard error per channel {worst:.2e}"
+        );
     }
-    let (lut, colorimeter) = match &method {
-        Method::RoughLut { path, alpha, .. } => {
-            let table = nacre_format::load::LoadedRoughLut::load(path)?;
-            color::check_stack_matches(&table.manifest, path, &stack, "rough-lut")?;
-            let m = &table.manifest;
-            for (flag, given, baked) in [
-                ("--observer", &args.observer, &m.observer),
-                ("--illuminant", &args.illuminant, &m.illuminant),
-                ("--space", &args.space, &m.space),
-            ] {
-                if let Some(g) = given
-                    && !g.eq_ignore_ascii_case(baked)
-                {
-                    return Err(Error::Flag {
-                        flag: flag.into(),
-                        value: g.clone(),
-                        message: format!("table `{}` was baked for `{baked}`", m.name),
-                    });
-                }
-            }
-            let a = &table.lut.axes;
-            if !(*alpha >= a.alpha_min && *alpha <= a.alpha_max) {
-                return Err(Error::Flag {
-                    flag: "--roughness".into(),
-                    value: alpha.to_string(),
-                    message: format!(
-                        "table `{}` covers GGX α {} to {}",
-                        m.name, a.alpha_min, a.alpha_max
-                    ),
-                });
-            }
-            let c = table.colorimeter.clone();
-            method = Method::RoughLut {
-                path: path.clone(),
-                alpha: *alpha,
-                table: Some(std::sync::Arc::new(table)),
-            };
-            (None, c)
-        }
-        Method::Lut(path) => {
-            let lut = LoadedLut::load(path)?;
-            lut.check_stack(path, &stack)?;
-            let m = &lut.manifest;
-            for (flag, given, table) in [
-                ("--observer", &args.observer, &m.observer),
-                ("--illuminant", &args.illuminant, &m.illuminant),
-                ("--space", &args.space, &m.space),
-            ] {
-                if let Some(g) = given
-                    && !g.eq_ignore_ascii_case(table)
-                {
-                    return Err(Error::Flag {
-                        flag: flag.into(),
-                        value: g.clone(),
-                        message: format!("table `{}` was baked for `{table}`", m.name),
-                    });
-                }
-            }
-            let c = lut.colorimeter.clone();
-            (Some(lut), c)
-        }
-        _ => {
-            fn flag_err(flag: &'static str, v: &str) -> impl FnOnce(nacre_optics::Error) -> Error {
-                let v = v.to_string();
-                move |e| Error::Flag {
-                    flag: flag.into(),
-                    value: v,
-                    message: e.to_string(),
-                }
-            }
-            let o = args.observer.clone().unwrap_or_else(|| "1931".into());
-            let i = args.illuminant.clone().unwrap_or_else(|| "d65".into());
-            let s = args.space.clone().unwrap_or_else(|| "srgb".into());
-            let c = Colorimeter::new(
-                o.parse().map_err(flag_err("--observer", &o))?,
-                i.parse().map_err(flag_err("--illuminant", &i))?,
-                s.parse().map_err(flag_err("--space", &s))?,
-            );
-            if method == Method::Rgb3 && s == "xyz" {
-                return Err(Error::Flag {
-                    flag: "--method".into(),
-                    value: "rgb3".into(),
-                    message: "rgb3 gives RGB directly: choose an RGB --space".into(),
-                });
-            }
-            if let Method::Fourier(h, sigma, None) = &method
-                && args.method.trim().starts_with("fourier:")
-            {
-                let table = load_fourier_table(args.fourier_table.as_deref(), &c)?;
-                method = Method::Fourier(*h, *sigma, Some(std::sync::Arc::new(table)));
-            }
-            (None, c)
-        }
-    };
-    let colours = match &method {
-        // The Monte Carlo reference reports its noise: the largest standard error.
-        Method::RoughMonteCarlo { alpha, samples } => {
-            let estimates = color::rough_monte_carlo(
-                &stack,
-                &points,
-                *alpha,
-                *samples,
-                &colorimeter,
-                quantity,
-            )?;
-            let worst = estimates
-                .iter()
-                .flat_map(|e| e.standard_error)
-                .fold(0.0f64, f64::max);
-            eprintln!(
-                "rough-mc: {samples} samples per point (seed = point index); largest standard error per channel {worst:.2e}"
-            );
-            estimates.iter().map(|e| e.colour).collect()
-        }
-        _ => color::evaluate(
-            &stack,
-            &points,
-            &method,
-            &colorimeter,
-            quantity,
-            lut.as_ref(),
-        )?,
-    };
     Ok(write_atomic(&args.output, |w| {
-        color::write_csv(w, &stack, &points, &colours, &colorimeter)
+        color::write_csv(w, &stack, &points, &out.colours, &prepared.colorimeter)
     })?)
-}
-
-/// The `fourier` table named by `--fourier-table`, or the default-set one baked for the same
-/// observer, illuminant and space as `colorimeter`.
-fn load_fourier_table(
-    given: Option<&str>,
-    colorimeter: &nacre_optics::colour::Colorimeter,
-) -> Result<nacre_format::fourier::FourierTable> {
-    use nacre_bake::error::Error;
-    let settings = (
-        colorimeter.observer().to_string(),
-        colorimeter.illuminant().to_string(),
-        colorimeter.space().to_string(),
-    );
-    let path = match given {
-        Some(name) => set::resolve_table(name),
-        None => {
-            let dir = set::default_baked_dir();
-            let mut found = None;
-            if let Ok(entries) = std::fs::read_dir(&dir) {
-                let mut paths: Vec<PathBuf> = entries
-                    .filter_map(|e| e.ok().map(|e| e.path()))
-                    .filter(|p| p.extension().is_some_and(|x| x == "json"))
-                    .collect();
-                paths.sort();
-                for p in paths {
-                    if let Ok(m) = Manifest::read(&p)
-                        && m.kind == nacre_format::TableKind::Fourier
-                        && (m.observer.clone(), m.illuminant.clone(), m.space.clone()) == settings
-                    {
-                        found = Some(p);
-                        break;
-                    }
-                }
-            }
-            found.ok_or_else(|| Error::Invalid {
-                context: "--method fourier".into(),
-                message: format!(
-                    "no fourier table for observer {}, illuminant {}, space {} in {}: bake one (kind = \"fourier\") and pass --fourier-table, or use fourier-exact:",
-                    settings.0,
-                    settings.1,
-                    settings.2,
-                    dir.display()
-                ),
-            })?
-        }
-    };
-    let manifest = Manifest::read(&path)?;
-    if (
-        manifest.observer.clone(),
-        manifest.illuminant.clone(),
-        manifest.space.clone(),
-    ) != settings
-    {
-        return Err(Error::Invalid {
-            context: format!("--fourier-table {}", path.display()),
-            message: format!(
-                "the table was baked for observer {}, illuminant {}, space {}; this run uses {}, {}, {}",
-                manifest.observer,
-                manifest.illuminant,
-                manifest.space,
-                settings.0,
-                settings.1,
-                settings.2
-            ),
-        });
-    }
-    Ok(manifest.load_fourier(&path)?)
 }
 
 fn run_compare(args: &CompareArgs) -> Result<()> {
     use nacre_bake::commands::compare;
-    use nacre_bake::error::Error;
-    let case = compare::CASES
-        .iter()
-        .find(|c| c.name == args.case)
-        .ok_or_else(|| Error::Flag {
-            flag: "--case".into(),
-            value: args.case.clone(),
-            message: format!(
-                "expected one of {}",
-                compare::CASES
-                    .iter()
-                    .map(|c| c.name)
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ),
-        })?;
-    let angles = parse_range("--angles", &args.angles)?;
-    if let Some(a) = angles.iter().find(|a| !(a.abs() < 90.0)) {
-        return Err(Error::Flag {
-            flag: "--angles".into(),
-            value: args.angles.clone(),
-            message: format!("angle {a} must lie strictly between -90 and 90 degrees"),
-        });
-    }
-    let thicknesses = parse_range("--thicknesses", &args.thicknesses)?;
-    if let Some(d) = thicknesses.iter().find(|d| !(**d >= 0.0)) {
-        return Err(Error::Flag {
-            flag: "--thicknesses".into(),
-            value: args.thicknesses.clone(),
-            message: format!("thickness {d} must be non-negative"),
-        });
-    }
-    let points = angles.len() as u64 * thicknesses.len() as u64;
-    if points > 200_000 {
-        return Err(Error::TooLarge {
-            what: "--angles × --thicknesses points".into(),
-            count: points,
-            limit: 200_000,
-        });
-    }
+    let case = compare::case_named(&args.case)?;
+    let (angles, thicknesses) = compare::grid(&args.angles, &args.thicknesses)?;
     let results = compare::compare(case, &angles, &thicknesses)?;
-    std::fs::create_dir_all(&args.output).map_err(|source| Error::Io {
-        path: args.output.clone(),
-        source,
-    })?;
-    compare::write_csv(
-        &args.output.join("compare.csv"),
-        &angles,
-        &thicknesses,
-        &results,
-    )?;
-    compare::write_png(
-        &args.output.join("compare.png"),
-        case,
-        &angles,
-        &thicknesses,
-        &results,
-    )?;
+    compare::write(&args.output, case, &angles, &thicknesses, &results)?;
     println!("{}", case.description);
     println!("| method | mean ΔE2000 | p95 | max |");
     println!("|---|---|---|---|");
@@ -799,7 +518,7 @@ fn run_bake(args: &BakeArgs) -> Result<()> {
     let recipes = paths
         .iter()
         .map(|p| kinds::read_recipe(p))
-        .collect::<Result<Vec<_>>>()?;
+        .collect::<nacre_bake::Result<Vec<_>>>()?;
     for recipe in &recipes {
         let bar = ProgressBar::new(recipe.work()).with_style(
             ProgressStyle::with_template("{prefix:>16} [{bar:30}] {pos}/{len} {elapsed}")
@@ -820,39 +539,16 @@ fn run_bake(args: &BakeArgs) -> Result<()> {
     Ok(())
 }
 
-/// A runtime error as the CLI's error type (the message unchanged).
-fn runtime_error(e: nacre_runtime::Error) -> nacre_bake::error::Error {
-    use nacre_bake::error::Error;
-    match e {
-        nacre_runtime::Error::Table(e) => Error::Format(e),
-        nacre_runtime::Error::Optics(e) => Error::Optics(e),
-        nacre_runtime::Error::Io { path, source } => Error::Io { path, source },
-        other => Error::Invalid {
-            context: "render".into(),
-            message: other.to_string(),
-        },
-    }
-}
-
 fn run_render(args: &RenderArgs) -> Result<()> {
     use nacre_runtime::render::{FilmEval, SceneKind, SceneOptions, render_scene};
     use nacre_runtime::{GpuContext, TableSet, Technique};
-    if args.scene == "rough-row" {
-        return run_render_rough_row(args);
-    }
-    if let Ok(scene) = args
-        .scene
-        .parse::<nacre_runtime::diffraction::DiffractionScene>()
-    {
-        return run_render_diffraction(args, scene);
-    }
-    let scene: SceneKind = args.scene.parse().map_err(runtime_error)?;
-    let film_eval: FilmEval = args.film_eval.parse().map_err(runtime_error)?;
-    let technique = match args.technique.as_str() {
-        "fourier" => Technique::Fourier,
-        "spectral" => Technique::Spectral,
-        _ => Technique::Lut,
+    let scene = match Scene::from(args.scene) {
+        Scene::RoughRow => return run_render_rough_row(args),
+        Scene::Diffraction(scene) => return run_render_diffraction(args, scene),
+        Scene::Film(scene) => scene,
     };
+    let film_eval = FilmEval::from(args.film_eval);
+    let technique = Technique::from(args.technique);
     let names: Vec<String> = if args.tables.is_empty() {
         let lut = match scene {
             _ if args.gltf.is_some() => "film-dielectric",
@@ -882,38 +578,33 @@ fn run_render(args: &RenderArgs) -> Result<()> {
         options.spectral_samples = n;
     }
     // Check the settings and read every input before starting the GPU: bad input fails fast.
-    options.validate().map_err(runtime_error)?;
+    options.validate()?;
     for name in &names {
         Manifest::read(&set::resolve_table(name))?;
     }
     if let Some(path) = &options.environment {
-        nacre_runtime::render::EnvironmentMap::load(path).map_err(runtime_error)?;
+        nacre_runtime::render::EnvironmentMap::load(path)?;
     }
     if let Some(path) = &options.thickness_map {
-        nacre_runtime::render::ThicknessMap::load_png(path).map_err(runtime_error)?;
+        nacre_runtime::render::ThicknessMap::load_png(path)?;
     }
     let gltf = match &args.gltf {
-        Some(path) => {
-            Some(nacre_runtime::gltf_scene::GltfScene::load(path).map_err(runtime_error)?)
-        }
+        Some(path) => Some(nacre_runtime::gltf_scene::GltfScene::load(path)?),
         None => None,
     };
-    let ctx = GpuContext::new_headless().map_err(runtime_error)?;
+    let ctx = GpuContext::new_headless()?;
     eprintln!("adapter: {}", ctx.describe());
     let mut tables = TableSet::default();
     for name in &names {
-        tables
-            .add(&ctx, &set::resolve_table(name))
-            .map_err(runtime_error)?;
+        tables.add(&ctx, &set::resolve_table(name))?;
     }
     if let Some(scene) = &gltf {
         let start = std::time::Instant::now();
-        let out = nacre_runtime::mesh::render_gltf(&ctx, &tables, technique, scene, &options)
-            .map_err(runtime_error)?;
+        let out = nacre_runtime::mesh::render_gltf(&ctx, &tables, technique, scene, &options)?;
         for note in &out.notes {
             eprintln!("note: {note}");
         }
-        let png = out.image.encode_png().map_err(runtime_error)?;
+        let png = out.image.encode_png()?;
         write_atomic(&args.output, |w| w.write_all(&png))?;
         eprintln!(
             "rendered {} ({}, {} primitives) at {}x{} in {:.2} s -> {}",
@@ -927,11 +618,11 @@ fn run_render(args: &RenderArgs) -> Result<()> {
         );
         return Ok(());
     }
-    options.fit_to_tables(&tables).map_err(runtime_error)?;
+    options.fit_to_tables(&tables)?;
     let start = std::time::Instant::now();
-    let image = render_scene(&ctx, &tables, technique, &options).map_err(runtime_error)?;
+    let image = render_scene(&ctx, &tables, technique, &options)?;
     let total = start.elapsed().as_secs_f64();
-    let png = image.encode_png().map_err(runtime_error)?;
+    let png = image.encode_png()?;
     write_atomic(&args.output, |w| w.write_all(&png))?;
     eprintln!(
         "rendered {} ({}) at {}x{} in {:.2} s (render pass {:.2} s) -> {}",
@@ -963,7 +654,8 @@ fn run_render_diffraction(
             return Err(nacre_bake::error::Error::Invalid {
                 context: "--tables".into(),
                 message: format!("the {} scene takes one diffraction table", scene.name()),
-            });
+            }
+            .into());
         }
     };
     let mut options = DiffractionSceneOptions::new(scene);
@@ -973,7 +665,7 @@ fn run_render_diffraction(
     options.exposure_ev = args.exposure;
     options.env_samples = args.env_samples;
     // Check the settings and read every input before starting the GPU: bad input fails fast.
-    options.validate().map_err(runtime_error)?;
+    options.validate()?;
     let path = set::resolve_table(&name);
     let manifest = Manifest::read(&path)?;
     let record =
@@ -989,7 +681,7 @@ fn run_render_diffraction(
                     scene.name()
                 ),
             })?;
-    let layout = DiffractionLayout::of(&record, &path).map_err(runtime_error)?;
+    let layout = DiffractionLayout::of(&record, &path)?;
     let sum = match layout {
         DiffractionLayout::Terms { .. } => {
             let step_nm = args.wavelength_step.unwrap_or(DEFAULT_WAVELENGTH_STEP_NM);
@@ -1011,16 +703,15 @@ fn run_render_diffraction(
         }
     };
     if let Some(path) = &options.environment {
-        nacre_runtime::render::EnvironmentMap::load(path).map_err(runtime_error)?;
+        nacre_runtime::render::EnvironmentMap::load(path)?;
     }
-    let ctx = GpuContext::new_headless().map_err(runtime_error)?;
+    let ctx = GpuContext::new_headless()?;
     eprintln!("adapter: {}", ctx.describe());
-    let table =
-        DiffractionTables::load(&ctx, &path, options.technique.fresnel).map_err(runtime_error)?;
+    let table = DiffractionTables::load(&ctx, &path, options.technique.fresnel)?;
     let start = std::time::Instant::now();
-    let image = render_diffraction_scene(&ctx, &table, &options).map_err(runtime_error)?;
+    let image = render_diffraction_scene(&ctx, &table, &options)?;
     let total = start.elapsed().as_secs_f64();
-    let png = image.encode_png().map_err(runtime_error)?;
+    let png = image.encode_png()?;
     write_atomic(&args.output, |w| w.write_all(&png))?;
     eprintln!(
         "rendered {} (diffraction, {}, {sum}) at {}x{} in {:.2} s (render pass {:.2} s) -> {}",
@@ -1050,7 +741,8 @@ fn refuse_step_for_integrated(flag: &str, step_nm: Option<f64>, manifest: &Manif
                 "{step_nm} nm: table `{}` has the layout \"integrated\", whose wavelength sum was done at bake time (the manifest's grid); the step applies to layout \"terms\" tables only",
                 manifest.name
             ),
-        }),
+        }
+        .into()),
     }
 }
 
@@ -1062,13 +754,10 @@ fn run_render_rough_row(args: &RenderArgs) -> Result<()> {
         return Err(nacre_bake::error::Error::Invalid {
             context: "--reference-samples".into(),
             message: format!("{} (expected 16 to 1048576)", args.reference_samples),
-        });
+        }
+        .into());
     }
-    let technique = match args.technique.as_str() {
-        "fourier" => Technique::Fourier,
-        "spectral" => Technique::Spectral,
-        _ => Technique::Lut,
-    };
+    let technique = Technique::from(args.technique);
     let names: Vec<String> = if args.tables.is_empty() {
         vec![
             "film-dielectric".into(),
@@ -1087,16 +776,14 @@ fn run_render_rough_row(args: &RenderArgs) -> Result<()> {
         environment: args.env.clone(),
         ..RoughRowOptions::default()
     };
-    let ctx = GpuContext::new_headless().map_err(runtime_error)?;
+    let ctx = GpuContext::new_headless()?;
     eprintln!("adapter: {}", ctx.describe());
     let mut tables = TableSet::default();
     for name in &names {
-        tables
-            .add(&ctx, &set::resolve_table(name))
-            .map_err(runtime_error)?;
+        tables.add(&ctx, &set::resolve_table(name))?;
     }
-    let row = render_rough_row(&ctx, &tables, technique, &options).map_err(runtime_error)?;
-    let png = row.image.encode_png().map_err(runtime_error)?;
+    let row = render_rough_row(&ctx, &tables, technique, &options)?;
+    let png = row.image.encode_png()?;
     write_atomic(&args.output, |w| w.write_all(&png))?;
     eprintln!("alpha   mean dE2000 vs Monte Carlo: film at n.v   exact");
     for (alpha, nv, exact) in &row.delta_e {
@@ -1134,7 +821,7 @@ fn run_bench_gpu(args: &BenchGpuArgs) -> Result<()> {
     // The sum the diffraction pass does, for the report.
     let diffraction_sum = match diffraction_manifest
         .diffraction()
-        .map(|record| DiffractionLayout::of(record, &diffraction_path).map_err(runtime_error))
+        .map(|record| DiffractionLayout::of(record, &diffraction_path))
     {
         Some(Ok(DiffractionLayout::Integrated { .. })) => {
             refuse_step_for_integrated(
@@ -1144,7 +831,7 @@ fn run_bench_gpu(args: &BenchGpuArgs) -> Result<()> {
             )?;
             "(layout integrated)".to_string()
         }
-        Some(Err(e)) => return Err(e),
+        Some(Err(e)) => return Err(e.into()),
         // Another kind fails in the loader, with its message.
         Some(Ok(DiffractionLayout::Terms { .. })) | None => {
             let step_nm = args.diffraction_step.unwrap_or(DEFAULT_WAVELENGTH_STEP_NM);
@@ -1164,16 +851,14 @@ fn run_bench_gpu(args: &BenchGpuArgs) -> Result<()> {
         warmup: 3,
         technique,
     };
-    let ctx = GpuContext::new_headless().map_err(runtime_error)?;
+    let ctx = GpuContext::new_headless()?;
     eprintln!("adapter: {}", ctx.describe());
     let mut tables = TableSet::default();
     for name in &names {
-        tables
-            .add(&ctx, &set::resolve_table(name))
-            .map_err(runtime_error)?;
+        tables.add(&ctx, &set::resolve_table(name))?;
     }
-    let diffraction = DiffractionTables::load(&ctx, &diffraction_path, diffraction_options.fresnel)
-        .map_err(runtime_error)?;
+    let diffraction =
+        DiffractionTables::load(&ctx, &diffraction_path, diffraction_options.fresnel)?;
     let passes = [
         BenchPass::Plain,
         BenchPass::Film(Technique::Lut),
@@ -1187,8 +872,7 @@ fn run_bench_gpu(args: &BenchGpuArgs) -> Result<()> {
         Some((&diffraction, &diffraction_options)),
         &passes,
         &options,
-    )
-    .map_err(runtime_error)?;
+    )?;
     let plain = results[0].median_ms;
     let lut = results[1].median_ms;
     println!(
@@ -1295,8 +979,8 @@ fn run(cli: Cli) -> Result<()> {
         Command::Bake(args) => run_bake(&args),
         Command::Color(args) => run_color(&args),
         Command::Compare(args) => run_compare(&args),
-        Command::Diffraction(args) => diffraction::run(&args),
-        Command::Plot(args) => plot::run(&args),
+        Command::Diffraction(args) => Ok(diffraction::run(&args)?),
+        Command::Plot(args) => Ok(plot::run(&args)?),
         Command::Conformance(args) => run_conformance(&args),
         Command::Render(args) => run_render(&args),
         Command::BenchGpu(args) => run_bench_gpu(&args),

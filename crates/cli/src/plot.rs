@@ -2,10 +2,9 @@
 //! extension. The figures and their colour conventions live in [`nacre_bake::commands::plot`]; this
 //! module parses the flags, computes the data and hands it over.
 
-use super::{StackArgs, load_fourier_table, load_stack};
+use super::{StackArgs, load_stack};
 use clap::{Args, Subcommand};
 use nacre_bake::commands::color::{self, LoadedLut, Method, Point, Quantity};
-use nacre_bake::commands::compare::CASES;
 use nacre_bake::commands::grid::{parse_range, parse_thickness_nm};
 use nacre_bake::commands::plot::{self, ChartColumns, ImageFormat, SpectrumQuantity};
 use nacre_bake::commands::stack_spec::StackSpec;
@@ -204,8 +203,8 @@ struct ChartArgs {
     #[arg(long, default_value = "spectral")]
     method: String,
     /// r (reflectance) or t (transmittance into the base).
-    #[arg(long, default_value = "r", value_parser = ["r", "t"])]
-    quantity: String,
+    #[arg(long, value_enum, default_value = "r")]
+    quantity: crate::choices::QuantityArg,
     /// Factor on the linear colour before clipping.
     #[arg(long, default_value = "1")]
     exposure: f64,
@@ -228,8 +227,8 @@ struct TableArgs {
     #[arg(value_name = "NAME|PATH", default_value = "film-dielectric")]
     table: String,
     /// film-lut: r (reflectance) or t (transmittance).
-    #[arg(long, default_value = "r", value_parser = ["r", "t"])]
-    quantity: String,
+    #[arg(long, value_enum, default_value = "r")]
+    quantity: crate::choices::QuantityArg,
     /// film-lut: film indices of the slices (a list and/or ranges) [default:
     /// n_min + (n_max − n_min)·k/4 for k = 1…4].
     #[arg(long, value_name = "LIST")]
@@ -301,17 +300,7 @@ fn case_or_stack(
         return Ok((built, describe(&spec, true)));
     }
     let name = case.unwrap_or(default_case);
-    let case = CASES
-        .iter()
-        .find(|c| c.name == name)
-        .ok_or_else(|| Error::Flag {
-            flag: "--case".into(),
-            value: name.into(),
-            message: format!(
-                "expected one of {}",
-                CASES.iter().map(|c| c.name).collect::<Vec<_>>().join(", ")
-            ),
-        })?;
+    let case = nacre_bake::commands::compare::case_named(name)?;
     let spec = StackSpec::from_flags(
         Some("1.0"),
         &[format!("{}@400", case.film_ior)],
@@ -329,29 +318,15 @@ fn prepare_method(
     colorimeter: &Colorimeter,
     fourier_table: Option<&str>,
 ) -> Result<(Method, Option<LoadedLut>)> {
-    let method = Method::parse(text).map_err(|e| match e {
-        Error::Flag { value, message, .. } => Error::Flag {
-            flag: flag.into(),
-            value,
-            message,
-        },
-        other => other,
-    })?;
-    match method {
-        Method::Lut(ref path) => {
-            let lut = LoadedLut::load(path)?;
-            lut.check_stack(path, stack)?;
-            Ok((method, Some(lut)))
-        }
-        Method::Fourier(h, sigma, None) if text.trim().starts_with("fourier:") => {
-            let table = load_fourier_table(fourier_table, colorimeter)?;
-            Ok((
-                Method::Fourier(h, sigma, Some(std::sync::Arc::new(table))),
-                None,
-            ))
-        }
-        m => Ok((m, None)),
-    }
+    nacre_bake::commands::color_request::prepare_method(text, stack, colorimeter, fourier_table)
+        .map_err(|e| match e {
+            Error::Flag { value, message, .. } => Error::Flag {
+                flag: flag.into(),
+                value,
+                message,
+            },
+            other => other,
+        })
 }
 
 fn reference_colorimeter() -> Colorimeter {
@@ -584,11 +559,7 @@ fn run_chart(args: &ChartArgs) -> Result<()> {
             })
         })
         .collect();
-    let quantity = if args.quantity == "t" {
-        Quantity::Transmittance
-    } else {
-        Quantity::Reflectance
-    };
+    let quantity = Quantity::from(args.quantity);
     let c = reference_colorimeter();
     let (method, lut) = prepare_method(
         "--method",
@@ -647,11 +618,7 @@ fn run_table(args: &TableArgs) -> Result<()> {
     let figure = plot::load_table_plot(
         &args.table,
         &plot::TableOptions {
-            quantity: if args.quantity == "t" {
-                Quantity::Transmittance
-            } else {
-                Quantity::Reflectance
-            },
+            quantity: Quantity::from(args.quantity),
             film_iors,
             exposure: args.exposure,
             max_opd_nm: args.max_opd,

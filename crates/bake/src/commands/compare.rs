@@ -315,3 +315,68 @@ pub fn write_png(
         writer.finish().map_err(std::io::Error::other)
     })?)
 }
+
+/// The named case of [`CASES`] (`--case`).
+pub fn case_named(name: &str) -> Result<&'static Case> {
+    CASES
+        .iter()
+        .find(|c| c.name == name)
+        .ok_or_else(|| Error::Flag {
+            flag: "--case".into(),
+            value: name.into(),
+            message: format!(
+                "expected one of {}",
+                CASES.iter().map(|c| c.name).collect::<Vec<_>>().join(", ")
+            ),
+        })
+}
+
+/// Most angle × thickness points of one comparison.
+pub const MAX_POINTS: u64 = 200_000;
+
+/// The angle and thickness grids of a comparison from their ranges (`--angles`,
+/// `--thicknesses`): angles strictly between -90 and 90 degrees, thicknesses
+/// non-negative, at most [`MAX_POINTS`] points.
+pub fn grid(angles_text: &str, thicknesses_text: &str) -> Result<(Vec<f64>, Vec<f64>)> {
+    let angles = crate::commands::grid::parse_range("--angles", angles_text)?;
+    if let Some(a) = angles.iter().find(|a| !(a.abs() < 90.0)) {
+        return Err(Error::Flag {
+            flag: "--angles".into(),
+            value: angles_text.into(),
+            message: format!("angle {a} must lie strictly between -90 and 90 degrees"),
+        });
+    }
+    let thicknesses = crate::commands::grid::parse_range("--thicknesses", thicknesses_text)?;
+    if let Some(d) = thicknesses.iter().find(|d| !(**d >= 0.0)) {
+        return Err(Error::Flag {
+            flag: "--thicknesses".into(),
+            value: thicknesses_text.into(),
+            message: format!("thickness {d} must be non-negative"),
+        });
+    }
+    let points = angles.len() as u64 * thicknesses.len() as u64;
+    if points > MAX_POINTS {
+        return Err(Error::TooLarge {
+            what: "--angles × --thicknesses points".into(),
+            count: points,
+            limit: MAX_POINTS,
+        });
+    }
+    Ok((angles, thicknesses))
+}
+
+/// Writes `dir/compare.csv` and `dir/compare.png` (the folder created if needed).
+pub fn write(
+    dir: &Path,
+    case: &Case,
+    angles: &[f64],
+    thicknesses: &[f64],
+    results: &[MethodResult],
+) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|source| Error::Io {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    write_csv(&dir.join("compare.csv"), angles, thicknesses, results)?;
+    write_png(&dir.join("compare.png"), case, angles, thicknesses, results)
+}

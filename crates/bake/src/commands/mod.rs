@@ -1,10 +1,13 @@
-//! The commands behind the `nacre` tool that evaluate rather than bake: `color` (and its
-//! methods), `compare`, `conformance`, `spectrum`, `plot`, with their inputs (stack flags and
+//! The commands behind the `nacre` tool that evaluate rather than bake: `color` (its methods,
+//! and [`color_request`]: a method prepared from the command line's values), `compare`,
+//! `conformance`, `diffraction`, `spectrum`, `plot`, with their inputs (stack flags and
 //! recipes, angle/wavelength grids).
 
 pub mod color;
+pub mod color_request;
 pub mod compare;
 pub mod conformance;
+pub mod diffraction;
 pub mod grid;
 pub mod plot;
 pub mod spectrum;

@@ -1,6 +1,7 @@
 //! Diffraction gratings: height-field sources (files and synthetic specs), the table kind
 //! `diffraction` (layout "terms" here, layout "integrated" in
-//! [`crate::kinds::diffraction_integrated`]), and the CPU evaluation behind `nacre diffraction`.
+//! [`crate::kinds::diffraction_integrated`]); the CPU evaluation behind `nacre diffraction` is
+//! [`crate::commands::diffraction`].
 //! The physics is [`nacre_optics::diffraction`] (Stam 1999; Dhillon et al. 2014).
 //!
 //! # Height-field sources
@@ -54,7 +55,6 @@
 //! `integrated_samples`, `integrated_gamma`, `integrated_tolerance`) is documented in
 //! [`crate::kinds::diffraction_integrated`].
 
-use crate::commands::spectrum::fmt_sig;
 use crate::error::{Error, Result};
 use crate::kinds::{KindEntry, TableRecipe};
 use crate::recipe::{RawColour, line_of, parse_colour, table_name, toml_error};
@@ -65,11 +65,9 @@ use nacre_optics::C64;
 use nacre_optics::colour::Colorimeter;
 use nacre_optics::diffraction::{
     CD_PIT_DEPTH_UM, CD_TRACK_PITCH_UM, DEFAULT_COHERENCE_DIAMETER_UM, DiffractionSurface,
-    FresnelTerm, HeightField, SpectralGrid, TaylorTerms, in_plane_directions, taylor_order_for,
+    HeightField, SpectralGrid, TaylorTerms, taylor_order_for,
 };
-use rayon::prelude::*;
 use serde::Deserialize;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
@@ -989,279 +987,6 @@ pub fn plan(
         sign_convention: SIGN_CONVENTION.into(),
         integrated: None,
     })
-}
-
-/// A `nacre diffraction` evaluation: one incidence, a list of in-plane view angles.
-pub struct ViewSweep<'a> {
-    /// The surface.
-    pub surface: &'a DiffractionSurface,
-    /// Incidence angle θ_i, degrees (light on the −x side when positive).
-    pub incidence_deg: f64,
-    /// View angles θ_r, degrees (viewer on the +x side when positive).
-    pub views_deg: &'a [f64],
-    /// Wavelengths, nm.
-    pub wavelengths_nm: &'a [f64],
-    /// Fresnel factor.
-    pub fresnel: FresnelTerm,
-}
-
-impl ViewSweep<'_> {
-    /// ρ for every (view, wavelength), view-major; views in parallel (each value
-    /// independent: the same result whatever the thread count).
-    pub fn reflectance(&self) -> Vec<f64> {
-        self.views_deg
-            .par_iter()
-            .flat_map_iter(|&view| {
-                let (wi, wr) = in_plane_directions(self.incidence_deg, view);
-                self.wavelengths_nm
-                    .iter()
-                    .map(move |&wl| self.surface.relative_reflectance(wi, wr, wl, self.fresnel))
-            })
-            .collect()
-    }
-
-    /// Writes `view_deg,wavelength_nm,reflectance`.
-    pub fn write_reflectance_csv(&self, w: &mut dyn Write, rho: &[f64]) -> std::io::Result<()> {
-        writeln!(w, "view_deg,wavelength_nm,reflectance")?;
-        let mut cells = rho.iter();
-        for &v in self.views_deg {
-            for &wl in self.wavelengths_nm {
-                writeln!(
-                    w,
-                    "{v},{wl},{}",
-                    fmt_sig(*cells.next().expect("one value per cell"))
-                )?;
-            }
-        }
-        Ok(())
-    }
-
-    /// Colours (XYZ, output space) per view from ρ on the wavelength grid.
-    pub fn colours(
-        &self,
-        rho: &[f64],
-        grid: &SpectralGrid,
-        colorimeter: &Colorimeter,
-    ) -> Vec<([f64; 3], [f64; 3])> {
-        rho.chunks(self.wavelengths_nm.len())
-            .map(|values| {
-                let xyz = grid.xyz(values);
-                (xyz, colorimeter.output_from_xyz(xyz))
-            })
-            .collect()
-    }
-
-    /// Writes `view_deg,X,Y,Z,R,G,B`.
-    pub fn write_colour_csv(
-        &self,
-        w: &mut dyn Write,
-        colours: &[([f64; 3], [f64; 3])],
-    ) -> std::io::Result<()> {
-        write_colour_csv(w, self.views_deg, colours)
-    }
-}
-
-/// `f` of every light/view pair, in parallel (each value independent, the order kept: the
-/// same result whatever the thread count).
-pub fn par_map_pairs<T: Send>(
-    pairs: &[([f64; 3], [f64; 3])],
-    f: &(dyn Fn([f64; 3], [f64; 3]) -> T + Sync),
-) -> Vec<T> {
-    pairs.par_iter().map(|&(wi, wr)| f(wi, wr)).collect()
-}
-
-/// Writes `view_deg,X,Y,Z,R,G,B`, one row per view angle (degrees) with its (XYZ,
-/// output-space) colour.
-pub fn write_colour_csv(
-    w: &mut dyn Write,
-    views_deg: &[f64],
-    colours: &[([f64; 3], [f64; 3])],
-) -> std::io::Result<()> {
-    writeln!(w, "view_deg,X,Y,Z,R,G,B")?;
-    for (&v, (xyz, rgb)) in views_deg.iter().zip(colours) {
-        writeln!(
-            w,
-            "{v},{},{},{},{},{},{}",
-            fmt_sig(xyz[0]),
-            fmt_sig(xyz[1]),
-            fmt_sig(xyz[2]),
-            fmt_sig(rgb[0]),
-            fmt_sig(rgb[1]),
-            fmt_sig(rgb[2])
-        )?;
-    }
-    Ok(())
-}
-
-/// A diffraction map (`nacre plot diffraction`): the colour of ρ over view directions for
-/// a fixed light, on the projected hemisphere (x = sin θ_r cos φ_r across the grating
-/// lines, y = sin θ_r sin φ_r along them; the light at θ_i in the x–z plane on the −x
-/// side), as sRGB: linear sRGB × exposure, clipped per channel (the `nacre plot`
-/// conventions).
-#[derive(Clone, Debug)]
-pub struct DiffractionMap {
-    /// Title.
-    pub title: String,
-    /// Cells per side.
-    pub cells: usize,
-    /// sin of the largest view angle drawn: the disc's radius.
-    pub radius: f64,
-    /// Linear sRGB per cell (row-major from y = −radius), `None` outside the disc.
-    pub colours: Vec<Option<[f64; 3]>>,
-    /// Factor applied before clipping.
-    pub exposure: f64,
-    /// (x, y) of the specular direction.
-    pub specular: [f64; 2],
-}
-
-/// The view direction of map cell (ix, iy), or `None` outside the disc.
-fn map_direction(ix: usize, iy: usize, cells: usize, radius: f64) -> Option<[f64; 3]> {
-    let at = |i: usize| radius * (2.0 * (i as f64 + 0.5) / cells as f64 - 1.0);
-    let (x, y) = (at(ix), at(iy));
-    let r2 = x * x + y * y;
-    (r2 <= radius * radius).then(|| [x, y, (1.0 - r2).sqrt()])
-}
-
-impl DiffractionMap {
-    /// Evaluates ρ over `grid`'s wavelengths at every cell (rows in parallel, each cell
-    /// independent) and converts to linear sRGB. With `exposure` `None` the exposure puts
-    /// the 98th percentile of the cells' largest channel at 1 (the specular highlight
-    /// saturates; the orders show).
-    #[allow(clippy::too_many_arguments)]
-    pub fn compute(
-        title: String,
-        surface: &DiffractionSurface,
-        incidence_deg: f64,
-        max_view_deg: f64,
-        cells: usize,
-        grid: &SpectralGrid,
-        colorimeter: &Colorimeter,
-        fresnel: FresnelTerm,
-        exposure: Option<f64>,
-    ) -> Self {
-        let colour = |omega_i: [f64; 3], omega_r: [f64; 3]| {
-            let rho: Vec<f64> = grid
-                .wavelengths_nm()
-                .iter()
-                .map(|&wl| surface.relative_reflectance(omega_i, omega_r, wl, fresnel))
-                .collect();
-            colorimeter.output_from_xyz(grid.xyz(&rho))
-        };
-        Self::compute_with(
-            title,
-            &colour,
-            incidence_deg,
-            max_view_deg,
-            cells,
-            colorimeter,
-            exposure,
-        )
-    }
-
-    /// As [`DiffractionMap::compute`] for any evaluation `colour(ω_i, ω_r)` giving the
-    /// colour in `colorimeter`'s output space (e.g. an integrated table's,
-    /// [`nacre_optics::diffraction::integrated::IntegratedTable::colour`]).
-    pub fn compute_with(
-        title: String,
-        colour: &(dyn Fn([f64; 3], [f64; 3]) -> [f64; 3] + Sync),
-        incidence_deg: f64,
-        max_view_deg: f64,
-        cells: usize,
-        colorimeter: &Colorimeter,
-        exposure: Option<f64>,
-    ) -> Self {
-        let radius = max_view_deg.to_radians().sin();
-        let (omega_i, _) = in_plane_directions(incidence_deg, 0.0);
-        let display = crate::commands::plot::DisplayConverter::new(colorimeter);
-        let colours: Vec<Option<[f64; 3]>> = (0..cells)
-            .into_par_iter()
-            .flat_map_iter(|iy| {
-                let display = &display;
-                (0..cells).map(move |ix| {
-                    let omega_r = map_direction(ix, iy, cells, radius)?;
-                    Some(display.linear_srgb(colour(omega_i, omega_r)))
-                })
-            })
-            .collect();
-        let exposure = exposure.unwrap_or_else(|| {
-            let mut peaks: Vec<f64> = colours
-                .iter()
-                .flatten()
-                .map(|c| c.iter().fold(0.0f64, |m, v| m.max(*v)))
-                .collect();
-            peaks.sort_by(f64::total_cmp);
-            let p = peaks.get(peaks.len() * 98 / 100).copied().unwrap_or(0.0);
-            if p > 0.0 { 1.0 / p } else { 1.0 }
-        });
-        DiffractionMap {
-            title,
-            cells,
-            radius,
-            colours,
-            exposure,
-            specular: [incidence_deg.to_radians().sin(), 0.0],
-        }
-    }
-}
-
-impl crate::commands::plot::Figure for DiffractionMap {
-    fn size(&self) -> (u32, u32) {
-        (760, 800)
-    }
-
-    fn draw<DB: plotters::prelude::DrawingBackend>(
-        &self,
-        root: &plotters::prelude::DrawingArea<DB, plotters::coord::Shift>,
-        format: crate::commands::plot::ImageFormat,
-    ) -> crate::commands::plot::DrawResult<DB> {
-        use plotters::prelude::*;
-        let area = root.titled(&self.title, ("sans-serif", 17))?;
-        let r = self.radius;
-        let mut chart = ChartBuilder::on(&area)
-            .margin(16)
-            .x_label_area_size(48)
-            .y_label_area_size(60)
-            .build_cartesian_2d(-r..r, -r..r)?;
-        chart
-            .configure_mesh()
-            .disable_mesh()
-            .x_desc("sin θ_r cos φ_r (across the grating lines)")
-            .y_desc("sin θ_r sin φ_r (along the lines)")
-            .label_style(("sans-serif", 14))
-            .axis_desc_style(("sans-serif", 16))
-            .draw()?;
-        chart.draw_series(std::iter::once(Rectangle::new(
-            [(-r, -r), (r, r)],
-            BLACK.filled(),
-        )))?;
-        // SVG: coarser cells (every other one) to keep files small.
-        let stride = if format == crate::commands::plot::ImageFormat::Png {
-            1
-        } else {
-            2
-        };
-        let step = 2.0 * r / self.cells as f64;
-        let mut rects = Vec::new();
-        for iy in (0..self.cells).step_by(stride) {
-            for ix in (0..self.cells).step_by(stride) {
-                if let Some(c) = self.colours[iy * self.cells + ix] {
-                    let (x0, y0) = (-r + ix as f64 * step, -r + iy as f64 * step);
-                    let span = step * stride as f64;
-                    rects.push(Rectangle::new(
-                        [(x0, y0), (x0 + span, y0 + span)],
-                        crate::commands::plot::srgb8(c.map(|v| v * self.exposure)).filled(),
-                    ));
-                }
-            }
-        }
-        chart.draw_series(rects)?;
-        chart.draw_series(std::iter::once(Cross::new(
-            (self.specular[0], self.specular[1]),
-            6,
-            WHITE.stroke_width(1),
-        )))?;
-        Ok(())
-    }
 }
 
 /// The registry entry of `diffraction` ([`crate::kinds::REGISTRY`]).
