@@ -169,9 +169,7 @@ pub fn rgb_metal(name: &str, index_rgb: [C64; 3]) -> Result<Material> {
     ] {
         csv.push_str(&format!("{w},{},{}\n", n.re, n.im));
     }
-    Material::from_nk_csv(name, name, &csv)
-        .map_err(crate::Error::from)
-        .map_err(Error::from)
+    Material::from_nk_csv(name, name, &csv).map_err(Error::from)
 }
 
 impl GltfMaterial {

@@ -13,12 +13,13 @@ pub mod bench;
 pub mod bindings;
 pub mod context;
 pub mod diffraction;
-pub mod diffraction_integrated;
+pub mod environment;
 pub mod error;
 pub mod fullscreen;
 pub mod gltf_assets;
 pub mod gltf_scene;
 pub mod ibl;
+pub mod image_io;
 pub mod mesh;
 pub mod params;
 pub mod probe;
@@ -30,6 +31,8 @@ pub mod tables;
 
 pub use bindings::{TechniqueBinding, TechniqueOptions};
 pub use context::{BufferInitExt, GpuContext};
+/// Layout "integrated" of the `diffraction` technique ([`diffraction::integrated`]).
+pub use diffraction::integrated as diffraction_integrated;
 pub use error::{Error, Result};
 pub use params::{FilmInput, FilmOutput};
 pub use render::{RenderedImage, Renderer, SceneKind, SceneOptions, render_scene};

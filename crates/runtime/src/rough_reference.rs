@@ -450,7 +450,7 @@ pub fn film_term_of(options: &SceneOptions, colorimeter: &Colorimeter) -> Result
         m.base.clone(),
     )
     .map_err(crate::Error::from)?;
-    Ok(FilmTerm::from_stack(&stack, colorimeter).map_err(crate::Error::from)?)
+    FilmTerm::from_stack(&stack, colorimeter).map_err(crate::Error::from)
 }
 
 /// The reference of `options` (built by [`comparison_options`] or alike) with `samples`
