@@ -42,7 +42,8 @@
 //! per wavelength) see the same three values.
 
 use crate::error::{Error, Result};
-use crate::render::{BaseKind, MaterialOptions, SceneKind, ThicknessMap, ThicknessMapping};
+use crate::render::{BaseKind, MaterialOptions, SceneKind, ThicknessMapping};
+use crate::thickness_map::ThicknessMap;
 use nacre_optics::{C64, Material};
 use std::path::{Path, PathBuf};
 

@@ -62,3 +62,68 @@ pub(crate) fn check_image_size(path: &Path, what: &str, width: usize, height: us
     }
     Ok(())
 }
+
+/// An image rendered by [`Renderer::render`].
+#[derive(Clone, Debug)]
+pub struct RenderedImage {
+    /// Width, pixels.
+    pub width: u32,
+    /// Height, pixels.
+    pub height: u32,
+    /// RGBA8, sRGB-encoded, alpha 255, row-major, top row first.
+    pub pixels: Vec<u8>,
+    /// Wall-clock seconds from submitting the render pass to its completion (excludes
+    /// pipeline creation, uploads and the readback; includes any shader compilation the driver
+    /// defers to the first draw, as lavapipe does without a warm shader cache).
+    pub gpu_seconds: f64,
+}
+
+impl RenderedImage {
+    /// The image as an 8-bit RGB PNG with an sRGB chunk.
+    pub fn encode_png(&self) -> Result<Vec<u8>> {
+        let err = |e: png::EncodingError| Error::Invalid {
+            context: "encoding the PNG".into(),
+            message: e.to_string(),
+        };
+        let rgb: Vec<u8> = self
+            .pixels
+            .chunks_exact(4)
+            .flat_map(|p| [p[0], p[1], p[2]])
+            .collect();
+        let mut bytes = Vec::new();
+        {
+            let mut encoder = png::Encoder::new(&mut bytes, self.width, self.height);
+            encoder.set_color(png::ColorType::Rgb);
+            encoder.set_depth(png::BitDepth::Eight);
+            encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+            encoder.set_compression(png::Compression::Balanced);
+            let mut writer = encoder.write_header().map_err(err)?;
+            writer.write_image_data(&rgb).map_err(err)?;
+            writer.finish().map_err(err)?;
+        }
+        Ok(bytes)
+    }
+
+    /// Writes [`RenderedImage::encode_png`] to `path` atomically.
+    pub fn write_png(&self, path: &Path) -> Result<()> {
+        let bytes = self.encode_png()?;
+        Ok(nacre_format::atomic::write_atomic(path, |w| {
+            w.write_all(&bytes)
+        })?)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mip_chain_averages_and_ends_at_one_texel() {
+        let texels: Vec<[f32; 1]> = (0..15).map(|i| [i as f32]).collect();
+        let chain = mip_chain(5, 3, texels);
+        let sizes: Vec<(usize, usize)> = chain.iter().map(|l| (l.0, l.1)).collect();
+        assert_eq!(sizes, vec![(5, 3), (2, 1), (1, 1)]);
+        // Level 1 texel 0 averages (0, 0), (1, 0), (0, 1), (1, 1) = 0, 1, 5, 6.
+        assert_eq!(chain[1].2[0][0], 3.0);
+    }
+}

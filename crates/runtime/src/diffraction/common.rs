@@ -262,6 +262,6 @@ pub(super) fn dispatch_probe(
         ctx.queue.submit([encoder.finish()]);
         readback
     })?;
-    let bytes = crate::readback::read_buffer(ctx, &readback, "reading the diffraction probe back")?;
+    let bytes = crate::gpu::read_buffer(ctx, &readback, "reading the diffraction probe back")?;
     Ok(bytemuck::pod_collect_to_vec(&bytes))
 }

@@ -6,10 +6,12 @@ use super::integrated;
 use super::tables::DiffractionTables;
 use super::terms::{DiffractionBinding, DiffractionOptions, LLVMPIPE_LOOP_LIMIT, composition};
 use crate::context::{BufferInitExt, GpuContext};
+use crate::environment::EnvironmentMap;
 use crate::error::{Error, Result};
-use crate::fullscreen;
-use crate::readback::read_texture;
-use crate::render::{Camera, EnvironmentMap, Level, Light, MAX_DIMENSION, RenderedImage};
+use crate::gpu;
+use crate::gpu::read_texture;
+use crate::image_io::{Level, MAX_DIMENSION, RenderedImage};
+use crate::render::{Camera, Light};
 use crate::shaders;
 use bytemuck::{Pod, Zeroable};
 use nacre_format::diffraction::DiffractionRecord;
@@ -310,7 +312,7 @@ fn view_group(
     uniform: &DiffractionViewUniform,
     env: &EnvironmentMap,
 ) -> Result<ViewGroup> {
-    let texture = crate::render::upload_mips(
+    let texture = crate::gpu::upload_mips(
         ctx,
         "diffraction environment",
         wgpu::TextureFormat::Rgba16Float,
@@ -321,9 +323,9 @@ fn view_group(
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("diffraction view"),
             entries: &[
-                crate::render::uniform_entry(0),
-                crate::render::texture_entry(1),
-                crate::render::sampler_entry(2),
+                crate::gpu::uniform_entry(0),
+                crate::gpu::texture_entry(1),
+                crate::gpu::sampler_entry(2),
             ],
         });
         let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -332,7 +334,7 @@ fn view_group(
             usage: wgpu::BufferUsages::UNIFORM,
         });
         let view = texture.create_view(&Default::default());
-        let sampler = crate::render::linear_sampler(device, "diffraction environment", false);
+        let sampler = crate::gpu::linear_sampler(device, "diffraction environment", false);
         let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("diffraction view"),
             layout: &layout,
@@ -423,7 +425,7 @@ impl ScenePass {
                 bind_group_layouts: &[Some(&view.layout), Some(technique_layout)],
                 immediate_size: 0,
             });
-            fullscreen::pipeline(
+            gpu::fullscreen_pipeline(
                 device,
                 "diffraction scene",
                 &module,
@@ -556,8 +558,8 @@ pub fn render_diffraction_scene(
     let env = match &options.environment {
         Some(path) => EnvironmentMap::load(path)?,
         None => {
-            let (w, h) = crate::render::DEFAULT_ENVIRONMENT_SIZE;
-            crate::render::procedural_environment_with(w, h, false)
+            let (w, h) = crate::environment::DEFAULT_ENVIRONMENT_SIZE;
+            crate::environment::procedural_environment_with(w, h, false)
         }
     };
     let (width, height) = (options.width, options.height);
