@@ -1,11 +1,50 @@
 //! CPU images: the size limit of every picture the runtime reads or renders, mip levels and
-//! their 2×2 box-filtered chains (uploaded as textures by the renderer).
+//! their 2×2 box-filtered chains (uploaded by [`crate::gpu::upload_mips`]).
 
 use crate::error::{Error, Result};
 use std::path::Path;
 
 /// Largest width or height of a rendered image, an environment map or a thickness map.
 pub const MAX_DIMENSION: u32 = 8192;
+
+/// Decodes the picture `bytes` read from `path` (PNG, JPEG or Radiance HDR, told apart by
+/// their content): its size is checked against [`MAX_DIMENSION`] (`what` names the picture
+/// in the error) before the pixels are decoded, and a decoder failure is an error, not a
+/// panic.
+///
+/// # Errors
+/// [`Error::Invalid`] naming `path`: not a picture of those formats, malformed, or too large.
+pub(crate) fn decode_picture(path: &Path, what: &str, bytes: &[u8]) -> Result<image::DynamicImage> {
+    let invalid = |message: String| Error::Invalid {
+        context: path.display().to_string(),
+        message,
+    };
+    let reader = || {
+        image::ImageReader::new(std::io::Cursor::new(bytes))
+            .with_guessed_format()
+            .map_err(|e| invalid(format!("not a readable picture: {e}")))
+    };
+    let decode = || -> Result<image::DynamicImage> {
+        if reader()?.format().is_none() {
+            return Err(invalid("not a PNG, JPEG or Radiance HDR picture".into()));
+        }
+        let (width, height) = reader()?
+            .into_dimensions()
+            .map_err(|e| invalid(format!("not a valid picture: {e}")))?;
+        check_image_size(path, what, width as usize, height as usize)?;
+        let mut r = reader()?;
+        let mut limits = image::Limits::default();
+        limits.max_alloc = Some(1 << 30);
+        r.limits(limits);
+        r.decode()
+            .map_err(|e| invalid(format!("not a valid picture: {e}")))
+    };
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(decode)).unwrap_or_else(|_| {
+        Err(invalid(
+            "malformed picture data (the decoder failed)".into(),
+        ))
+    })
+}
 
 /// One mip level: width, height, texels (row-major, top row first).
 pub type Level<const C: usize> = (usize, usize, Vec<[f32; C]>);

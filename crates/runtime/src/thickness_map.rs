@@ -1,10 +1,9 @@
 //! The thickness map: a greyscale image g ∈ [0, 1] that the material maps to the film
-//! thickness ([`crate::render::ThicknessMapping`]), read from a PNG file or computed
+//! thickness ([`crate::render::ThicknessMapping`]), read from a PNG or JPEG file or computed
 //! ([`procedural_thickness_map`]); uploaded as (g, g²) with its mip chain.
 
 use crate::error::{Error, Result};
-use crate::image_io::{Level, check_image_size, mip_chain};
-use std::io::Cursor;
+use crate::image_io::{Level, decode_picture, mip_chain};
 use std::path::Path;
 
 /// Size of the built-in thickness map, texels (square).
@@ -23,80 +22,54 @@ pub struct ThicknessMap {
 }
 
 impl ThicknessMap {
-    /// Reads an 8- or 16-bit greyscale PNG (grey + alpha too: alpha ignored; 1-, 2- and 4-bit
-    /// greyscale are expanded to 8 bits), g = value / (2^bits − 1).
+    /// Reads an 8- or 16-bit greyscale picture, PNG or JPEG (grey + alpha too: alpha
+    /// ignored; 1-, 2- and 4-bit greyscale PNGs are expanded to 8 bits), g = value /
+    /// (2^bits − 1).
     ///
     /// # Errors
     /// [`Error::Io`] when the file cannot be read; [`Error::Invalid`] when it is not a valid
-    /// PNG, not greyscale, or a side is 0 or larger than [`MAX_DIMENSION`] (checked before the
-    /// pixels are decoded).
-    pub fn load_png(path: &Path) -> Result<ThicknessMap> {
+    /// PNG or JPEG, not greyscale, or a side is 0 or larger than
+    /// [`crate::image_io::MAX_DIMENSION`] (checked before the pixels are decoded).
+    pub fn load(path: &Path) -> Result<ThicknessMap> {
         let bytes = std::fs::read(path).map_err(|source| Error::Io {
             path: path.to_path_buf(),
             source,
         })?;
-        let invalid = |message: String| Error::Invalid {
-            context: path.display().to_string(),
-            message,
-        };
-        let decode = || -> Result<ThicknessMap> {
-            let bad = |e: png::DecodingError| invalid(format!("not a valid PNG file: {e}"));
-            let mut decoder = png::Decoder::new_with_limits(
-                Cursor::new(&bytes[..]),
-                png::Limits { bytes: 1 << 29 },
-            );
-            decoder.set_transformations(png::Transformations::EXPAND);
-            let info = decoder.read_header_info().map_err(bad)?;
-            let (width, height) = (info.width as usize, info.height as usize);
-            check_image_size(path, "a thickness map", width, height)?;
-            let mut reader = decoder.read_info().map_err(bad)?;
-            let (colour, depth) = reader.output_color_type();
-            let channels = match colour {
-                png::ColorType::Grayscale => 1,
-                png::ColorType::GrayscaleAlpha => 2,
-                other => {
-                    return Err(invalid(format!(
-                        "a {other:?} PNG; a thickness map must be greyscale (8 or 16 bits)"
-                    )));
-                }
-            };
-            let bytes_per_sample = match depth {
-                png::BitDepth::Eight => 1,
-                png::BitDepth::Sixteen => 2,
-                other => {
-                    return Err(invalid(format!(
-                        "{} bits per sample; expected 8 or 16",
-                        other as u8
-                    )));
-                }
-            };
-            let size = reader
-                .output_buffer_size()
-                .ok_or_else(|| invalid("image too large".into()))?;
-            let mut buf = vec![0u8; size];
-            let frame = reader.next_frame(&mut buf).map_err(bad)?;
-            reader.finish().map_err(bad)?;
-            let stride = channels * bytes_per_sample;
-            let mut values = Vec::with_capacity(width * height);
-            for y in 0..height {
-                let row = &buf[y * frame.line_size..];
-                for x in 0..width {
-                    let at = x * stride;
-                    values.push(if bytes_per_sample == 2 {
-                        f32::from(u16::from_be_bytes([row[at], row[at + 1]])) / 65535.0
-                    } else {
-                        f32::from(row[at]) / 255.0
-                    });
-                }
+        let picture = decode_picture(path, "a thickness map", &bytes)?;
+        let (width, height) = (picture.width() as usize, picture.height() as usize);
+        let values: Vec<f32> = match picture {
+            image::DynamicImage::ImageLuma8(p) => {
+                p.pixels().map(|v| f32::from(v.0[0]) / 255.0).collect()
             }
-            Ok(ThicknessMap {
-                width,
-                height,
-                values,
-            })
+            image::DynamicImage::ImageLumaA8(p) => {
+                p.pixels().map(|v| f32::from(v.0[0]) / 255.0).collect()
+            }
+            image::DynamicImage::ImageLuma16(p) => {
+                p.pixels().map(|v| f32::from(v.0[0]) / 65535.0).collect()
+            }
+            image::DynamicImage::ImageLumaA16(p) => {
+                p.pixels().map(|v| f32::from(v.0[0]) / 65535.0).collect()
+            }
+            other => {
+                return Err(Error::Invalid {
+                    context: path.display().to_string(),
+                    message: format!(
+                        "a {:?} picture; a thickness map must be greyscale (8 or 16 bits)",
+                        other.color()
+                    ),
+                });
+            }
         };
-        std::panic::catch_unwind(std::panic::AssertUnwindSafe(decode))
-            .unwrap_or_else(|_| Err(invalid("malformed PNG data (the decoder failed)".into())))
+        Ok(ThicknessMap {
+            width,
+            height,
+            values,
+        })
+    }
+
+    /// [`ThicknessMap::load`] (the name from when only PNG was read).
+    pub fn load_png(path: &Path) -> Result<ThicknessMap> {
+        ThicknessMap::load(path)
     }
 
     /// The mip chain of (g, g²) uploaded to the GPU.
