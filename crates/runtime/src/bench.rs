@@ -17,7 +17,7 @@ use crate::context::BufferInitExt;
 use crate::context::GpuContext;
 use crate::diffraction::{DiffractionOptions, DiffractionTables, ScenePass};
 use crate::error::{Error, Result};
-use crate::fullscreen;
+use crate::gpu;
 use crate::render::Light;
 use crate::shaders::{self, Technique};
 use crate::tables::TableSet;
@@ -256,7 +256,7 @@ pub fn run_bench_with_diffraction(
                 bind_group_layouts: &[Some(&view_layout), Some(table_layout)],
                 immediate_size: 0,
             });
-            fullscreen::pipeline(
+            gpu::fullscreen_pipeline(
                 device,
                 pass.name(),
                 &module,

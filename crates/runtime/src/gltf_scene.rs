@@ -42,7 +42,8 @@
 //! per wavelength) see the same three values.
 
 use crate::error::{Error, Result};
-use crate::render::{BaseKind, MaterialOptions, SceneKind, ThicknessMap, ThicknessMapping};
+use crate::render::{BaseKind, MaterialOptions, SceneKind, ThicknessMapping};
+use crate::thickness_map::ThicknessMap;
 use nacre_optics::{C64, Material};
 use std::path::{Path, PathBuf};
 
@@ -428,8 +429,10 @@ fn thickness_texture(
         .ok_or_else(|| format!("texture {index} does not exist"))?;
     let bytes: Vec<u8> = match texture.source().source() {
         gltf::image::Source::View { view, mime_type } => {
-            if mime_type != "image/png" {
-                return Err(format!("{mime_type} images are not supported (PNG only)"));
+            if mime_type != "image/png" && mime_type != "image/jpeg" {
+                return Err(format!(
+                    "{mime_type} images are not supported (PNG or JPEG only)"
+                ));
             }
             let data = buffers.get(view.buffer().index()).ok_or("missing buffer")?;
             data.get(view.offset()..view.offset().saturating_add(view.length()))
@@ -454,33 +457,29 @@ fn thickness_texture(
             }
         }
     };
-    let mut decoder = png::Decoder::new(std::io::Cursor::new(bytes));
-    decoder.set_transformations(png::Transformations::normalize_to_color8());
-    let mut reader = decoder
-        .read_info()
-        .map_err(|e| format!("not a readable PNG: {e}"))?;
-    let (width, height) = (reader.info().width, reader.info().height);
+    let picture = crate::image_io::decode_picture(path, "a thickness texture", &bytes)
+        .map_err(|e| e.to_string())?;
+    let (width, height) = (picture.width(), picture.height());
     if width == 0 || height == 0 || width.max(height) > MAX_TEXTURE_DIMENSION {
         return Err(format!(
             "{width}x{height} texels (at most {MAX_TEXTURE_DIMENSION})"
         ));
     }
-    let mut buf = vec![0u8; reader.output_buffer_size().ok_or("image too large")?];
-    let frame = reader
-        .next_frame(&mut buf)
-        .map_err(|e| format!("not a readable PNG: {e}"))?;
-    let (colour, _) = reader.output_color_type();
-    let channels = colour.samples();
-    // The green channel, or the grey of a greyscale image.
-    let green = if channels >= 3 { 1 } else { 0 };
-    let values: Vec<f32> = buf[..frame.buffer_size()]
-        .chunks_exact(channels)
-        .take((width * height) as usize)
-        .map(|px| f32::from(px[green]) / 255.0)
-        .collect();
-    if values.len() != (width * height) as usize {
-        return Err("truncated image data".into());
-    }
+    // The green channel, or the grey of a greyscale image, in 8 bits (16-bit samples keep
+    // their high byte).
+    let high = |v: u16| f32::from((v >> 8) as u8) / 255.0;
+    let byte = |v: u8| f32::from(v) / 255.0;
+    let values: Vec<f32> = match &picture {
+        image::DynamicImage::ImageLuma8(p) => p.pixels().map(|v| byte(v.0[0])).collect(),
+        image::DynamicImage::ImageLumaA8(p) => p.pixels().map(|v| byte(v.0[0])).collect(),
+        image::DynamicImage::ImageRgb8(p) => p.pixels().map(|v| byte(v.0[1])).collect(),
+        image::DynamicImage::ImageRgba8(p) => p.pixels().map(|v| byte(v.0[1])).collect(),
+        image::DynamicImage::ImageLuma16(p) => p.pixels().map(|v| high(v.0[0])).collect(),
+        image::DynamicImage::ImageLumaA16(p) => p.pixels().map(|v| high(v.0[0])).collect(),
+        image::DynamicImage::ImageRgb16(p) => p.pixels().map(|v| high(v.0[1])).collect(),
+        image::DynamicImage::ImageRgba16(p) => p.pixels().map(|v| high(v.0[1])).collect(),
+        other => other.to_rgb8().pixels().map(|v| byte(v.0[1])).collect(),
+    };
     Ok(ThicknessMap {
         width: width as usize,
         height: height as usize,

@@ -70,7 +70,8 @@
 //! cached per environment (the last one prefiltered), so that renders of one environment
 //! pay for it once.
 
-use crate::render::{EnvironmentMap, Level};
+use crate::environment::EnvironmentMap;
+use crate::image_io::Level;
 use nacre_optics::microfacet::{sample_ggx_vndf, smith_g1, smith_g2};
 use rayon::prelude::*;
 use std::f64::consts::PI;

@@ -17,16 +17,19 @@
 use crate::bindings::TechniqueBinding;
 use crate::context::BufferInitExt;
 use crate::context::GpuContext;
+use crate::environment::EnvironmentMap;
 use crate::error::{Error, Result};
 use crate::gltf_scene::{GltfScene, is_gold_like};
-use crate::readback::read_texture;
+use crate::gpu::read_texture;
+use crate::gpu::{group_layout, uniform_texture_group, upload_mips};
+use crate::image_io::RenderedImage;
 use crate::render::{
-    BaseKind, EnvironmentMap, MaterialOptions, MaterialUniform, RenderedImage, SceneOptions,
-    TARGET_FORMAT, ThicknessMap, ViewUniform, check_film_lut, group_layout, uniform_texture_group,
-    upload_mips,
+    BaseKind, MaterialOptions, MaterialUniform, SceneOptions, TARGET_FORMAT, ViewUniform,
+    check_film_lut,
 };
 use crate::shaders::{self, Technique};
 use crate::tables::TableSet;
+use crate::thickness_map::ThicknessMap;
 use bytemuck::{Pod, Zeroable};
 
 /// Depth buffer format.

@@ -155,32 +155,3 @@ impl SpectralParams {
         }
     }
 }
-
-/// The samples of `film_spectral` for `setup`: the wavelengths and weights of `nacre color
-/// --method samples:N` ([`nacre_optics::spectral::sample_weights`]) and the base's index at each.
-pub fn spectral_samples(
-    colorimeter: &nacre_optics::colour::Colorimeter,
-    setup: &crate::bindings::SpectralSetup,
-) -> crate::Result<Vec<SpectralSample>> {
-    if !(1..=4096).contains(&setup.samples) {
-        return Err(crate::Error::Invalid {
-            context: "spectral technique".into(),
-            message: format!("{} wavelengths (expected 1 to 4096)", setup.samples),
-        });
-    }
-    let (wavelengths, weights) = nacre_optics::spectral::sample_weights(colorimeter, setup.samples);
-    wavelengths
-        .iter()
-        .zip(&weights)
-        .map(|(&wl, w)| {
-            let n = setup.base.index_at(wl).map_err(crate::Error::from)?;
-            Ok(SpectralSample {
-                wavelength_nm: wl as f32,
-                base_ior: n.re as f32,
-                base_kappa: n.im as f32,
-                _pad: 0.0,
-                weight: [w[0] as f32, w[1] as f32, w[2] as f32, 0.0],
-            })
-        })
-        .collect()
-}

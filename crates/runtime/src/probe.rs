@@ -6,9 +6,9 @@ use crate::bindings::TechniqueBinding;
 use crate::context::BufferInitExt;
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
-use crate::fullscreen;
+use crate::gpu;
+use crate::gpu::read_texture;
 use crate::params::{FilmInput, FilmOutput};
-use crate::readback::read_texture;
 use crate::shaders;
 
 /// Pixels per row of the probe target (64 × 16 bytes: rows already 256-byte aligned).
@@ -79,7 +79,7 @@ pub fn run_probe(
             ],
             immediate_size: 0,
         });
-        let pipeline = fullscreen::pipeline(
+        let pipeline = gpu::fullscreen_pipeline(
             device,
             "probe",
             &module,

@@ -31,11 +31,12 @@
 //! [`ReferenceImage::mean_relative_error`] summarises it.
 
 use crate::context::GpuContext;
+use crate::environment::{EnvironmentMap, procedural_environment_with};
 use crate::error::{Error, Result};
 use crate::ibl::{env_direction_to_uv, sample_level_bilinear, tangent_frame};
+use crate::image_io::{Level, RenderedImage};
 use crate::render::{
-    Camera, EnvironmentMap, FilmEval, Level, Light, RenderOutput, RenderedImage, Renderer,
-    SceneKind, SceneOptions, ThicknessMapping, procedural_environment_with,
+    Camera, FilmEval, Light, RenderOutput, Renderer, SceneKind, SceneOptions, ThicknessMapping,
 };
 use crate::shaders::Technique;
 use crate::tables::TableSet;

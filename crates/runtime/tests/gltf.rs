@@ -386,21 +386,25 @@ fn bad_gltf_files_are_errors() {
     // A finite but absurd scale is accepted by the loader (bounds stay finite).
     let _ = GltfScene::load(&nan);
 
-    // A thickness texture nacre cannot decode (JPEG) is skipped with a note: d = d_max.
+    // A thickness texture nacre cannot decode (GIF) is skipped with a note: d = d_max.
     let textured = sweep_glb(&SWEEPS[5]);
     let json_len = u32::from_le_bytes(textured[12..16].try_into().unwrap()) as usize;
     let mut doc: serde_json::Value = serde_json::from_slice(&textured[20..20 + json_len]).unwrap();
-    doc["images"][0]["mimeType"] = "image/jpeg".into();
-    let jpeg = dir.path().join("jpeg.glb");
+    doc["images"][0]["mimeType"] = "image/gif".into();
+    let gif = dir.path().join("gif.glb");
     std::fs::write(
-        &jpeg,
+        &gif,
         nacre_runtime::gltf_assets::glb(&doc, &textured[20 + json_len + 8..]),
     )
     .unwrap();
-    let scene = GltfScene::load(&jpeg).unwrap();
+    let scene = GltfScene::load(&gif).unwrap();
     assert!(scene.thickness_maps.iter().all(Option::is_none));
     assert_eq!(scene.notes.len(), 5, "{:?}", scene.notes);
-    assert!(scene.notes[0].contains("PNG only"), "{:?}", scene.notes);
+    assert!(
+        scene.notes[0].contains("PNG or JPEG only"),
+        "{:?}",
+        scene.notes
+    );
 
     // Absurd image sizes are refused before any GPU work.
     let scene = GltfScene::load(&asset_dir().join(SWEEPS[0].file)).unwrap();

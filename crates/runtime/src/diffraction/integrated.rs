@@ -61,8 +61,8 @@
 //! ⌈(N + 1)/2⌉ layers per bin for (2R + 1)² bins per wavelength (the CD table at 5 nm:
 //! 6 × 25 × 81 = 12 150 loads).
 
+use super::common::{check_array_limits, dispatch_probe, upload_rgba32f_array};
 use crate::context::{BufferInitExt, GpuContext};
-use crate::diffraction::{check_array_limits, dispatch_probe, upload_rgba32f_array};
 use crate::error::{Error, Result};
 use crate::shaders;
 use crate::tables::verify_files;
@@ -81,17 +81,17 @@ use std::path::{Path, PathBuf};
 /// `diffraction_integrated_colour`, `diffraction_integrated_specular_colour`, with
 /// `diffraction_frame` and `diffraction_fresnel_of` from the common module.
 pub const WGSL: &str = concat!(
-    include_str!("../../../shaders/diffraction_common.wgsl"),
+    include_str!("../../../../shaders/diffraction_common.wgsl"),
     "\n",
-    include_str!("../../../shaders/diffraction_integrated.wgsl")
+    include_str!("../../../../shaders/diffraction_integrated.wgsl")
 );
 /// `shaders/diffraction_integrated_technique.wgsl`: the names a terms-technique consumer
 /// calls (`diffraction_colour`, …), defined from [`WGSL`] with F² from the uniform.
 pub const TECHNIQUE_ADAPTER: &str =
-    include_str!("../../../shaders/diffraction_integrated_technique.wgsl");
+    include_str!("../../../../shaders/diffraction_integrated_technique.wgsl");
 /// `shaders/diffraction_integrated_probe.wgsl`: the compute probe (entry point
 /// `diffraction_integrated_probe`; group 2 its buffers).
-pub const PROBE: &str = include_str!("../../../shaders/diffraction_integrated_probe.wgsl");
+pub const PROBE: &str = include_str!("../../../../shaders/diffraction_integrated_probe.wgsl");
 
 /// The probe pipeline's source: [`WGSL`] then [`PROBE`] ([`probe_composition`]'s source).
 pub fn compose_probe() -> String {

@@ -1,0 +1,267 @@
+//! What both `diffraction` layouts share: the WGSL both technique modules begin with
+//! ([`DIFFRACTION_COMMON`]), the manifest's layout ([`DiffractionLayout`]) and `diffraction`
+//! record, the upload of a table's `Rgba32Float` array texture and the compute dispatch of
+//! the GPU = CPU probes.
+
+use crate::context::{BufferInitExt, GpuContext};
+use crate::error::{Error, Result};
+use crate::shaders;
+use crate::tables::check_limit;
+use nacre_format::Manifest;
+use nacre_format::diffraction::DiffractionRecord;
+use std::path::Path;
+
+/// What both layouts share (`shaders/diffraction_common.wgsl`): `diffraction_finite`,
+/// `diffraction_unit`, `diffraction_frame`, `diffraction_fresnel_of`,
+/// `diffraction_geometry_over_w2`; no bindings. [`DIFFRACTION`] and
+/// [`super::integrated::WGSL`] each begin with it.
+pub const DIFFRACTION_COMMON: &str = include_str!("../../../../shaders/diffraction_common.wgsl");
+
+/// How a `diffraction` table stores the surface (the manifest's `layout`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DiffractionLayout {
+    /// "terms": the Taylor terms T₀ … T_N, `order` = N.
+    Terms {
+        /// N.
+        order: usize,
+    },
+    /// "integrated": the wavelength-integrated colour tables I₀ … I₂N, `order` = N
+    /// ([`super::integrated`]).
+    Integrated {
+        /// N.
+        order: usize,
+    },
+}
+
+impl DiffractionLayout {
+    /// The layout of `record`, read from the manifest at `manifest_path`.
+    ///
+    /// # Errors
+    /// [`Error::Manifest`] naming a layout the runtime does not know, or an "integrated"
+    /// record without its `integrated` part.
+    pub fn of(record: &DiffractionRecord, manifest_path: &Path) -> Result<Self> {
+        let bad = |message: String| Error::Manifest {
+            path: manifest_path.to_path_buf(),
+            message,
+        };
+        match (record.layout.as_str(), &record.integrated) {
+            ("terms", _) => Ok(DiffractionLayout::Terms {
+                order: record.taylor_order,
+            }),
+            ("integrated", Some(_)) => Ok(DiffractionLayout::Integrated {
+                order: record.taylor_order,
+            }),
+            ("integrated", None) => Err(bad(
+                "diffraction layout \"integrated\" without its `integrated` record".into(),
+            )),
+            (other, _) => Err(bad(format!(
+                "diffraction layout `{other}` has no GPU technique (the runtime samples layouts \"terms\" and \"integrated\")"
+            ))),
+        }
+    }
+
+    /// The manifest's name of the layout: "terms" or "integrated".
+    pub fn name(self) -> &'static str {
+        match self {
+            DiffractionLayout::Terms { .. } => "terms",
+            DiffractionLayout::Integrated { .. } => "integrated",
+        }
+    }
+}
+
+/// The manifest at `manifest_path` and its `diffraction` record.
+///
+/// # Errors
+/// [`Error::Manifest`] for a table of another kind or a manifest without the record.
+pub(super) fn diffraction_record(manifest_path: &Path) -> Result<(Manifest, DiffractionRecord)> {
+    let manifest = Manifest::read(manifest_path)?;
+    if manifest.kind != nacre_format::TableKind::Diffraction {
+        return Err(Error::Manifest {
+            path: manifest_path.to_path_buf(),
+            message: format!(
+                "table `{}` is a `{}` table, not a `diffraction` table",
+                manifest.name, manifest.kind
+            ),
+        });
+    }
+    let record = manifest
+        .diffraction()
+        .cloned()
+        .ok_or_else(|| Error::Manifest {
+            path: manifest_path.to_path_buf(),
+            message: "a diffraction manifest without its `diffraction` record".into(),
+        })?;
+    Ok((manifest, record))
+}
+
+/// Refuses a 2-D array texture of `[width, height, layers]` beyond the device's limits
+/// (before anything is uploaded), naming `what`.
+pub(super) fn check_array_limits(ctx: &GpuContext, what: &str, size: [usize; 3]) -> Result<()> {
+    let limits = ctx.device.limits();
+    for (axis, n, limit) in [
+        ("width", size[0], limits.max_texture_dimension_2d),
+        ("height", size[1], limits.max_texture_dimension_2d),
+        ("layers", size[2], limits.max_texture_array_layers),
+    ] {
+        check_limit(ctx, &format!("{what} {axis}"), n as u64, limit)?;
+    }
+    Ok(())
+}
+
+/// Uploads `texels` (RGBA, layer-major, rows of `width`) into a new `Rgba32Float` 2-D array
+/// texture of `[width, height, layers]` named `name`: the storage of both diffraction
+/// layouts, unfilterable and read with `textureLoad`.
+pub(super) fn upload_rgba32f_array(
+    ctx: &GpuContext,
+    name: &str,
+    [width, height, layers]: [usize; 3],
+    texels: &[f32],
+) -> Result<wgpu::Texture> {
+    ctx.checked(&format!("uploading the diffraction table `{name}`"), || {
+        let size = wgpu::Extent3d {
+            width: width as u32,
+            height: height as u32,
+            depth_or_array_layers: layers as u32,
+        };
+        let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(name),
+            size,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba32Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        ctx.queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            bytemuck::cast_slice(texels),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(width as u32 * 16),
+                rows_per_image: Some(height as u32),
+            },
+            size,
+        );
+        texture
+    })
+}
+
+/// One compute dispatch of `entry` in `source` (64 invocations per workgroup, one per
+/// case) for the probes of both layouts: group 0 empty, group 1 the technique's
+/// (`technique`: layout and bind group), group 2 binding 0 the `input` (read-only storage),
+/// binding 1 two vec4<f32> outputs per case; returns the outputs.
+///
+/// # Errors
+/// [`Error::Invalid`] for more cases than one dispatch takes; [`Error::Gpu`] or
+/// [`Error::DeviceLost`] from the device.
+pub(super) fn dispatch_probe(
+    ctx: &GpuContext,
+    source: &shaders::Composed,
+    entry: &str,
+    technique: (&wgpu::BindGroupLayout, &wgpu::BindGroup),
+    input: &[[f32; 4]],
+    cases: usize,
+) -> Result<Vec<[f32; 4]>> {
+    if cases == 0 {
+        return Ok(Vec::new());
+    }
+    let groups = u32::try_from(cases.div_ceil(64))
+        .ok()
+        .filter(|g| *g <= ctx.device.limits().max_compute_workgroups_per_dimension)
+        .ok_or_else(|| Error::Invalid {
+            context: format!("diffraction probe `{entry}`"),
+            message: format!("{cases} cases are too many for one dispatch"),
+        })?;
+    let out_bytes = (cases * 2 * 16) as u64;
+    let device = &ctx.device;
+    let module = shaders::create_module(ctx, entry, source)?;
+    let readback = ctx.checked(&format!("running the diffraction probe `{entry}`"), || {
+        let storage = |binding, read_only| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let io_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("diffraction probe io"),
+            entries: &[storage(0, true), storage(1, false)],
+        });
+        let empty = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("diffraction probe (no view)"),
+            entries: &[],
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("diffraction probe"),
+            bind_group_layouts: &[Some(&empty), Some(technique.0), Some(&io_layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(entry),
+            layout: Some(&layout),
+            module: &module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        let inputs = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("diffraction probe inputs"),
+            contents: bytemuck::cast_slice(input),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let outputs = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("diffraction probe outputs"),
+            size: out_bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("diffraction probe readback"),
+            size: out_bytes,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let empty_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("diffraction probe (no view)"),
+            layout: &empty,
+            entries: &[],
+        });
+        let io = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("diffraction probe io"),
+            layout: &io_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: inputs.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: outputs.as_entire_binding(),
+                },
+            ],
+        });
+        let mut encoder = device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&pipeline);
+            pass.set_bind_group(0, &empty_group, &[]);
+            pass.set_bind_group(1, technique.1, &[]);
+            pass.set_bind_group(2, &io, &[]);
+            pass.dispatch_workgroups(groups, 1, 1);
+        }
+        encoder.copy_buffer_to_buffer(&outputs, 0, &readback, 0, out_bytes);
+        ctx.queue.submit([encoder.finish()]);
+        readback
+    })?;
+    let bytes = crate::gpu::read_buffer(ctx, &readback, "reading the diffraction probe back")?;
+    Ok(bytemuck::pod_collect_to_vec(&bytes))
+}

@@ -1,0 +1,641 @@
+//! The ray-cast diffraction scenes of `nacre render --scene cd-disc | snake-skin`
+//! (`shaders/diffraction_scene.wgsl`) and the scene pass the GPU bench reuses ([`ScenePass`]),
+//! with a table of either layout.
+
+use super::integrated;
+use super::tables::DiffractionTables;
+use super::terms::{DiffractionBinding, DiffractionOptions, LLVMPIPE_LOOP_LIMIT, composition};
+use crate::context::{BufferInitExt, GpuContext};
+use crate::environment::EnvironmentMap;
+use crate::error::{Error, Result};
+use crate::gpu;
+use crate::gpu::read_texture;
+use crate::image_io::{Level, MAX_DIMENSION, RenderedImage};
+use crate::render::{Camera, Light};
+use crate::shaders;
+use bytemuck::{Pod, Zeroable};
+use nacre_format::diffraction::DiffractionRecord;
+use nacre_optics::diffraction::FresnelTerm;
+use std::path::PathBuf;
+use std::str::FromStr;
+
+/// Its consumers (`shaders/diffraction_scene.wgsl`): the scenes, the bench pass and the probe.
+pub const DIFFRACTION_SCENE: &str = include_str!("../../../../shaders/diffraction_scene.wgsl");
+
+/// Most environment samples of a scene (`DiffractionView.samples`).
+pub const MAX_ENV_SAMPLES: usize = 8;
+
+/// The diffraction scenes of `nacre render` (`shaders/diffraction_scene.wgsl`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum DiffractionScene {
+    /// A CD-like disc (an annulus in y = 0, radius 1) with circular tracks, seen at an angle.
+    CdDisc,
+    /// A patch of a cylinder (a snake's body) tiled with domed scales whose ridges run along
+    /// the body, rotated and fanned per scale.
+    SnakeSkin,
+}
+
+impl DiffractionScene {
+    /// Every scene.
+    pub const ALL: [DiffractionScene; 2] = [DiffractionScene::CdDisc, DiffractionScene::SnakeSkin];
+
+    /// The name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            DiffractionScene::CdDisc => "cd-disc",
+            DiffractionScene::SnakeSkin => "snake-skin",
+        }
+    }
+
+    /// The default-set table the scene uses.
+    pub fn default_table(self) -> &'static str {
+        match self {
+            DiffractionScene::CdDisc => "cd-tracks",
+            DiffractionScene::SnakeSkin => "snake-ridges",
+        }
+    }
+
+    fn id(self) -> u32 {
+        match self {
+            DiffractionScene::CdDisc => 0,
+            DiffractionScene::SnakeSkin => 1,
+        }
+    }
+
+    /// The scene's camera.
+    pub fn camera(self) -> Camera {
+        match self {
+            DiffractionScene::CdDisc => Camera {
+                eye: [0.0, 1.9, 2.2],
+                target: [0.0, -0.12, 0.0],
+                up: [0.0, 1.0, 0.0],
+                fov_y_deg: 40.0,
+            },
+            DiffractionScene::SnakeSkin => Camera {
+                eye: [0.35, 2.6, 2.3],
+                target: [0.0, 0.55, 0.0],
+                up: [0.0, 1.0, 0.0],
+                fov_y_deg: 42.0,
+            },
+        }
+    }
+
+    /// The scene's Fresnel factor: 1 for the disc (an aluminium-coated CD reflects ~90 %),
+    /// the Fresnel reflectance of keratin (n = 1.56, about 5 % at normal incidence) for the
+    /// snake's scales.
+    pub fn fresnel(self) -> FresnelTerm {
+        match self {
+            DiffractionScene::CdDisc => FresnelTerm::Unity,
+            DiffractionScene::SnakeSkin => FresnelTerm::Index(nacre_optics::C64::new(1.56, 0.0)),
+        }
+    }
+
+    /// The scene's light: a white directional light (the sun) from behind and to the left
+    /// of the camera for the disc, from above and behind for the snake.
+    pub fn light(self) -> Light {
+        match self {
+            DiffractionScene::CdDisc => Light {
+                direction: [-0.35, 0.8, -0.5],
+                colour: [1.0, 0.97, 0.92],
+                intensity: 3.0,
+            },
+            DiffractionScene::SnakeSkin => Light {
+                direction: [0.3, 0.85, -0.45],
+                colour: [1.0, 0.97, 0.92],
+                intensity: 3.0,
+            },
+        }
+    }
+}
+
+impl FromStr for DiffractionScene {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        DiffractionScene::ALL
+            .into_iter()
+            .find(|k| k.name().eq_ignore_ascii_case(s.trim()))
+            .ok_or_else(|| Error::Invalid {
+                context: format!("diffraction scene `{s}`"),
+                message: "expected cd-disc or snake-skin".into(),
+            })
+    }
+}
+
+/// Settings of a diffraction scene.
+#[derive(Clone, Debug)]
+pub struct DiffractionSceneOptions {
+    /// The scene.
+    pub scene: DiffractionScene,
+    /// Image width, pixels.
+    pub width: u32,
+    /// Image height, pixels.
+    pub height: u32,
+    /// The camera.
+    pub camera: Camera,
+    /// Equirectangular environment (OpenEXR); `None`: the default studio without its sun
+    /// (the directional light is the sun) — [`crate::render::procedural_environment_with`].
+    pub environment: Option<PathBuf>,
+    /// Environment multiplier (default 0.5: a dim room, so that the rainbows stand out).
+    pub env_intensity: f32,
+    /// Environment samples diffracted like the light (0 to [`MAX_ENV_SAMPLES`]).
+    pub env_samples: usize,
+    /// The directional light; `intensity` is its irradiance E₀ at normal incidence (the
+    /// grating sees the radiance E₀ (σ_s k₀)²/π of its mirror image, [`lobe_gain`]).
+    pub light: Light,
+    /// Exposure, EV stops.
+    pub exposure_ev: f32,
+    /// The technique's settings (default here: a 10 nm wavelength step, which an
+    /// integrated table leaves unused: [`DiffractionOptions`]).
+    pub technique: DiffractionOptions,
+}
+
+impl DiffractionSceneOptions {
+    /// The defaults of `scene`: 800 × 600, 4 environment samples, 10 nm wavelength step,
+    /// the scene's [`DiffractionScene::fresnel`].
+    pub fn new(scene: DiffractionScene) -> DiffractionSceneOptions {
+        DiffractionSceneOptions {
+            scene,
+            width: 800,
+            height: 600,
+            camera: scene.camera(),
+            environment: None,
+            env_intensity: 0.5,
+            env_samples: 4,
+            light: scene.light(),
+            exposure_ev: 0.0,
+            technique: DiffractionOptions {
+                wavelength_step_nm: Some(10.0),
+                fresnel: scene.fresnel(),
+                ..DiffractionOptions::default()
+            },
+        }
+    }
+
+    /// Checks the settings.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] naming the setting.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |context: &str, message: String| {
+            Err(Error::Invalid {
+                context: context.into(),
+                message,
+            })
+        };
+        for (what, n) in [("width", self.width), ("height", self.height)] {
+            if n == 0 || n > MAX_DIMENSION {
+                return bad(what, format!("{n} (expected 1 to {MAX_DIMENSION} pixels)"));
+            }
+        }
+        if !self.exposure_ev.is_finite() || self.exposure_ev.abs() > 64.0 {
+            return bad(
+                "exposure",
+                format!("{} (expected −64 to 64 EV)", self.exposure_ev),
+            );
+        }
+        if !(self.env_intensity.is_finite() && self.env_intensity >= 0.0) {
+            return bad(
+                "environment intensity",
+                format!("{} (expected ≥ 0)", self.env_intensity),
+            );
+        }
+        if self.env_samples > MAX_ENV_SAMPLES {
+            return bad(
+                "environment samples",
+                format!("{} (expected 0 to {MAX_ENV_SAMPLES})", self.env_samples),
+            );
+        }
+        let l = &self.light;
+        if !(l.direction.iter().chain(&l.colour).all(|x| x.is_finite())
+            && l.intensity.is_finite()
+            && l.intensity >= 0.0
+            && l.direction.iter().any(|x| *x != 0.0))
+        {
+            return bad("light", format!("{l:?} (finite, non-zero direction)"));
+        }
+        self.camera
+            .inverse_view_projection(f64::from(self.width) / f64::from(self.height))?;
+        Ok(())
+    }
+}
+
+/// Mirror of `DiffractionView` (shaders/diffraction_scene.wgsl, 400 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct DiffractionViewUniform {
+    /// Clip → world.
+    pub inv_view_proj: [[f32; 4]; 4],
+    /// Camera position.
+    pub eye: [f32; 3],
+    /// 2^EV.
+    pub exposure: f32,
+    /// Towards the light, unit.
+    pub light_direction: [f32; 3],
+    /// Light intensity.
+    pub light_intensity: f32,
+    /// Light colour.
+    pub light_colour: [f32; 3],
+    /// Environment multiplier.
+    pub env_intensity: f32,
+    /// Target size, pixels.
+    pub resolution: [f32; 2],
+    /// 0 cd-disc, 1 snake-skin, 2 bench.
+    pub scene: u32,
+    /// Environment samples used.
+    pub sample_count: u32,
+    /// Sample directions (xyz unit, w 0).
+    pub samples: [[f32; 4]; MAX_ENV_SAMPLES],
+    /// Sample radiance I_k (rgb, × env_intensity; w 0).
+    pub sample_radiance: [[f32; 4]; MAX_ENV_SAMPLES],
+    /// E₀, the light's irradiance at normal incidence.
+    pub light_irradiance: f32,
+    /// Padding.
+    pub pad: [f32; 3],
+}
+
+/// The `count` brightest texels (by luminance 0.2126 R + 0.7152 G + 0.0722 B) of the 32 × 16
+/// (or the first narrower) level of `env`'s mip chain, above the horizon (y > 0.05) and at
+/// least 25° apart, as (unit direction, irradiance L·Ω at normal incidence, Ω the texel's
+/// solid angle (2π/w)(π/h) sin θ); brightest first, ties by texel index.
+pub fn environment_samples(env: &EnvironmentMap, count: usize) -> Vec<([f32; 3], [f32; 3])> {
+    let levels = env.mip_chain();
+    let (w, h, texels): &Level<4> = levels
+        .iter()
+        .find(|(w, _, _)| *w <= 32)
+        .unwrap_or_else(|| levels.last().expect("a mip chain has a level"));
+    let mut order: Vec<(f32, usize)> = texels
+        .iter()
+        .enumerate()
+        .map(|(i, t)| (0.2126 * t[0] + 0.7152 * t[1] + 0.0722 * t[2], i))
+        .collect();
+    order.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+    let min_cos = 25f64.to_radians().cos();
+    let mut chosen: Vec<([f32; 3], [f32; 3])> = Vec::new();
+    for (lum, i) in order {
+        if chosen.len() == count || lum.is_nan() || lum <= 0.0 {
+            break;
+        }
+        let (u, v) = (
+            ((i % w) as f64 + 0.5) / *w as f64,
+            ((i / w) as f64 + 0.5) / *h as f64,
+        );
+        let d = crate::ibl::env_uv_to_direction(u, v);
+        if d[1] <= 0.05 {
+            continue;
+        }
+        let far = chosen.iter().all(|(c, _)| {
+            f64::from(c[0]) * d[0] + f64::from(c[1]) * d[1] + f64::from(c[2]) * d[2] < min_cos
+        });
+        if far {
+            let t = texels[i];
+            let theta = std::f64::consts::PI * v;
+            let omega = (std::f64::consts::TAU / *w as f64)
+                * (std::f64::consts::PI / *h as f64)
+                * theta.sin();
+            chosen.push((
+                d.map(|x| x as f32),
+                [t[0], t[1], t[2]].map(|x| (f64::from(x) * omega) as f32),
+            ));
+        }
+    }
+    chosen
+}
+
+/// Group 0 of the scene and bench passes: the view uniform, the environment and its sampler.
+struct ViewGroup {
+    layout: wgpu::BindGroupLayout,
+    group: wgpu::BindGroup,
+}
+
+fn view_group(
+    ctx: &GpuContext,
+    uniform: &DiffractionViewUniform,
+    env: &EnvironmentMap,
+) -> Result<ViewGroup> {
+    let texture = crate::gpu::upload_mips(
+        ctx,
+        "diffraction environment",
+        wgpu::TextureFormat::Rgba16Float,
+        &env.mip_chain(),
+    )?;
+    let device = &ctx.device;
+    ctx.checked("binding the diffraction view", || {
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("diffraction view"),
+            entries: &[
+                crate::gpu::uniform_entry(0),
+                crate::gpu::texture_entry(1),
+                crate::gpu::sampler_entry(2),
+            ],
+        });
+        let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("DiffractionView"),
+            contents: bytemuck::bytes_of(uniform),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let view = texture.create_view(&Default::default());
+        let sampler = crate::gpu::linear_sampler(device, "diffraction environment", false);
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("diffraction view"),
+            layout: &layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::Sampler(&sampler),
+                },
+            ],
+        });
+        ViewGroup { layout, group }
+    })
+}
+
+/// Group 1 of a scene pass: the technique of the table's layout.
+enum SceneTechnique {
+    /// Layout "terms": the table, its uniform and the spectral weights.
+    Terms(DiffractionBinding),
+    /// Layout "integrated": the table's own bind group
+    /// ([`DiffractionIntegrated::bind_group`]).
+    Integrated {
+        layout: wgpu::BindGroupLayout,
+        bind_group: wgpu::BindGroup,
+    },
+}
+
+/// The scene (or bench) pipeline with its groups 0 and 1, ready to draw.
+pub struct ScenePass {
+    pipeline: wgpu::RenderPipeline,
+    view: ViewGroup,
+    technique: SceneTechnique,
+}
+
+impl ScenePass {
+    /// Group 1 and the source for `table`: the terms technique ([`compose`]) with a
+    /// [`DiffractionBinding`], or the integrated module with the adapter
+    /// ([`integrated::compose_scene`]) and the table's own bind group.
+    fn new(
+        ctx: &GpuContext,
+        table: &DiffractionTables,
+        technique: &DiffractionOptions,
+        uniform: &DiffractionViewUniform,
+        env: &EnvironmentMap,
+    ) -> Result<ScenePass> {
+        let (technique, source) = match table {
+            DiffractionTables::Terms(t) => (
+                SceneTechnique::Terms(DiffractionBinding::new(ctx, t, technique)?),
+                composition(),
+            ),
+            DiffractionTables::Integrated(t) => {
+                let wanted = integrated::fresnel_parameters(technique.fresnel)?;
+                if wanted != (t.uniform.fresnel_kind, t.uniform.fresnel_ior) {
+                    return Err(Error::Invalid {
+                        context: format!("integrated diffraction `{}`", t.name),
+                        message: format!(
+                            "the table was loaded with another Fresnel factor than the pass's {:?} (load it with that one)",
+                            technique.fresnel
+                        ),
+                    });
+                }
+                (
+                    SceneTechnique::Integrated {
+                        layout: t.bind_group_layout().clone(),
+                        bind_group: t.bind_group().clone(),
+                    },
+                    integrated::scene_composition(),
+                )
+            }
+        };
+        let technique_layout = match &technique {
+            SceneTechnique::Terms(b) => &b.layout,
+            SceneTechnique::Integrated { layout, .. } => layout,
+        };
+        let view = view_group(ctx, uniform, env)?;
+        let device = &ctx.device;
+        let module = shaders::create_module(ctx, "diffraction scene", &source)?;
+        let pipeline = ctx.checked("building the diffraction pipeline", || {
+            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("diffraction scene"),
+                bind_group_layouts: &[Some(&view.layout), Some(technique_layout)],
+                immediate_size: 0,
+            });
+            gpu::fullscreen_pipeline(
+                device,
+                "diffraction scene",
+                &module,
+                &layout,
+                ("diffraction_vs", "diffraction_scene_fs"),
+                &[crate::render::TARGET_FORMAT],
+            )
+        })?;
+        Ok(ScenePass {
+            pipeline,
+            view,
+            technique,
+        })
+    }
+
+    /// The bench pass of `nacre bench-gpu`: every pixel of a `width × height` target shaded
+    /// with the technique of `table`'s layout (scene 2 of `shaders/diffraction_scene.wgsl`),
+    /// lit by `light`.
+    pub fn bench(
+        ctx: &GpuContext,
+        table: &DiffractionTables,
+        technique: &DiffractionOptions,
+        width: u32,
+        height: u32,
+        light: &Light,
+    ) -> Result<ScenePass> {
+        let mut uniform = DiffractionViewUniform::zeroed();
+        uniform.exposure = 1.0;
+        uniform.light_direction = unit(light.direction);
+        uniform.light_colour = light.colour;
+        uniform.light_intensity = light.intensity * lobe_gain(table.record());
+        uniform.light_irradiance = light.intensity;
+        uniform.resolution = [width as f32, height as f32];
+        uniform.scene = 2;
+        let env = EnvironmentMap {
+            width: 1,
+            height: 1,
+            rgb: vec![[0.0; 3]],
+        };
+        let pass = ScenePass::new(ctx, table, technique, &uniform, &env)?;
+        pass.check_loop_cap(ctx, 1, "bench")?;
+        Ok(pass)
+    }
+
+    /// On llvmpipe, refuses a terms-layout pass whose per-pixel loops — `diffracted` calls of
+    /// `diffraction_colour` plus the specular order — could run past
+    /// [`LLVMPIPE_LOOP_LIMIT`], which would silently cut them short. The estimate counts
+    /// the sums' own loops; llvmpipe's count runs ~20 % higher (cd-disc went wrong from 56
+    /// wavelengths on, an estimate of 54,824), so the pass is refused above three quarters of
+    /// the cap. Other adapters and integrated tables (a few dozen iterations) always pass.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] naming the way out (a coarser step, fewer samples, the fast layout).
+    pub fn check_loop_cap(&self, ctx: &GpuContext, diffracted: u64, what: &str) -> Result<()> {
+        let Some(binding) = self.technique() else {
+            return Ok(());
+        };
+        let u = &binding.uniform;
+        let specular = u64::from(u.wavelength_count) * (u64::from(u.order) + 3);
+        let needed = diffracted * binding.loop_iterations_per_colour() + specular;
+        if ctx.info.name.contains("llvmpipe") && needed > LLVMPIPE_LOOP_LIMIT * 3 / 4 {
+            return Err(Error::Invalid {
+                context: format!("the diffraction {what} pass on {}", ctx.info.name),
+                message: format!(
+                    "needs about {needed} shader loop iterations per pixel ({diffracted} diffracted lights × {} wavelengths), more than llvmpipe allows with margin (it stops every shader invocation after {LLVMPIPE_LOOP_LIMIT} and would draw a wrong picture): use a coarser --wavelength-step (--diffraction-step in bench-gpu), fewer --env-samples, or a table in the layout \"integrated\" (e.g. --tables cd-tracks-fast)",
+                    u.wavelength_count
+                ),
+            });
+        }
+        Ok(())
+    }
+
+    /// Records the draw into `pass` (a render pass on a [`crate::render::TARGET_FORMAT`] target).
+    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.view.group, &[]);
+        let technique = match &self.technique {
+            SceneTechnique::Terms(b) => &b.bind_group,
+            SceneTechnique::Integrated { bind_group, .. } => bind_group,
+        };
+        pass.set_bind_group(1, technique, &[]);
+        pass.draw(0..3, 0..1);
+    }
+
+    /// The terms technique's bind group (uniform, spectrum) as built; `None` for an
+    /// integrated table (its group 1 is the table's own).
+    pub fn technique(&self) -> Option<&DiffractionBinding> {
+        match &self.technique {
+            SceneTechnique::Terms(b) => Some(b),
+            SceneTechnique::Integrated { .. } => None,
+        }
+    }
+}
+
+/// Reference wavelength of [`lobe_gain`], nm.
+pub const LOBE_REFERENCE_NM: f64 = 555.0;
+
+/// (σ_s k₀)²/π at k₀ = 2π/[`LOBE_REFERENCE_NM`]: the radiance, per unit irradiance at normal
+/// incidence, of a light's mirror image spread over the coherence lobe. A flat mirror's
+/// |P̃|² = exp(−σ_s² k² |Δ(u, v)|²) integrates to π/(σ_s k)² over (u, v), so a source of
+/// irradiance E seen in a surface of relative reflectance ρ has radiance
+/// ρ · E · (σ_s k)²/π (the k² of Stam's BRDF); the scenes take k at 555 nm for every
+/// wavelength (the lobe's wavelength dependence, a factor (555/λ)², is left out).
+pub fn lobe_gain(record: &DiffractionRecord) -> f32 {
+    let k0 = std::f64::consts::TAU / (LOBE_REFERENCE_NM * 1e-3);
+    ((record.sigma_s_um * k0).powi(2) / std::f64::consts::PI) as f32
+}
+
+fn unit(v: [f32; 3]) -> [f32; 3] {
+    let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    if l > 0.0 && l.is_finite() {
+        v.map(|x| x / l)
+    } else {
+        [0.0, 1.0, 0.0]
+    }
+}
+
+/// Renders a diffraction scene with `table` (either layout) and reads it back as
+/// sRGB-encoded RGBA8.
+///
+/// # Errors
+/// [`Error::Invalid`] for bad options (and an integrated table loaded with another F² than
+/// `options.technique.fresnel`); environment and GPU errors as [`crate::render`].
+pub fn render_diffraction_scene(
+    ctx: &GpuContext,
+    table: &DiffractionTables,
+    options: &DiffractionSceneOptions,
+) -> Result<RenderedImage> {
+    options.validate()?;
+    let env = match &options.environment {
+        Some(path) => EnvironmentMap::load(path)?,
+        None => {
+            let (w, h) = crate::environment::DEFAULT_ENVIRONMENT_SIZE;
+            crate::environment::procedural_environment_with(w, h, false)
+        }
+    };
+    let (width, height) = (options.width, options.height);
+    let mut uniform = DiffractionViewUniform::zeroed();
+    uniform.inv_view_proj = options
+        .camera
+        .inverse_view_projection(f64::from(width) / f64::from(height))?;
+    uniform.eye = options.camera.eye;
+    uniform.exposure = 2f32.powf(options.exposure_ev);
+    let gain = lobe_gain(table.record());
+    uniform.light_direction = unit(options.light.direction);
+    uniform.light_colour = options.light.colour;
+    uniform.light_intensity = options.light.intensity * gain;
+    uniform.light_irradiance = options.light.intensity;
+    uniform.env_intensity = options.env_intensity;
+    uniform.resolution = [width as f32, height as f32];
+    uniform.scene = options.scene.id();
+    let samples = environment_samples(&env, options.env_samples);
+    uniform.sample_count = samples.len() as u32;
+    for (k, (d, l)) in samples.iter().enumerate() {
+        uniform.samples[k] = [d[0], d[1], d[2], 0.0];
+        uniform.sample_radiance[k] =
+            [l[0], l[1], l[2], 0.0].map(|x| x * options.env_intensity * gain);
+    }
+    let pass = ScenePass::new(ctx, table, &options.technique, &uniform, &env)?;
+    // The light and every environment sample are diffracted.
+    pass.check_loop_cap(ctx, 1 + samples.len() as u64, options.scene.name())?;
+    let device = &ctx.device;
+    let target = ctx.checked("creating the diffraction target", || {
+        device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("diffraction scene"),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: crate::render::TARGET_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        })
+    })?;
+    let target_view = target.create_view(&Default::default());
+    let start = std::time::Instant::now();
+    ctx.checked("drawing the diffraction scene", || {
+        let mut encoder = device.create_command_encoder(&Default::default());
+        {
+            let mut rp = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("diffraction scene"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &target_view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.draw(&mut rp);
+        }
+        ctx.queue.submit([encoder.finish()]);
+    })?;
+    ctx.wait("rendering the diffraction scene")?;
+    let gpu_seconds = start.elapsed().as_secs_f64();
+    let pixels = read_texture(ctx, &target, 4)?;
+    Ok(RenderedImage {
+        width,
+        height,
+        pixels,
+        gpu_seconds,
+    })
+}

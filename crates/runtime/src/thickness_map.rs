@@ -1,0 +1,142 @@
+//! The thickness map: a greyscale image g ∈ [0, 1] that the material maps to the film
+//! thickness ([`crate::render::ThicknessMapping`]), read from a PNG or JPEG file or computed
+//! ([`procedural_thickness_map`]); uploaded as (g, g²) with its mip chain.
+
+use crate::error::{Error, Result};
+use crate::image_io::{Level, decode_picture, mip_chain};
+use std::path::Path;
+
+/// Size of the built-in thickness map, texels (square).
+pub const DEFAULT_THICKNESS_MAP_SIZE: usize = 256;
+
+/// A greyscale thickness map: values g ∈ [0, 1], row-major, top row first. Values are data,
+/// not colours: a PNG's gamma or sRGB chunks are ignored.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ThicknessMap {
+    /// Width, texels.
+    pub width: usize,
+    /// Height, texels.
+    pub height: usize,
+    /// `width × height` values in [0, 1].
+    pub values: Vec<f32>,
+}
+
+impl ThicknessMap {
+    /// Reads an 8- or 16-bit greyscale picture, PNG or JPEG (grey + alpha too: alpha
+    /// ignored; 1-, 2- and 4-bit greyscale PNGs are expanded to 8 bits), g = value /
+    /// (2^bits − 1).
+    ///
+    /// # Errors
+    /// [`Error::Io`] when the file cannot be read; [`Error::Invalid`] when it is not a valid
+    /// PNG or JPEG, not greyscale, or a side is 0 or larger than
+    /// [`crate::image_io::MAX_DIMENSION`] (checked before the pixels are decoded).
+    pub fn load(path: &Path) -> Result<ThicknessMap> {
+        let bytes = std::fs::read(path).map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let picture = decode_picture(path, "a thickness map", &bytes)?;
+        let (width, height) = (picture.width() as usize, picture.height() as usize);
+        let values: Vec<f32> = match picture {
+            image::DynamicImage::ImageLuma8(p) => {
+                p.pixels().map(|v| f32::from(v.0[0]) / 255.0).collect()
+            }
+            image::DynamicImage::ImageLumaA8(p) => {
+                p.pixels().map(|v| f32::from(v.0[0]) / 255.0).collect()
+            }
+            image::DynamicImage::ImageLuma16(p) => {
+                p.pixels().map(|v| f32::from(v.0[0]) / 65535.0).collect()
+            }
+            image::DynamicImage::ImageLumaA16(p) => {
+                p.pixels().map(|v| f32::from(v.0[0]) / 65535.0).collect()
+            }
+            other => {
+                return Err(Error::Invalid {
+                    context: path.display().to_string(),
+                    message: format!(
+                        "a {:?} picture; a thickness map must be greyscale (8 or 16 bits)",
+                        other.color()
+                    ),
+                });
+            }
+        };
+        Ok(ThicknessMap {
+            width,
+            height,
+            values,
+        })
+    }
+
+    /// [`ThicknessMap::load`] (the name from when only PNG was read).
+    pub fn load_png(path: &Path) -> Result<ThicknessMap> {
+        ThicknessMap::load(path)
+    }
+
+    /// The mip chain of (g, g²) uploaded to the GPU.
+    pub fn mip_chain(&self) -> Vec<Level<2>> {
+        let texels = self
+            .values
+            .iter()
+            .map(|&g| {
+                let g = if g.is_finite() {
+                    g.clamp(0.0, 1.0)
+                } else {
+                    0.5
+                };
+                [g, g * g]
+            })
+            .collect();
+        mip_chain(self.width, self.height, texels)
+    }
+}
+
+/// The built-in thickness map: `size` × `size` marbled swirls, tileable (every term is
+/// periodic with period 1 in both coordinates), normalised to span [0, 1].
+///
+/// g(x, y) = ½ + ½ Σ_k a_k sin(2π(m_k u + n_k v) + φ_k) after three rounds of domain warping
+/// (u, v) ← (u, v) + A sin(2π(integer frequencies) + phase).
+pub fn procedural_thickness_map(size: usize) -> ThicknessMap {
+    use std::f64::consts::TAU;
+    let size = size.max(1);
+    // Warps: amplitude; integer frequencies (x, y) and phase of the u displacement; of the v one.
+    type Warp = (f64, [f64; 2], f64, [f64; 2], f64);
+    let warps: [Warp; 3] = [
+        (0.12, [1.0, 2.0], 0.3, [2.0, -1.0], 1.7),
+        (0.07, [3.0, -2.0], 2.1, [-1.0, 3.0], 0.4),
+        (0.035, [4.0, 5.0], 4.0, [5.0, -3.0], 2.9),
+    ];
+    let waves: [(f64, [f64; 2], f64); 4] = [
+        (0.55, [2.0, 1.0], 0.0),
+        (0.35, [-1.0, 3.0], 1.0),
+        (0.2, [4.0, -2.0], 2.2),
+        (0.1, [5.0, 6.0], 0.7),
+    ];
+    let mut raw = Vec::with_capacity(size * size);
+    for j in 0..size {
+        for i in 0..size {
+            let (mut u, mut v) = (
+                (i as f64 + 0.5) / size as f64,
+                (j as f64 + 0.5) / size as f64,
+            );
+            for &(a, fu, pu, fv, pv) in &warps {
+                let du = a * (TAU * (fu[0] * u + fu[1] * v) + pu).sin();
+                let dv = a * (TAU * (fv[0] * u + fv[1] * v) + pv).sin();
+                u += du;
+                v += dv;
+            }
+            let g: f64 = waves
+                .iter()
+                .map(|&(a, f, p)| a * (TAU * (f[0] * u + f[1] * v) + p).sin())
+                .sum();
+            raw.push(g);
+        }
+    }
+    let lo = raw.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = raw.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let span = (hi - lo).max(1e-12);
+    ThicknessMap {
+        width: size,
+        height: size,
+        values: raw.iter().map(|&g| ((g - lo) / span) as f32).collect(),
+    }
+}
