@@ -56,6 +56,7 @@
 //! [`crate::kinds::diffraction_integrated`].
 
 use crate::error::{Error, Result};
+pub use crate::kinds::diffraction_recipe::DiffractionRecipe;
 use crate::kinds::{KindEntry, TableRecipe};
 use crate::recipe::{RawColour, line_of, parse_colour, table_name, toml_error};
 use nacre_format::diffraction::{DiffractionRecord, SIGN_CONVENTION};
@@ -557,29 +558,6 @@ struct RawDiffractionRecipe {
     colour: Option<toml::Value>,
     height_field: Spanned<RawHeightField>,
     diffraction: Option<RawDiffraction>,
-}
-
-/// A parsed `diffraction` recipe (module docs).
-pub struct DiffractionRecipe {
-    /// Table name.
-    pub name: String,
-    /// Recipe file.
-    pub path: PathBuf,
-    /// Recipe text.
-    pub text: String,
-    /// Description.
-    pub description: String,
-    /// Colour settings.
-    pub colorimeter: Colorimeter,
-    /// The height field, as written.
-    pub source_text: String,
-    /// The height field (generated or read and checked at parse time).
-    pub field: HeightField,
-    /// The Taylor order, bound and checks, as recorded (layout "integrated": the
-    /// measured error is filled in by the bake).
-    pub record: DiffractionRecord,
-    /// The wavelength grid of the colour sums, nm.
-    pub wavelengths_nm: Vec<f64>,
 }
 
 impl DiffractionRecipe {

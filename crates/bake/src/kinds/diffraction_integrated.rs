@@ -60,7 +60,7 @@
 //! of one index at the half-vector angle.
 
 use crate::error::{Error, Result};
-use crate::kinds::diffraction::DiffractionRecipe;
+use crate::kinds::diffraction_recipe::DiffractionRecipe;
 use nacre_format::diffraction::{
     DiffractionRecord, ERROR_METRIC, IntegratedRecord, MAX_INTEGRATED_BYTES,
 };

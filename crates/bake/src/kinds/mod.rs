@@ -8,6 +8,7 @@
 
 pub mod diffraction;
 pub mod diffraction_integrated;
+pub mod diffraction_recipe;
 pub mod film_lut;
 pub mod fourier;
 pub mod rough_film_lut;
