@@ -12,6 +12,16 @@ fn nacre(args: &[&str], dir: &Path) -> Output {
         .expect("run nacre")
 }
 
+/// The data rows (after the header) of CSV output as numbers, read as CSV.
+fn csv_numbers(text: &str) -> Vec<Vec<f64>> {
+    nacre_optics::csv_rows::rows("output", text)
+        .unwrap()
+        .into_iter()
+        .skip(1)
+        .map(|r| r.fields.iter().map(|x| x.parse().unwrap()).collect())
+        .collect()
+}
+
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
@@ -22,14 +32,11 @@ fn default_spectrum_to_stdout() {
     let o = nacre(&["spectrum"], dir.path());
     assert!(o.status.success(), "{}", stderr(&o));
     let text = String::from_utf8(o.stdout).unwrap();
-    let mut lines = text.lines();
     assert_eq!(
-        lines.next(),
+        text.lines().next(),
         Some("angle_deg,wavelength_nm,R_s,R_p,R,T_s,T_p,T,A")
     );
-    let rows: Vec<Vec<f64>> = lines
-        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
-        .collect();
+    let rows = csv_numbers(&text);
     assert_eq!(rows.len(), 90 * 81);
     assert_eq!((rows[0][0], rows[0][1]), (0.0, 380.0));
     assert_eq!((rows[81][0], rows[81][1]), (1.0, 380.0));
@@ -216,11 +223,7 @@ fn color_methods_and_info() {
             .unwrap();
         assert!(o.status.success(), "{method}: {}", stderr(&o));
         let text = std::fs::read_to_string(d.join("c.csv")).unwrap();
-        let rows: Vec<Vec<f64>> = text
-            .lines()
-            .skip(1)
-            .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
-            .collect();
+        let rows = csv_numbers(&text);
         assert_eq!(rows.len(), 2, "{method}");
         assert_eq!((rows[1][0], rows[1][1], rows[1][2]), (45.0, 250.5, 1.4));
         assert!(rows.iter().all(|r| r[3..].iter().all(|v| v.is_finite())));
@@ -800,14 +803,11 @@ fn color_rough_methods() {
     };
     let rows = |o: &Output| -> Vec<Vec<f64>> {
         let text = String::from_utf8(o.stdout.clone()).unwrap();
-        let mut lines = text.lines();
         assert_eq!(
-            lines.next(),
+            text.lines().next(),
             Some("angle_deg,thickness_nm,film_ior,X,Y,Z,R,G,B")
         );
-        lines
-            .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
-            .collect()
+        csv_numbers(&text)
     };
     for quantity in ["r", "t"] {
         let lut = run(&[

@@ -18,10 +18,12 @@ fn stderr(o: &Output) -> String {
 
 fn rows(o: &Output) -> (String, Vec<Vec<f64>>) {
     let text = String::from_utf8(o.stdout.clone()).unwrap();
-    let mut lines = text.lines();
-    let header = lines.next().unwrap().to_string();
-    let rows = lines
-        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+    let header = text.lines().next().unwrap().to_string();
+    let rows = nacre_optics::csv_rows::rows("stdout", &text)
+        .unwrap()
+        .into_iter()
+        .skip(1)
+        .map(|r| r.fields.iter().map(|x| x.parse().unwrap()).collect())
         .collect();
     (header, rows)
 }

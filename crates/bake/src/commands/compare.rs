@@ -189,17 +189,23 @@ pub fn write_csv(
     results: &[MethodResult],
 ) -> Result<()> {
     Ok(write_atomic(path, |w| {
-        writeln!(w, "method,angle_deg,thickness_nm,delta_e_2000")?;
+        let mut csv = crate::csv_text::writer(w);
+        csv.write_record(["method", "angle_deg", "thickness_nm", "delta_e_2000"])?;
         for r in results {
             let mut it = r.delta_e.iter();
             for &a in angles_deg {
                 for &d in thicknesses_nm {
                     let de = it.next().expect("one value per point");
-                    writeln!(w, "{},{a},{d},{de:.6}", r.label)?;
+                    csv.write_record([
+                        r.label.to_string(),
+                        a.to_string(),
+                        d.to_string(),
+                        format!("{de:.6}"),
+                    ])?;
                 }
             }
         }
-        Ok(())
+        csv.flush()
     })?)
 }
 

@@ -433,7 +433,9 @@ fn decode_exr(path: &Path, bytes: &[u8]) -> Result<(usize, usize, Vec<f64>)> {
     })
 }
 
-/// CSV: rows of comma-separated numbers (row 0 = y = 0), `#` comments, blank lines skipped.
+/// CSV: rows of comma-separated numbers (row 0 = y = 0); `#` comments (whole lines, or
+/// the end of a row), blank lines, quoted fields, a UTF-8 BOM, CRLF and spaces around
+/// fields are accepted (see [`nacre_optics::csv_rows`]).
 fn decode_csv(path: &Path, bytes: &[u8]) -> Result<(usize, usize, Vec<f64>)> {
     let bad = |line: usize, message: String| Error::Recipe {
         path: path.to_path_buf(),
@@ -443,16 +445,19 @@ fn decode_csv(path: &Path, bytes: &[u8]) -> Result<(usize, usize, Vec<f64>)> {
     let text = std::str::from_utf8(bytes).map_err(|e| bad(1, format!("not UTF-8 text: {e}")))?;
     let mut values = Vec::new();
     let (mut nx, mut ny) = (0, 0);
-    for (i, line) in text.lines().enumerate() {
-        let line_no = i + 1;
-        let content = line.split('#').next().unwrap_or("").trim();
-        if content.is_empty() {
-            continue;
+    for row in crate::csv_text::rows(path, text) {
+        let row = row?;
+        let line_no = row.line;
+        let mut fields = row.fields;
+        // A `#` ends the row: the rest of the line is a comment.
+        if let Some(k) = fields.iter().position(|f| f.contains('#')) {
+            fields.truncate(k + 1);
+            let kept = fields[k].split('#').next().unwrap_or("").trim().to_string();
+            fields[k] = kept;
         }
-        let row: Vec<f64> = content
-            .split(',')
+        let row: Vec<f64> = fields
+            .iter()
             .map(|c| {
-                let c = c.trim();
                 c.parse::<f64>()
                     .ok()
                     .filter(|v| v.is_finite())
@@ -1470,6 +1475,24 @@ mod tests {
         std::fs::write(&p, "0,x\n").unwrap();
         let e = read_height_field(&p, 0.1, 1.0).unwrap_err().to_string();
         assert!(e.contains("h.csv:1:") && e.contains("`x`"), "{e}");
+    }
+
+    #[test]
+    fn csv_height_fields_accept_csv_conventions() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("h.csv");
+        // BOM, CRLF, comment and blank lines, quoted fields, spaces, a comment after a row.
+        std::fs::write(
+            &p,
+            "\u{feff}# heights\r\n\r\n 0 , \"1\" ,2\r\n# between\r\n\"3\",4, 5 # last row\r\n",
+        )
+        .unwrap();
+        let f = read_height_field(&p, 0.1, 2.0).unwrap();
+        assert_eq!((f.nx(), f.ny()), (3, 2));
+        assert_eq!(f.mean_removed_um(), 5.0);
+        std::fs::write(&p, "# a\r\n\r\n0,1,2\r\n# b\r\n3,4\r\n").unwrap();
+        let e = read_height_field(&p, 0.1, 1.0).unwrap_err().to_string();
+        assert!(e.contains("h.csv:5:"), "{e}");
     }
 
     #[test]
