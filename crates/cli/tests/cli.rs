@@ -503,13 +503,9 @@ fn render_bad_input_exits_2_without_output() {
     std::fs::write(d.join("junk.exr"), b"not an OpenEXR file").unwrap();
     std::fs::write(d.join("junk.png"), b"not a PNG file").unwrap();
     // A valid 2x2 8-bit RGB PNG: colour, not a greyscale thickness map.
-    const RGB_PNG: [u8; 73] = [
-        137, 80, 78, 71, 13, 10, 26, 10, 0, 0, 0, 13, 73, 72, 68, 82, 0, 0, 0, 2, 0, 0, 0, 2, 8, 2,
-        0, 0, 0, 253, 212, 154, 115, 0, 0, 0, 16, 73, 68, 65, 84, 120, 156, 99, 104, 112, 80, 0,
-        34, 6, 8, 5, 0, 26, 14, 3, 129, 156, 14, 57, 199, 0, 0, 0, 0, 73, 69, 78, 68, 174, 66, 96,
-        130,
-    ];
-    std::fs::write(d.join("rgb.png"), RGB_PNG).unwrap();
+    image::RgbImage::from_pixel(2, 2, image::Rgb([200, 100, 50]))
+        .save(d.join("rgb.png"))
+        .unwrap();
     let small = ["--width", "16", "--height", "12"];
     let cases: &[(&[&str], &str)] = &[
         (&["--scene", "cube"], "--scene"),

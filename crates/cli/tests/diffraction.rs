@@ -360,9 +360,8 @@ fn diffraction_map_png() {
     );
     assert!(o.status.success(), "{}", stderr(&o));
     let bytes = std::fs::read(dir.path().join("map.png")).unwrap();
-    let decoder = png::Decoder::new(std::io::Cursor::new(bytes));
-    let reader = decoder.read_info().unwrap();
-    assert_eq!((reader.info().width, reader.info().height), (760, 800));
+    let map = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png).unwrap();
+    assert_eq!((map.width(), map.height()), (760, 800));
     for (args, needle) in [
         (&["sine:1.6:0.05", "-o", "map.jpg"][..], "-o/--output"),
         (

@@ -311,13 +311,13 @@ pub fn write_png(
         root.present().map_err(|e| draw_err(e.to_string()))?;
     }
     Ok(write_atomic(path, |out| {
-        let mut enc = png::Encoder::new(out, w, h);
-        enc.set_color(png::ColorType::Rgb);
-        enc.set_depth(png::BitDepth::Eight);
-        let mut writer = enc.write_header().map_err(std::io::Error::other)?;
-        writer
-            .write_image_data(&buf)
-            .map_err(std::io::Error::other)?;
-        writer.finish().map_err(std::io::Error::other)
+        use image::ImageEncoder;
+        image::codecs::png::PngEncoder::new_with_quality(
+            out,
+            image::codecs::png::CompressionType::Default,
+            image::codecs::png::FilterType::Adaptive,
+        )
+        .write_image(&buf, w, h, image::ExtendedColorType::Rgb8)
+        .map_err(std::io::Error::other)
     })?)
 }

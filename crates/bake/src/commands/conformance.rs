@@ -496,14 +496,14 @@ impl Conformance {
         }
         let mut png_bytes = Vec::new();
         {
-            let mut enc = png::Encoder::new(&mut png_bytes, w, h);
-            enc.set_color(png::ColorType::Rgb);
-            enc.set_depth(png::BitDepth::Eight);
-            let mut writer = enc.write_header().map_err(|e| draw_err(e.to_string()))?;
-            writer
-                .write_image_data(&buf)
-                .map_err(|e| draw_err(e.to_string()))?;
-            writer.finish().map_err(|e| draw_err(e.to_string()))?;
+            use image::ImageEncoder;
+            image::codecs::png::PngEncoder::new_with_quality(
+                &mut png_bytes,
+                image::codecs::png::CompressionType::Default,
+                image::codecs::png::FilterType::Adaptive,
+            )
+            .write_image(&buf, w, h, image::ExtendedColorType::Rgb8)
+            .map_err(|e| draw_err(e.to_string()))?;
         }
         Ok(png_bytes)
     }

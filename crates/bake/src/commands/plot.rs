@@ -144,14 +144,16 @@ pub fn render(figure: &impl Figure, format: ImageFormat) -> Result<Vec<u8>> {
                 root.present().map_err(|e| err(e.to_string()))?;
             }
             let mut out = Vec::new();
-            let mut enc = png::Encoder::new(&mut out, w, h);
-            enc.set_color(png::ColorType::Rgb);
-            enc.set_depth(png::BitDepth::Eight);
-            let mut writer = enc.write_header().map_err(|e| err(e.to_string()))?;
-            writer
-                .write_image_data(&buf)
+            {
+                use image::ImageEncoder;
+                image::codecs::png::PngEncoder::new_with_quality(
+                    &mut out,
+                    image::codecs::png::CompressionType::Default,
+                    image::codecs::png::FilterType::Adaptive,
+                )
+                .write_image(&buf, w, h, image::ExtendedColorType::Rgb8)
                 .map_err(|e| err(e.to_string()))?;
-            writer.finish().map_err(|e| err(e.to_string()))?;
+            }
             Ok(out)
         }
         ImageFormat::Svg => {
