@@ -55,17 +55,25 @@ fn spec(case: &Case) -> StackSpec {
 /// Rows of (angle, wavelength, R_s, R_p, T_s, T_p).
 fn read_golden(path: &Path) -> Vec<[f64; 6]> {
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
+    let rows = nacre_optics::csv_rows::rows(&path.display().to_string(), &text)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let mut rows = rows.into_iter();
     assert_eq!(
-        lines.next(),
+        rows.next().map(|r| r.text()).as_deref(),
         Some("angle_deg,wavelength_nm,R_s,R_p,T_s,T_p")
     );
-    lines
-        .map(|l| {
-            let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
-            v.try_into().unwrap()
-        })
-        .collect()
+    rows.map(|r| {
+        let v: Vec<f64> = r
+            .fields
+            .iter()
+            .map(|x| {
+                x.parse()
+                    .unwrap_or_else(|e| panic!("{}:{}: {e}", path.display(), r.line))
+            })
+            .collect();
+        v.try_into().unwrap()
+    })
+    .collect()
 }
 
 #[test]

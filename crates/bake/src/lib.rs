@@ -15,6 +15,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod commands;
+mod csv_text;
 pub mod error;
 pub mod kinds;
 pub mod recipe;

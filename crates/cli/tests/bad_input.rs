@@ -490,12 +490,13 @@ fn fixtures(d: &Path) -> Vec<Case> {
     // Render inputs: environment maps, thickness maps and glTF files.
     let mut png = Vec::new();
     {
-        let mut encoder = png::Encoder::new(&mut png, 16, 16);
-        encoder.set_color(png::ColorType::Grayscale);
-        encoder.set_depth(png::BitDepth::Sixteen);
-        let mut w = encoder.write_header().unwrap();
-        let pixels: Vec<u8> = (0..512).map(|i| (i * 37 % 251) as u8).collect();
-        w.write_image_data(&pixels).unwrap();
+        let pixels: Vec<u16> = (0..256)
+            .map(|i| u16::from_be_bytes([(2 * i * 37 % 251) as u8, ((2 * i + 1) * 37 % 251) as u8]))
+            .collect();
+        image::ImageBuffer::<image::Luma<u16>, _>::from_raw(16, 16, pixels)
+            .unwrap()
+            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+            .unwrap();
     }
     write(&d.join("g/truncated16.png"), &png[..png.len() - 20]);
     write(&d.join("g/truncated.exr"), &exr[..exr.len() - 40]);

@@ -12,6 +12,16 @@ fn nacre(args: &[&str], dir: &Path) -> Output {
         .expect("run nacre")
 }
 
+/// The data rows (after the header) of CSV output as numbers, read as CSV.
+fn csv_numbers(text: &str) -> Vec<Vec<f64>> {
+    nacre_optics::csv_rows::rows("output", text)
+        .unwrap()
+        .into_iter()
+        .skip(1)
+        .map(|r| r.fields.iter().map(|x| x.parse().unwrap()).collect())
+        .collect()
+}
+
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
@@ -22,14 +32,11 @@ fn default_spectrum_to_stdout() {
     let o = nacre(&["spectrum"], dir.path());
     assert!(o.status.success(), "{}", stderr(&o));
     let text = String::from_utf8(o.stdout).unwrap();
-    let mut lines = text.lines();
     assert_eq!(
-        lines.next(),
+        text.lines().next(),
         Some("angle_deg,wavelength_nm,R_s,R_p,R,T_s,T_p,T,A")
     );
-    let rows: Vec<Vec<f64>> = lines
-        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
-        .collect();
+    let rows = csv_numbers(&text);
     assert_eq!(rows.len(), 90 * 81);
     assert_eq!((rows[0][0], rows[0][1]), (0.0, 380.0));
     assert_eq!((rows[81][0], rows[81][1]), (1.0, 380.0));
@@ -216,11 +223,7 @@ fn color_methods_and_info() {
             .unwrap();
         assert!(o.status.success(), "{method}: {}", stderr(&o));
         let text = std::fs::read_to_string(d.join("c.csv")).unwrap();
-        let rows: Vec<Vec<f64>> = text
-            .lines()
-            .skip(1)
-            .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
-            .collect();
+        let rows = csv_numbers(&text);
         assert_eq!(rows.len(), 2, "{method}");
         assert_eq!((rows[1][0], rows[1][1], rows[1][2]), (45.0, 250.5, 1.4));
         assert!(rows.iter().all(|r| r[3..].iter().all(|v| v.is_finite())));
@@ -500,13 +503,9 @@ fn render_bad_input_exits_2_without_output() {
     std::fs::write(d.join("junk.exr"), b"not an OpenEXR file").unwrap();
     std::fs::write(d.join("junk.png"), b"not a PNG file").unwrap();
     // A valid 2x2 8-bit RGB PNG: colour, not a greyscale thickness map.
-    const RGB_PNG: [u8; 73] = [
-        137, 80, 78, 71, 13, 10, 26, 10, 0, 0, 0, 13, 73, 72, 68, 82, 0, 0, 0, 2, 0, 0, 0, 2, 8, 2,
-        0, 0, 0, 253, 212, 154, 115, 0, 0, 0, 16, 73, 68, 65, 84, 120, 156, 99, 104, 112, 80, 0,
-        34, 6, 8, 5, 0, 26, 14, 3, 129, 156, 14, 57, 199, 0, 0, 0, 0, 73, 69, 78, 68, 174, 66, 96,
-        130,
-    ];
-    std::fs::write(d.join("rgb.png"), RGB_PNG).unwrap();
+    image::RgbImage::from_pixel(2, 2, image::Rgb([200, 100, 50]))
+        .save(d.join("rgb.png"))
+        .unwrap();
     let small = ["--width", "16", "--height", "12"];
     let cases: &[(&[&str], &str)] = &[
         (&["--scene", "cube"], "--scene"),
@@ -800,14 +799,11 @@ fn color_rough_methods() {
     };
     let rows = |o: &Output| -> Vec<Vec<f64>> {
         let text = String::from_utf8(o.stdout.clone()).unwrap();
-        let mut lines = text.lines();
         assert_eq!(
-            lines.next(),
+            text.lines().next(),
             Some("angle_deg,thickness_nm,film_ior,X,Y,Z,R,G,B")
         );
-        lines
-            .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
-            .collect()
+        csv_numbers(&text)
     };
     for quantity in ["r", "t"] {
         let lut = run(&[

@@ -36,12 +36,21 @@ fn files(dir: &Path) -> Vec<String> {
     v
 }
 
+/// The rows of a CSV text, header included, read as CSV.
+fn csv_rows(text: &str) -> Vec<Vec<String>> {
+    nacre_optics::csv_rows::rows("output", text)
+        .unwrap()
+        .into_iter()
+        .map(|r| r.fields)
+        .collect()
+}
+
 /// Rows of a CSV keyed by their first four fields (base, angle, thickness, film index).
 fn rows_by_point(text: &str) -> HashMap<String, Vec<f64>> {
-    text.lines()
+    csv_rows(text)
+        .into_iter()
         .skip(1)
-        .map(|l| {
-            let f: Vec<&str> = l.split(',').collect();
+        .map(|f| {
             let key = f[..4].join(",");
             let values = f[4..].iter().map(|x| x.parse::<f64>().unwrap()).collect();
             (key, values)
@@ -57,16 +66,15 @@ fn quick_grid_is_well_formed_and_agrees_with_nacre_color() {
     let out = dir.path().join("out");
 
     let csv = std::fs::read_to_string(out.join("conformance.csv")).unwrap();
-    let mut lines = csv.lines();
     assert_eq!(
-        lines.next(),
+        csv.lines().next(),
         Some("base_ior,angle_deg,thickness_nm,film_ior,X,Y,Z,R,G,B")
     );
     let mut count = 0;
-    for line in lines {
-        let f: Vec<&str> = line.split(',').collect();
+    for f in csv_rows(&csv).into_iter().skip(1) {
+        let line = f.join(",");
         assert_eq!(f.len(), 10, "{line}");
-        assert!(BASES.contains(&f[0]), "{line}");
+        assert!(BASES.contains(&f[0].as_str()), "{line}");
         let v: Vec<f64> = f[1..].iter().map(|x| x.parse().unwrap()).collect();
         assert!(v.iter().all(|x| x.is_finite()), "{line}");
         let (angle, d, n) = (v[0], v[1], v[2]);
@@ -77,7 +85,7 @@ fn quick_grid_is_well_formed_and_agrees_with_nacre_color() {
         assert!((1.0..=2.333).contains(&n), "{line}");
         // A reflectance colour: 0 ≤ Y ≤ 1; at least 8 significant digits.
         assert!((0.0..=1.0).contains(&v[4]), "{line}");
-        let y = f[5];
+        let y = &f[5];
         assert!(
             v[4] == 0.0 || y.trim_start_matches("0.").len() >= 8,
             "{line}"
@@ -122,11 +130,8 @@ fn quick_grid_is_well_formed_and_agrees_with_nacre_color() {
             );
             assert!(o.status.success(), "{}", stderr(&o));
             let text = String::from_utf8(o.stdout).unwrap();
-            let row: Vec<f64> = text
-                .lines()
-                .nth(1)
-                .unwrap()
-                .split(',')
+            let row: Vec<f64> = csv_rows(&text)[1]
+                .iter()
                 .map(|x| x.parse().unwrap())
                 .collect();
             let ours = &table[&key];

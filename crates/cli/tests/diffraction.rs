@@ -18,10 +18,12 @@ fn stderr(o: &Output) -> String {
 
 fn rows(o: &Output) -> (String, Vec<Vec<f64>>) {
     let text = String::from_utf8(o.stdout.clone()).unwrap();
-    let mut lines = text.lines();
-    let header = lines.next().unwrap().to_string();
-    let rows = lines
-        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+    let header = text.lines().next().unwrap().to_string();
+    let rows = nacre_optics::csv_rows::rows("stdout", &text)
+        .unwrap()
+        .into_iter()
+        .skip(1)
+        .map(|r| r.fields.iter().map(|x| x.parse().unwrap()).collect())
         .collect();
     (header, rows)
 }
@@ -358,9 +360,8 @@ fn diffraction_map_png() {
     );
     assert!(o.status.success(), "{}", stderr(&o));
     let bytes = std::fs::read(dir.path().join("map.png")).unwrap();
-    let decoder = png::Decoder::new(std::io::Cursor::new(bytes));
-    let reader = decoder.read_info().unwrap();
-    assert_eq!((reader.info().width, reader.info().height), (760, 800));
+    let map = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png).unwrap();
+    assert_eq!((map.width(), map.height()), (760, 800));
     for (args, needle) in [
         (&["sine:1.6:0.05", "-o", "map.jpg"][..], "-o/--output"),
         (

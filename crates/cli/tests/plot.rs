@@ -20,19 +20,16 @@ fn stderr(o: &Output) -> String {
 
 /// Decodes an 8-bit RGB PNG: (width, height, pixels).
 fn decode(path: &Path) -> (u32, u32, Vec<[u8; 3]>) {
-    let file = std::io::BufReader::new(std::fs::File::open(path).unwrap());
-    let mut reader = png::Decoder::new(file).read_info().unwrap();
-    let mut buf = vec![0u8; reader.output_buffer_size().unwrap()];
-    let info = reader.next_frame(&mut buf).unwrap();
-    assert_eq!(
-        (info.color_type, info.bit_depth),
-        (png::ColorType::Rgb, png::BitDepth::Eight)
-    );
-    let pixels = buf[..info.buffer_size()]
-        .chunks_exact(3)
-        .map(|p| [p[0], p[1], p[2]])
-        .collect();
-    (info.width, info.height, pixels)
+    let picture = image::ImageReader::open(path)
+        .unwrap()
+        .with_guessed_format()
+        .unwrap()
+        .decode()
+        .unwrap();
+    assert_eq!(picture.color(), image::ColorType::Rgb8);
+    let rgb = picture.into_rgb8();
+    let (w, h) = rgb.dimensions();
+    (w, h, rgb.pixels().map(|p| p.0).collect())
 }
 
 /// Checks a PNG: at least `min_size` pixels each way, `min_colours` distinct colours and

@@ -9,12 +9,16 @@
 //! is `#` is a comment too, as before `csv` was used.
 //!
 //! Every row carries the 1-based line it starts on, for `file:line` errors.
+//!
+//! Public so that the other crates of the workspace read their CSV files (points files,
+//! spectra, height fields) the same way; `csv` alone stamps a record with the line *before*
+//! the comment and blank lines it skipped.
 
 use crate::error::{Error, Result};
 
 /// One row that is neither blank nor a comment.
 #[derive(Clone, Debug, PartialEq)]
-pub(crate) struct Row {
+pub struct Row {
     /// 1-based line of the text on which the row starts.
     pub line: usize,
     /// The fields, trimmed and unquoted.
@@ -29,40 +33,79 @@ impl Row {
 }
 
 /// Reads every row of `text`; `source_name` labels errors (`file:line`).
-pub(crate) fn rows(source_name: &str, text: &str) -> Result<Vec<Row>> {
-    // Untrimmed reading: the newlines inside a record's raw fields locate its first line
-    // (see `start_line`); `StringRecord::trim` then trims as `csv::Trim::All` would.
-    let mut reader = csv::ReaderBuilder::new()
-        .has_headers(false)
-        .flexible(true)
-        .comment(Some(b'#'))
-        .trim(csv::Trim::None)
-        .from_reader(text.as_bytes());
-    let mut record = csv::StringRecord::new();
-    let mut rows = Vec::new();
-    loop {
-        match reader.read_record(&mut record) {
-            Ok(true) => {}
-            Ok(false) => break,
-            Err(e) => {
-                let line = e.position().map_or(reader.position().line(), |p| p.line());
-                return Err(Error::Parse {
-                    source_name: source_name.to_string(),
-                    line: line as usize,
-                    message: format!("malformed CSV: {e}"),
-                });
-            }
+///
+/// # Errors
+///
+/// [`Error::Parse`] naming `source_name` and the line for malformed CSV.
+pub fn rows(source_name: &str, text: &str) -> Result<Vec<Row>> {
+    Rows::new(source_name, text).collect()
+}
+
+/// The rows of a text one at a time (for files too long to hold as rows): the iterator
+/// behind [`rows`]. It ends after the first error.
+pub struct Rows<'a> {
+    source_name: String,
+    text: &'a str,
+    reader: csv::Reader<&'a [u8]>,
+    record: csv::StringRecord,
+    done: bool,
+}
+
+impl<'a> Rows<'a> {
+    /// The rows of `text`; `source_name` labels errors (`file:line`).
+    pub fn new(source_name: &str, text: &'a str) -> Self {
+        // Untrimmed reading: the newlines inside a record's raw fields locate its first line
+        // (see `start_line`); `StringRecord::trim` then trims as `csv::Trim::All` would.
+        let reader = csv::ReaderBuilder::new()
+            .has_headers(false)
+            .flexible(true)
+            .comment(Some(b'#'))
+            .trim(csv::Trim::None)
+            .from_reader(text.as_bytes());
+        Rows {
+            source_name: source_name.to_string(),
+            text,
+            reader,
+            record: csv::StringRecord::new(),
+            done: false,
         }
-        let line = start_line(text, reader.position(), &record);
-        record.trim();
-        let fields: Vec<String> = record.iter().map(unquote).collect();
-        let blank = fields.iter().all(String::is_empty);
-        if blank || fields[0].starts_with('#') {
-            continue;
-        }
-        rows.push(Row { line, fields });
     }
-    Ok(rows)
+}
+
+impl Iterator for Rows<'_> {
+    type Item = Result<Row>;
+
+    fn next(&mut self) -> Option<Result<Row>> {
+        while !self.done {
+            match self.reader.read_record(&mut self.record) {
+                Ok(true) => {}
+                Ok(false) => {
+                    self.done = true;
+                    break;
+                }
+                Err(e) => {
+                    self.done = true;
+                    let line = e
+                        .position()
+                        .map_or(self.reader.position().line(), |p| p.line());
+                    return Some(Err(Error::Parse {
+                        source_name: self.source_name.clone(),
+                        line: line as usize,
+                        message: format!("malformed CSV: {e}"),
+                    }));
+                }
+            }
+            let line = start_line(self.text, self.reader.position(), &self.record);
+            self.record.trim();
+            let fields: Vec<String> = self.record.iter().map(unquote).collect();
+            let blank = fields.iter().all(String::is_empty);
+            if blank || fields[0].starts_with('#') {
+                continue;
+            }
+            return Some(Ok(Row { line, fields }));
+        }
+        None
+    }
 }
 
 /// The line on which the record just read (untrimmed) starts.

@@ -91,6 +91,7 @@ use crate::colour::Colorimeter;
 use crate::error::{Error, Result};
 use crate::fresnel::{Interface, normal_component};
 use crate::microfacet::SplitMix64;
+use ndarray::{Array2, Array3, ArrayView2, Axis, s};
 use num_complex::Complex64 as C64;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -508,8 +509,8 @@ pub struct TaylorTerms {
     ny: usize,
     pitch_um: f64,
     order: usize,
-    /// Bin-major: `data[(sy * nx + sx) * (order + 1) + n]`.
-    data: Vec<C64>,
+    /// Bin-major: `data[[sy, sx, n]]`, shape (ny, nx, order + 1).
+    data: Array3<C64>,
 }
 
 impl TaylorTerms {
@@ -521,6 +522,8 @@ impl TaylorTerms {
         let mut planner = rustfft::FftPlanner::<f64>::new();
         let fx = planner.plan_fft_inverse(nx);
         let fy = planner.plan_fft_inverse(ny);
+        let heights =
+            ArrayView2::from_shape((ny, nx), &field.heights_um[..]).expect("nx × ny heights");
         let terms: Vec<Vec<C64>> = (0..=order)
             .into_par_iter()
             .map(|n| {
@@ -531,29 +534,18 @@ impl TaylorTerms {
                     C64::new(-1.0, 0.0),
                     C64::new(0.0, -1.0),
                 ][n % 4];
-                let mut buf: Vec<C64> = field
-                    .heights_um
-                    .iter()
-                    .map(|h| phase * h.powi(n as i32))
-                    .collect();
-                fx.process(&mut buf);
-                let mut t = vec![C64::new(0.0, 0.0); nx * ny];
-                for y in 0..ny {
-                    for x in 0..nx {
-                        t[x * ny + y] = buf[y * nx + x];
-                    }
-                }
-                fy.process(&mut t);
+                // Rows y of x samples: FFT along x, one contiguous row at a time.
+                let mut rows = heights.mapv(|h| phase * h.powi(n as i32));
+                fx.process(rows.as_slice_mut().expect("standard layout"));
+                // Columns x of y samples (the transpose, contiguous): FFT along y.
+                let mut columns = rows.t().as_standard_layout().into_owned();
+                fy.process(columns.as_slice_mut().expect("standard layout"));
                 // Back to x fastest, DC centred, divided by M.
-                let mut out = vec![C64::new(0.0, 0.0); nx * ny];
-                for x in 0..nx {
-                    let sx = (x + nx / 2) % nx;
-                    for y in 0..ny {
-                        let sy = (y + ny / 2) % ny;
-                        out[sy * nx + sx] = t[x * ny + y] / m;
-                    }
+                let mut out = Array2::from_elem((ny, nx), C64::new(0.0, 0.0));
+                for ((x, y), v) in columns.indexed_iter() {
+                    out[[(y + ny / 2) % ny, (x + nx / 2) % nx]] = v / m;
                 }
-                out
+                out.into_raw_vec_and_offset().0
             })
             .collect();
         Self::from_terms(nx, ny, field.pitch_um, &terms).expect("consistent terms")
@@ -575,12 +567,7 @@ impl TaylorTerms {
             });
         }
         let order = terms.len() - 1;
-        let mut data = vec![C64::new(0.0, 0.0); count * (order + 1)];
-        for (n, t) in terms.iter().enumerate() {
-            for (i, v) in t.iter().enumerate() {
-                data[i * (order + 1) + n] = *v;
-            }
-        }
+        let data = Array3::from_shape_fn((ny, nx, order + 1), |(sy, sx, n)| terms[n][sy * nx + sx]);
         Ok(TaylorTerms {
             nx,
             ny,
@@ -607,34 +594,37 @@ impl TaylorTerms {
 
     /// Term n as a layer, DC centred, x fastest.
     pub fn layer(&self, n: usize) -> Vec<C64> {
-        (0..self.nx * self.ny)
-            .map(|i| self.data[i * (self.order + 1) + n])
-            .collect()
+        self.data.slice(s![.., .., n]).iter().copied().collect()
     }
 
     /// Tₙ at frequency (jₓ, j_y), jₓ ∈ [−⌊Mₓ/2⌋, ⌈Mₓ/2⌉ − 1]; `None` outside.
     pub fn bin(&self, n: usize, jx: i64, jy: i64) -> Option<C64> {
-        let i = self.index(jx, jy)?;
-        (n <= self.order).then(|| self.data[i * (self.order + 1) + n])
+        let (sy, sx) = self.index(jx, jy)?;
+        (n <= self.order).then(|| self.data[[sy, sx, n]])
     }
 
-    fn index(&self, jx: i64, jy: i64) -> Option<usize> {
+    /// The (row, column) = (sy, sx) of frequency (jₓ, j_y) in the DC-centred arrays.
+    fn index(&self, jx: i64, jy: i64) -> Option<(usize, usize)> {
         let sx = jx + (self.nx / 2) as i64;
         let sy = jy + (self.ny / 2) as i64;
         (sx >= 0 && sy >= 0 && (sx as usize) < self.nx && (sy as usize) < self.ny)
-            .then(|| sy as usize * self.nx + sx as usize)
+            .then_some((sy as usize, sx as usize))
     }
 
     /// The Taylor sum P_j = Σₙ (kw)ⁿ/n! Tₙ[j] at every bin (DC centred, x fastest): the
     /// DFT coefficients of e^{ikwh} up to the truncation.
     pub fn series(&self, kw: f64) -> Vec<C64> {
         let c = taylor_coefficients(kw, self.order);
-        (0..self.nx * self.ny).map(|i| self.sum_at(i, &c)).collect()
+        self.data
+            .lanes(Axis(2))
+            .into_iter()
+            .map(|t| t.iter().zip(&c).map(|(t, c)| t * c).sum())
+            .collect()
     }
 
     #[inline]
-    fn sum_at(&self, i: usize, c: &[f64]) -> C64 {
-        let t = &self.data[i * (self.order + 1)..(i + 1) * (self.order + 1)];
+    fn sum_at(&self, (sy, sx): (usize, usize), c: &[f64]) -> C64 {
+        let t = self.data.slice(s![sy, sx, ..]);
         t.iter().zip(c).map(|(t, c)| t * c).sum()
     }
 }
@@ -791,8 +781,8 @@ impl DiffractionSurface {
         let ys = self.axis_weights(k * v, false);
         for &(jy, wy) in &ys {
             for &(jx, wx) in &xs {
-                if let Some(i) = self.terms.index(jx, jy) {
-                    let t = &self.terms.data[i * (order + 1)..(i + 1) * (order + 1)];
+                if let Some((sy, sx)) = self.terms.index(jx, jy) {
+                    let t = self.terms.data.slice(s![sy, sx, ..]);
                     for (o, t) in out.iter_mut().zip(t) {
                         *o += t * (wx * wy);
                     }
@@ -827,7 +817,7 @@ impl DiffractionSurface {
     }
 
     /// Σ_j P_j exp(−σ²|q − κ_j|²/2) for bin values given by `p(index)`.
-    fn transform_with(&self, qx: f64, qy: f64, p: &dyn Fn(usize) -> C64) -> C64 {
+    fn transform_with(&self, qx: f64, qy: f64, p: &dyn Fn((usize, usize)) -> C64) -> C64 {
         let t = &self.terms;
         let xs = self.axis_weights(qx, true);
         let ys = self.axis_weights(qy, false);

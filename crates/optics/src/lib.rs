@@ -22,7 +22,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod colour;
-mod csv_rows;
+pub mod csv_rows;
 pub mod diffraction;
 pub mod error;
 pub mod fourier;

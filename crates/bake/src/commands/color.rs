@@ -228,7 +228,9 @@ pub struct Point {
     pub film_ior: Option<f64>,
 }
 
-/// Reads `--points` CSV: header `angle_deg,thickness_nm,film_ior`, then rows.
+/// Reads `--points` CSV: header `angle_deg,thickness_nm,film_ior`, then rows. `#` comment
+/// lines, blank lines, quoted fields, a UTF-8 BOM, CRLF and spaces around fields are
+/// accepted (see [`nacre_optics::csv_rows`]).
 pub fn parse_points(path: &Path, text: &str) -> Result<Vec<Point>> {
     let perr = |line: usize, message: String| Error::Recipe {
         path: path.to_path_buf(),
@@ -237,28 +239,26 @@ pub fn parse_points(path: &Path, text: &str) -> Result<Vec<Point>> {
     };
     let mut out = Vec::new();
     let mut header = false;
-    for (i, raw) in text.lines().enumerate() {
-        let line = raw.trim();
-        if line.is_empty() || line.starts_with('#') {
-            continue;
-        }
+    for row in crate::csv_text::rows(path, text) {
+        let row = row?;
+        let line = row.line;
+        let f = &row.fields;
         if !header {
-            let cols: Vec<&str> = line.split(',').map(str::trim).collect();
-            if cols != ["angle_deg", "thickness_nm", "film_ior"] {
+            if f != &["angle_deg", "thickness_nm", "film_ior"] {
                 return Err(perr(
-                    i + 1,
+                    line,
                     format!(
-                        "expected the header `angle_deg,thickness_nm,film_ior`, found `{line}`"
+                        "expected the header `angle_deg,thickness_nm,film_ior`, found `{}`",
+                        crate::csv_text::line_text(text, line)
                     ),
                 ));
             }
             header = true;
             continue;
         }
-        let f: Vec<&str> = line.split(',').map(str::trim).collect();
         if f.len() != 3 {
             return Err(perr(
-                i + 1,
+                line,
                 format!(
                     "expected 3 comma-separated numbers, found {} field(s)",
                     f.len()
@@ -269,27 +269,24 @@ pub fn parse_points(path: &Path, text: &str) -> Result<Vec<Point>> {
             s.parse::<f64>()
                 .ok()
                 .filter(|v| v.is_finite())
-                .ok_or_else(|| perr(i + 1, format!("{what} `{s}` is not a finite number")))
+                .ok_or_else(|| perr(line, format!("{what} `{s}` is not a finite number")))
         };
         let (a, d, n) = (
-            num(f[0], "angle_deg")?,
-            num(f[1], "thickness_nm")?,
-            num(f[2], "film_ior")?,
+            num(&f[0], "angle_deg")?,
+            num(&f[1], "thickness_nm")?,
+            num(&f[2], "film_ior")?,
         );
         if !(a.abs() < 90.0) {
             return Err(perr(
-                i + 1,
+                line,
                 format!("angle_deg {a} must lie strictly between -90 and 90"),
             ));
         }
         if d < 0.0 {
-            return Err(perr(
-                i + 1,
-                format!("thickness_nm {d} must be non-negative"),
-            ));
+            return Err(perr(line, format!("thickness_nm {d} must be non-negative")));
         }
         if !(n > 0.0) {
-            return Err(perr(i + 1, format!("film_ior {n} must be positive")));
+            return Err(perr(line, format!("film_ior {n} must be positive")));
         }
         out.push(Point {
             angle_deg: a,
@@ -846,28 +843,27 @@ pub fn write_csv(
     colours: &[[f64; 3]],
     colorimeter: &Colorimeter,
 ) -> std::io::Result<()> {
-    writeln!(w, "{HEADER}")?;
+    let mut csv = crate::csv_text::writer(w);
+    csv.write_record(HEADER.split(','))?;
     for (p, c) in points.iter().zip(colours) {
         let xyz = match colorimeter.space() {
             OutputSpace::Xyz => *c,
             OutputSpace::Rgb(_) => colorimeter.xyz_from_output(*c),
         };
         let (d, n) = film_columns(stack, p);
-        writeln!(
-            w,
-            "{},{},{},{},{},{},{},{},{}",
-            p.angle_deg,
-            d,
-            n,
+        csv.write_record([
+            p.angle_deg.to_string(),
+            d.to_string(),
+            n.to_string(),
             fmt_sig(xyz[0]),
             fmt_sig(xyz[1]),
             fmt_sig(xyz[2]),
             fmt_sig(c[0]),
             fmt_sig(c[1]),
             fmt_sig(c[2]),
-        )?;
+        ])?;
     }
-    Ok(())
+    csv.flush()
 }
 
 /// Builds the stack of a film over fixed layers (used by tests and tools).
@@ -884,4 +880,55 @@ pub fn film_stack(
     }];
     layers.extend(under);
     Ok(Stack::new(ambient, layers, base)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn points_files_accept_csv_conventions() {
+        let path = Path::new("p.csv");
+        // BOM, CRLF, comment and blank lines, quoted fields, spaces around fields.
+        let text = "\u{feff}# points\r\n angle_deg , \"thickness_nm\",film_ior\r\n\r\n# a\r\n  10 , \"250.5\" , 1.33 \r\n\"20\",300,1.5";
+        let points = parse_points(path, text).unwrap();
+        assert_eq!(
+            points,
+            vec![
+                Point {
+                    angle_deg: 10.0,
+                    thickness_nm: Some(250.5),
+                    film_ior: Some(1.33)
+                },
+                Point {
+                    angle_deg: 20.0,
+                    thickness_nm: Some(300.0),
+                    film_ior: Some(1.5)
+                },
+            ]
+        );
+    }
+
+    #[test]
+    fn points_errors_name_file_and_line() {
+        let path = Path::new("p.csv");
+        let header = "angle_deg,thickness_nm,film_ior";
+        for (text, start) in [
+            ("# c\n\nangle, d\n".to_string(), "p.csv:3: "),
+            (
+                format!("# c\r\n{header}\r\n# x\r\n\r\n10,x,1.5\r\n"),
+                "p.csv:5: ",
+            ),
+            (format!("{header}\n\n10,200\n"), "p.csv:3: "),
+            (format!("# a\n# b\n{header}\n95,200,1.5\n"), "p.csv:4: "),
+            ("# only\n".to_string(), "p.csv:0: "),
+        ] {
+            let e = parse_points(path, &text).unwrap_err().to_string();
+            assert!(e.starts_with(start), "{e}");
+        }
+        let e = parse_points(path, "# c\n\nangle, d\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.ends_with("found `angle, d`"), "{e}");
+    }
 }

@@ -189,17 +189,23 @@ pub fn write_csv(
     results: &[MethodResult],
 ) -> Result<()> {
     Ok(write_atomic(path, |w| {
-        writeln!(w, "method,angle_deg,thickness_nm,delta_e_2000")?;
+        let mut csv = crate::csv_text::writer(w);
+        csv.write_record(["method", "angle_deg", "thickness_nm", "delta_e_2000"])?;
         for r in results {
             let mut it = r.delta_e.iter();
             for &a in angles_deg {
                 for &d in thicknesses_nm {
                     let de = it.next().expect("one value per point");
-                    writeln!(w, "{},{a},{d},{de:.6}", r.label)?;
+                    csv.write_record([
+                        r.label.to_string(),
+                        a.to_string(),
+                        d.to_string(),
+                        format!("{de:.6}"),
+                    ])?;
                 }
             }
         }
-        Ok(())
+        csv.flush()
     })?)
 }
 
@@ -305,14 +311,14 @@ pub fn write_png(
         root.present().map_err(|e| draw_err(e.to_string()))?;
     }
     Ok(write_atomic(path, |out| {
-        let mut enc = png::Encoder::new(out, w, h);
-        enc.set_color(png::ColorType::Rgb);
-        enc.set_depth(png::BitDepth::Eight);
-        let mut writer = enc.write_header().map_err(std::io::Error::other)?;
-        writer
-            .write_image_data(&buf)
-            .map_err(std::io::Error::other)?;
-        writer.finish().map_err(std::io::Error::other)
+        use image::ImageEncoder;
+        image::codecs::png::PngEncoder::new_with_quality(
+            out,
+            image::codecs::png::CompressionType::Default,
+            image::codecs::png::FilterType::Adaptive,
+        )
+        .write_image(&buf, w, h, image::ExtendedColorType::Rgb8)
+        .map_err(std::io::Error::other)
     })?)
 }
 

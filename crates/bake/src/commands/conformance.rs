@@ -320,58 +320,62 @@ pub fn compute(grid: Grid) -> Result<Conformance> {
     })
 }
 
+/// The text a CSV writer wrote to memory (its fields are UTF-8 strings).
+fn csv_string(csv: csv::Writer<Vec<u8>>) -> String {
+    let bytes = csv.into_inner().expect("writing to memory cannot fail");
+    String::from_utf8(bytes).expect("CSV of UTF-8 fields")
+}
+
 impl Conformance {
     /// `conformance.csv`.
     pub fn csv(&self) -> String {
-        let mut s = String::with_capacity(self.bases.len() * self.grid.points_per_base() * 120);
-        s.push_str(HEADER);
-        s.push('\n');
+        let s = Vec::with_capacity(self.bases.len() * self.grid.points_per_base() * 120);
+        let mut csv = crate::csv_text::writer(s);
+        // Writing to memory cannot fail.
+        let _ = csv.write_record(HEADER.split(','));
         let points = self.grid.points();
         for b in &self.bases {
             for (p, rgb) in points.iter().zip(&b.reference) {
                 let xyz = self.colorimeter.xyz_from_output(*rgb);
-                let _ = writeln!(
-                    s,
-                    "{},{},{},{},{},{},{},{},{},{}",
-                    b.base.label,
-                    p.angle_deg,
-                    p.thickness_nm.unwrap_or(0.0),
-                    p.film_ior.unwrap_or(1.0),
+                let _ = csv.write_record([
+                    b.base.label.to_string(),
+                    p.angle_deg.to_string(),
+                    p.thickness_nm.unwrap_or(0.0).to_string(),
+                    p.film_ior.unwrap_or(1.0).to_string(),
                     fmt_sig(xyz[0]),
                     fmt_sig(xyz[1]),
                     fmt_sig(xyz[2]),
                     fmt_sig(rgb[0]),
                     fmt_sig(rgb[1]),
                     fmt_sig(rgb[2]),
-                );
+                ]);
             }
         }
-        s
+        csv_string(csv)
     }
 
     /// `gltf-reference-error.csv`.
     pub fn error_csv(&self) -> String {
-        let mut s = String::with_capacity(self.bases.len() * self.grid.points_per_base() * 80);
-        s.push_str(ERROR_HEADER);
-        s.push('\n');
+        let s = Vec::with_capacity(self.bases.len() * self.grid.points_per_base() * 80);
+        let mut csv = crate::csv_text::writer(s);
+        // Writing to memory cannot fail.
+        let _ = csv.write_record(ERROR_HEADER.split(','));
         let points = self.grid.points();
         for b in &self.bases {
             for ((p, rgb), de) in points.iter().zip(&b.gltf).zip(&b.delta_e) {
-                let _ = writeln!(
-                    s,
-                    "{},{},{},{},{},{},{},{:.6}",
-                    b.base.label,
-                    p.angle_deg,
-                    p.thickness_nm.unwrap_or(0.0),
-                    p.film_ior.unwrap_or(1.0),
+                let _ = csv.write_record([
+                    b.base.label.to_string(),
+                    p.angle_deg.to_string(),
+                    p.thickness_nm.unwrap_or(0.0).to_string(),
+                    p.film_ior.unwrap_or(1.0).to_string(),
                     fmt_sig(rgb[0]),
                     fmt_sig(rgb[1]),
                     fmt_sig(rgb[2]),
-                    de,
-                );
+                    format!("{de:.6}"),
+                ]);
             }
         }
-        s
+        csv_string(csv)
     }
 
     /// Every file of the set, named relative to the output folder: `conformance.csv`,
@@ -492,14 +496,14 @@ impl Conformance {
         }
         let mut png_bytes = Vec::new();
         {
-            let mut enc = png::Encoder::new(&mut png_bytes, w, h);
-            enc.set_color(png::ColorType::Rgb);
-            enc.set_depth(png::BitDepth::Eight);
-            let mut writer = enc.write_header().map_err(|e| draw_err(e.to_string()))?;
-            writer
-                .write_image_data(&buf)
-                .map_err(|e| draw_err(e.to_string()))?;
-            writer.finish().map_err(|e| draw_err(e.to_string()))?;
+            use image::ImageEncoder;
+            image::codecs::png::PngEncoder::new_with_quality(
+                &mut png_bytes,
+                image::codecs::png::CompressionType::Default,
+                image::codecs::png::FilterType::Adaptive,
+            )
+            .write_image(&buf, w, h, image::ExtendedColorType::Rgb8)
+            .map_err(|e| draw_err(e.to_string()))?;
         }
         Ok(png_bytes)
     }

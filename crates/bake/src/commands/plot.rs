@@ -144,14 +144,16 @@ pub fn render(figure: &impl Figure, format: ImageFormat) -> Result<Vec<u8>> {
                 root.present().map_err(|e| err(e.to_string()))?;
             }
             let mut out = Vec::new();
-            let mut enc = png::Encoder::new(&mut out, w, h);
-            enc.set_color(png::ColorType::Rgb);
-            enc.set_depth(png::BitDepth::Eight);
-            let mut writer = enc.write_header().map_err(|e| err(e.to_string()))?;
-            writer
-                .write_image_data(&buf)
+            {
+                use image::ImageEncoder;
+                image::codecs::png::PngEncoder::new_with_quality(
+                    &mut out,
+                    image::codecs::png::CompressionType::Default,
+                    image::codecs::png::FilterType::Adaptive,
+                )
+                .write_image(&buf, w, h, image::ExtendedColorType::Rgb8)
                 .map_err(|e| err(e.to_string()))?;
-            writer.finish().map_err(|e| err(e.to_string()))?;
+            }
             Ok(out)
         }
         ImageFormat::Svg => {
@@ -694,19 +696,18 @@ pub fn read_spectrum_csv(path: &Path, text: &str) -> Result<Vec<SpectrumCurve>> 
     let names: Vec<&str> = crate::commands::spectrum::HEADER.split(',').collect();
     let mut header = false;
     let mut curves: Vec<SpectrumCurve> = Vec::new();
-    for (i, raw) in text.lines().enumerate() {
-        let line = raw.trim();
-        if line.is_empty() || line.starts_with('#') {
-            continue;
-        }
-        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+    for row in crate::csv_text::rows(path, text) {
+        let row = row?;
+        let line = row.line;
+        let fields = &row.fields;
         if !header {
-            if fields != names {
+            if fields != &names {
                 return Err(perr(
-                    i + 1,
+                    line,
                     format!(
-                        "expected the `nacre spectrum` header `{}`, found `{line}`",
-                        crate::commands::spectrum::HEADER
+                        "expected the `nacre spectrum` header `{}`, found `{}`",
+                        crate::commands::spectrum::HEADER,
+                        crate::csv_text::line_text(text, line)
                     ),
                 ));
             }
@@ -715,7 +716,7 @@ pub fn read_spectrum_csv(path: &Path, text: &str) -> Result<Vec<SpectrumCurve>> 
         }
         if fields.len() != names.len() {
             return Err(perr(
-                i + 1,
+                line,
                 format!(
                     "expected {} comma-separated numbers, found {} field(s)",
                     names.len(),
@@ -729,17 +730,17 @@ pub fn read_spectrum_csv(path: &Path, text: &str) -> Result<Vec<SpectrumCurve>> 
                 .parse::<f64>()
                 .ok()
                 .filter(|x| x.is_finite())
-                .ok_or_else(|| perr(i + 1, format!("{name} `{f}` is not a finite number")))?;
+                .ok_or_else(|| perr(line, format!("{name} `{f}` is not a finite number")))?;
         }
         if !(v[0].abs() < 90.0) {
             return Err(perr(
-                i + 1,
+                line,
                 format!("angle_deg {} must lie strictly between -90 and 90", v[0]),
             ));
         }
         if !(v[1] > 0.0) {
             return Err(perr(
-                i + 1,
+                line,
                 format!("wavelength_nm {} must be positive", v[1]),
             ));
         }
@@ -1941,6 +1942,21 @@ mod tests {
             let e = read_spectrum_csv(path, &text).unwrap_err().to_string();
             assert!(e.starts_with(&format!("s.csv:{line}: ")), "{e}");
         }
+    }
+
+    #[test]
+    fn spectrum_csv_accepts_csv_conventions() {
+        let path = Path::new("s.csv");
+        let header = crate::commands::spectrum::HEADER.replace(',', " , ");
+        let text = format!(
+            "\u{feff}# spectrum\r\n{header}\r\n\r\n\"0\", 410 ,0.1,0.1,0.1,0.9,0.9,0.9,0\r\n# c\r\n0,400,0.2,0.2,0.2,0.8,0.8,0.8,0\r\n"
+        );
+        let curves = read_spectrum_csv(path, &text).unwrap();
+        assert_eq!(curves.len(), 1);
+        assert_eq!(curves[0].wavelengths_nm, vec![400.0, 410.0]);
+        let bad = format!("# c\r\n\r\n{header}\r\n# x\r\n0,410,0.1,y,0.1,0.9,0.9,0.9,0\r\n");
+        let e = read_spectrum_csv(path, &bad).unwrap_err().to_string();
+        assert!(e.starts_with("s.csv:5: "), "{e}");
     }
 
     #[test]

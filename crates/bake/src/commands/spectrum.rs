@@ -79,14 +79,15 @@ pub fn write_csv(
     wavelengths_nm: &[f64],
     powers: &[Power],
 ) -> std::io::Result<()> {
-    writeln!(w, "{HEADER}")?;
+    let mut csv = crate::csv_text::writer(w);
+    csv.write_record(HEADER.split(','))?;
     let mut cells = powers.iter();
     for &a in angles_deg {
         for &wl in wavelengths_nm {
             let p = cells.next().expect("one power per (angle, wavelength)");
-            writeln!(
-                w,
-                "{a},{wl},{},{},{},{},{},{},{}",
+            csv.write_record([
+                a.to_string(),
+                wl.to_string(),
                 fmt_sig(p.R_s),
                 fmt_sig(p.R_p),
                 fmt_sig(p.R()),
@@ -94,10 +95,10 @@ pub fn write_csv(
                 fmt_sig(p.T_p),
                 fmt_sig(p.T()),
                 fmt_sig(p.A()),
-            )?;
+            ])?;
         }
     }
-    Ok(())
+    csv.flush()
 }
 
 #[cfg(test)]

@@ -12,8 +12,8 @@
 //!   (Stam's random bumps). Gratings are one row (invariant along the lines) spanning
 //!   whole periods over at least the coherence diameter; `cd` and `bumps` are square
 //!   patches at least the coherence diameter wide.
-//! * Files ([`read_height_field`]): 8- or 16-bit greyscale PNG (value / full scale ×
-//!   height scale), OpenEXR (one channel `Y`, `Z`, `R` or the only channel, × height
+//! * Files ([`read_height_field`]): 8- or 16-bit greyscale PNG or greyscale JPEG (value /
+//!   full scale × height scale), OpenEXR (one channel `Y`, `Z`, `R` or the only channel, × height
 //!   scale), or CSV (rows of comma-separated numbers, `#` comments, × height scale; row
 //!   0 is y = 0). The pitch (µm per sample) and the height scale (µm) come from the
 //!   recipe or the command line.
@@ -253,11 +253,11 @@ fn auto_samples(l: f64, pitch_um: Option<f64>, samples: Option<usize>) -> usize 
     })
 }
 
-/// Reads a height-field file (PNG, OpenEXR or CSV by extension; module docs) with
+/// Reads a height-field file (PNG, JPEG, OpenEXR or CSV by extension; module docs) with
 /// `pitch_um` µm per sample and heights scaled by `height_scale_um`.
 ///
 /// # Errors
-/// [`Error::Io`]; [`Error::Table`] (PNG, EXR) or [`Error::Recipe`] (CSV, with the line)
+/// [`Error::Io`]; [`Error::Table`] (PNG, JPEG, EXR) or [`Error::Recipe`] (CSV, with the line)
 /// naming the file for malformed content; [`Error::OpticsIn`] for a bad pitch.
 pub fn read_height_field(path: &Path, pitch_um: f64, height_scale_um: f64) -> Result<HeightField> {
     if !(height_scale_um.is_finite() && height_scale_um >= 0.0) {
@@ -276,13 +276,15 @@ pub fn read_height_field(path: &Path, pitch_um: f64, height_scale_um: f64) -> Re
         .unwrap_or("")
         .to_ascii_lowercase();
     let (nx, ny, values) = match ext.as_str() {
-        "png" => decode_png(path, &bytes)?,
+        "png" => decode_picture(path, &bytes, image::ImageFormat::Png)?,
+        "jpg" | "jpeg" => decode_picture(path, &bytes, image::ImageFormat::Jpeg)?,
         "exr" => decode_exr(path, &bytes)?,
         "csv" | "txt" => decode_csv(path, &bytes)?,
         _ => {
             return Err(Error::Table {
                 path: path.to_path_buf(),
-                message: "unknown height-field format: expected a .png, .exr or .csv file".into(),
+                message: "unknown height-field format: expected a .png, .jpg, .exr or .csv file"
+                    .into(),
             });
         }
     };
@@ -312,63 +314,62 @@ fn table_err(path: &Path, message: String) -> Error {
     }
 }
 
-/// Greyscale PNG, 8 or 16 bits: value / full scale.
-fn decode_png(path: &Path, bytes: &[u8]) -> Result<(usize, usize, Vec<f64>)> {
+/// Greyscale picture (PNG 8 or 16 bits, JPEG 8 bits), read with the `image` crate:
+/// value / full scale.
+fn decode_picture(
+    path: &Path,
+    bytes: &[u8],
+    format: image::ImageFormat,
+) -> Result<(usize, usize, Vec<f64>)> {
+    let name = if format == image::ImageFormat::Png {
+        "PNG"
+    } else {
+        "JPEG"
+    };
     let decode = || -> Result<(usize, usize, Vec<f64>)> {
-        let bad = |e: png::DecodingError| table_err(path, format!("not a valid PNG file: {e}"));
-        let mut decoder = png::Decoder::new_with_limits(
-            std::io::Cursor::new(bytes),
-            png::Limits { bytes: 1 << 29 },
-        );
-        decoder.set_transformations(png::Transformations::EXPAND);
-        let mut reader = decoder.read_info().map_err(bad)?;
-        let (colour, depth) = reader.output_color_type();
-        let channels = match colour {
-            png::ColorType::Grayscale => 1,
-            png::ColorType::GrayscaleAlpha => 2,
-            other => {
-                return Err(table_err(
-                    path,
-                    format!("a {other:?} PNG; a height field must be greyscale (8 or 16 bits)"),
-                ));
+        let bad = |e: image::ImageError| table_err(path, format!("not a valid {name} file: {e}"));
+        let mut reader = image::ImageReader::with_format(std::io::Cursor::new(bytes), format);
+        let mut limits = image::Limits::default();
+        limits.max_alloc = Some(1 << 29);
+        reader.limits(limits);
+        let picture = reader.decode().map_err(bad)?;
+        let (w, h) = (picture.width() as usize, picture.height() as usize);
+        // Greyscale (with or without alpha): the grey channel.
+        let values: Vec<f64> = match &picture {
+            image::DynamicImage::ImageLuma8(p) => {
+                p.pixels().map(|p| f64::from(p.0[0]) / 255.0).collect()
             }
-        };
-        let (bytes_per_sample, full) = match depth {
-            png::BitDepth::Eight => (1, 255.0),
-            png::BitDepth::Sixteen => (2, 65535.0),
-            other => {
-                return Err(table_err(
-                    path,
-                    format!("{} bits per sample; expected 8 or 16", other as u8),
-                ));
+            image::DynamicImage::ImageLumaA8(p) => {
+                p.pixels().map(|p| f64::from(p.0[0]) / 255.0).collect()
             }
-        };
-        let size = reader
-            .output_buffer_size()
-            .ok_or_else(|| table_err(path, "image too large".into()))?;
-        let mut buf = vec![0u8; size];
-        let frame = reader.next_frame(&mut buf).map_err(bad)?;
-        let (w, h) = (frame.width as usize, frame.height as usize);
-        let stride = channels * bytes_per_sample;
-        let mut values = Vec::with_capacity(w * h);
-        for y in 0..h {
-            let row = &buf[y * frame.line_size..];
-            for x in 0..w {
-                let at = x * stride;
-                let v = if bytes_per_sample == 2 {
-                    f64::from(u16::from_be_bytes([row[at], row[at + 1]]))
-                } else {
-                    f64::from(row[at])
+            image::DynamicImage::ImageLuma16(p) => {
+                p.pixels().map(|p| f64::from(p.0[0]) / 65535.0).collect()
+            }
+            image::DynamicImage::ImageLumaA16(p) => {
+                p.pixels().map(|p| f64::from(p.0[0]) / 65535.0).collect()
+            }
+            other => {
+                let colour = match other.color() {
+                    image::ColorType::Rgb8 | image::ColorType::Rgb16 | image::ColorType::Rgb32F => {
+                        "Rgb"
+                    }
+                    image::ColorType::Rgba8
+                    | image::ColorType::Rgba16
+                    | image::ColorType::Rgba32F => "Rgba",
+                    _ => "non-greyscale",
                 };
-                values.push(v / full);
+                return Err(table_err(
+                    path,
+                    format!("a {colour} {name}; a height field must be greyscale (8 or 16 bits)"),
+                ));
             }
-        }
+        };
         Ok((w, h, values))
     };
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(decode)).unwrap_or_else(|_| {
         Err(table_err(
             path,
-            "malformed PNG data (the decoder failed)".into(),
+            format!("malformed {name} data (the decoder failed)"),
         ))
     })
 }
@@ -430,7 +431,9 @@ fn decode_exr(path: &Path, bytes: &[u8]) -> Result<(usize, usize, Vec<f64>)> {
     })
 }
 
-/// CSV: rows of comma-separated numbers (row 0 = y = 0), `#` comments, blank lines skipped.
+/// CSV: rows of comma-separated numbers (row 0 = y = 0); `#` comments (whole lines, or
+/// the end of a row), blank lines, quoted fields, a UTF-8 BOM, CRLF and spaces around
+/// fields are accepted (see [`nacre_optics::csv_rows`]).
 fn decode_csv(path: &Path, bytes: &[u8]) -> Result<(usize, usize, Vec<f64>)> {
     let bad = |line: usize, message: String| Error::Recipe {
         path: path.to_path_buf(),
@@ -440,16 +443,19 @@ fn decode_csv(path: &Path, bytes: &[u8]) -> Result<(usize, usize, Vec<f64>)> {
     let text = std::str::from_utf8(bytes).map_err(|e| bad(1, format!("not UTF-8 text: {e}")))?;
     let mut values = Vec::new();
     let (mut nx, mut ny) = (0, 0);
-    for (i, line) in text.lines().enumerate() {
-        let line_no = i + 1;
-        let content = line.split('#').next().unwrap_or("").trim();
-        if content.is_empty() {
-            continue;
+    for row in crate::csv_text::rows(path, text) {
+        let row = row?;
+        let line_no = row.line;
+        let mut fields = row.fields;
+        // A `#` ends the row: the rest of the line is a comment.
+        if let Some(k) = fields.iter().position(|f| f.contains('#')) {
+            fields.truncate(k + 1);
+            let kept = fields[k].split('#').next().unwrap_or("").trim().to_string();
+            fields[k] = kept;
         }
-        let row: Vec<f64> = content
-            .split(',')
+        let row: Vec<f64> = fields
+            .iter()
             .map(|c| {
-                let c = c.trim();
                 c.parse::<f64>()
                     .ok()
                     .filter(|v| v.is_finite())
@@ -1155,26 +1161,75 @@ mod tests {
     }
 
     #[test]
+    fn csv_height_fields_accept_csv_conventions() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("h.csv");
+        // BOM, CRLF, comment and blank lines, quoted fields, spaces, a comment after a row.
+        std::fs::write(
+            &p,
+            "\u{feff}# heights\r\n\r\n 0 , \"1\" ,2\r\n# between\r\n\"3\",4, 5 # last row\r\n",
+        )
+        .unwrap();
+        let f = read_height_field(&p, 0.1, 2.0).unwrap();
+        assert_eq!((f.nx(), f.ny()), (3, 2));
+        assert_eq!(f.mean_removed_um(), 5.0);
+        std::fs::write(&p, "# a\r\n\r\n0,1,2\r\n# b\r\n3,4\r\n").unwrap();
+        let e = read_height_field(&p, 0.1, 1.0).unwrap_err().to_string();
+        assert!(e.contains("h.csv:5:"), "{e}");
+    }
+
+    #[test]
     fn png_height_fields_scale_to_full_range() {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("h.png");
-        let mut bytes = Vec::new();
-        {
-            let mut enc = png::Encoder::new(&mut bytes, 2, 1);
-            enc.set_color(png::ColorType::Grayscale);
-            enc.set_depth(png::BitDepth::Sixteen);
-            let mut w = enc.write_header().unwrap();
-            w.write_image_data(&[0, 0, 255, 255]).unwrap();
-        }
-        std::fs::write(&p, &bytes).unwrap();
+        let sixteen = image::ImageBuffer::<image::Luma<u16>, _>::from_raw(2, 1, vec![0, 65535]);
+        sixteen.unwrap().save(&p).unwrap();
         let f = read_height_field(&p, 0.1, 0.2).unwrap();
         assert_eq!(f.heights_um(), &[-0.1, 0.1]);
+        // 16 bits keep full precision: one step of 65535 is resolved.
+        let steps = image::ImageBuffer::<image::Luma<u16>, _>::from_raw(2, 1, vec![1000, 1001]);
+        steps.unwrap().save(&p).unwrap();
+        let f = read_height_field(&p, 0.1, 65535.0).unwrap();
+        let h = f.heights_um();
+        assert!((h[1] - h[0] - 1.0).abs() < 1e-9, "{h:?}");
+        // A colour picture is not a height field.
+        image::RgbImage::new(2, 2).save(&p).unwrap();
+        let e = read_height_field(&p, 0.1, 0.2).unwrap_err().to_string();
+        assert!(
+            e.contains("a Rgb PNG; a height field must be greyscale"),
+            "{e}"
+        );
         std::fs::write(&p, b"not a png").unwrap();
         assert!(
             read_height_field(&p, 0.1, 0.2)
                 .unwrap_err()
                 .to_string()
                 .contains("h.png")
+        );
+    }
+
+    #[test]
+    fn jpeg_height_fields_are_accepted() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("h.jpg");
+        // A left half at 64 and a right half at 192, 16 × 16 (whole 8 × 8 JPEG blocks).
+        let grey =
+            image::GrayImage::from_fn(16, 16, |x, _| image::Luma([if x < 8 { 64 } else { 192 }]));
+        grey.save(&p).unwrap();
+        let f = read_height_field(&p, 0.1, 1.0).unwrap();
+        assert_eq!((f.nx(), f.ny()), (16, 16));
+        let h = f.heights_um();
+        let (left, right) = (h[0] + f.mean_removed_um(), h[15] + f.mean_removed_um());
+        assert!((left - 64.0 / 255.0).abs() < 0.02, "{left}");
+        assert!((right - 192.0 / 255.0).abs() < 0.02, "{right}");
+        let jpeg = dir.path().join("h.jpeg");
+        std::fs::copy(&p, &jpeg).unwrap();
+        assert_eq!(read_height_field(&jpeg, 0.1, 1.0).unwrap().nx(), 16);
+        std::fs::write(&p, b"not a jpeg").unwrap();
+        let e = read_height_field(&p, 0.1, 1.0).unwrap_err().to_string();
+        assert!(
+            e.contains("h.jpg") && e.contains("not a valid JPEG file"),
+            "{e}"
         );
     }
 }

@@ -83,6 +83,7 @@ use super::{DiffractionSurface, FresnelTerm, SpectralGrid, geometry_over_w2, k_p
 use crate::C64;
 use crate::colour::Colorimeter;
 use crate::error::{Error, Result};
+use ndarray::{Array2, Axis};
 use rayon::prelude::*;
 
 /// Most texels per axis of an integrated table.
@@ -195,7 +196,8 @@ impl IntegratedTable {
             .map(|iv| {
                 let v = axis.texel_centre(iv);
                 let mut acc = vec![[0.0f64; 3]; half * layers];
-                let mut r = vec![C64::new(0.0, 0.0); nx * terms_per_bin];
+                // Σ_y over the rows of the terms: (sx, n) for one wavelength.
+                let mut r = Array2::from_elem((nx, terms_per_bin), C64::new(0.0, 0.0));
                 let mut pt = vec![C64::new(0.0, 0.0); terms_per_bin];
                 let mut q = vec![0.0f64; layers];
                 let mut k_pow = vec![0.0f64; layers];
@@ -204,11 +206,7 @@ impl IntegratedTable {
                     r.fill(C64::new(0.0, 0.0));
                     for (jy, wy) in surface.axis_weights(k * v, false) {
                         let sy = (jy + (ny / 2) as i64) as usize;
-                        let row =
-                            &terms.data[sy * nx * terms_per_bin..(sy + 1) * nx * terms_per_bin];
-                        for (r, t) in r.iter_mut().zip(row) {
-                            *r += t * wy;
-                        }
+                        r.zip_mut_with(&terms.data.index_axis(Axis(0), sy), |r, t| *r += t * wy);
                     }
                     let mut kp = 1.0;
                     for v in k_pow.iter_mut() {
@@ -219,8 +217,7 @@ impl IntegratedTable {
                         pt.fill(C64::new(0.0, 0.0));
                         for (jx, wx) in surface.axis_weights(k * u, true) {
                             let sx = (jx + (nx / 2) as i64) as usize;
-                            let bins = &r[sx * terms_per_bin..(sx + 1) * terms_per_bin];
-                            for (p, b) in pt.iter_mut().zip(bins) {
+                            for (p, b) in pt.iter_mut().zip(r.row(sx)) {
                                 *p += b * wx;
                             }
                         }

@@ -1,0 +1,49 @@
+//! CSV files read by the commands and kinds (points files, spectra, height fields), through
+//! [`nacre_optics::csv_rows`]: `#` comment lines, blank lines, quoted fields, a UTF-8 BOM,
+//! CRLF and spaces around fields are accepted, and every row knows its line. CSV written by
+//! the commands goes through [`writer`]: numbers formatted by the commands themselves, LF
+//! line ends, fields quoted only where CSV needs it.
+
+use std::path::Path;
+
+use crate::error::{Error, Result};
+pub(crate) use nacre_optics::csv_rows::Row;
+
+/// The rows of `text`, read from `path`, one at a time; malformed CSV is an
+/// [`Error::Recipe`] naming the file and line.
+pub(crate) fn rows<'a>(path: &'a Path, text: &'a str) -> impl Iterator<Item = Result<Row>> + 'a {
+    nacre_optics::csv_rows::Rows::new(&path.display().to_string(), text).map(move |row| {
+        row.map_err(|e| match e {
+            nacre_optics::Error::Parse { line, message, .. } => Error::Recipe {
+                path: path.to_path_buf(),
+                line,
+                message,
+            },
+            other => Error::Recipe {
+                path: path.to_path_buf(),
+                line: 0,
+                message: other.to_string(),
+            },
+        })
+    })
+}
+
+/// Line `line` (1-based) of `text` as written, trimmed (and without a leading BOM): the
+/// row as error messages quote it.
+pub(crate) fn line_text(text: &str, line: usize) -> &str {
+    text.lines()
+        .nth(line.saturating_sub(1))
+        .unwrap_or("")
+        .trim_start_matches('\u{feff}')
+        .trim()
+}
+
+/// A CSV writer onto `w` with `\n` line ends (quotes only where a field needs them). Fields
+/// are written as the strings given, so numbers keep the caller's formatting; flush it (or
+/// drop it, ignoring errors) when done.
+pub(crate) fn writer<W: std::io::Write>(w: W) -> csv::Writer<W> {
+    csv::WriterBuilder::new()
+        .has_headers(false)
+        .terminator(csv::Terminator::Any(b'\n'))
+        .from_writer(w)
+}
