@@ -718,18 +718,16 @@ impl ViewSweep<'_> {
 
     /// Writes `view_deg,wavelength_nm,reflectance`.
     pub fn write_reflectance_csv(&self, w: &mut dyn Write, rho: &[f64]) -> std::io::Result<()> {
-        writeln!(w, "view_deg,wavelength_nm,reflectance")?;
+        let mut csv = crate::csv_text::writer(w);
+        csv.write_record(["view_deg", "wavelength_nm", "reflectance"])?;
         let mut cells = rho.iter();
         for &v in self.views_deg {
             for &wl in self.wavelengths_nm {
-                writeln!(
-                    w,
-                    "{v},{wl},{}",
-                    fmt_sig(*cells.next().expect("one value per cell"))
-                )?;
+                let value = *cells.next().expect("one value per cell");
+                csv.write_record([v.to_string(), wl.to_string(), fmt_sig(value)])?;
             }
         }
-        Ok(())
+        csv.flush()
     }
 
     /// Colours (XYZ, output space) per view from ρ on the wavelength grid.
@@ -773,20 +771,14 @@ pub fn write_colour_csv(
     views_deg: &[f64],
     colours: &[([f64; 3], [f64; 3])],
 ) -> std::io::Result<()> {
-    writeln!(w, "view_deg,X,Y,Z,R,G,B")?;
+    let mut csv = crate::csv_text::writer(w);
+    csv.write_record(["view_deg", "X", "Y", "Z", "R", "G", "B"])?;
     for (&v, (xyz, rgb)) in views_deg.iter().zip(colours) {
-        writeln!(
-            w,
-            "{v},{},{},{},{},{},{}",
-            fmt_sig(xyz[0]),
-            fmt_sig(xyz[1]),
-            fmt_sig(xyz[2]),
-            fmt_sig(rgb[0]),
-            fmt_sig(rgb[1]),
-            fmt_sig(rgb[2])
-        )?;
+        let mut row = vec![v.to_string()];
+        row.extend(xyz.iter().chain(rgb).map(|&c| fmt_sig(c)));
+        csv.write_record(&row)?;
     }
-    Ok(())
+    csv.flush()
 }
 
 /// A diffraction map (`nacre plot diffraction`): the colour of ρ over view directions for
