@@ -510,7 +510,7 @@ fn table_error(path: &Path, message: impl Into<String>) -> Error {
     }
 }
 
-/// Writes `image` to `path` atomically (see [`crate::output::write_atomic`]).
+/// Writes `image` to `path` atomically (see [`crate::atomic::write_atomic`]).
 ///
 /// # Errors
 /// As [`Ktx2Image::encode`]; [`Error::Io`] when the file cannot be written.

@@ -44,7 +44,7 @@
 //!
 //! Every writer refuses non-finite values (and, for half floats, values beyond the `f16`
 //! range) before touching the file system, and writes atomically through
-//! [`crate::output::write_atomic`]: an existing file is replaced only by a complete new
+//! [`crate::atomic::write_atomic`]: an existing file is replaced only by a complete new
 //! one and is left untouched when writing fails. Readers validate the dimensions, channels
 //! and values and never panic on malformed or truncated files; every error names the file.
 

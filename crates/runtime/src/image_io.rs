@@ -1,5 +1,5 @@
 //! CPU images: the size limit of every picture the runtime reads or renders, mip levels and
-//! their 2×2 box-filtered chains (uploaded by [`crate::gpu::upload_mips`]).
+//! their 2×2 box-filtered chains (uploaded by `crate::gpu::upload_mips`).
 
 use crate::error::{Error, Result};
 use std::path::Path;
@@ -102,7 +102,7 @@ pub(crate) fn check_image_size(path: &Path, what: &str, width: usize, height: us
     Ok(())
 }
 
-/// An image rendered by [`Renderer::render`].
+/// An image rendered by [`Renderer::render`](crate::render::Renderer::render).
 #[derive(Clone, Debug)]
 pub struct RenderedImage {
     /// Width, pixels.

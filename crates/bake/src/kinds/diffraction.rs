@@ -569,7 +569,7 @@ struct RawDiffractionRecipe {
 impl DiffractionRecipe {
     /// Parses and validates a recipe: reads or generates the height field, chooses N and
     /// checks the sampling (nothing is transformed yet). `colorimeter` and `name` come from
-    /// the shared `[colour]` parsing of [`crate::bake`].
+    /// the shared `[colour]` parsing of [`crate::recipe`].
     pub fn parse(
         path: &Path,
         text: String,

@@ -13,7 +13,7 @@ use std::path::Path;
 
 /// What both layouts share (`shaders/diffraction_common.wgsl`): `diffraction_finite`,
 /// `diffraction_unit`, `diffraction_frame`, `diffraction_fresnel_of`,
-/// `diffraction_geometry_over_w2`; no bindings. [`DIFFRACTION`] and
+/// `diffraction_geometry_over_w2`; no bindings. [`DIFFRACTION`](super::terms::DIFFRACTION) and
 /// [`super::integrated::WGSL`] each begin with it.
 pub const DIFFRACTION_COMMON: &str = include_str!("../../../../shaders/diffraction_common.wgsl");
 

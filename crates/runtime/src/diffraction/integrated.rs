@@ -9,7 +9,7 @@
 //! Iₚ(u, v), p = 0 … 2N, wavelength-integrated colour tables in the manifest's output space
 //! such that colour = F²(θ_h) · G/w² · Σₚ wᵖ Iₚ(u, v), (u, v, w) = −ω_i − ω_r
 //! (Stam 1999; Dhillon et al. 2014; derivation in
-//! [`nacre_optics::diffraction::integrated`], files in [`nacre_bake::kinds::diffraction_integrated`]).
+//! [`nacre_optics::diffraction::integrated`], files in `nacre_bake::kinds::diffraction_integrated`).
 //! The shader folds u < 0 onto u ≥ 0 ((u, v, w) → (−u, −v, −w), since
 //! Iₚ(−u, −v) = (−1)ᵖ Iₚ(u, v)), maps u and v to texel coordinates on the warped axes,
 //! reads every layer bilinearly from four `textureLoad`s and sums by Horner in w. It is the

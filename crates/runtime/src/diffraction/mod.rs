@@ -16,8 +16,8 @@
 //!
 //! [`DiffractionTables::load`] dispatches on the manifest's `layout` ([`DiffractionLayout`]):
 //! "terms" loads as a [`DiffractionTable`] (`terms.rs`), "integrated" (the fast path, the
-//! wavelength sum done at bake time) as a [`DiffractionIntegrated`]; another layout is an
-//! [`Error::Manifest`] naming it. The scenes, the bench pass ([`ScenePass`]) and
+//! wavelength sum done at bake time) as a [`DiffractionIntegrated`](integrated::DiffractionIntegrated); another layout is an
+//! [`Error::Manifest`](crate::Error::Manifest) naming it. The scenes, the bench pass ([`ScenePass`]) and
 //! [`render_diffraction_scene`] take either: an integrated table runs the same consumers
 //! (`shaders/diffraction_scene.wgsl`) through the adapter
 //! `shaders/diffraction_integrated_technique.wgsl`
@@ -29,7 +29,7 @@
 //! ([`DiffractionOptions::wavelength_step_nm`]): by default the table's own grid (the one the
 //! CPU evaluation uses, `nacre diffraction --color`); a coarser step trades accuracy for
 //! speed (10 nm halves the cost of the 5 nm default set). Each grid gets its own CIE weights
-//! ([`SpectralGrid`]: the 1 nm weights interpolated, × step, rescaled so that ρ ≡ 1 is white),
+//! ([`SpectralGrid`](nacre_optics::diffraction::SpectralGrid): the 1 nm weights interpolated, × step, rescaled so that ρ ≡ 1 is white),
 //! times the table's output matrix M: u(λ) = M · xyz_weight(λ).
 //!
 //! # Coherence-window neighbourhood

@@ -11,8 +11,8 @@ use nacre_optics::diffraction::FresnelTerm;
 use std::path::Path;
 
 /// A `diffraction` table on the GPU in either layout, as [`DiffractionTables::load`] reads it
-/// from its manifest: what the scenes ([`render_diffraction_scene`]) and the bench pass
-/// ([`ScenePass::bench`]) take.
+/// from its manifest: what the scenes ([`render_diffraction_scene`](super::scene::render_diffraction_scene)) and the bench pass
+/// ([`ScenePass::bench`](super::scene::ScenePass::bench)) take.
 pub enum DiffractionTables {
     /// Layout "terms": the Taylor terms, summed over wavelengths per pixel.
     Terms(Box<DiffractionTable>),
@@ -25,10 +25,10 @@ impl DiffractionTables {
     /// [`DiffractionTable::load`] for "terms",
     /// [`DiffractionIntegrated::load`] for "integrated", whose uniform holds `fresnel` (the F²
     /// the scene consumers apply; the terms technique takes F² from
-    /// [`DiffractionOptions::fresnel`] instead, and ignores this argument).
+    /// [`DiffractionOptions::fresnel`](super::terms::DiffractionOptions::fresnel) instead, and ignores this argument).
     ///
     /// # Errors
-    /// As the loaders; [`Error::Manifest`] for a table of another kind or an unknown layout.
+    /// As the loaders; [`Error::Manifest`](crate::Error::Manifest) for a table of another kind or an unknown layout.
     pub fn load(
         ctx: &GpuContext,
         manifest_path: &Path,

@@ -17,7 +17,7 @@ use nacre_optics::colour::Colorimeter;
 use nacre_optics::diffraction::{FresnelTerm, SpectralGrid, TaylorTerms};
 use std::path::{Path, PathBuf};
 
-/// The technique module, layout "terms" ([`DIFFRACTION_COMMON`], then
+/// The technique module, layout "terms" ([`DIFFRACTION_COMMON`](super::common::DIFFRACTION_COMMON), then
 /// `shaders/diffraction.wgsl`, which imports it; `shaders::flatten("diffraction")` plus a
 /// newline): bind group 1 and the functions `diffraction_colour`,
 /// `diffraction_specular_order_colour`, `diffraction_fresnel`, `diffraction_frame`.
@@ -72,7 +72,7 @@ impl DiffractionTable {
     /// # Errors
     /// [`Error::Table`] for unreadable or malformed files; [`Error::Manifest`] for a table
     /// of another kind or layout (an "integrated" table loads with
-    /// [`DiffractionTables::load`]), a file that does not match its manifest, or an order
+    /// [`DiffractionTables::load`](super::tables::DiffractionTables::load)), a file that does not match its manifest, or an order
     /// above [`MAX_TAYLOR_ORDER`]; [`Error::Limit`] when the texture exceeds the device.
     pub fn load(ctx: &GpuContext, manifest_path: &Path) -> Result<DiffractionTable> {
         let (manifest, record) = diffraction_record(manifest_path)?;
@@ -202,7 +202,7 @@ pub struct DiffractionOptions {
     /// table's own step (the CPU's grid). Layout "terms" only.
     pub wavelength_step_nm: Option<f64>,
     /// The Fresnel factor F² (default: 1, a perfect reflector). An integrated table holds
-    /// its F² in its uniform ([`DiffractionTables::load`]); a scene or bench pass refuses
+    /// its F² in its uniform ([`DiffractionTables::load`](super::tables::DiffractionTables::load)); a scene or bench pass refuses
     /// one loaded with another F².
     pub fresnel: FresnelTerm,
     /// Largest window weight the neighbourhood may drop (default 10⁻³; module docs). Layout

@@ -552,11 +552,11 @@ pub struct SceneOptions {
     /// The camera (default: [`Camera::for_scene`]).
     pub camera: Camera,
     /// An OpenEXR equirectangular environment, or `None` for the default
-    /// ([`EnvironmentMap::default_map`]).
+    /// ([`EnvironmentMap::default_map`](crate::environment::EnvironmentMap::default_map)).
     pub environment: Option<PathBuf>,
     /// Scale of the environment's radiance (default 1).
     pub env_intensity: f32,
-    /// A greyscale PNG thickness map, or `None` for [`procedural_thickness_map`].
+    /// A greyscale PNG thickness map, or `None` for [`procedural_thickness_map`](crate::thickness_map::procedural_thickness_map).
     pub thickness_map: Option<PathBuf>,
     /// The material (default: [`MaterialOptions::for_scene`]).
     pub material: MaterialOptions,
@@ -625,7 +625,7 @@ impl SceneOptions {
     }
 
     /// Checks sizes, exposure, intensities, the light and the material (not the files, not
-    /// the tables): [`Renderer::render`] calls it first.
+    /// the tables): [`Renderer::render`](super::Renderer::render) calls it first.
     pub fn validate(&self) -> Result<()> {
         for (name, v) in [("width", self.width), ("height", self.height)] {
             if !(1..=MAX_DIMENSION).contains(&v) {

@@ -17,7 +17,7 @@ use bytemuck::{Pod, Zeroable};
 /// (`material_display`), not an `…Srgb` format: the bytes read back are the bytes of the PNG.
 pub const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
-/// What a [`Renderer`] writes: display pixels or linear radiance.
+/// What a [`Renderer`](super::Renderer) writes: display pixels or linear radiance.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum RenderOutput {
     /// Exposed, tone-mapped (PBR Neutral), sRGB-encoded RGBA8 ([`TARGET_FORMAT`]).
