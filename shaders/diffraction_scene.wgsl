@@ -1,5 +1,5 @@
 // nacre · shaders/diffraction_scene.wgsl
-// import: diffraction_common, <technique>
+// import: diffraction_common, <technique>, output
 //
 // Consumers of the `diffraction` technique (composed after diffraction.wgsl by
 // `nacre_runtime::diffraction`): the ray-cast scenes of `nacre render --scene cd-disc |
@@ -45,7 +45,8 @@
 //                 whole target, t swirling over the screen, the light only, no environment.
 //
 // Output: linear radiance × 2^exposure, tone mapped c/(1 + max channel) (hue-preserving
-// Reinhard on the largest channel), sRGB-encoded into an Rgba8Unorm target.
+// Reinhard on the largest channel), sRGB-encoded into an Rgba8Unorm target (the tone mapper
+// and the sRGB transfer function are output.wgsl's).
 
 // Byte layout (400 bytes; `nacre_runtime::diffraction::DiffractionViewUniform` mirrors it):
 //
@@ -238,11 +239,8 @@ fn scene_display(radiance: vec3<f32>) -> vec4<f32> {
     if !diffraction_finite3(c) {
         c = vec3<f32>(0.0);
     }
-    let peak = max(c.r, max(c.g, c.b));
-    let mapped = c / (1.0 + peak);
-    let lo = mapped * 12.92;
-    let hi = 1.055 * pow(mapped, vec3<f32>(1.0 / 2.4)) - 0.055;
-    return vec4<f32>(select(hi, lo, mapped <= vec3<f32>(0.0031308)), 1.0);
+    let mapped = tone_map_max_channel(c);
+    return vec4<f32>(srgb_transfer(mapped), 1.0);
 }
 
 fn scene_bench(position: vec2<f32>) -> vec3<f32> {

@@ -1,12 +1,13 @@
 // nacre · shaders/material.wgsl — consumer: a thin-film microfacet material
-// import: common, <technique>, rough_lut_mapping
+// import: common, <technique>, rough_lut_mapping, output
 //
 // A GGX specular lobe whose Fresnel term is the technique's film colour, over a Lambertian
 // (dielectric) or metallic base, lit by one directional light and by an equirectangular HDR
 // environment, with optional transmission through a thin transparent shell (soap bubble),
 // exposure, the Khronos PBR Neutral tone mapper and an sRGB encoding. Composed after
-// common.wgsl, lut_mapping.wgsl, one technique module (which supplies `film_colour`) and
-// rough_lut_mapping.wgsl (its import line above: `nacre_runtime::shaders` resolves them), and before
+// common.wgsl, lut_mapping.wgsl, one technique module (which supplies `film_colour`),
+// rough_lut_mapping.wgsl and output.wgsl (its import line above: `nacre_runtime::shaders`
+// resolves them), and before
 // scene.wgsl or mesh.wgsl, which ray-casts the geometry and calls `material_shade`
 // (crates/runtime/src/render.rs; shaders/README.md).
 //
@@ -145,6 +146,7 @@
 // Output: exposure (a factor 2^EV), tone mapping by Khronos PBR Neutral
 // (KhronosGroup/ToneMapping, PBR_Neutral, 2024), then the sRGB transfer function
 // (IEC 61966-2-1) applied here: the render target is Rgba8Unorm and holds sRGB-encoded bytes.
+// The tone mapper and the encoding are output.wgsl's; the exposure and guards are here.
 //
 // NaN guards: every film evaluation is sanitised by the technique; vectors are normalised
 // with a fallback; the final colour replaces non-finite channels by 0 before tone mapping.
@@ -657,34 +659,6 @@ fn material_shade(s: SurfacePoint) -> ShadeResult {
 }
 
 // ─── Output ──────────────────────────────────────────────────────────────────────────────
-
-// Khronos PBR Neutral tone mapping (KhronosGroup/ToneMapping, PBR_Neutral; linear in,
-// linear out, [0, 1]): hue-preserving, identity below 0.76 apart from a small black offset.
-fn tone_map_pbr_neutral(colour: vec3<f32>) -> vec3<f32> {
-    let start_compression = 0.8 - 0.04;
-    let desaturation = 0.15;
-    var c = colour;
-    let x = min(c.r, min(c.g, c.b));
-    let offset = select(0.04, x - 6.25 * x * x, x < 0.08);
-    c -= offset;
-    let peak = max(c.r, max(c.g, c.b));
-    if peak < start_compression {
-        return c;
-    }
-    let d = 1.0 - start_compression;
-    let new_peak = 1.0 - d * d / (peak + d - start_compression);
-    c *= new_peak / peak;
-    let g = 1.0 - 1.0 / (desaturation * (peak - new_peak) + 1.0);
-    return mix(c, vec3<f32>(new_peak), g);
-}
-
-// The sRGB transfer function (IEC 61966-2-1), linear [0, 1] → encoded [0, 1].
-fn srgb_encode(linear: vec3<f32>) -> vec3<f32> {
-    let c = clamp(linear, vec3<f32>(0.0), vec3<f32>(1.0));
-    let lo = c * 12.92;
-    let hi = 1.055 * pow(c, vec3<f32>(1.0 / 2.4)) - 0.055;
-    return select(hi, lo, c <= vec3<f32>(0.0031308));
-}
 
 // Linear scene radiance → the sRGB-encoded colour written to the Rgba8Unorm target:
 // exposure, PBR Neutral, sRGB. Non-finite or negative channels count as 0.

@@ -47,9 +47,12 @@ pub const PROBE: &str = include_str!("../../../shaders/probe.wgsl");
 /// The rough-film-lut coordinate mappings and two-fetch lookup (mirror of
 /// `nacre_bake::kinds::rough_film_lut`; no bindings of its own).
 pub const ROUGH_LUT_MAPPING: &str = include_str!("../../../shaders/rough_lut_mapping.wgsl");
+/// Display output shared by [`MATERIAL`] and the diffraction scenes: the Khronos PBR Neutral
+/// and max-channel tone mappers and the sRGB encoding (no bindings of its own).
+pub const OUTPUT: &str = include_str!("../../../shaders/output.wgsl");
 /// Consumer: the thin-film microfacet material (GGX + film, environment, light, tone
 /// mapping; groups 0 and 2). It imports [`ROUGH_LUT_MAPPING`] (its exact split-sum path
-/// samples a `rough-film-lut`), which [`compose`] places before it. Compose it before
+/// samples a `rough-film-lut`) and [`OUTPUT`], which [`compose`] places before it. Compose it before
 /// [`SCENE`] or [`MESH`] (which import it).
 pub const MATERIAL: &str = include_str!("../../../shaders/material.wgsl");
 /// Consumer: the ray-cast analytic scenes of `nacre render` (sphere, bubble, plane).
@@ -98,6 +101,7 @@ pub const MODULES: &[Module] = modules![
     "film_spectral",
     "plain",
     "rough_lut_mapping",
+    "output",
     "material",
     "scene",
     "mesh",
@@ -699,7 +703,11 @@ mod tests {
             ("film_spectral", &["common"]),
             ("plain", &["common"]),
             ("rough_lut_mapping", &[]),
-            ("material", &["common", "<technique>", "rough_lut_mapping"]),
+            ("output", &[]),
+            (
+                "material",
+                &["common", "<technique>", "rough_lut_mapping", "output"],
+            ),
             ("scene", &["material"]),
             ("mesh", &["material"]),
             ("probe", &["common", "<technique>"]),
@@ -711,7 +719,10 @@ mod tests {
                 "diffraction_integrated_technique",
                 &["diffraction_integrated"],
             ),
-            ("diffraction_scene", &["diffraction_common", "<technique>"]),
+            (
+                "diffraction_scene",
+                &["diffraction_common", "<technique>", "output"],
+            ),
             ("diffraction_integrated_probe", &["diffraction_integrated"]),
         ];
         assert_eq!(expected.len(), MODULES.len());
@@ -841,7 +852,7 @@ mod tests {
     }
 
     /// The compositions the runtime used before the import headers, by hand: each part
-    /// followed by a newline, `MATERIAL` = rough_lut_mapping + material.
+    /// followed by a newline, `MATERIAL` = rough_lut_mapping + output + material.
     #[test]
     fn compositions_are_the_historical_concatenations() {
         let cat = |parts: &[&str]| parts.iter().map(|p| format!("{p}\n")).collect::<String>();
@@ -852,15 +863,15 @@ mod tests {
             assert_eq!(compose(t, &[BENCH]), with(&[BENCH]));
             assert_eq!(
                 compose(t, &[MATERIAL, SCENE]),
-                with(&[ROUGH_LUT_MAPPING, MATERIAL, SCENE])
+                with(&[ROUGH_LUT_MAPPING, OUTPUT, MATERIAL, SCENE])
             );
             assert_eq!(
                 compose(t, &[MATERIAL, MESH]),
-                with(&[ROUGH_LUT_MAPPING, MATERIAL, MESH])
+                with(&[ROUGH_LUT_MAPPING, OUTPUT, MATERIAL, MESH])
             );
             assert_eq!(
                 film_pipeline(t.module(), &["scene"]).unwrap().source,
-                with(&[ROUGH_LUT_MAPPING, MATERIAL, SCENE])
+                with(&[ROUGH_LUT_MAPPING, OUTPUT, MATERIAL, SCENE])
             );
             assert_eq!(
                 film_pipeline(t.module(), &["mesh"]).unwrap().source,
@@ -894,6 +905,7 @@ mod tests {
                 "lut_mapping.wgsl",
                 "film_lut.wgsl",
                 "rough_lut_mapping.wgsl",
+                "output.wgsl",
                 "material.wgsl",
                 "consumer 2"
             ]

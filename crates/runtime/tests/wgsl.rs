@@ -460,6 +460,7 @@ fn diffraction_constants_are_the_flattened_modules() {
     use nacre_runtime::diffraction_integrated::{
         self as integrated, PROBE, TECHNIQUE_ADAPTER, WGSL,
     };
+    use nacre_runtime::shaders::OUTPUT;
     let flat = |name: &str| shaders::flatten(name).unwrap().source;
     assert_eq!(format!("{DIFFRACTION}\n"), flat("diffraction"));
     assert_eq!(format!("{WGSL}\n"), flat("diffraction_integrated"));
@@ -470,12 +471,12 @@ fn diffraction_constants_are_the_flattened_modules() {
     // The historical concatenations of the three pipelines.
     assert_eq!(
         diffraction::compose(),
-        format!("{DIFFRACTION}\n{DIFFRACTION_SCENE}\n")
+        format!("{DIFFRACTION}\n{OUTPUT}\n{DIFFRACTION_SCENE}\n")
     );
     assert_eq!(integrated::compose_probe(), format!("{WGSL}\n{PROBE}\n"));
     assert_eq!(
         integrated::compose_scene(),
-        format!("{WGSL}\n{TECHNIQUE_ADAPTER}\n{DIFFRACTION_SCENE}\n")
+        format!("{WGSL}\n{TECHNIQUE_ADAPTER}\n{OUTPUT}\n{DIFFRACTION_SCENE}\n")
     );
 }
 

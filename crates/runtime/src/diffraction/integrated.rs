@@ -114,7 +114,7 @@ pub fn compose_scene() -> String {
 
 /// `shaders/diffraction_scene.wgsl` with its imports, `<technique>` =
 /// `diffraction_integrated_technique` (diffraction_common, diffraction_integrated, the
-/// adapter, diffraction_scene), and its source map.
+/// adapter, output, diffraction_scene), and its source map.
 pub fn scene_composition() -> shaders::Composed {
     shaders::flatten_with("diffraction_scene", "diffraction_integrated_technique")
         .expect("the diffraction modules resolve (tested)")

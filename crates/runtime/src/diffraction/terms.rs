@@ -41,7 +41,7 @@ pub fn compose() -> String {
 }
 
 /// `shaders/diffraction_scene.wgsl` with its imports, `<technique>` = `diffraction`
-/// (diffraction_common, diffraction, diffraction_scene), and its source map.
+/// (diffraction_common, diffraction, output, diffraction_scene), and its source map.
 pub fn composition() -> shaders::Composed {
     shaders::flatten_with("diffraction_scene", "diffraction")
         .expect("the diffraction modules resolve (tested)")
