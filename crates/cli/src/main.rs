@@ -249,8 +249,8 @@ film on water to the horizon, the thickness map minified towards it). Techniques
 (trilinear lookup in the film-lut table), fourier (Belcour & Barla 2017 Eq. 10 with the
 fourier table, prefiltered by the thickness's pixel footprint), spectral (N wavelengths, brute
 force). The base, ambient and film index range come from the film-lut table. The environment
-is an equirectangular OpenEXR (default tables/env/studio.exr); the thickness map an 8/16-bit
-greyscale PNG (default: built-in swirls). Output: 8-bit sRGB PNG (Khronos PBR Neutral tone
+is an equirectangular OpenEXR, Radiance HDR, or sRGB PNG/JPEG (default tables/env/studio.exr);
+the thickness map an 8/16-bit greyscale PNG or JPEG (default: built-in swirls). Output: 8-bit sRGB PNG (Khronos PBR Neutral tone
 mapping).
 
 Examples:
@@ -318,9 +318,9 @@ struct RenderArgs {
     /// Image height, pixels (1 to 8192).
     #[arg(long, default_value_t = 600)]
     height: u32,
-    /// Equirectangular HDR environment (OpenEXR, RGB, row 0 = zenith) [default:
-    /// tables/env/studio.exr].
-    #[arg(long, value_name = "FILE.exr")]
+    /// Equirectangular environment (OpenEXR or Radiance HDR, linear; PNG or JPEG, sRGB;
+    /// row 0 = zenith) [default: tables/env/studio.exr].
+    #[arg(long, value_name = "FILE")]
     env: Option<PathBuf>,
     /// Greyscale thickness map (8- or 16-bit PNG) [default: built-in swirls].
     #[arg(long, value_name = "FILE.png")]

@@ -37,18 +37,30 @@ pub fn default_environment_path() -> PathBuf {
 }
 
 impl EnvironmentMap {
-    /// Reads an OpenEXR equirectangular image (half or float `R`, `G`, `B` channels; other
-    /// channels ignored). Negative values become 0.
+    /// Reads an equirectangular image: OpenEXR (half or float `R`, `G`, `B` channels; other
+    /// channels ignored), Radiance HDR (linear floats), or PNG/JPEG (8 or 16 bits, sRGB
+    /// encoded: decoded to linear with the IEC 61966-2-1 transfer function, so 1.0 is the
+    /// brightest a low-dynamic-range picture can hold). A file named `.exr`, or starting
+    /// with the OpenEXR magic number, is read as OpenEXR; any other through the `image`
+    /// crate. Negative values become 0.
     ///
     /// # Errors
     /// [`Error::Io`] or [`Error::Table`] when the file cannot be read or is not a valid flat
-    /// single-part RGB OpenEXR image with finite values; [`Error::Invalid`] when a side is 0
-    /// or larger than [`crate::image_io::MAX_DIMENSION`] (checked before the pixels are decoded).
+    /// single-part RGB OpenEXR image with finite values; [`Error::Invalid`] for a picture
+    /// that is not a valid PNG, JPEG or Radiance HDR file, or when a side is 0 or larger than
+    /// [`crate::image_io::MAX_DIMENSION`] (checked before the pixels are decoded).
     pub fn load(path: &Path) -> Result<EnvironmentMap> {
         let bytes = std::fs::read(path).map_err(|source| Error::Io {
             path: path.to_path_buf(),
             source,
         })?;
+        const EXR_MAGIC: [u8; 4] = [0x76, 0x2f, 0x31, 0x01];
+        let named_exr = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+        if !named_exr && !bytes.starts_with(&EXR_MAGIC) {
+            return Self::from_picture(path, &bytes);
+        }
         let header = std::panic::catch_unwind(|| {
             exr::meta::MetaData::read_from_buffered(Cursor::new(&bytes[..]), false)
         });
@@ -81,6 +93,28 @@ impl EnvironmentMap {
                 .map(|c| [c[0].max(0.0), c[1].max(0.0), c[2].max(0.0)])
                 .collect(),
         })
+    }
+
+    /// A PNG, JPEG or Radiance HDR environment (see [`EnvironmentMap::load`]).
+    fn from_picture(path: &Path, bytes: &[u8]) -> Result<EnvironmentMap> {
+        let picture = crate::image_io::decode_picture(path, "an environment", bytes)?;
+        let (width, height) = (picture.width() as usize, picture.height() as usize);
+        check_image_size(path, "an environment", width, height)?;
+        let linear = matches!(
+            picture,
+            image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)
+        );
+        let rgb = picture
+            .to_rgb32f()
+            .pixels()
+            .map(|p| {
+                p.0.map(|v| {
+                    let v = if v.is_finite() { v.max(0.0) } else { 0.0 };
+                    if linear { v } else { srgb_to_linear(v) }
+                })
+            })
+            .collect();
+        Ok(EnvironmentMap { width, height, rgb })
     }
 
     /// The default environment: [`default_environment_path`] when it exists, else the same
@@ -227,4 +261,67 @@ pub fn procedural_environment_with(width: usize, height: usize, sun_on: bool) ->
         }
     }
     EnvironmentMap { width, height, rgb }
+}
+
+/// The sRGB electro-optical transfer function (IEC 61966-2-1): an encoded value in [0, 1]
+/// to linear.
+fn srgb_to_linear(v: f32) -> f32 {
+    if v <= 0.04045 {
+        v / 12.92
+    } else {
+        ((v + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+#[cfg(test)]
+mod picture_tests {
+    use super::*;
+
+    /// PNG environments are sRGB-decoded to linear; Radiance HDR ones are read as linear
+    /// floats; a junk file named `.png` is an error naming the file.
+    #[test]
+    fn png_and_hdr_environments_load_as_linear_radiance() {
+        let dir = tempfile::tempdir().unwrap();
+        let png = dir.path().join("env.png");
+        let img = image::RgbImage::from_fn(4, 2, |x, _| match x {
+            0 => image::Rgb([0, 0, 0]),
+            1 => image::Rgb([255, 255, 255]),
+            _ => image::Rgb([128, 10, 250]),
+        });
+        img.save(&png).unwrap();
+        let env = EnvironmentMap::load(&png).unwrap();
+        assert_eq!((env.width, env.height), (4, 2));
+        assert_eq!(env.rgb[0], [0.0; 3]);
+        assert_eq!(env.rgb[1], [1.0; 3]);
+        let expect = [128.0f32, 10.0, 250.0].map(|v| srgb_to_linear(v / 255.0));
+        for (got, want) in env.rgb[2].iter().zip(expect) {
+            assert!((got - want).abs() < 1e-6, "{:?}", env.rgb[2]);
+        }
+        assert!((env.rgb[2][0] - 0.2158605).abs() < 1e-6);
+
+        let hdr = dir.path().join("env.hdr");
+        let pixels: Vec<f32> = (0..4 * 2)
+            .flat_map(|i| [i as f32 * 2.5, 0.25, 40.0])
+            .collect();
+        image::DynamicImage::ImageRgb32F(image::Rgb32FImage::from_raw(4, 2, pixels).unwrap())
+            .save(&hdr)
+            .unwrap();
+        let env = EnvironmentMap::load(&hdr).unwrap();
+        assert_eq!((env.width, env.height), (4, 2));
+        // Radiance HDR stores an 8-bit mantissa per channel with a shared exponent.
+        for (i, t) in env.rgb.iter().enumerate() {
+            let want = [i as f32 * 2.5, 0.25, 40.0];
+            for c in 0..3 {
+                assert!(
+                    (t[c] - want[c]).abs() <= want[c].abs() / 64.0 + 1e-3,
+                    "{t:?} {want:?}"
+                );
+            }
+        }
+
+        let junk = dir.path().join("junk.png");
+        std::fs::write(&junk, b"not a picture").unwrap();
+        let e = EnvironmentMap::load(&junk).unwrap_err().to_string();
+        assert!(e.contains("junk.png"), "{e}");
+    }
 }
