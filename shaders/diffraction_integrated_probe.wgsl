@@ -3,7 +3,7 @@
 //
 // The GPU = CPU probe of the layout "integrated" (compute; composed after
 // diffraction_integrated.wgsl by `nacre_runtime::diffraction_integrated::run_probe`).
-// Group 0 is empty, group 1 the technique, group 2 the probe's buffers.
+// Group 0 is empty, group 1 the technique, group 2 unused, group 3 the probe's buffers.
 //
 // Input i (three vec4 per case):
 //   probe_in[3i]     = (ω_i.xyz, F² kind as a float: 0 or 1)    grating frame, any values
@@ -13,8 +13,8 @@
 //   probe_out[2i]     = (diffraction_integrated_colour(ω_i, ω_r, F²), 0)
 //   probe_out[2i + 1] = (diffraction_integrated_specular_colour(cos θ, F²), 0)
 
-@group(2) @binding(0) var<storage, read> probe_in: array<vec4<f32>>;
-@group(2) @binding(1) var<storage, read_write> probe_out: array<vec4<f32>>;
+@group(3) @binding(0) var<storage, read> probe_in: array<vec4<f32>>;
+@group(3) @binding(1) var<storage, read_write> probe_out: array<vec4<f32>>;
 
 @compute @workgroup_size(64)
 fn diffraction_integrated_probe(@builtin(global_invocation_id) id: vec3<u32>) {

@@ -1,5 +1,5 @@
 // nacre · shaders/diffraction_scene.wgsl
-// import: diffraction_common, <technique>, output
+// import: diffraction_common, <technique>, view, output
 //
 // Consumers of the `diffraction` technique (composed after diffraction.wgsl by
 // `nacre_runtime::diffraction`): the ray-cast scenes of `nacre render --scene cd-disc |
@@ -25,7 +25,7 @@
 // The environment enters twice, as a documented approximation: its mirror image through the
 // zeroth order (exact for an extended source: the order keeps |P_DC|² of the radiance), and
 // the K brightest texels of a 32 × 16 downsampled copy as directional samples
-// (`DiffractionView.samples`, chosen on the CPU at least 25° apart above the horizon, each
+// (`DiffractionLights.samples`, chosen on the CPU at least 25° apart above the horizon, each
 // with E_k = L_texel · Ω_texel) whose diffracted orders are evaluated like the light's:
 // extended sources are thus diffracted as if they were points (thin rainbow lines, with the
 // right total power, instead of wide smeared bands).
@@ -48,45 +48,29 @@
 // Reinhard on the largest channel), sRGB-encoded into an Rgba8Unorm target (the tone mapper
 // and the sRGB transfer function are output.wgsl's).
 
-// Byte layout (400 bytes; `nacre_runtime::diffraction::DiffractionViewUniform` mirrors it):
+// Group 0 is every scene's (view.wgsl: `view`, `env_map`, `env_sampler`; the split-sum
+// textures there are unused placeholders), with view.light_intensity = E_0, the light's
+// irradiance at normal incidence, and view.scene = 0 cd-disc, 1 snake-skin, 2 bench.
+//
+// Group 2, the lights as the gratings see them (272 bytes, uniform;
+// `nacre_runtime::diffraction::DiffractionLightsUniform` mirrors it):
 //
 //   offset size field
-//        0   64 inv_view_proj: mat4x4<f32>  clip (x, y ∈ [−1, 1], z ∈ [0, 1]) → world
-//       64   12 eye: vec3<f32>              camera position
-//       76    4 exposure: f32               2^EV
-//       80   12 light_direction: vec3<f32>  towards the light (unit)
-//       92    4 light_intensity: f32        I_0 = E_0 (σ_s k₀)²/π
-//      96   12 light_colour: vec3<f32>
-//      108    4 env_intensity: f32
-//      112    8 resolution: vec2<f32>       pixels
-//      120    4 scene: u32
-//      124    4 sample_count: u32           environment samples used (≤ 8)
-//      128  128 samples: array<vec4<f32>, 8>          direction xyz (unit), w unused
-//      256  128 sample_radiance: array<vec4<f32>, 8>  I_k rgb (× env_intensity on the CPU)
-//      384    4 light_irradiance: f32       E_0 (the snake's diffuse skin)
-//      388   12 _pad0, _pad1, _pad2: f32
-struct DiffractionView {
-    inv_view_proj: mat4x4<f32>,
-    eye: vec3<f32>,
-    exposure: f32,
-    light_direction: vec3<f32>,
-    light_intensity: f32,
-    light_colour: vec3<f32>,
-    env_intensity: f32,
-    resolution: vec2<f32>,
-    scene: u32,
+//        0    4 light_radiance: f32         I_0 = E_0 (σ_s k₀)²/π
+//        4    4 sample_count: u32           environment samples used (≤ 8)
+//        8    8 _pad0, _pad1: f32
+//       16  128 samples: array<vec4<f32>, 8>          direction xyz (unit), w unused
+//      144  128 sample_radiance: array<vec4<f32>, 8>  I_k rgb (× env_intensity on the CPU)
+struct DiffractionLights {
+    light_radiance: f32,
     sample_count: u32,
-    samples: array<vec4<f32>, 8>,
-    sample_radiance: array<vec4<f32>, 8>,
-    light_irradiance: f32,
     _pad0: f32,
     _pad1: f32,
-    _pad2: f32,
+    samples: array<vec4<f32>, 8>,
+    sample_radiance: array<vec4<f32>, 8>,
 }
 
-@group(0) @binding(0) var<uniform> view: DiffractionView;
-@group(0) @binding(1) var environment: texture_2d<f32>;
-@group(0) @binding(2) var environment_sampler: sampler;
+@group(2) @binding(0) var<uniform> lights: DiffractionLights;
 
 const SCENE_PI: f32 = 3.14159265358979;
 
@@ -105,7 +89,7 @@ fn scene_env_uv(d: vec3<f32>) -> vec2<f32> {
 }
 
 fn scene_env(d: vec3<f32>, lod: f32) -> vec3<f32> {
-    return textureSampleLevel(environment, environment_sampler, scene_env_uv(d), lod).rgb * view.env_intensity;
+    return textureSampleLevel(env_map, env_sampler, scene_env_uv(d), lod).rgb * view.env_intensity;
 }
 
 // Deterministic hash of a lattice cell, in [0, 1)².
@@ -211,12 +195,12 @@ fn scene_shade(s: Surface, to_eye: vec3<f32>) -> vec3<f32> {
     let wr = frame * to_eye;
     var radiance = vec3<f32>(0.0);
     let light = normalize(view.light_direction);
-    let light_radiance = view.light_colour * view.light_intensity;
+    let light_radiance = view.light_colour * lights.light_radiance;
     if s.grating > 0.0 {
         var diffracted = diffraction_colour(frame * light, wr) * light_radiance;
-        let count = min(view.sample_count, 8u);
+        let count = min(lights.sample_count, 8u);
         for (var k = 0u; k < count; k++) {
-            diffracted += diffraction_colour(frame * view.samples[k].xyz, wr) * view.sample_radiance[k].rgb;
+            diffracted += diffraction_colour(frame * lights.samples[k].xyz, wr) * lights.sample_radiance[k].rgb;
         }
         radiance += s.grating * diffracted;
     }
@@ -230,7 +214,7 @@ fn scene_shade(s: Surface, to_eye: vec3<f32>) -> vec3<f32> {
     radiance += env * mix(clear, specular, s.grating);
     // The snake's dark skin: diffuse under the light and a constant sky term.
     let n_dot_l = max(dot(n, light), 0.0);
-    radiance += s.base * (n_dot_l * view.light_colour * view.light_irradiance + vec3<f32>(0.6) * view.env_intensity);
+    radiance += s.base * (n_dot_l * view.light_colour * view.light_intensity + vec3<f32>(0.6) * view.env_intensity);
     return radiance;
 }
 
@@ -257,7 +241,7 @@ fn scene_bench(position: vec2<f32>) -> vec3<f32> {
     let frame = diffraction_frame(n, across);
     let v = vec3<f32>(0.0, 0.0, 1.0);
     let l = normalize(view.light_direction);
-    return diffraction_colour(frame * l, frame * v) * view.light_colour * view.light_intensity;
+    return diffraction_colour(frame * l, frame * v) * view.light_colour * lights.light_radiance;
 }
 
 @fragment
@@ -291,8 +275,8 @@ fn diffraction_scene_fs(@builtin(position) position: vec4<f32>) -> @location(0) 
 // Output i: probe_out[2i] = diffraction_colour(ω_i, ω_r),
 //           probe_out[2i + 1] = diffraction_specular_order_colour(ω_r.z).
 
-@group(2) @binding(0) var<storage, read> probe_in: array<vec4<f32>>;
-@group(2) @binding(1) var<storage, read_write> probe_out: array<vec4<f32>>;
+@group(3) @binding(0) var<storage, read> probe_in: array<vec4<f32>>;
+@group(3) @binding(1) var<storage, read_write> probe_out: array<vec4<f32>>;
 
 @compute @workgroup_size(64)
 fn diffraction_probe(@builtin(global_invocation_id) id: vec3<u32>) {

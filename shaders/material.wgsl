@@ -1,15 +1,15 @@
 // nacre · shaders/material.wgsl — consumer: a thin-film microfacet material
-// import: common, <technique>, rough_lut_mapping, output
+// import: common, <technique>, rough_lut_mapping, view, output
 //
 // A GGX specular lobe whose Fresnel term is the technique's film colour, over a Lambertian
 // (dielectric) or metallic base, lit by one directional light and by an equirectangular HDR
 // environment, with optional transmission through a thin transparent shell (soap bubble),
 // exposure, the Khronos PBR Neutral tone mapper and an sRGB encoding. Composed after
 // common.wgsl, lut_mapping.wgsl, one technique module (which supplies `film_colour`),
-// rough_lut_mapping.wgsl and output.wgsl (its import line above: `nacre_runtime::shaders`
+// rough_lut_mapping.wgsl, view.wgsl (group 0) and output.wgsl (its import line above: `nacre_runtime::shaders`
 // resolves them), and before
 // scene.wgsl or mesh.wgsl, which ray-casts the geometry and calls `material_shade`
-// (crates/runtime/src/render.rs; shaders/README.md).
+// (crates/runtime/src/render/mod.rs; shaders/README.md).
 //
 // Symbols
 //
@@ -151,58 +151,11 @@
 // NaN guards: every film evaluation is sanitised by the technique; vectors are normalised
 // with a fallback; the final colour replaces non-finite channels by 0 before tone mapping.
 
-// ─── Group 0: the view (changes per frame) ───────────────────────────────────────────────
-//
-// 128 bytes, uniform (mirrored by `ViewUniform` in crates/runtime/src/render.rs):
-//
-//   offset size field
-//        0   64 inv_view_proj: mat4x4<f32>    clip (x, y ∈ [−1, 1], z ∈ [0, 1]) → world
-//       64   12 eye_position: vec3<f32>       camera position, world units
-//       76    4 exposure: f32                 linear factor 2^EV before tone mapping
-//       80   12 light_direction: vec3<f32>    unit vector from the surface towards the light
-//       92    4 light_intensity: f32          scale of light_colour
-//       96   12 light_colour: vec3<f32>       linear RGB
-//      108    4 env_intensity: f32            scale of the environment radiance
-//      112    8 resolution: vec2<f32>         render target size, pixels
-//      120    4 scene: u32                    scene.wgsl: 0 sphere, 1 bubble, 2 plane
-//      124    4 env_lod_max: f32              last mip level of env_map (GLSL ES cannot query it)
-struct ViewParams {
-    inv_view_proj: mat4x4<f32>,
-    eye_position: vec3<f32>,
-    exposure: f32,
-    light_direction: vec3<f32>,
-    light_intensity: f32,
-    light_colour: vec3<f32>,
-    env_intensity: f32,
-    resolution: vec2<f32>,
-    scene: u32,
-    env_lod_max: f32,
-}
-
-@group(0) @binding(0) var<uniform> view: ViewParams;
-// Equirectangular HDR environment, Rgba16Float with a full mip chain. Row 0 is the zenith
-// (+y); u = 0.5 looks down −z, u increases towards +x (env_direction_to_uv).
-@group(0) @binding(1) var env_map: texture_2d<f32>;
-// Linear min/mag/mip; u repeats, v clamps.
-@group(0) @binding(2) var env_sampler: sampler;
-// The GGX-prefiltered environment of the split sum (Rgba16Float, ENV_PREFILTER_LEVELS array
-// layers of one size, layer k = the convolution with GGX of α_k = (k/(L − 1))², n = v = r;
-// crates/runtime/src/ibl.rs). Same equirectangular layout and sampler as env_map.
-@group(0) @binding(3) var env_prefiltered: texture_2d_array<f32>;
-// E₁(μ_o, α): directional albedo of GGX with F = 1 (Rg16Float, GGX_ALBEDO_SIZE², x = μ_o,
-// y = α, texel i at t = i/(n − 1), sampled at (t (n − 1) + 0.5)/n; r = E₁).
-@group(0) @binding(4) var env_ggx_albedo: texture_2d<f32>;
-// Linear, clamp to edge (env_ggx_albedo and the rough-film-lut).
-@group(0) @binding(5) var env_lut_sampler: sampler;
-// The rough-film-lut's reflected albedo E_r (Rgba16Float; layout and mapping in
-// rough_lut_mapping.wgsl, which this module is composed after) and its axes. A 1×1×1
-// placeholder unless the exact path is drawn.
-@group(0) @binding(6) var env_rough_lut: texture_3d<f32>;
-@group(0) @binding(7) var<uniform> env_rough_lut_params: RoughLutParams;
+// ─── Group 0: the view and the environment (changes per frame): view.wgsl ───────────────
 
 // ─── Group 2: the material (changes per draw) ────────────────────────────────────────────
 //
-// 96 bytes, uniform (mirrored by `MaterialUniform` in crates/runtime/src/render.rs):
+// 96 bytes, uniform (mirrored by `MaterialUniform` in crates/runtime/src/render/options.rs):
 //
 //   offset size field
 //        0    4 film_ior: f32                 real film index n₂

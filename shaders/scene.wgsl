@@ -5,7 +5,7 @@
 // per pixel into an analytic scene chosen by ViewParams.scene, shades the hit with
 // material.wgsl's `material_shade` and writes the tone-mapped, sRGB-encoded colour to an
 // Rgba8Unorm target. No meshes, no depth buffer. Composed after material.wgsl
-// (crates/runtime/src/render.rs: `shaders::compose(technique, &[MATERIAL, SCENE])`).
+// (crates/runtime/src/render/mod.rs: `shaders::compose(technique, &[MATERIAL, SCENE])`).
 //
 // Scenes (world units; y up; the camera comes from ViewParams.inv_view_proj):
 //
@@ -177,7 +177,7 @@ fn scene_fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
 }
 
 // Linear output: the pixel's scene radiance before exposure and tone mapping, for an
-// Rgba32Float target (crates/runtime/src/render.rs, RenderOutput::Linear; the Monte Carlo
+// Rgba32Float target (crates/runtime/src/render/mod.rs, RenderOutput::Linear; the Monte Carlo
 // comparisons of issue 6). Non-finite or negative channels are 0.
 @fragment
 fn scene_fs_linear(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {

@@ -50,18 +50,9 @@ pub enum SceneArg {
     SnakeSkin,
 }
 
-/// What a `--scene` renders.
-pub enum Scene {
-    /// A film scene of `render_scene`.
-    Film(nacre_runtime::render::SceneKind),
-    /// The rough-row comparison.
-    RoughRow,
-    /// A diffraction scene.
-    Diffraction(nacre_runtime::diffraction::DiffractionScene),
-}
-
-impl From<SceneArg> for Scene {
+impl From<SceneArg> for nacre_runtime::Scene {
     fn from(s: SceneArg) -> Self {
+        use nacre_runtime::Scene;
         use nacre_runtime::diffraction::DiffractionScene;
         use nacre_runtime::render::SceneKind;
         match s {

@@ -18,7 +18,7 @@ mod diffraction;
 mod error;
 mod plot;
 
-use choices::{FilmEvalArg, QuantityArg, Scene, SceneArg, TechniqueArg};
+use choices::{FilmEvalArg, QuantityArg, SceneArg, TechniqueArg};
 use error::Result;
 
 #[derive(Parser)]
@@ -540,30 +540,17 @@ fn run_bake(args: &BakeArgs) -> Result<()> {
 }
 
 fn run_render(args: &RenderArgs) -> Result<()> {
-    use nacre_runtime::render::{FilmEval, SceneKind, SceneOptions, render_scene};
-    use nacre_runtime::{GpuContext, TableSet, Technique};
-    let scene = match Scene::from(args.scene) {
+    use nacre_runtime::render::{FilmEval, SceneOptions, render_scene};
+    use nacre_runtime::{GpuContext, Scene, TableSet, Technique};
+    let film_eval = FilmEval::from(args.film_eval);
+    let all = Scene::from(args.scene);
+    let scene = match all {
         Scene::RoughRow => return run_render_rough_row(args),
         Scene::Diffraction(scene) => return run_render_diffraction(args, scene),
         Scene::Film(scene) => scene,
     };
-    let film_eval = FilmEval::from(args.film_eval);
     let technique = Technique::from(args.technique);
-    let names: Vec<String> = if args.tables.is_empty() {
-        let lut = match scene {
-            _ if args.gltf.is_some() => "film-dielectric",
-            SceneKind::Sphere => "film-dielectric",
-            SceneKind::Bubble => "soap-film",
-            SceneKind::Plane => "oil-slick",
-        };
-        let mut names = vec![lut.to_string(), "fourier-srgb".into()];
-        if film_eval == FilmEval::Exact {
-            names.push("rough-film-dielectric".into());
-        }
-        names
-    } else {
-        args.tables.clone()
-    };
+    let names = table_names(args, all, film_eval);
     let mut options = SceneOptions::new(scene);
     options.width = args.width;
     options.height = args.height;
@@ -635,6 +622,23 @@ fn run_render(args: &RenderArgs) -> Result<()> {
         args.output.display()
     );
     Ok(())
+}
+
+/// `--tables`, or the tables `scene` reads by default.
+fn table_names(
+    args: &RenderArgs,
+    scene: nacre_runtime::Scene,
+    film_eval: nacre_runtime::render::FilmEval,
+) -> Vec<String> {
+    if args.tables.is_empty() {
+        scene
+            .default_tables(film_eval, args.gltf.is_some())
+            .into_iter()
+            .map(String::from)
+            .collect()
+    } else {
+        args.tables.clone()
+    }
 }
 
 /// `nacre render --scene cd-disc | snake-skin`: the `diffraction` technique.
@@ -758,15 +762,11 @@ fn run_render_rough_row(args: &RenderArgs) -> Result<()> {
         .into());
     }
     let technique = Technique::from(args.technique);
-    let names: Vec<String> = if args.tables.is_empty() {
-        vec![
-            "film-dielectric".into(),
-            "fourier-srgb".into(),
-            "rough-film-dielectric".into(),
-        ]
-    } else {
-        args.tables.clone()
-    };
+    let names = table_names(
+        args,
+        nacre_runtime::Scene::RoughRow,
+        nacre_runtime::render::FilmEval::Exact,
+    );
     for name in &names {
         Manifest::read(&set::resolve_table(name))?;
     }

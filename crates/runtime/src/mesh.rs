@@ -392,8 +392,12 @@ pub fn render_gltf(
     }
 
     crate::render::check_film_eval(tables, options)?;
-    let env =
-        crate::render::EnvironmentTextures::new(ctx, &environment, options.film_eval, tables)?;
+    let env = crate::render::EnvironmentTextures::new(
+        ctx,
+        &environment,
+        options.film_eval,
+        tables.rough_film_lut.as_ref(),
+    )?;
     let view_uniform = ViewUniform::new(&view_options, env.env_levels)?;
     // Per material its thickness texture, or a 1×1 map of g = 1 (d = d_max) without one.
     let flat = ThicknessMap {

@@ -50,9 +50,14 @@ pub const ROUGH_LUT_MAPPING: &str = include_str!("../../../shaders/rough_lut_map
 /// Display output shared by [`MATERIAL`] and the diffraction scenes: the Khronos PBR Neutral
 /// and max-channel tone mappers and the sRGB encoding (no bindings of its own).
 pub const OUTPUT: &str = include_str!("../../../shaders/output.wgsl");
+/// Group 0 of every scene (the material scenes, glTF meshes and diffraction scenes): the
+/// view uniform `ViewParams` ([`crate::render::ViewUniform`]) and the environment's
+/// textures. It imports [`ROUGH_LUT_MAPPING`] (the `RoughLutParams` of binding 7).
+pub const VIEW: &str = include_str!("../../../shaders/view.wgsl");
 /// Consumer: the thin-film microfacet material (GGX + film, environment, light, tone
 /// mapping; groups 0 and 2). It imports [`ROUGH_LUT_MAPPING`] (its exact split-sum path
-/// samples a `rough-film-lut`) and [`OUTPUT`], which [`compose`] places before it. Compose it before
+/// samples a `rough-film-lut`), [`VIEW`] (group 0) and [`OUTPUT`], which [`compose`] places
+/// before it. Compose it before
 /// [`SCENE`] or [`MESH`] (which import it).
 pub const MATERIAL: &str = include_str!("../../../shaders/material.wgsl");
 /// Consumer: the ray-cast analytic scenes of `nacre render` (sphere, bubble, plane).
@@ -102,6 +107,7 @@ pub const MODULES: &[Module] = modules![
     "plain",
     "rough_lut_mapping",
     "output",
+    "view",
     "material",
     "scene",
     "mesh",
@@ -704,9 +710,16 @@ mod tests {
             ("plain", &["common"]),
             ("rough_lut_mapping", &[]),
             ("output", &[]),
+            ("view", &["rough_lut_mapping"]),
             (
                 "material",
-                &["common", "<technique>", "rough_lut_mapping", "output"],
+                &[
+                    "common",
+                    "<technique>",
+                    "rough_lut_mapping",
+                    "view",
+                    "output",
+                ],
             ),
             ("scene", &["material"]),
             ("mesh", &["material"]),
@@ -721,7 +734,7 @@ mod tests {
             ),
             (
                 "diffraction_scene",
-                &["diffraction_common", "<technique>", "output"],
+                &["diffraction_common", "<technique>", "view", "output"],
             ),
             ("diffraction_integrated_probe", &["diffraction_integrated"]),
         ];

@@ -335,7 +335,7 @@ fn the_runtimes_own_pipelines_validate_and_translate() {
 #[test]
 fn diffraction_technique_validates_and_translates() {
     use nacre_runtime::diffraction::{
-        DIFFRACTION, DiffractionUniform, DiffractionViewUniform, compose,
+        DIFFRACTION, DiffractionLightsUniform, DiffractionUniform, compose,
     };
     let source = compose();
     let (module, info) = validate(
@@ -375,14 +375,18 @@ fn diffraction_technique_validates_and_translates() {
     assert_eq!(span as usize, std::mem::size_of::<DiffractionUniform>());
     let offsets: Vec<u32> = members.iter().map(|m| m.1).collect();
     assert_eq!(offsets, [0, 8, 16, 24, 32, 36, 40, 44, 48, 56]);
-    let (span, members) = layout("DiffractionView");
-    assert_eq!(span as usize, std::mem::size_of::<DiffractionViewUniform>());
-    let offsets: Vec<u32> = members.iter().map(|m| m.1).collect();
+    let (span, members) = layout("DiffractionLights");
     assert_eq!(
-        offsets,
-        [
-            0, 64, 76, 80, 92, 96, 108, 112, 120, 124, 128, 256, 384, 388, 392, 396
-        ]
+        span as usize,
+        std::mem::size_of::<DiffractionLightsUniform>()
+    );
+    let offsets: Vec<u32> = members.iter().map(|m| m.1).collect();
+    assert_eq!(offsets, [0, 4, 8, 12, 16, 144]);
+    // Group 0 is every scene's view (shaders/view.wgsl, `ViewUniform`).
+    let (span, _) = layout("ViewParams");
+    assert_eq!(
+        span as usize,
+        std::mem::size_of::<nacre_runtime::render::ViewUniform>()
     );
 
     // The technique alone, with a consumer that binds nothing: group 1 only.
@@ -460,7 +464,7 @@ fn diffraction_constants_are_the_flattened_modules() {
     use nacre_runtime::diffraction_integrated::{
         self as integrated, PROBE, TECHNIQUE_ADAPTER, WGSL,
     };
-    use nacre_runtime::shaders::OUTPUT;
+    use nacre_runtime::shaders::{OUTPUT, ROUGH_LUT_MAPPING, VIEW};
     let flat = |name: &str| shaders::flatten(name).unwrap().source;
     assert_eq!(format!("{DIFFRACTION}\n"), flat("diffraction"));
     assert_eq!(format!("{WGSL}\n"), flat("diffraction_integrated"));
@@ -468,15 +472,17 @@ fn diffraction_constants_are_the_flattened_modules() {
         format!("{DIFFRACTION_COMMON}\n"),
         flat("diffraction_common")
     );
-    // The historical concatenations of the three pipelines.
+    // The concatenations of the three pipelines (the scenes share view.wgsl's group 0).
     assert_eq!(
         diffraction::compose(),
-        format!("{DIFFRACTION}\n{OUTPUT}\n{DIFFRACTION_SCENE}\n")
+        format!("{DIFFRACTION}\n{ROUGH_LUT_MAPPING}\n{VIEW}\n{OUTPUT}\n{DIFFRACTION_SCENE}\n")
     );
     assert_eq!(integrated::compose_probe(), format!("{WGSL}\n{PROBE}\n"));
     assert_eq!(
         integrated::compose_scene(),
-        format!("{WGSL}\n{TECHNIQUE_ADAPTER}\n{OUTPUT}\n{DIFFRACTION_SCENE}\n")
+        format!(
+            "{WGSL}\n{TECHNIQUE_ADAPTER}\n{ROUGH_LUT_MAPPING}\n{VIEW}\n{OUTPUT}\n{DIFFRACTION_SCENE}\n"
+        )
     );
 }
 

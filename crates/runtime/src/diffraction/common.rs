@@ -154,8 +154,9 @@ pub(super) fn upload_rgba32f_array(
 
 /// One compute dispatch of `entry` in `source` (64 invocations per workgroup, one per
 /// case) for the probes of both layouts: group 0 empty, group 1 the technique's
-/// (`technique`: layout and bind group), group 2 binding 0 the `input` (read-only storage),
-/// binding 1 two vec4<f32> outputs per case; returns the outputs.
+/// (`technique`: layout and bind group), group 2 empty (the scenes' lights), group 3 binding 0
+/// the `input` (read-only storage), binding 1 two vec4<f32> outputs per case; returns the
+/// outputs.
 ///
 /// # Errors
 /// [`Error::Invalid`] for more cases than one dispatch takes; [`Error::Gpu`] or
@@ -197,12 +198,17 @@ pub(super) fn dispatch_probe(
             entries: &[storage(0, true), storage(1, false)],
         });
         let empty = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("diffraction probe (no view)"),
+            label: Some("diffraction probe (no view, no lights)"),
             entries: &[],
         });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("diffraction probe"),
-            bind_group_layouts: &[Some(&empty), Some(technique.0), Some(&io_layout)],
+            bind_group_layouts: &[
+                Some(&empty),
+                Some(technique.0),
+                Some(&empty),
+                Some(&io_layout),
+            ],
             immediate_size: 0,
         });
         let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -255,7 +261,8 @@ pub(super) fn dispatch_probe(
             pass.set_pipeline(&pipeline);
             pass.set_bind_group(0, &empty_group, &[]);
             pass.set_bind_group(1, technique.1, &[]);
-            pass.set_bind_group(2, &io, &[]);
+            pass.set_bind_group(2, &empty_group, &[]);
+            pass.set_bind_group(3, &io, &[]);
             pass.dispatch_workgroups(groups, 1, 1);
         }
         encoder.copy_buffer_to_buffer(&outputs, 0, &readback, 0, out_bytes);

@@ -57,7 +57,7 @@ mod terms;
 
 pub use common::{DIFFRACTION_COMMON, DiffractionLayout};
 pub use scene::{
-    DIFFRACTION_SCENE, DiffractionScene, DiffractionSceneOptions, DiffractionViewUniform,
+    DIFFRACTION_SCENE, DiffractionLightsUniform, DiffractionScene, DiffractionSceneOptions,
     LOBE_REFERENCE_NM, MAX_ENV_SAMPLES, ScenePass, environment_samples, lobe_gain,
     render_diffraction_scene,
 };

@@ -11,7 +11,7 @@ use crate::error::{Error, Result};
 use crate::gpu;
 use crate::gpu::read_texture;
 use crate::image_io::{Level, MAX_DIMENSION, RenderedImage};
-use crate::render::{Camera, Light};
+use crate::render::{Camera, EnvironmentTextures, FilmEval, Light, ViewUniform, view_group_layout};
 use crate::shaders;
 use bytemuck::{Pod, Zeroable};
 use nacre_format::diffraction::DiffractionRecord;
@@ -22,7 +22,7 @@ use std::str::FromStr;
 /// Its consumers (`shaders/diffraction_scene.wgsl`): the scenes, the bench pass and the probe.
 pub const DIFFRACTION_SCENE: &str = include_str!("../../../../shaders/diffraction_scene.wgsl");
 
-/// Most environment samples of a scene (`DiffractionView.samples`).
+/// Most environment samples of a scene (`DiffractionLights.samples`).
 pub const MAX_ENV_SAMPLES: usize = 8;
 
 /// The diffraction scenes of `nacre render` (`shaders/diffraction_scene.wgsl`).
@@ -219,38 +219,23 @@ impl DiffractionSceneOptions {
     }
 }
 
-/// Mirror of `DiffractionView` (shaders/diffraction_scene.wgsl, 400 bytes).
+/// Mirror of `DiffractionLights` (shaders/diffraction_scene.wgsl, group 2, 272 bytes): the
+/// light and the environment samples as the gratings see them. The camera, the exposure, the
+/// light's direction, colour and irradiance E₀ and the environment are every scene's group 0
+/// ([`ViewUniform`], `shaders/view.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct DiffractionViewUniform {
-    /// Clip → world.
-    pub inv_view_proj: [[f32; 4]; 4],
-    /// Camera position.
-    pub eye: [f32; 3],
-    /// 2^EV.
-    pub exposure: f32,
-    /// Towards the light, unit.
-    pub light_direction: [f32; 3],
-    /// Light intensity.
-    pub light_intensity: f32,
-    /// Light colour.
-    pub light_colour: [f32; 3],
-    /// Environment multiplier.
-    pub env_intensity: f32,
-    /// Target size, pixels.
-    pub resolution: [f32; 2],
-    /// 0 cd-disc, 1 snake-skin, 2 bench.
-    pub scene: u32,
+pub struct DiffractionLightsUniform {
+    /// I₀ = E₀ (σ_s k₀)²/π, the radiance of the light's mirror image ([`lobe_gain`]).
+    pub light_radiance: f32,
     /// Environment samples used.
     pub sample_count: u32,
+    /// Padding.
+    pub pad: [f32; 2],
     /// Sample directions (xyz unit, w 0).
     pub samples: [[f32; 4]; MAX_ENV_SAMPLES],
     /// Sample radiance I_k (rgb, × env_intensity; w 0).
     pub sample_radiance: [[f32; 4]; MAX_ENV_SAMPLES],
-    /// E₀, the light's irradiance at normal incidence.
-    pub light_irradiance: f32,
-    /// Padding.
-    pub pad: [f32; 3],
 }
 
 /// The `count` brightest texels (by luminance 0.2126 R + 0.7152 G + 0.0722 B) of the 32 × 16
@@ -301,59 +286,55 @@ pub fn environment_samples(env: &EnvironmentMap, count: usize) -> Vec<([f32; 3],
     chosen
 }
 
-/// Group 0 of the scene and bench passes: the view uniform, the environment and its sampler.
-struct ViewGroup {
-    layout: wgpu::BindGroupLayout,
-    group: wgpu::BindGroup,
+/// Groups 0 and 2 of the scene and bench passes: every scene's view and environment
+/// ([`view_group_layout`], the environment's box chain; the split-sum textures are
+/// placeholders) and the diffraction lights.
+struct SceneGroups {
+    view_layout: wgpu::BindGroupLayout,
+    view: wgpu::BindGroup,
+    lights_layout: wgpu::BindGroupLayout,
+    lights: wgpu::BindGroup,
 }
 
-fn view_group(
+fn scene_groups(
     ctx: &GpuContext,
-    uniform: &DiffractionViewUniform,
+    view: &ViewUniform,
+    lights: &DiffractionLightsUniform,
     env: &EnvironmentMap,
-) -> Result<ViewGroup> {
-    let texture = crate::gpu::upload_mips(
-        ctx,
-        "diffraction environment",
-        wgpu::TextureFormat::Rgba16Float,
-        &env.mip_chain(),
-    )?;
+) -> Result<SceneGroups> {
+    let textures = EnvironmentTextures::new(ctx, env, FilmEval::Classic, None)?;
     let device = &ctx.device;
     ctx.checked("binding the diffraction view", || {
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("diffraction view"),
-            entries: &[
-                crate::gpu::uniform_entry(0),
-                crate::gpu::texture_entry(1),
-                crate::gpu::sampler_entry(2),
-            ],
+        let view_layout = view_group_layout(device, "diffraction view");
+        let view = textures.bind_group(
+            device,
+            &view_layout,
+            "diffraction view",
+            bytemuck::bytes_of(view),
+        );
+        let lights_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("diffraction lights"),
+            entries: &[crate::gpu::uniform_entry(0)],
         });
         let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("DiffractionView"),
-            contents: bytemuck::bytes_of(uniform),
+            label: Some("DiffractionLights"),
+            contents: bytemuck::bytes_of(lights),
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let view = texture.create_view(&Default::default());
-        let sampler = crate::gpu::linear_sampler(device, "diffraction environment", false);
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("diffraction view"),
-            layout: &layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(&view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::Sampler(&sampler),
-                },
-            ],
+        let lights = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("diffraction lights"),
+            layout: &lights_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: buffer.as_entire_binding(),
+            }],
         });
-        ViewGroup { layout, group }
+        SceneGroups {
+            view_layout,
+            view,
+            lights_layout,
+            lights,
+        }
     })
 }
 
@@ -369,10 +350,11 @@ enum SceneTechnique {
     },
 }
 
-/// The scene (or bench) pipeline with its groups 0 and 1, ready to draw.
+/// The scene (or bench) pipeline with its groups 0 (view), 1 (technique) and 2 (lights),
+/// ready to draw.
 pub struct ScenePass {
     pipeline: wgpu::RenderPipeline,
-    view: ViewGroup,
+    groups: SceneGroups,
     technique: SceneTechnique,
 }
 
@@ -384,7 +366,8 @@ impl ScenePass {
         ctx: &GpuContext,
         table: &DiffractionTables,
         technique: &DiffractionOptions,
-        uniform: &DiffractionViewUniform,
+        view: &ViewUniform,
+        lights: &DiffractionLightsUniform,
         env: &EnvironmentMap,
     ) -> Result<ScenePass> {
         let (technique, source) = match table {
@@ -416,13 +399,17 @@ impl ScenePass {
             SceneTechnique::Terms(b) => &b.layout,
             SceneTechnique::Integrated { layout, .. } => layout,
         };
-        let view = view_group(ctx, uniform, env)?;
+        let groups = scene_groups(ctx, view, lights, env)?;
         let device = &ctx.device;
         let module = shaders::create_module(ctx, "diffraction scene", &source)?;
         let pipeline = ctx.checked("building the diffraction pipeline", || {
             let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("diffraction scene"),
-                bind_group_layouts: &[Some(&view.layout), Some(technique_layout)],
+                bind_group_layouts: &[
+                    Some(&groups.view_layout),
+                    Some(technique_layout),
+                    Some(&groups.lights_layout),
+                ],
                 immediate_size: 0,
             });
             gpu::fullscreen_pipeline(
@@ -436,7 +423,7 @@ impl ScenePass {
         })?;
         Ok(ScenePass {
             pipeline,
-            view,
+            groups,
             technique,
         })
     }
@@ -452,20 +439,25 @@ impl ScenePass {
         height: u32,
         light: &Light,
     ) -> Result<ScenePass> {
-        let mut uniform = DiffractionViewUniform::zeroed();
-        uniform.exposure = 1.0;
-        uniform.light_direction = unit(light.direction);
-        uniform.light_colour = light.colour;
-        uniform.light_intensity = light.intensity * lobe_gain(table.record());
-        uniform.light_irradiance = light.intensity;
-        uniform.resolution = [width as f32, height as f32];
-        uniform.scene = 2;
+        let view = ViewUniform {
+            exposure: 1.0,
+            light_direction: unit(light.direction),
+            light_colour: light.colour,
+            light_intensity: light.intensity,
+            resolution: [width as f32, height as f32],
+            scene: 2,
+            ..ViewUniform::zeroed()
+        };
+        let lights = DiffractionLightsUniform {
+            light_radiance: light.intensity * lobe_gain(table.record()),
+            ..DiffractionLightsUniform::zeroed()
+        };
         let env = EnvironmentMap {
             width: 1,
             height: 1,
             rgb: vec![[0.0; 3]],
         };
-        let pass = ScenePass::new(ctx, table, technique, &uniform, &env)?;
+        let pass = ScenePass::new(ctx, table, technique, &view, &lights, &env)?;
         pass.check_loop_cap(ctx, 1, "bench")?;
         Ok(pass)
     }
@@ -501,12 +493,13 @@ impl ScenePass {
     /// Records the draw into `pass` (a render pass on a [`crate::render::TARGET_FORMAT`] target).
     pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &self.view.group, &[]);
+        pass.set_bind_group(0, &self.groups.view, &[]);
         let technique = match &self.technique {
             SceneTechnique::Terms(b) => &b.bind_group,
             SceneTechnique::Integrated { bind_group, .. } => bind_group,
         };
         pass.set_bind_group(1, technique, &[]);
+        pass.set_bind_group(2, &self.groups.lights, &[]);
         pass.draw(0..3, 0..1);
     }
 
@@ -563,28 +556,33 @@ pub fn render_diffraction_scene(
         }
     };
     let (width, height) = (options.width, options.height);
-    let mut uniform = DiffractionViewUniform::zeroed();
-    uniform.inv_view_proj = options
-        .camera
-        .inverse_view_projection(f64::from(width) / f64::from(height))?;
-    uniform.eye = options.camera.eye;
-    uniform.exposure = 2f32.powf(options.exposure_ev);
     let gain = lobe_gain(table.record());
-    uniform.light_direction = unit(options.light.direction);
-    uniform.light_colour = options.light.colour;
-    uniform.light_intensity = options.light.intensity * gain;
-    uniform.light_irradiance = options.light.intensity;
-    uniform.env_intensity = options.env_intensity;
-    uniform.resolution = [width as f32, height as f32];
-    uniform.scene = options.scene.id();
+    let view = ViewUniform {
+        inv_view_proj: options
+            .camera
+            .inverse_view_projection(f64::from(width) / f64::from(height))?,
+        eye_position: options.camera.eye,
+        exposure: 2f32.powf(options.exposure_ev),
+        light_direction: unit(options.light.direction),
+        light_intensity: options.light.intensity,
+        light_colour: options.light.colour,
+        env_intensity: options.env_intensity,
+        resolution: [width as f32, height as f32],
+        scene: options.scene.id(),
+        env_lod_max: env.mip_chain().len().saturating_sub(1) as f32,
+    };
     let samples = environment_samples(&env, options.env_samples);
-    uniform.sample_count = samples.len() as u32;
+    let mut lights = DiffractionLightsUniform {
+        light_radiance: options.light.intensity * gain,
+        sample_count: samples.len() as u32,
+        ..DiffractionLightsUniform::zeroed()
+    };
     for (k, (d, l)) in samples.iter().enumerate() {
-        uniform.samples[k] = [d[0], d[1], d[2], 0.0];
-        uniform.sample_radiance[k] =
+        lights.samples[k] = [d[0], d[1], d[2], 0.0];
+        lights.sample_radiance[k] =
             [l[0], l[1], l[2], 0.0].map(|x| x * options.env_intensity * gain);
     }
-    let pass = ScenePass::new(ctx, table, &options.technique, &uniform, &env)?;
+    let pass = ScenePass::new(ctx, table, &options.technique, &view, &lights, &env)?;
     // The light and every environment sample are diffracted.
     pass.check_loop_cap(ctx, 1 + samples.len() as u64, options.scene.name())?;
     let device = &ctx.device;

@@ -291,7 +291,12 @@ impl Renderer {
                 adapter: ctx.info.name.clone(),
             });
         }
-        let env = EnvironmentTextures::new(ctx, environment, options.film_eval, tables)?;
+        let env = EnvironmentTextures::new(
+            ctx,
+            environment,
+            options.film_eval,
+            tables.rough_film_lut.as_ref(),
+        )?;
         let view_uniform = ViewUniform::new(options, env.env_levels)?;
         let mut material_uniform = MaterialUniform::new(&options.material, tables)?;
         material_uniform.film_eval = options.film_eval.id();

@@ -10,7 +10,7 @@ use crate::error::{Error, Result};
 use crate::gpu::{
     linear_sampler, sampler_entry, texture_entry, uniform_entry, upload_layers, upload_mips,
 };
-use crate::tables::TableSet;
+use crate::tables::RoughFilmLutTextures;
 use bytemuck::{Pod, Zeroable};
 
 /// The render target format: 8-bit RGBA holding sRGB-encoded values written by the shader
@@ -146,7 +146,7 @@ pub struct RoughLutUniform {
 
 impl RoughLutUniform {
     /// The uniform of a loaded table.
-    pub fn new(lut: &crate::tables::RoughFilmLutTextures) -> RoughLutUniform {
+    pub fn new(lut: &RoughFilmLutTextures) -> RoughLutUniform {
         let a = &lut.axes;
         RoughLutUniform {
             cos_theta_count: a.cos_theta_count as u32,
@@ -181,15 +181,17 @@ pub(crate) struct EnvironmentTextures {
 }
 
 impl EnvironmentTextures {
-    /// Uploads `environment` (and, for the split-sum paths, prefilters it and builds E₁).
+    /// Uploads `environment` (and, for the split-sum paths, prefilters it and builds E₁);
+    /// `rough_lut` is bound for [`FilmEval::Exact`]. The diffraction scenes pass
+    /// [`FilmEval::Classic`] and no table: they read the environment's box chain only.
     pub(crate) fn new(
         ctx: &GpuContext,
         environment: &EnvironmentMap,
         film_eval: FilmEval,
-        tables: &TableSet,
+        rough_lut: Option<&RoughFilmLutTextures>,
     ) -> Result<EnvironmentTextures> {
         let split_sum = film_eval.split_sum();
-        let (rough_lut, rough_lut_uniform) = match (&tables.rough_film_lut, film_eval) {
+        let (rough_lut, rough_lut_uniform) = match (rough_lut, film_eval) {
             (Some(lut), FilmEval::Exact) => (
                 lut.reflectance.create_view(&Default::default()),
                 RoughLutUniform::new(lut),
