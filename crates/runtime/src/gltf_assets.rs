@@ -77,12 +77,14 @@ pub fn gradient_png() -> Vec<u8> {
         }
     }
     let mut bytes = Vec::new();
-    let mut encoder = png::Encoder::new(&mut bytes, w, h);
-    encoder.set_color(png::ColorType::Rgb);
-    encoder.set_depth(png::BitDepth::Eight);
-    let mut writer = encoder.write_header().expect("PNG header");
-    writer.write_image_data(&rgb).expect("PNG data");
-    writer.finish().expect("PNG end");
+    image::ImageEncoder::write_image(
+        image::codecs::png::PngEncoder::new(&mut bytes),
+        &rgb,
+        w,
+        h,
+        image::ExtendedColorType::Rgb8,
+    )
+    .expect("an RGB8 image of its own size encodes");
     bytes
 }
 

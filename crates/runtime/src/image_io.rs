@@ -118,7 +118,9 @@ pub struct RenderedImage {
 }
 
 impl RenderedImage {
-    /// The image as an 8-bit RGB PNG with an sRGB chunk.
+    /// The image as an 8-bit RGB PNG with an sRGB chunk. Written with the `png` crate, the
+    /// one picture outside the table atlases that is not: the `image` crate's PNG encoder
+    /// cannot write the sRGB chunk that tells viewers how the bytes are encoded.
     pub fn encode_png(&self) -> Result<Vec<u8>> {
         let err = |e: png::EncodingError| Error::Invalid {
             context: "encoding the PNG".into(),

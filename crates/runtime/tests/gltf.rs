@@ -262,15 +262,11 @@ fn gltf_meshes_render_with_the_rough_film_paths() {
 
 /// RGB8 pixels of a PNG.
 fn read_png_rgb(path: &Path) -> Option<(u32, u32, Vec<u8>)> {
-    let file = std::io::BufReader::new(std::fs::File::open(path).ok()?);
-    let mut reader = png::Decoder::new(file).read_info().ok()?;
-    let mut buf = vec![0u8; reader.output_buffer_size()?];
-    let info = reader.next_frame(&mut buf).ok()?;
-    if info.color_type != png::ColorType::Rgb || info.bit_depth != png::BitDepth::Eight {
+    let image = image::ImageReader::open(path).ok()?.decode().ok()?;
+    let image::DynamicImage::ImageRgb8(rgb) = image else {
         return None;
-    }
-    buf.truncate((info.width * info.height * 3) as usize);
-    Some((info.width, info.height, buf))
+    };
+    Some((rgb.width(), rgb.height(), rgb.into_raw()))
 }
 
 // Threshold as tests/render.rs's STRICT (set on Mesa lavapipe; no hardware adapter was

@@ -250,15 +250,11 @@ const CASES: [(SceneKind, Technique, Threshold); 9] = [
 
 /// RGB8 pixels of a PNG written by `RenderedImage::encode_png`.
 fn read_png_rgb(path: &Path) -> Option<(u32, u32, Vec<u8>)> {
-    let file = std::io::BufReader::new(std::fs::File::open(path).ok()?);
-    let mut reader = png::Decoder::new(file).read_info().ok()?;
-    let mut buf = vec![0u8; reader.output_buffer_size()?];
-    let info = reader.next_frame(&mut buf).ok()?;
-    if info.color_type != png::ColorType::Rgb || info.bit_depth != png::BitDepth::Eight {
+    let image = image::ImageReader::open(path).ok()?.decode().ok()?;
+    let image::DynamicImage::ImageRgb8(rgb) = image else {
         return None;
-    }
-    buf.truncate((info.width * info.height * 3) as usize);
-    Some((info.width, info.height, buf))
+    };
+    Some((rgb.width(), rgb.height(), rgb.into_raw()))
 }
 
 fn rgb_of(image: &RenderedImage) -> Vec<u8> {
@@ -296,16 +292,7 @@ fn compare(actual: &[u8], reference: &[u8], max_allowed: u8) -> Comparison {
 }
 
 fn write_rgb_png(path: &Path, width: u32, height: u32, rgb: &[u8]) {
-    let mut bytes = Vec::new();
-    {
-        let mut encoder = png::Encoder::new(&mut bytes, width, height);
-        encoder.set_color(png::ColorType::Rgb);
-        encoder.set_depth(png::BitDepth::Eight);
-        let mut writer = encoder.write_header().unwrap();
-        writer.write_image_data(rgb).unwrap();
-        writer.finish().unwrap();
-    }
-    std::fs::write(path, bytes).unwrap();
+    image::save_buffer(path, rgb, width, height, image::ExtendedColorType::Rgb8).unwrap();
 }
 
 #[test]
@@ -465,44 +452,24 @@ fn bad_files_and_settings_are_errors() {
     let err = EnvironmentMap::load(&wide_exr).unwrap_err();
     assert!(err.to_string().contains("8192"), "{err}");
     let wide_png = dir.path().join("wide.png");
-    let grey = |path: &Path, w: u32, h: u32, colour: png::ColorType, depth: png::BitDepth| {
-        let channels = if colour == png::ColorType::Rgb { 3 } else { 1 };
-        let bytes = if depth == png::BitDepth::Sixteen {
-            2
-        } else {
-            1
-        };
-        let mut out = Vec::new();
-        {
-            let mut e = png::Encoder::new(&mut out, w, h);
-            e.set_color(colour);
-            e.set_depth(depth);
-            let mut wr = e.write_header().unwrap();
-            wr.write_image_data(&vec![128u8; (w * h) as usize * channels * bytes])
-                .unwrap();
-            wr.finish().unwrap();
-        }
-        std::fs::write(path, out).unwrap();
+    // Every byte 128 (a 16-bit sample reads 0x8080 in either byte order).
+    let grey = |path: &Path, w: u32, h: u32, colour: image::ExtendedColorType| {
+        let bytes = vec![128u8; (w * h) as usize * usize::from(colour.bits_per_pixel() / 8)];
+        image::save_buffer(path, &bytes, w, h, colour).unwrap();
     };
-    grey(
-        &wide_png,
-        9000,
-        1,
-        png::ColorType::Grayscale,
-        png::BitDepth::Eight,
-    );
+    grey(&wide_png, 9000, 1, image::ExtendedColorType::L8);
     let err = ThicknessMap::load_png(&wide_png).unwrap_err();
     assert!(err.to_string().contains("8192"), "{err}");
     // Colour PNGs are not thickness maps; 8- and 16-bit greyscale are.
     let rgb = dir.path().join("rgb.png");
-    grey(&rgb, 4, 4, png::ColorType::Rgb, png::BitDepth::Eight);
+    grey(&rgb, 4, 4, image::ExtendedColorType::Rgb8);
     assert!(ThicknessMap::load_png(&rgb).is_err());
-    for depth in [png::BitDepth::Eight, png::BitDepth::Sixteen] {
+    for depth in [image::ExtendedColorType::L8, image::ExtendedColorType::L16] {
         let p = dir.path().join("ok.png");
-        grey(&p, 5, 3, png::ColorType::Grayscale, depth);
+        grey(&p, 5, 3, depth);
         let map = ThicknessMap::load_png(&p).unwrap();
         assert_eq!((map.width, map.height), (5, 3));
-        let expect = if depth == png::BitDepth::Eight {
+        let expect = if depth == image::ExtendedColorType::L8 {
             128.0 / 255.0
         } else {
             f32::from(u16::from_be_bytes([128, 128])) / 65535.0
