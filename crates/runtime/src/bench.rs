@@ -143,20 +143,13 @@ pub fn run_bench_with_diffraction(
         .features()
         .contains(wgpu::Features::TIMESTAMP_QUERY);
     let device = &ctx.device;
-    let target = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("bench target"),
-        size: wgpu::Extent3d {
-            width: options.width,
-            height: options.height,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::Rgba8Unorm,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-        view_formats: &[],
-    });
+    let target = crate::gpu::render_target(
+        device,
+        "bench target",
+        (options.width, options.height),
+        wgpu::TextureFormat::Rgba8Unorm,
+        false,
+    );
     let view = target.create_view(&Default::default());
     let params = BenchParams {
         resolution: [options.width as f32, options.height as f32],
@@ -315,15 +308,7 @@ fn time_pass(
             {
                 let mut rp = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some(pass.name()),
-                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                        view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                            store: wgpu::StoreOp::Store,
-                        },
-                    })],
+                    color_attachments: &[crate::gpu::cleared_attachment(view, wgpu::Color::BLACK)],
                     depth_stencil_attachment: None,
                     timestamp_writes: query.as_ref().map(|(q, _, _)| {
                         wgpu::RenderPassTimestampWrites {

@@ -284,6 +284,69 @@ pub fn fullscreen_pipeline(
     })
 }
 
+// ─── Render targets and passes ───────────────────────────────────────────────────────────
+
+/// A `width × height` 2-D texture of `format` to render into (one mip, one sample), also a
+/// copy source when `readback` (for [`read_texture`]).
+pub fn render_target(
+    device: &wgpu::Device,
+    label: &str,
+    (width, height): (u32, u32),
+    format: wgpu::TextureFormat,
+    readback: bool,
+) -> wgpu::Texture {
+    let mut usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+    if readback {
+        usage |= wgpu::TextureUsages::COPY_SRC;
+    }
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
+}
+
+/// A colour attachment that clears `view` to `clear` and stores what the pass draws.
+pub fn cleared_attachment(
+    view: &wgpu::TextureView,
+    clear: wgpu::Color,
+) -> Option<wgpu::RenderPassColorAttachment<'_>> {
+    Some(wgpu::RenderPassColorAttachment {
+        view,
+        depth_slice: None,
+        resolve_target: None,
+        ops: wgpu::Operations {
+            load: wgpu::LoadOp::Clear(clear),
+            store: wgpu::StoreOp::Store,
+        },
+    })
+}
+
+/// A render pass labelled `label` drawing into `colour` (no depth, no queries).
+pub fn begin_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    colour: &[Option<wgpu::RenderPassColorAttachment<'_>>],
+) -> wgpu::RenderPass<'e> {
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: colour,
+        depth_stencil_attachment: None,
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
+}
+
 // ─── Readback ──────────────────────────────────────────────────────────────────────────────
 
 /// Reads mip level 0 of a 2-D `texture` whose texels are `bytes_per_texel` bytes, returning

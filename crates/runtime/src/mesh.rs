@@ -503,26 +503,9 @@ pub fn render_gltf(
             height,
             depth_or_array_layers: 1,
         };
-        let target = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("mesh target"),
-            size,
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: TARGET_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
-        let depth = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("mesh depth"),
-            size,
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: DEPTH_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-            view_formats: &[],
-        });
+        let extent = (size.width, size.height);
+        let target = crate::gpu::render_target(device, "mesh target", extent, TARGET_FORMAT, true);
+        let depth = crate::gpu::render_target(device, "mesh depth", extent, DEPTH_FORMAT, false);
         let target_view = target.create_view(&Default::default());
         let depth_view = depth.create_view(&Default::default());
         // The background: the environment seen by the fitted camera is not drawn (a clear
@@ -531,20 +514,15 @@ pub fn render_gltf(
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("mesh"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &target_view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color {
-                            r: 0.18,
-                            g: 0.18,
-                            b: 0.2,
-                            a: 1.0,
-                        }),
-                        store: wgpu::StoreOp::Store,
+                color_attachments: &[crate::gpu::cleared_attachment(
+                    &target_view,
+                    wgpu::Color {
+                        r: 0.18,
+                        g: 0.18,
+                        b: 0.2,
+                        a: 1.0,
                     },
-                })],
+                )],
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                     view: &depth_view,
                     depth_ops: Some(wgpu::Operations {

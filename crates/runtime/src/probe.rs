@@ -121,20 +121,13 @@ pub fn run_probe(
             ],
         });
         let make_target = |label| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width: WIDTH,
-                    height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::Rgba32Float,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-                view_formats: &[],
-            })
+            crate::gpu::render_target(
+                device,
+                label,
+                (WIDTH, height),
+                wgpu::TextureFormat::Rgba32Float,
+                true,
+            )
         };
         let (r, t) = (
             make_target("probe reflectance"),
@@ -144,27 +137,17 @@ pub fn run_probe(
             r.create_view(&Default::default()),
             t.create_view(&Default::default()),
         );
-        let attachment = |view| {
-            Some(wgpu::RenderPassColorAttachment {
-                view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                    store: wgpu::StoreOp::Store,
-                },
-            })
-        };
+        let clear = wgpu::Color::TRANSPARENT;
         let mut encoder = device.create_command_encoder(&Default::default());
         {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("probe"),
-                color_attachments: &[attachment(&rv), attachment(&tv)],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+            let mut pass = crate::gpu::begin_pass(
+                &mut encoder,
+                "probe",
+                &[
+                    crate::gpu::cleared_attachment(&rv, clear),
+                    crate::gpu::cleared_attachment(&tv, clear),
+                ],
+            );
             pass.set_pipeline(&pipeline);
             pass.set_bind_group(0, &view_group, &[]);
             pass.set_bind_group(1, &binding.bind_group, &[]);

@@ -865,7 +865,7 @@ mod tests {
     }
 
     /// The compositions the runtime used before the import headers, by hand: each part
-    /// followed by a newline, `MATERIAL` = rough_lut_mapping + output + material.
+    /// followed by a newline, `MATERIAL` = rough_lut_mapping + view + output + material.
     #[test]
     fn compositions_are_the_historical_concatenations() {
         let cat = |parts: &[&str]| parts.iter().map(|p| format!("{p}\n")).collect::<String>();
@@ -876,15 +876,15 @@ mod tests {
             assert_eq!(compose(t, &[BENCH]), with(&[BENCH]));
             assert_eq!(
                 compose(t, &[MATERIAL, SCENE]),
-                with(&[ROUGH_LUT_MAPPING, OUTPUT, MATERIAL, SCENE])
+                with(&[ROUGH_LUT_MAPPING, VIEW, OUTPUT, MATERIAL, SCENE])
             );
             assert_eq!(
                 compose(t, &[MATERIAL, MESH]),
-                with(&[ROUGH_LUT_MAPPING, OUTPUT, MATERIAL, MESH])
+                with(&[ROUGH_LUT_MAPPING, VIEW, OUTPUT, MATERIAL, MESH])
             );
             assert_eq!(
                 film_pipeline(t.module(), &["scene"]).unwrap().source,
-                with(&[ROUGH_LUT_MAPPING, OUTPUT, MATERIAL, SCENE])
+                with(&[ROUGH_LUT_MAPPING, VIEW, OUTPUT, MATERIAL, SCENE])
             );
             assert_eq!(
                 film_pipeline(t.module(), &["mesh"]).unwrap().source,
@@ -918,6 +918,7 @@ mod tests {
                 "lut_mapping.wgsl",
                 "film_lut.wgsl",
                 "rough_lut_mapping.wgsl",
+                "view.wgsl",
                 "output.wgsl",
                 "material.wgsl",
                 "consumer 2"

@@ -587,42 +587,24 @@ pub fn render_diffraction_scene(
     pass.check_loop_cap(ctx, 1 + samples.len() as u64, options.scene.name())?;
     let device = &ctx.device;
     let target = ctx.checked("creating the diffraction target", || {
-        device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("diffraction scene"),
-            size: wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: crate::render::TARGET_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        })
+        gpu::render_target(
+            device,
+            "diffraction scene",
+            (width, height),
+            crate::render::TARGET_FORMAT,
+            true,
+        )
     })?;
     let target_view = target.create_view(&Default::default());
     let start = std::time::Instant::now();
     ctx.checked("drawing the diffraction scene", || {
         let mut encoder = device.create_command_encoder(&Default::default());
         {
-            let mut rp = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("diffraction scene"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &target_view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+            let mut rp = gpu::begin_pass(
+                &mut encoder,
+                "diffraction scene",
+                &[gpu::cleared_attachment(&target_view, wgpu::Color::BLACK)],
+            );
             pass.draw(&mut rp);
         }
         ctx.queue.submit([encoder.finish()]);

@@ -44,7 +44,10 @@
 use crate::bindings::{TechniqueBinding, TechniqueOptions};
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
-use crate::gpu::{group_layout, read_texture, uniform_texture_group, upload_mips};
+use crate::gpu::{
+    begin_pass, cleared_attachment, fullscreen_pipeline, group_layout, read_texture, render_target,
+    uniform_texture_group, upload_mips,
+};
 use crate::shaders::{self, Technique};
 use crate::tables::TableSet;
 use std::path::Path;
@@ -125,31 +128,14 @@ impl Renderer {
                     ],
                     immediate_size: 0,
                 });
-                let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                    label: Some("scene"),
-                    layout: Some(&layout),
-                    vertex: wgpu::VertexState {
-                        module: &module,
-                        entry_point: Some("scene_vs"),
-                        compilation_options: Default::default(),
-                        buffers: &[],
-                    },
-                    primitive: Default::default(),
-                    depth_stencil: None,
-                    multisample: Default::default(),
-                    fragment: Some(wgpu::FragmentState {
-                        module: &module,
-                        entry_point: Some(entry_point),
-                        compilation_options: Default::default(),
-                        targets: &[Some(wgpu::ColorTargetState {
-                            format,
-                            blend: None,
-                            write_mask: wgpu::ColorWrites::ALL,
-                        })],
-                    }),
-                    multiview_mask: None,
-                    cache: None,
-                });
+                let pipeline = fullscreen_pipeline(
+                    device,
+                    "scene",
+                    &module,
+                    &layout,
+                    ("scene_vs", entry_point),
+                    &[format],
+                );
                 (view_layout, material_layout, pipeline)
             })?;
         Ok(Renderer {
@@ -328,42 +314,19 @@ impl Renderer {
                 &thickness_texture,
                 true,
             );
-            let target = device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("scene target"),
-                size: wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: match self.output {
-                    RenderOutput::Display => TARGET_FORMAT,
-                    RenderOutput::Linear => LINEAR_TARGET_FORMAT,
-                },
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-                view_formats: &[],
-            });
+            let format = match self.output {
+                RenderOutput::Display => TARGET_FORMAT,
+                RenderOutput::Linear => LINEAR_TARGET_FORMAT,
+            };
+            let target = render_target(device, "scene target", (width, height), format, true);
             let target_view = target.create_view(&Default::default());
             let mut encoder = device.create_command_encoder(&Default::default());
             {
-                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("scene"),
-                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                        view: &target_view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                            store: wgpu::StoreOp::Store,
-                        },
-                    })],
-                    depth_stencil_attachment: None,
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
+                let mut pass = begin_pass(
+                    &mut encoder,
+                    "scene",
+                    &[cleared_attachment(&target_view, wgpu::Color::BLACK)],
+                );
                 pass.set_pipeline(&self.pipeline);
                 pass.set_bind_group(0, &view_group, &[]);
                 pass.set_bind_group(1, &self.binding.bind_group, &[]);
