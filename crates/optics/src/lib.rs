@@ -25,6 +25,7 @@ pub mod colour;
 pub mod csv_rows;
 pub mod diffraction;
 pub mod error;
+pub mod few_wavelengths;
 pub mod fourier;
 pub mod fresnel;
 pub mod material;
