@@ -278,6 +278,252 @@ impl RuleLadder {
     }
 }
 
+/// Most films of a real-time stack (`shaders/film_stack.wgsl`).
+pub const MAX_STACK_FILMS: usize = 8;
+
+/// The real-time multilayer evaluation shared by the GPU technique `film_stack` and its CPU
+/// twin (`nacre color --method stack`): a stack whose top film takes the pixel's thickness
+/// and whose other films vary together, d_j = d_j⁰ + r_j s (Sussenbach 2013 §4.2, Eq. 4.3:
+/// the spatially varying thickness d_avg + d_rel Δ(x), with s = 2g − 1 ∈ [−1, 1] from a
+/// greyscale map g), integrated with the rule of [`count_for_opd`] for the pixel's films
+/// (or one fixed rule).
+///
+/// The rule's OPD is h Σ_j k_j d_j, k_j = 2 max_λ |ñ_j| over 380, 480, …, 780 nm (as
+/// [`crate::Stack::max_opd_nm`]) and h = [`finesse_factor`] of the stack at 550 nm; both are
+/// constants of the stack, so the GPU computes the OPD per pixel from the films' thicknesses.
+/// Every medium's index is resolved on the CPU at every node of every rule (a dispersive
+/// material costs nothing per pixel); when no material is dispersive the interfaces'
+/// Fresnel coefficients are wavelength-invariant and the GPU computes them once per pixel
+/// (the thesis's precalculation, §4.3).
+#[derive(Clone, Debug, PartialEq)]
+pub struct StackEvaluation {
+    rules: Vec<FewWavelengthRule>,
+    fixed: bool,
+    /// Per node of every rule (rules concatenated), every medium's index.
+    indices: Vec<Vec<crate::C64>>,
+    thickness_nm: Vec<f64>,
+    relative_nm: Vec<f64>,
+    opd_factors: Vec<f64>,
+    finesse: f64,
+    dispersive: bool,
+}
+
+impl StackEvaluation {
+    /// Prepares `stack` (1 to [`MAX_STACK_FILMS`] films) with per-film relative thicknesses
+    /// `relative_nm` (r_j, ≥ 0; the top film's is unused: its thickness is the pixel's) for
+    /// `colorimeter`, with the [`RuleLadder`] (`samples` = None) or the rule of `samples`
+    /// nodes (1 to 256).
+    ///
+    /// # Errors
+    /// [`crate::Error::Invalid`] for a film count, relative thickness or sample count out
+    /// of range; a material's error where it has no data at a node.
+    pub fn new(
+        colorimeter: &Colorimeter,
+        stack: &crate::Stack,
+        relative_nm: &[f64],
+        samples: Option<usize>,
+    ) -> crate::Result<Self> {
+        let films = stack.layers().len();
+        let out_of_range =
+            |what: &'static str, value: f64, expected: &'static str| crate::Error::OutOfRange {
+                what,
+                value,
+                expected,
+            };
+        if !(1..=MAX_STACK_FILMS).contains(&films) {
+            return Err(out_of_range(
+                "films of a real-time stack",
+                films as f64,
+                "1 to 8",
+            ));
+        }
+        if relative_nm.len() != films {
+            return Err(out_of_range(
+                "relative thicknesses given",
+                relative_nm.len() as f64,
+                "one per film",
+            ));
+        }
+        if let Some(&r) = relative_nm.iter().find(|r| !(r.is_finite() && **r >= 0.0)) {
+            return Err(out_of_range(
+                "relative thickness (nm)",
+                r,
+                "a finite value ≥ 0",
+            ));
+        }
+        let (rules, fixed) = match samples {
+            None => (RuleLadder::new(colorimeter).rules, false),
+            Some(n) if (1..=256).contains(&n) => {
+                (vec![FewWavelengthRule::new(colorimeter, n)], true)
+            }
+            Some(n) => {
+                return Err(out_of_range(
+                    "wavelengths of the stack rule",
+                    n as f64,
+                    "1 to 256",
+                ));
+            }
+        };
+        let mut indices = Vec::new();
+        for rule in &rules {
+            for &l in rule.wavelengths_nm() {
+                indices.push(stack.indices_at(l)?);
+            }
+        }
+        let opd_factors = stack
+            .layers()
+            .iter()
+            .map(|l| {
+                2.0 * [380.0, 480.0, 580.0, 680.0, 780.0]
+                    .iter()
+                    .filter_map(|&wl| l.material.index_at(wl).ok())
+                    .map(|n| n.norm())
+                    .fold(0.0f64, f64::max)
+            })
+            .collect();
+        let at_550: Vec<crate::C64> = std::iter::once(stack.ambient())
+            .chain(stack.layers().iter().map(|l| &l.material))
+            .chain(std::iter::once(stack.substrate()))
+            .map(|m| m.index_at(550.0).unwrap_or(crate::C64::new(1.0, 0.0)))
+            .collect();
+        let dispersive = !(stack.ambient().is_constant()
+            && stack.substrate().is_constant()
+            && stack.layers().iter().all(|l| l.material.is_constant()));
+        Ok(StackEvaluation {
+            rules,
+            fixed,
+            indices,
+            thickness_nm: stack.thicknesses_nm(),
+            relative_nm: relative_nm.to_vec(),
+            opd_factors,
+            finesse: finesse_factor(&at_550),
+            dispersive,
+        })
+    }
+
+    /// The rules (the ladder, or the one fixed rule), by increasing count.
+    pub fn rules(&self) -> &[FewWavelengthRule] {
+        &self.rules
+    }
+
+    /// True for one fixed rule (`stack:N`).
+    pub fn fixed(&self) -> bool {
+        self.fixed
+    }
+
+    /// Every medium's index at every node, rules concatenated (node-major).
+    pub fn indices(&self) -> &[Vec<crate::C64>] {
+        &self.indices
+    }
+
+    /// The films' own thicknesses d_j⁰, nm, top first.
+    pub fn thickness_nm(&self) -> &[f64] {
+        &self.thickness_nm
+    }
+
+    /// The films' relative thicknesses r_j, nm.
+    pub fn relative_nm(&self) -> &[f64] {
+        &self.relative_nm
+    }
+
+    /// The films' OPD factors k_j = 2 max |ñ_j|.
+    pub fn opd_factors(&self) -> &[f64] {
+        &self.opd_factors
+    }
+
+    /// The stack's [`finesse_factor`] h.
+    pub fn finesse(&self) -> f64 {
+        self.finesse
+    }
+
+    /// True when some medium's index varies with wavelength.
+    pub fn dispersive(&self) -> bool {
+        self.dispersive
+    }
+
+    /// The films' thicknesses at a pixel: the top film `top_thickness_nm`, film j ≥ 2
+    /// max(0, d_j⁰ + r_j s), s = `variation` clamped to [−1, 1] (NaN → 0); thicknesses
+    /// sanitised as the GPU's FilmInput (NaN or ≤ 0 → 0, at most 10⁶ nm).
+    pub fn thicknesses_at(&self, top_thickness_nm: f64, variation: f64) -> Vec<f64> {
+        let clean = |d: f64| if d > 0.0 { d.min(1e6) } else { 0.0 };
+        let s = if variation.is_nan() {
+            0.0
+        } else {
+            variation.clamp(-1.0, 1.0)
+        };
+        (0..self.thickness_nm.len())
+            .map(|j| {
+                if j == 0 {
+                    clean(top_thickness_nm)
+                } else {
+                    clean(self.thickness_nm[j] + self.relative_nm[j] * s)
+                }
+            })
+            .collect()
+    }
+
+    /// The index of the rule used for films of `thickness_nm`: the fixed rule, or the
+    /// ladder's rule for the OPD h Σ_j k_j d_j.
+    pub fn rule_index(&self, thickness_nm: &[f64]) -> usize {
+        if self.fixed {
+            return 0;
+        }
+        let opd: f64 = thickness_nm
+            .iter()
+            .zip(&self.opd_factors)
+            .map(|(d, k)| d * k)
+            .sum::<f64>()
+            * self.finesse;
+        let n = count_for_opd(opd);
+        self.rules
+            .iter()
+            .position(|r| r.wavelengths_nm().len() == n)
+            .unwrap_or(self.rules.len() - 1)
+    }
+
+    /// Unpolarised (reflectance, transmittance) colours at incidence cosine `cos_theta_i`
+    /// (in the ambient; clamped to [10⁻⁶, 1], NaN → 1) for the pixel's films
+    /// ([`StackEvaluation::thicknesses_at`]): Σ_k W_k (R_s + R_p)/2 at the nodes of the
+    /// pixel's rule, and likewise T.
+    pub fn colour(
+        &self,
+        cos_theta_i: f64,
+        top_thickness_nm: f64,
+        variation: f64,
+    ) -> ([f64; 3], [f64; 3]) {
+        let c = if cos_theta_i.is_nan() {
+            1.0
+        } else {
+            cos_theta_i.clamp(1e-6, 1.0)
+        };
+        let sin = (1.0 - c * c).max(0.0).sqrt();
+        let d = self.thicknesses_at(top_thickness_nm, variation);
+        let rule = self.rule_index(&d);
+        let first: usize = self.rules[..rule]
+            .iter()
+            .map(|r| r.wavelengths_nm().len())
+            .sum();
+        let (mut r, mut t) = ([0.0; 3], [0.0; 3]);
+        let chosen = &self.rules[rule];
+        for (k, (&l, w)) in chosen
+            .wavelengths_nm()
+            .iter()
+            .zip(chosen.weights())
+            .enumerate()
+        {
+            let idx = &self.indices[first + k];
+            let prepared = crate::Prepared::new(idx, idx[0].re * sin);
+            let p = prepared.power(&prepared.amplitudes(l, &d));
+            let (rv, tv) = (p.R(), p.T());
+            for ch in 0..3 {
+                r[ch] += rv * w[ch];
+                t[ch] += tv * w[ch];
+            }
+        }
+        (r, t)
+    }
+}
+
 /// Solves A X = B for a symmetric positive definite n × n `a` (row-major) and three
 /// right-hand sides, by Cholesky factorisation.
 fn solve_spd(a: &[f64], b: &[[f64; 3]], n: usize) -> Vec<[f64; 3]> {
@@ -492,6 +738,47 @@ mod tests {
         }
     }
 
+    /// The evaluation is the stack at the pixel's thicknesses through the ladder's rule;
+    /// bad inputs are refused or sanitised.
+    #[test]
+    fn stack_evaluation_is_the_stack_through_its_rule() {
+        let c = colorimeter();
+        let mut rng = Rng(5);
+        for _ in 0..20 {
+            let (stack, angle) = random_stack(&mut rng);
+            let films = stack.layers().len();
+            let relative: Vec<f64> = (0..films).map(|j| 10.0 * j as f64).collect();
+            let eval = StackEvaluation::new(&c, &stack, &relative, None).unwrap();
+            let cos = angle.to_radians().cos();
+            let top = stack.layers()[0].thickness_nm;
+            // s = 0.5: film j ≥ 2 is 5 j nm thicker.
+            let mut layers = stack.layers().to_vec();
+            for (j, l) in layers.iter_mut().enumerate().skip(1) {
+                l.thickness_nm += 5.0 * j as f64;
+            }
+            let moved =
+                Stack::new(stack.ambient().clone(), layers, stack.substrate().clone()).unwrap();
+            let d = eval.thicknesses_at(top, 0.5);
+            let rule = &eval.rules()[eval.rule_index(&d)];
+            let want = reflectance_colour(&moved, angle, rule.wavelengths_nm(), rule.weights());
+            let (got, t) = eval.colour(cos, top, 0.5);
+            for k in 0..3 {
+                assert!((got[k] - want[k]).abs() < 1e-9, "{got:?} {want:?}");
+                assert!(t[k].is_finite());
+            }
+            let (nan, _) = eval.colour(f64::NAN, f64::NAN, f64::NAN);
+            assert!(nan.iter().all(|x| x.is_finite()));
+        }
+        let (stack, _) = random_stack(&mut Rng(9));
+        let films = stack.layers().len();
+        assert!(StackEvaluation::new(&c, &stack, &vec![0.0; films + 1], None).is_err());
+        assert!(StackEvaluation::new(&c, &stack, &vec![-1.0; films], None).is_err());
+        assert!(StackEvaluation::new(&c, &stack, &vec![0.0; films], Some(0)).is_err());
+        let fixed = StackEvaluation::new(&c, &stack, &vec![0.0; films], Some(7)).unwrap();
+        assert!(fixed.fixed() && fixed.rules()[0].wavelengths_nm().len() == 7);
+        assert_eq!(fixed.indices().len(), 7);
+    }
+
     /// The accuracy target over 2000 random stacks: 2–6 films (dielectric n 1.2–2.5,
     /// metals au/ag/cr/al 5–30 nm), optical thickness ≤ 2 µm, dielectric/metal/air bases,
     /// 0–85°: ΔE2000 p95 ≤ 0.3, max ≤ 1.0 with the count of [`count_for_opd`].
@@ -517,7 +804,14 @@ mod tests {
                 .iter()
                 .map(|&n| {
                     let r = FewWavelengthRule::new(&c, n);
-                    format!("{:.2}", delta_e(&c, reflectance_colour(s, *a, r.wavelengths_nm(), r.weights()), *x))
+                    format!(
+                        "{:.2}",
+                        delta_e(
+                            &c,
+                            reflectance_colour(s, *a, r.wavelengths_nm(), r.weights()),
+                            *x
+                        )
+                    )
                 })
                 .collect();
             let films: Vec<String> = s
