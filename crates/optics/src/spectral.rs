@@ -37,6 +37,37 @@ const MAX_CELL_NM: f64 = 2.0;
 /// Gauss–Legendre 2-point abscissa on [−1, 1]: 1/√3.
 const GL2: f64 = 0.577_350_269_189_625_8;
 
+/// Bound on the aliased part of the reflectance, ε of [`phase_step_rad`].
+const FRINGE_TOLERANCE: f64 = 1e-6;
+
+/// Most quadrature cells per fringe (2π of film phase): [`phase_step_rad`]'s floor.
+const MAX_CELLS_PER_FRINGE: f64 = 4096.0;
+
+/// The phase step of the quadrature cells for fringes of finesse `rho` (module docs,
+/// "High finesse"): 2π/M with M the smallest number of cells per fringe such that
+///
+/// ```text
+/// 2 D (x/4 + x²/(1 − x)) ≤ ε,   x = ρᴹ,   D = (1 − ρ)/(1 + ρ),   ε = 10⁻⁵,
+/// ```
+///
+/// i.e. x = 2t / (a + √(a² + 3t)), a = 1/4 + t, t = ε/(2D) (the root of
+/// ¾x² + a x − t = 0), M = ln x / ln ρ; clamped to [2π/4096, 0.5] rad.
+pub fn phase_step_rad(rho: f64) -> f64 {
+    if !(rho > 0.0) {
+        return MAX_PHASE_STEP_RAD;
+    }
+    let min_step = 2.0 * PI / MAX_CELLS_PER_FRINGE;
+    if rho >= 1.0 {
+        return min_step;
+    }
+    let d = (1.0 - rho) / (1.0 + rho);
+    let t = FRINGE_TOLERANCE / (2.0 * d);
+    let a = 0.25 + t;
+    let x = 2.0 * t / (a + (a * a + 3.0 * t).sqrt());
+    let cells = x.ln() / rho.ln();
+    (2.0 * PI / cells).clamp(min_step, MAX_PHASE_STEP_RAD)
+}
+
 /// Quadrature nodes and sensitivity-weighted weights: colour = Σₖ f(λₖ) Wₖ.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SpectralRule {
@@ -46,17 +77,65 @@ pub struct SpectralRule {
 
 impl SpectralRule {
     /// The rule for spectra whose interference terms have optical path differences up to
-    /// `max_opd_nm` (0 for smooth spectra), for `colorimeter`'s sensitivities.
+    /// `max_opd_nm` (0 for smooth spectra) and broad fringes (fringe finesse ρ ≤ 0.4, see
+    /// [`SpectralRule::with_finesse`]), for `colorimeter`'s sensitivities.
     pub fn new(colorimeter: &Colorimeter, max_opd_nm: f64) -> Self {
+        Self::build(colorimeter, max_opd_nm, |_| Ok(0.0)).expect("infallible finesse")
+    }
+
+    /// The rule for films whose fringes have finesse up to `finesse(λ)` (the round-trip
+    /// amplitude ρ of [`Stack::fringe_finesse`], in [0, 1]) near wavelength λ: each cell's
+    /// phase step is [`phase_step_rad`]`(ρ)`, with ρ the larger of its values at the
+    /// cell's two ends. For ρ ≤ 0.4 this is [`SpectralRule::new`]'s rule, node for node.
+    pub fn with_finesse(
+        colorimeter: &Colorimeter,
+        max_opd_nm: f64,
+        mut finesse: impl FnMut(f64) -> f64,
+    ) -> Self {
+        Self::build(colorimeter, max_opd_nm, |wl| Ok(finesse(wl))).expect("infallible finesse")
+    }
+
+    /// The rule for `stack` seen at every angle of `angles_deg`, with optical path
+    /// differences up to `max_opd_nm` (e.g. [`Stack::max_opd_nm`]): its fringe finesse is
+    /// the largest [`Stack::fringe_finesse`] over the angles. Errors where the stack does
+    /// (an angle of 90° or more, a material without data at a node).
+    pub fn for_stack(
+        colorimeter: &Colorimeter,
+        stack: &Stack,
+        angles_deg: &[f64],
+        max_opd_nm: f64,
+    ) -> Result<Self> {
+        Self::build(colorimeter, max_opd_nm, |wl| {
+            angles_deg
+                .iter()
+                .try_fold(0.0f64, |m, &a| Ok(m.max(stack.fringe_finesse(a, wl)?)))
+        })
+    }
+
+    fn build(
+        colorimeter: &Colorimeter,
+        max_opd_nm: f64,
+        mut finesse: impl FnMut(f64) -> Result<f64>,
+    ) -> Result<Self> {
         let max_opd_nm = max_opd_nm.max(0.0);
         let mut wavelengths_nm = Vec::new();
         let mut weights = Vec::new();
         let mut lo = SPECTRAL_MIN_NM;
         while lo < SPECTRAL_MAX_NM {
             let rate = 2.0 * PI * max_opd_nm / (lo * lo);
-            let h = (MAX_PHASE_STEP_RAD / rate)
-                .min(MAX_CELL_NM)
-                .min(SPECTRAL_MAX_NM - lo);
+            let cell = |step: f64| (step / rate).min(MAX_CELL_NM).min(SPECTRAL_MAX_NM - lo);
+            let mut h = cell(MAX_PHASE_STEP_RAD);
+            if max_opd_nm > 0.0 {
+                // ρ varies with the media's dispersion: take the larger of the cell's ends.
+                let step = phase_step_rad(finesse(lo)?);
+                if step < MAX_PHASE_STEP_RAD {
+                    h = cell(step);
+                }
+                let step = phase_step_rad(finesse(lo + h)?);
+                if step < MAX_PHASE_STEP_RAD {
+                    h = h.min(cell(step));
+                }
+            }
             let centre = lo + 0.5 * h;
             for x in [centre - 0.5 * h * GL2, centre + 0.5 * h * GL2] {
                 wavelengths_nm.push(x);
@@ -77,10 +156,10 @@ impl SpectralRule {
         for w in &mut weights {
             *w = std::array::from_fn(|c| w[c] * scale[c]);
         }
-        SpectralRule {
+        Ok(SpectralRule {
             wavelengths_nm,
             weights,
-        }
+        })
     }
 
     /// The quadrature nodes, nm, increasing.
