@@ -37,6 +37,9 @@ const MAX_CELL_NM: f64 = 2.0;
 /// Gauss–Legendre 2-point abscissa on [−1, 1]: 1/√3.
 const GL2: f64 = 0.577_350_269_189_625_8;
 
+/// Spacing of the fringe-finesse samples of [`SpectralRule::for_stack`], nm.
+pub const FINESSE_GRID_NM: f64 = 5.0;
+
 /// Bound on the aliased part of the reflectance, ε of [`phase_step_rad`].
 const FRINGE_TOLERANCE: f64 = 1e-6;
 
@@ -97,18 +100,33 @@ impl SpectralRule {
 
     /// The rule for `stack` seen at every angle of `angles_deg`, with optical path
     /// differences up to `max_opd_nm` (e.g. [`Stack::max_opd_nm`]): its fringe finesse is
-    /// the largest [`Stack::fringe_finesse`] over the angles. Errors where the stack does
-    /// (an angle of 90° or more, a material without data at a node).
+    /// the largest [`Stack::fringe_finesse`] over the angles, sampled every
+    /// [`FINESSE_GRID_NM`] nm (the media's dispersion is slow on that scale); a wavelength
+    /// between two samples takes the larger. Errors where the stack does (an angle of 90°
+    /// or more, a material without data in 360–830 nm).
     pub fn for_stack(
         colorimeter: &Colorimeter,
         stack: &Stack,
         angles_deg: &[f64],
         max_opd_nm: f64,
     ) -> Result<Self> {
+        let samples = ((SPECTRAL_MAX_NM - SPECTRAL_MIN_NM) / FINESSE_GRID_NM).ceil() as usize;
+        let grid = if max_opd_nm > 0.0 && !stack.layers().is_empty() {
+            (0..=samples)
+                .map(|i| {
+                    let wl = (SPECTRAL_MIN_NM + i as f64 * FINESSE_GRID_NM).min(SPECTRAL_MAX_NM);
+                    angles_deg
+                        .iter()
+                        .try_fold(0.0f64, |m, &a| Ok(m.max(stack.fringe_finesse(a, wl)?)))
+                })
+                .collect::<Result<Vec<f64>>>()?
+        } else {
+            vec![0.0; samples + 1]
+        };
         Self::build(colorimeter, max_opd_nm, |wl| {
-            angles_deg
-                .iter()
-                .try_fold(0.0f64, |m, &a| Ok(m.max(stack.fringe_finesse(a, wl)?)))
+            let x = ((wl - SPECTRAL_MIN_NM) / FINESSE_GRID_NM).clamp(0.0, samples as f64);
+            let (i, j) = (x.floor() as usize, (x.ceil() as usize).min(samples));
+            Ok(grid[i].max(grid[j]))
         })
     }
 

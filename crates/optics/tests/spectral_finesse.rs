@@ -183,6 +183,7 @@ fn issue_16_absorbing_base_at_81_degrees() {
     assert!(delta_e(&c, truth, brute_force_at(&c, &stack, case.angle_deg, 0.02)) < 1e-4);
     let (ours, _) = spectral(&c, &stack, case.angle_deg);
     let de = delta_e(&c, ours, truth);
+    eprintln!("issue 16 case: ΔE2000 {de:.2e}");
     assert!(de <= BOUND, "ΔE2000 {de}");
     // The finesse-blind rule misses it.
     let blind = SpectralRule::new(&c, stack.max_opd_nm(None));
