@@ -558,25 +558,23 @@ pub(crate) fn fringe_finesse_of(indices: &[C64], beta: f64) -> f64 {
     }
     let q: Vec<C64> = indices.iter().map(|&n| normal_component(n, beta)).collect();
     // |r| of interface j (medium j into j + 1), per polarisation; |r_ji| = |r_ij|.
-    let r: Vec<[f64; 2]> = (0..=films)
-        .map(|j| {
-            let i = Interface::new(indices[j], q[j], indices[j + 1], q[j + 1]);
-            [i.r_s.norm(), i.r_p.norm()]
-        })
+    let interfaces: Vec<Interface> = (0..=films)
+        .map(|j| Interface::new(indices[j], q[j], indices[j + 1], q[j + 1]))
         .collect();
     let mobius = |a: f64, b: f64| ((a + b) / (1.0 + a * b)).min(1.0);
     let mut rho: f64 = 0.0;
-    for pol in 0..2 {
+    for magnitude in [|i: &Interface| i.r_s.norm(), |i: &Interface| i.r_p.norm()] {
+        let r: Vec<f64> = interfaces.iter().map(magnitude).collect();
         // down[j - 1]: everything below film j, seen from inside it.
         let mut down = vec![0.0; films];
-        down[films - 1] = r[films][pol].min(1.0);
+        down[films - 1] = r[films].min(1.0);
         for j in (1..films).rev() {
-            down[j - 1] = mobius(r[j][pol], down[j]);
+            down[j - 1] = mobius(r[j], down[j]);
         }
-        let mut up = r[0][pol].min(1.0);
+        let mut up = r[0].min(1.0);
         for j in 1..=films {
             if j > 1 {
-                up = mobius(r[j - 1][pol], up);
+                up = mobius(r[j - 1], up);
             }
             rho = rho.max(up * down[j - 1]);
         }
