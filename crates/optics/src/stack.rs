@@ -513,6 +513,24 @@ impl Stack {
         Ok(())
     }
 
+    /// The fringe finesse ρ of the stack at incidence `angle_deg` and `wavelength_nm`: the
+    /// largest round-trip amplitude |Γ↑ⱼ| |Γ↓ⱼ| of any film j, either polarisation, where
+    /// Γ↓ⱼ is the composite reflection amplitude of everything below film j seen from inside
+    /// it and Γ↑ⱼ that of everything above it. A film's Airy sum is a geometric series in
+    /// ρ e^{iφ} (Born & Wolf §7.6.1): its reflectance has Fourier harmonics in the film
+    /// phase φ that decay as ρᵏ, and its fringes are lines of width ≈ 2(1 − ρ) rad.
+    ///
+    /// For one film ρ = |r₀₁| |r₁₂| exactly. Below and above a film of a multilayer the
+    /// composite magnitudes are bounded by the lossless Möbius bound of the recurrence
+    /// of the module docs, |Γⱼ| ≤ (|r_{j,j+1}| + |Γ_{j+1}|) / (1 + |r_{j,j+1}| |Γ_{j+1}|)
+    /// (exact for real Fresnel coefficients, with the films' attenuation taken as 1), so ρ
+    /// is an upper bound there. Clamped to [0, 1].
+    pub fn fringe_finesse(&self, angle_deg: f64, wavelength_nm: f64) -> Result<f64> {
+        let sin_theta = sin_of_angle(angle_deg)?;
+        let indices = self.indices_at(wavelength_nm)?;
+        Ok(fringe_finesse_of(&indices, indices[0].re * sin_theta))
+    }
+
     /// Validates angles and resolves indices once per wavelength.
     pub(crate) fn resolve(
         &self,
@@ -528,6 +546,43 @@ impl Stack {
             .map(|&wl| self.indices_at(wl))
             .collect::<Result<Vec<_>>>()?;
         Ok((sines, indices))
+    }
+}
+
+/// [`Stack::fringe_finesse`] for media `indices` (ambient first) and tangential component
+/// `beta`.
+pub(crate) fn fringe_finesse_of(indices: &[C64], beta: f64) -> f64 {
+    let films = indices.len() - 2;
+    if films == 0 {
+        return 0.0;
+    }
+    let q: Vec<C64> = indices.iter().map(|&n| normal_component(n, beta)).collect();
+    // |r| of interface j (medium j into j + 1), per polarisation; |r_ji| = |r_ij|.
+    let interfaces: Vec<Interface> = (0..=films)
+        .map(|j| Interface::new(indices[j], q[j], indices[j + 1], q[j + 1]))
+        .collect();
+    let mobius = |a: f64, b: f64| ((a + b) / (1.0 + a * b)).min(1.0);
+    let mut rho: f64 = 0.0;
+    for magnitude in [|i: &Interface| i.r_s.norm(), |i: &Interface| i.r_p.norm()] {
+        let r: Vec<f64> = interfaces.iter().map(magnitude).collect();
+        // down[j - 1]: everything below film j, seen from inside it.
+        let mut down = vec![0.0; films];
+        down[films - 1] = r[films].min(1.0);
+        for j in (1..films).rev() {
+            down[j - 1] = mobius(r[j], down[j]);
+        }
+        let mut up = r[0].min(1.0);
+        for j in 1..=films {
+            if j > 1 {
+                up = mobius(r[j - 1], up);
+            }
+            rho = rho.max(up * down[j - 1]);
+        }
+    }
+    if rho.is_nan() {
+        1.0
+    } else {
+        rho.clamp(0.0, 1.0)
     }
 }
 

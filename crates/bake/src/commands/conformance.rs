@@ -530,7 +530,11 @@ impl Conformance {
              [`KHR_materials_iridescence`](https://github.com/KhronosGroup/glTF/tree/main/extensions/2.0/Khronos/KHR_materials_iridescence),\n\
              for renderer authors to test their implementation against. They are computed by\n\
              [nacre](../../README.md)'s `spectral` method: the exact multilayer reflectance, in f64,\n\
-             integrated over the spectrum (within ΔE2000 0.01 of a 0.1 nm integration).\n",
+             integrated over the spectrum with a rule that resolves the film's fringes however\n\
+             sharp they are: within ΔE2000 0.01 of a converged brute-force integration (0.05 nm,\n\
+             finer where the fringes need it) for every film up to 10 µm of index 1.0–2.5 at\n\
+             0–89.9° on the bundled materials and on constant indices n 1.0–3.0, κ 0–5 (the\n\
+             worst case a search of the highest-finesse corners finds: ΔE2000 0.0013).\n",
             env!("CARGO_PKG_VERSION")
         );
         let _ = writeln!(w, "## Files\n\n| file | bytes | what |\n|---|---|---|");
