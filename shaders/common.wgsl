@@ -72,7 +72,8 @@ const BRANCH_TOLERANCE: f32 = 1.1920929e-5;
 //        8    4 film_ior: f32
 //       12    4 sigma_thickness_nm: f32
 //       16    4 ambient_ior: f32
-//       20   12 _pad0, _pad1, _pad2: f32
+//       20    4 variation: f32
+//       24    8 _pad1, _pad2: f32
 //       32   12 base_ior: vec3<f32>
 //       44    4 _pad3: f32
 //       48   12 base_kappa: vec3<f32>
@@ -88,7 +89,9 @@ struct FilmInput {
     sigma_thickness_nm: f32,
     // Ambient index n₁ (film_lut: baked into the table, this field is ignored).
     ambient_ior: f32,
-    _pad0: f32,
+    // Spatial variation s = 2g − 1 ∈ [−1, 1] of a stack's lower films (film_stack: film j ≥ 2
+    // is d_j + r_j s; NaN → 0; the other techniques ignore it).
+    variation: f32,
     _pad1: f32,
     _pad2: f32,
     // Base index per output channel, real part n (film_fourier; film_lut bakes the base and
@@ -152,6 +155,7 @@ fn unit_power(x: f32) -> f32 {
 //   film_ior            NaN, ±∞ or ≤ 0 → the (sanitised) ambient index; clamped likewise;
 //   base_ior            NaN or ±∞ → BASE_IOR_FALLBACK (1.5); clamped to [IOR_MIN, IOR_MAX];
 //   base_kappa          NaN, ±∞ or < 0 → 0; clamped to [0, IOR_MAX];
+//   variation           NaN → 0; clamped to [−1, 1];
 //   _pad*               0.
 // Techniques still evaluate the physics at max(cos_theta_i, COS_THETA_MIN).
 fn sanitize_input(input: FilmInput) -> FilmInput {
@@ -167,7 +171,7 @@ fn sanitize_input(input: FilmInput) -> FilmInput {
     o.base_ior = clamp(select(vec3<f32>(BASE_IOR_FALLBACK), input.base_ior, base_ok), vec3<f32>(IOR_MIN), vec3<f32>(IOR_MAX));
     let kappa_ok = vec3_is_finite(input.base_kappa) & (input.base_kappa > vec3<f32>(0.0));
     o.base_kappa = select(vec3<f32>(0.0), min(input.base_kappa, vec3<f32>(IOR_MAX)), kappa_ok);
-    o._pad0 = 0.0;
+    o.variation = select(clamp(input.variation, -1.0, 1.0), 0.0, f32_is_nan(input.variation));
     o._pad1 = 0.0;
     o._pad2 = 0.0;
     o._pad3 = 0.0;

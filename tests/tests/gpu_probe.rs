@@ -284,6 +284,152 @@ fn film_spectral_matches_samples_n() {
     }
 }
 
+/// `film_stack` against its CPU twin (`StackEvaluation`) over random pixels (incidence,
+/// top-film thickness, variation s) for stacks of 1 to 8 films: dielectric, absorbing metal
+/// films (10 nm silver, chromium), dispersive materials, and an ambient denser than its
+/// films (total internal reflection and evanescent films), with the rule ladder and with a
+/// fixed rule: max |GPU − CPU| ≤ 1e-4 per channel.
+#[test]
+fn film_stack_matches_its_cpu_twin() {
+    use nacre_optics::few_wavelengths::StackEvaluation;
+    use nacre_optics::{Layer, Stack};
+    use nacre_runtime::bindings::StackSetup;
+    let ctx = ctx();
+    let tables = TableSet::load(ctx, &manifest("fourier-srgb")).unwrap();
+    let colorimeter = tables.colorimeter().unwrap();
+    let constant = |n: f64| Material::constant(format!("{n}"), C64::new(n, 0.0)).unwrap();
+    let bundled = |name: &str| materials::resolve(name, "test", None).unwrap();
+    let layer = |material: Material, thickness_nm: f64| Layer {
+        material,
+        thickness_nm,
+    };
+    let cases: Vec<(&str, Stack, Option<usize>)> = vec![
+        (
+            "one film on gold",
+            Stack::new(
+                constant(1.0),
+                vec![layer(constant(1.45), 300.0)],
+                bundled("au"),
+            )
+            .unwrap(),
+            None,
+        ),
+        (
+            "metal-dielectric-metal",
+            Stack::new(
+                constant(1.0),
+                vec![layer(bundled("ag"), 10.0), layer(constant(1.38), 150.0)],
+                bundled("ag"),
+            )
+            .unwrap(),
+            None,
+        ),
+        (
+            "dispersive four films on silicon",
+            Stack::new(
+                bundled("air"),
+                vec![
+                    layer(bundled("mgf2"), 90.0),
+                    layer(bundled("tio2"), 50.0),
+                    layer(bundled("cr"), 8.0),
+                    layer(bundled("water"), 200.0),
+                ],
+                bundled("si"),
+            )
+            .unwrap(),
+            None,
+        ),
+        (
+            "eight films, fixed 16 nodes",
+            Stack::new(
+                constant(1.0),
+                (0..8)
+                    .map(|j| {
+                        layer(
+                            constant(if j % 2 == 0 { 1.38 } else { 2.3 }),
+                            40.0 + 10.0 * j as f64,
+                        )
+                    })
+                    .collect(),
+                constant(1.52),
+            )
+            .unwrap(),
+            Some(16),
+        ),
+        (
+            "dense ambient, total internal reflection",
+            Stack::new(
+                constant(1.6),
+                vec![layer(constant(1.0), 120.0), layer(constant(1.33), 200.0)],
+                constant(1.2),
+            )
+            .unwrap(),
+            None,
+        ),
+    ];
+    for (name, stack, samples) in cases {
+        let films = stack.layers().len();
+        let relative_nm: Vec<f64> = (0..films).map(|j| 15.0 * j as f64).collect();
+        let eval = StackEvaluation::new(&colorimeter, &stack, &relative_nm, samples).unwrap();
+        let options = TechniqueOptions {
+            stack: StackSetup {
+                stack,
+                relative_nm,
+                samples,
+            },
+            ..Default::default()
+        };
+        let binding =
+            TechniqueBinding::new(ctx, &tables, Technique::Stack, &options, &colorimeter).unwrap();
+        let mut rng = Lcg(41);
+        let pixels: Vec<(f64, f64, f64)> = (0..400)
+            .map(|_| (rng.next(), 500.0 * rng.next(), 2.0 * rng.next() - 1.0))
+            .collect();
+        let inputs: Vec<FilmInput> = pixels
+            .iter()
+            .map(|&(c, d, s)| FilmInput {
+                variation: s as f32,
+                ..input(c, d, 1.5, 0.0, 1.0, C64::new(1.5, 0.0))
+            })
+            .collect();
+        let gpu = run_probe(ctx, &binding, &inputs).unwrap();
+        // The CPU twin at the f32 inputs the GPU saw.
+        let cpu: Vec<([f64; 3], [f64; 3])> = inputs
+            .iter()
+            .map(|i| {
+                eval.colour(
+                    f64::from(i.cos_theta_i),
+                    f64::from(i.thickness_nm),
+                    f64::from(i.variation),
+                )
+            })
+            .collect();
+        for (quantity, pick) in [("R", 0usize), ("T", 1)] {
+            let c: Vec<[f64; 3]> = cpu
+                .iter()
+                .map(|x| if pick == 0 { x.0 } else { x.1 })
+                .collect();
+            let g: Vec<[f32; 3]> = gpu
+                .iter()
+                .map(|o| {
+                    if pick == 0 {
+                        o.reflectance
+                    } else {
+                        o.transmittance
+                    }
+                })
+                .collect();
+            let (worst, at) = max_diff(&c, &g);
+            eprintln!("stack {name}: {quantity} max |GPU − CPU| = {worst:.2e}");
+            assert!(
+                worst <= 1e-4,
+                "{name} {quantity}: {worst:e} at {:?}",
+                pixels[at]
+            );
+        }
+    }
+}
+
 /// Every technique returns finite colours for every input a host engine might send: NaN,
 /// ±∞, negative, zero and huge values in every field, grazing and total internal reflection.
 #[test]

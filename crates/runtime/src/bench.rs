@@ -43,6 +43,7 @@ impl BenchPass {
             BenchPass::Film(Technique::Lut) => "film_lut",
             BenchPass::Film(Technique::Fourier) => "film_fourier",
             BenchPass::Film(Technique::Spectral) => "film_spectral",
+            BenchPass::Film(Technique::Stack) => "film_stack",
             BenchPass::Diffraction => "diffraction",
         }
     }

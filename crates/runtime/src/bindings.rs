@@ -48,7 +48,9 @@ fn buffer_entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLay
 /// * `Lut`: 0 reflectance `texture_3d<f32>`, 1 transmittance `texture_3d<f32>`,
 ///   2 filtering sampler, 3 `uniform FilmLutParams`;
 /// * `Fourier`: 0 `texture_2d_array<f32>` (unfilterable), 1 `uniform FourierParams`;
-/// * `Spectral`: 0 `storage, read array<SpectralSample>`, 1 `uniform SpectralParams`.
+/// * `Spectral`: 0 `storage, read array<SpectralSample>`, 1 `uniform SpectralParams`;
+/// * `Stack`: 0 `storage, read array<StackNode>`, 1 `storage, read array<vec2<f32>>` (every
+///   medium's index at every node), 2 `uniform StackParams`.
 pub fn table_layout(device: &wgpu::Device, technique: Technique) -> wgpu::BindGroupLayout {
     use wgpu::BufferBindingType::{Storage, Uniform};
     let entries: Vec<wgpu::BindGroupLayoutEntry> = match technique {
@@ -70,6 +72,11 @@ pub fn table_layout(device: &wgpu::Device, technique: Technique) -> wgpu::BindGr
         Technique::Spectral => vec![
             buffer_entry(0, Storage { read_only: true }),
             buffer_entry(1, Uniform),
+        ],
+        Technique::Stack => vec![
+            buffer_entry(0, Storage { read_only: true }),
+            buffer_entry(1, Storage { read_only: true }),
+            buffer_entry(2, Uniform),
         ],
     };
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -117,6 +124,95 @@ pub fn spectral_samples(
         .collect()
 }
 
+/// What `film_stack` evaluates: a stack of 1 to 8 films whose top film takes the pixel's
+/// thickness and whose other films vary as d_j + r_j s
+/// ([`nacre_optics::few_wavelengths::StackEvaluation`]).
+#[derive(Clone, Debug)]
+pub struct StackSetup {
+    /// Ambient, films (their own thicknesses d_j⁰) and base.
+    pub stack: nacre_optics::Stack,
+    /// Relative thickness r_j of each film, nm (the top film's is unused).
+    pub relative_nm: Vec<f64>,
+    /// `None`: the rule ladder (counts from the pixel's OPD); `Some(N)`: N nodes everywhere.
+    pub samples: Option<usize>,
+}
+
+impl Default for StackSetup {
+    /// A two-film dielectric stack in air on glass (n 1.5): 100 nm of n 1.38 over 60 nm of
+    /// n 2.3, the lower film varying by ±30 nm.
+    fn default() -> Self {
+        let constant = |n: f64| {
+            nacre_optics::Material::constant(format!("{n}"), nacre_optics::C64::new(n, 0.0))
+                .expect("a real index above zero is a valid material")
+        };
+        let layers = vec![
+            nacre_optics::Layer {
+                material: constant(1.38),
+                thickness_nm: 100.0,
+            },
+            nacre_optics::Layer {
+                material: constant(2.3),
+                thickness_nm: 60.0,
+            },
+        ];
+        StackSetup {
+            stack: nacre_optics::Stack::new(constant(1.0), layers, constant(1.5))
+                .expect("finite thicknesses and a clear ambient"),
+            relative_nm: vec![0.0, 30.0],
+            samples: None,
+        }
+    }
+}
+
+/// Group 1 of `film_stack` for `setup`: the nodes of every rule, every medium's index at
+/// every node and the uniform ([`StackEvaluation`](nacre_optics::few_wavelengths::StackEvaluation)
+/// holds the same numbers in f64 for the CPU twin).
+pub fn stack_buffers(
+    colorimeter: &Colorimeter,
+    setup: &StackSetup,
+) -> Result<(Vec<params::StackNode>, Vec<[f32; 2]>, params::StackParams)> {
+    use nacre_optics::few_wavelengths::{BASE_COUNT, COUNT_PER_OPD_NM, StackEvaluation};
+    let eval = StackEvaluation::new(colorimeter, &setup.stack, &setup.relative_nm, setup.samples)?;
+    let mut nodes = Vec::new();
+    let mut u = params::StackParams {
+        films: eval.thickness_nm().len() as u32,
+        dispersive: u32::from(eval.dispersive()),
+        rule_count: eval.rules().len() as u32,
+        fixed: u32::from(eval.fixed()),
+        base_count: BASE_COUNT as f32,
+        count_per_opd_nm: COUNT_PER_OPD_NM as f32,
+        finesse: eval.finesse() as f32,
+        ..params::StackParams::default()
+    };
+    for (i, rule) in eval.rules().iter().enumerate() {
+        u.rule_offset[i] = nodes.len() as u32;
+        u.rule_size[i] = rule.wavelengths_nm().len() as u32;
+        for (&l, w) in rule.wavelengths_nm().iter().zip(rule.weights()) {
+            nodes.push(params::StackNode {
+                wavelength_nm: l as f32,
+                _pad: [0.0; 3],
+                weight: [w[0] as f32, w[1] as f32, w[2] as f32, 0.0],
+            });
+        }
+    }
+    for (j, ((d, r), k)) in eval
+        .thickness_nm()
+        .iter()
+        .zip(eval.relative_nm())
+        .zip(eval.opd_factors())
+        .enumerate()
+    {
+        u.layers[j] = [*d as f32, *r as f32, *k as f32, 0.0];
+    }
+    let indices = eval
+        .indices()
+        .iter()
+        .flatten()
+        .map(|n| [n.re as f32, n.im as f32])
+        .collect();
+    Ok((nodes, indices, u))
+}
+
 /// Options of a technique's group-1 bind group.
 #[derive(Clone, Debug)]
 pub struct TechniqueOptions {
@@ -124,6 +220,8 @@ pub struct TechniqueOptions {
     pub harmonics: u32,
     /// Setup of `film_spectral`.
     pub spectral: SpectralSetup,
+    /// Setup of `film_stack`.
+    pub stack: StackSetup,
 }
 
 impl Default for TechniqueOptions {
@@ -135,6 +233,7 @@ impl Default for TechniqueOptions {
                 base: Material::constant("1.5", nacre_optics::C64::new(1.5, 0.0))
                     .expect("a real index above zero is a valid material"),
             },
+            stack: StackSetup::default(),
         }
     }
 }
@@ -274,6 +373,44 @@ impl TechniqueBinding {
                                 },
                                 wgpu::BindGroupEntry {
                                     binding: 1,
+                                    resource: uniform.as_entire_binding(),
+                                },
+                            ],
+                        })
+                    }
+                    Technique::Stack => {
+                        let (nodes, indices, uniform) = stack_buffers(colorimeter, &options.stack)?;
+                        let nodes = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                            label: Some("StackNode[]"),
+                            contents: bytemuck::cast_slice(&nodes),
+                            usage: wgpu::BufferUsages::STORAGE,
+                        });
+                        let indices =
+                            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                                label: Some("stack indices"),
+                                contents: bytemuck::cast_slice(&indices),
+                                usage: wgpu::BufferUsages::STORAGE,
+                            });
+                        let uniform =
+                            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                                label: Some("StackParams"),
+                                contents: bytemuck::bytes_of(&uniform),
+                                usage: wgpu::BufferUsages::UNIFORM,
+                            });
+                        device.create_bind_group(&wgpu::BindGroupDescriptor {
+                            label: Some("stack tables"),
+                            layout: &layout,
+                            entries: &[
+                                wgpu::BindGroupEntry {
+                                    binding: 0,
+                                    resource: nodes.as_entire_binding(),
+                                },
+                                wgpu::BindGroupEntry {
+                                    binding: 1,
+                                    resource: indices.as_entire_binding(),
+                                },
+                                wgpu::BindGroupEntry {
+                                    binding: 2,
                                     resource: uniform.as_entire_binding(),
                                 },
                             ],

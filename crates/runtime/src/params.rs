@@ -17,8 +17,11 @@ pub struct FilmInput {
     pub sigma_thickness_nm: f32,
     /// Ambient index n₁.
     pub ambient_ior: f32,
+    /// Spatial variation s = 2g − 1 ∈ [−1, 1] of a stack's lower films (`film_stack`:
+    /// film j ≥ 2 is d_j + r_j s); the other techniques ignore it.
+    pub variation: f32,
     /// Padding.
-    pub _pad0: [f32; 3],
+    pub _pad1: [f32; 2],
     /// Base index per output channel, real part.
     pub base_ior: [f32; 3],
     /// Padding.
@@ -154,4 +157,44 @@ impl SpectralParams {
             _pad: [0; 3],
         }
     }
+}
+
+/// Mirror of `StackNode` (`shaders/film_stack.wgsl`): 32 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct StackNode {
+    /// Node wavelength λ_k, nm.
+    pub wavelength_nm: f32,
+    /// Padding.
+    pub _pad: [f32; 3],
+    /// Per-channel weight W_k (rgb), 0.
+    pub weight: [f32; 4],
+}
+
+/// Mirror of `StackParams` (`shaders/film_stack.wgsl`): 288 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct StackParams {
+    /// Films F.
+    pub films: u32,
+    /// 1 when some index varies with wavelength.
+    pub dispersive: u32,
+    /// Rules in the ladder.
+    pub rule_count: u32,
+    /// 1: always rule 0 (`stack:N`).
+    pub fixed: u32,
+    /// N at OPD 0.
+    pub base_count: f32,
+    /// Samples per nm of OPD.
+    pub count_per_opd_nm: f32,
+    /// The stack's finesse factor h.
+    pub finesse: f32,
+    /// Padding.
+    pub _pad0: f32,
+    /// First node of rule i.
+    pub rule_offset: [u32; 16],
+    /// Nodes of rule i.
+    pub rule_size: [u32; 16],
+    /// Film j: (d_j⁰, r_j, k_j, 0).
+    pub layers: [[f32; 4]; 8],
 }

@@ -37,6 +37,9 @@ pub const FILM_LUT: &str = include_str!("../../../shaders/film_lut.wgsl");
 pub const FILM_FOURIER: &str = include_str!("../../../shaders/film_fourier.wgsl");
 /// Technique: brute-force loop over N wavelengths.
 pub const FILM_SPECTRAL: &str = include_str!("../../../shaders/film_spectral.wgsl");
+/// Technique: real-time multilayer stacks at a few wavelengths chosen well
+/// (`nacre_optics::few_wavelengths`).
+pub const FILM_STACK: &str = include_str!("../../../shaders/film_stack.wgsl");
 
 /// Baseline "technique" without a film (Schlick Fresnel) for `nacre bench-gpu`.
 pub const PLAIN: &str = include_str!("../../../shaders/plain.wgsl");
@@ -104,6 +107,7 @@ pub const MODULES: &[Module] = modules![
     "film_lut",
     "film_fourier",
     "film_spectral",
+    "film_stack",
     "plain",
     "rough_lut_mapping",
     "output",
@@ -126,6 +130,7 @@ pub const TECHNIQUE_MODULES: &[&str] = &[
     "film_lut",
     "film_fourier",
     "film_spectral",
+    "film_stack",
     "plain",
     "diffraction",
     "diffraction_integrated",
@@ -547,11 +552,18 @@ pub enum Technique {
     Fourier,
     /// `film_spectral.wgsl`.
     Spectral,
+    /// `film_stack.wgsl`.
+    Stack,
 }
 
 impl Technique {
     /// Every technique.
-    pub const ALL: [Technique; 3] = [Technique::Lut, Technique::Fourier, Technique::Spectral];
+    pub const ALL: [Technique; 4] = [
+        Technique::Lut,
+        Technique::Fourier,
+        Technique::Spectral,
+        Technique::Stack,
+    ];
 
     /// The technique module's WGSL source.
     pub fn source(self) -> &'static str {
@@ -559,6 +571,7 @@ impl Technique {
             Technique::Lut => FILM_LUT,
             Technique::Fourier => FILM_FOURIER,
             Technique::Spectral => FILM_SPECTRAL,
+            Technique::Stack => FILM_STACK,
         }
     }
 
@@ -568,6 +581,7 @@ impl Technique {
             Technique::Lut => "film_lut",
             Technique::Fourier => "film_fourier",
             Technique::Spectral => "film_spectral",
+            Technique::Stack => "film_stack",
         }
     }
 
@@ -577,6 +591,7 @@ impl Technique {
             Technique::Lut => "lut",
             Technique::Fourier => "fourier",
             Technique::Spectral => "spectral",
+            Technique::Stack => "stack",
         }
     }
 }
@@ -707,6 +722,7 @@ mod tests {
             ("film_lut", &["common", "lut_mapping"]),
             ("film_fourier", &["common"]),
             ("film_spectral", &["common"]),
+            ("film_stack", &["common"]),
             ("plain", &["common"]),
             ("rough_lut_mapping", &[]),
             ("output", &[]),
@@ -933,6 +949,7 @@ mod tests {
             ("film_lut", &["common", "lut_mapping", "film_lut"]),
             ("film_fourier", &["common", "film_fourier"]),
             ("film_spectral", &["common", "film_spectral"]),
+            ("film_stack", &["common", "film_stack"]),
             ("plain", &["common", "plain"]),
             ("diffraction", &["diffraction_common", "diffraction"]),
             (

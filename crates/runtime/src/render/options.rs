@@ -3,7 +3,7 @@
 //! ([`MaterialOptions`], mirrored by [`MaterialUniform`]) and everything together
 //! ([`SceneOptions`]).
 
-use crate::bindings::{SpectralSetup, TechniqueOptions};
+use crate::bindings::{SpectralSetup, StackSetup, TechniqueOptions};
 use crate::environment::SUN_DIRECTION;
 use crate::error::{Error, Result};
 use crate::image_io::MAX_DIMENSION;
@@ -568,6 +568,9 @@ pub struct SceneOptions {
     pub harmonics: u32,
     /// Wavelengths N of `film_spectral` (default 30).
     pub spectral_samples: usize,
+    /// The stack of `film_stack` (default [`StackSetup::default`]): its top film takes the
+    /// material's thickness, its other films vary with the thickness map (s = 2g − 1).
+    pub stack: StackSetup,
     /// How the film enters the lighting (default [`FilmEval::Classic`]).
     pub film_eval: FilmEval,
 }
@@ -589,6 +592,7 @@ impl SceneOptions {
             exposure_ev: 0.0,
             harmonics: technique.harmonics,
             spectral_samples: technique.spectral.samples,
+            stack: technique.stack,
             film_eval: FilmEval::Classic,
         }
     }
@@ -621,6 +625,7 @@ impl SceneOptions {
                 samples: self.spectral_samples,
                 base: self.material.base.clone(),
             },
+            stack: self.stack.clone(),
         }
     }
 
