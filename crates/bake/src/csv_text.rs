@@ -14,16 +14,10 @@ pub(crate) use nacre_optics::csv_rows::Row;
 pub(crate) fn rows<'a>(path: &'a Path, text: &'a str) -> impl Iterator<Item = Result<Row>> + 'a {
     nacre_optics::csv_rows::Rows::new(&path.display().to_string(), text).map(move |row| {
         row.map_err(|e| match e {
-            nacre_optics::Error::Parse { line, message, .. } => Error::Recipe {
-                path: path.to_path_buf(),
-                line,
-                message,
-            },
-            other => Error::Recipe {
-                path: path.to_path_buf(),
-                line: 0,
-                message: other.to_string(),
-            },
+            nacre_optics::Error::Parse { line, message, .. } => {
+                Error::recipe(path.to_path_buf(), line, message)
+            }
+            other => Error::recipe(path.to_path_buf(), 0, other.to_string()),
         })
     })
 }

@@ -64,10 +64,10 @@ pub enum Error {
         source: std::io::Error,
     },
     /// A request larger than the documented limits.
-    #[error("{what}: {count} exceeds the limit of {limit}")]
+    #[error("{}", self.named(&Neutral))]
     TooLarge {
-        /// What was counted.
-        what: String,
+        /// What was counted (it may name parameters).
+        what: Msg,
         /// The requested count.
         count: u64,
         /// The limit.
@@ -146,6 +146,11 @@ impl Render for Error {
                 "{}: unknown material `{name}`: expected a number (`1.5`), a complex index (`0.27+2.9i`), a bundled material ({bundled}), a path to a `.yml`/`.csv` file or a refractiveindex.info page SHELF/BOOK/PAGE (with {})",
                 context.named(naming),
                 naming.name(Param::MaterialDb)
+            ),
+            Error::TooLarge { what, count, limit } => write!(
+                f,
+                "{}: {count} exceeds the limit of {limit}",
+                what.named(naming)
             ),
             Error::MaterialDb {
                 context, message, ..

@@ -263,7 +263,7 @@ pub fn validate_axes(axes: &FilmLutAxes, context: &str, max_texels: u64) -> Resu
         .saturating_mul(axes.ior_count as u64);
     if texels > max_texels {
         return Err(Error::TooLarge {
-            what: format!("{context}: texels (cos_theta × opd × film_ior)"),
+            what: format!("{context}: texels (cos_theta × opd × film_ior)").into(),
             count: texels,
             limit: max_texels,
         });

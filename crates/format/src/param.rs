@@ -364,6 +364,12 @@ impl From<String> for Origin {
     }
 }
 
+impl From<&String> for Origin {
+    fn from(s: &String) -> Self {
+        Origin::Other(s.as_str().into())
+    }
+}
+
 impl From<&str> for Origin {
     fn from(s: &str) -> Self {
         Origin::Other(s.into())

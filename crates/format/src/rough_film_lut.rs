@@ -349,7 +349,7 @@ pub fn validate_axes(axes: &RoughLutAxes, context: &str, max_texels: u64) -> Res
         * axes.alpha_count as u64;
     if texels > max_texels {
         return Err(Error::TooLarge {
-            what: format!("{context}: texels (cos_theta × opd × film_ior × alpha)"),
+            what: format!("{context}: texels (cos_theta × opd × film_ior × alpha)").into(),
             count: texels,
             limit: max_texels,
         });
