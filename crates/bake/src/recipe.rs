@@ -1,7 +1,7 @@
 //! The recipe sections every table kind shares — `[colour]`, `[stack]`, `[output]` — and
 //! the table name, each parsed once here for every kind (`crate::kinds`).
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Origin, Result};
 use nacre_format::materials::resolve;
 use nacre_format::table_io::Precision;
 use nacre_optics::colour::{Colorimeter, Illuminant, Observer, OutputSpace};
@@ -67,7 +67,7 @@ impl OutputSettings {
     /// `png`.
     ///
     /// # Errors
-    /// [`Error::Invalid`] for a `transmittance` that is not `"auto"`, true or false.
+    /// [`nacre_format::Error::Invalid`] for a `transmittance` that is not `"auto"`, true or false.
     pub(crate) fn parse(
         path: &Path,
         output: Option<RawOutput>,
@@ -138,20 +138,21 @@ impl RecipeStack {
     /// Resolves `stack` of the recipe `path` (text `text`) for a table of `kind`.
     ///
     /// # Errors
-    /// [`Error::Invalid`] naming the file and line of an ambient without a constant real
-    /// index or a material that cannot be resolved; [`Error::Recipe`] for a negative or
+    /// [`nacre_format::Error::Invalid`] naming the file and line of an ambient without a constant real
+    /// index or a material that cannot be resolved; [`nacre_format::Error::Parse`] for a negative or
     /// non-finite layer thickness.
     pub(crate) fn parse(path: &Path, text: &str, stack: &RawStack, kind: &str) -> Result<Self> {
-        let at = |span: std::ops::Range<usize>| {
-            format!("{}:{}", path.display(), line_of(text, span.start))
+        let at = |span: std::ops::Range<usize>| Origin::Line {
+            path: path.to_path_buf(),
+            line: line_of(text, span.start),
         };
         let base_dir = path.parent();
-        let ambient = resolve(stack.ambient.get_ref(), &at(stack.ambient.span()), base_dir)?;
+        let ambient = resolve(stack.ambient.get_ref(), at(stack.ambient.span()), base_dir)?;
         let ambient_index = constant_real_index(&ambient).ok_or_else(|| Error::invalid(at(stack.ambient.span()), format!(
                 "the ambient of a {kind} must have a constant real index (e.g. \"1.0\"), not `{}`",
                 stack.ambient.get_ref()
             )))?;
-        let base = resolve(stack.base.get_ref(), &at(stack.base.span()), base_dir)?;
+        let base = resolve(stack.base.get_ref(), at(stack.base.span()), base_dir)?;
         let mut under = Vec::new();
         let mut under_specs = Vec::new();
         for l in &stack.under {
@@ -164,7 +165,7 @@ impl RecipeStack {
                 ));
             }
             under.push(Layer {
-                material: resolve(l.material.get_ref(), &at(l.material.span()), base_dir)?,
+                material: resolve(l.material.get_ref(), at(l.material.span()), base_dir)?,
                 thickness_nm: d,
             });
             under_specs.push((l.material.get_ref().clone(), d));

@@ -259,7 +259,7 @@ impl MaterialDb {
                 context,
                 spec: spec.to_string(),
                 tried,
-                message: message.into(),
+                message,
             });
         };
         let text = std::fs::read_to_string(&path).map_err(|source| Error::Io {

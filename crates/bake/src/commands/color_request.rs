@@ -67,7 +67,7 @@ pub fn angle_points(text: Option<String>) -> Result<Vec<Point>> {
     if let Some(a) = angles.iter().find(|a| !(a.abs() < 90.0)) {
         return Err(Error::Angle {
             origin: Param::Angles.into(),
-            value: text.into(),
+            value: text,
             angle: *a,
         });
     }

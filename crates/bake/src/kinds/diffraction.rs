@@ -171,8 +171,8 @@ impl SyntheticSpec {
     /// `samples` (per axis; along x for gratings) overrides the patch size.
     ///
     /// # Errors
-    /// [`Error::OpticsIn`] naming `context` for out-of-range parameters;
-    /// [`Error::TooLarge`] beyond [`MAX_AXIS`] samples per axis.
+    /// [`nacre_format::Error::OpticsIn`] naming `context` for out-of-range parameters;
+    /// [`nacre_format::Error::TooLarge`] beyond [`MAX_AXIS`] samples per axis.
     pub fn generate(
         &self,
         context: &Origin,
@@ -252,8 +252,8 @@ fn auto_samples(l: f64, pitch_um: Option<f64>, samples: Option<usize>) -> usize 
 /// `pitch_um` µm per sample and heights scaled by `height_scale_um`.
 ///
 /// # Errors
-/// [`Error::Io`]; [`Error::Table`] (PNG, JPEG, EXR) or [`Error::Recipe`] (CSV, with the line)
-/// naming the file for malformed content; [`Error::OpticsIn`] for a bad pitch.
+/// [`nacre_format::Error::Io`]; [`nacre_format::Error::Table`] (PNG, JPEG, EXR) or [`nacre_format::Error::Parse`] (CSV, with the line)
+/// naming the file for malformed content; [`nacre_format::Error::OpticsIn`] for a bad pitch.
 pub fn read_height_field(path: &Path, pitch_um: f64, height_scale_um: f64) -> Result<HeightField> {
     if !(height_scale_um.is_finite() && height_scale_um >= 0.0) {
         return Err(Error::invalid(

@@ -224,7 +224,7 @@ fn sig4(v: f64) -> f64 {
 /// returns the manifest path.
 ///
 /// # Errors
-/// [`Error::Invalid`] naming the recipe when the measured error exceeds the tolerance
+/// [`nacre_format::Error::Invalid`] naming the recipe when the measured error exceeds the tolerance
 /// (nothing written) or the recipe is not of the layout "integrated"; write errors.
 pub fn bake(
     recipe: &DiffractionRecipe,

@@ -76,7 +76,7 @@ pub fn read_recipe(path: &Path) -> Result<Box<dyn TableRecipe>> {
 /// Parses recipe text of any kind; `path` names it and anchors relative material paths.
 ///
 /// # Errors
-/// [`Error::Recipe`] naming the line of a missing or unknown `kind`, else the kind's own
+/// [`nacre_format::Error::Parse`] naming the line of a missing or unknown `kind`, else the kind's own
 /// errors.
 pub fn parse_recipe(path: &Path, text: String) -> Result<Box<dyn TableRecipe>> {
     #[derive(Deserialize)]
