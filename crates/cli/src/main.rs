@@ -10,7 +10,7 @@ use nacre_bake::commands::stack_spec::{StackRecipe, StackSpec};
 use nacre_bake::kinds;
 use nacre_format::atomic::write_atomic;
 use nacre_format::msg;
-use nacre_format::{Manifest, Origin, Param, materials, set};
+use nacre_format::{Manifest, Origin, Param, Render, materials, set};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -603,7 +603,7 @@ fn run_render(args: &RenderArgs) -> Result<()> {
         let start = std::time::Instant::now();
         let out = nacre_runtime::mesh::render_gltf(&ctx, &tables, technique, scene, &options)?;
         for note in &out.notes {
-            eprintln!("note: {note}");
+            eprintln!("note: {}", note.named(&error::Flags));
         }
         let png = out.image.encode_png()?;
         write_atomic(&args.output, |w| w.write_all(&png))?;

@@ -254,6 +254,12 @@ impl From<Param> for Piece {
     }
 }
 
+impl From<Msg> for Piece {
+    fn from(m: Msg) -> Self {
+        Piece::Nested(Arc::new(m))
+    }
+}
+
 impl From<Origin> for Piece {
     fn from(o: Origin) -> Self {
         Piece::Origin(o)
