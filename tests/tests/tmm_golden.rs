@@ -38,7 +38,7 @@ fn golden_dir() -> PathBuf {
 fn spec(case: &Case) -> StackSpec {
     let m = |s: &str| MaterialRef {
         spec: s.to_string(),
-        context: format!("case {}", case.name),
+        context: format!("case {}", case.name).into(),
     };
     StackSpec {
         ambient: m(&case.ambient),

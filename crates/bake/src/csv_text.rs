@@ -10,20 +10,14 @@ use crate::error::{Error, Result};
 pub(crate) use nacre_optics::csv_rows::Row;
 
 /// The rows of `text`, read from `path`, one at a time; malformed CSV is an
-/// [`Error::Recipe`] naming the file and line.
+/// [`nacre_format::Error::Parse`] naming the file and line.
 pub(crate) fn rows<'a>(path: &'a Path, text: &'a str) -> impl Iterator<Item = Result<Row>> + 'a {
     nacre_optics::csv_rows::Rows::new(&path.display().to_string(), text).map(move |row| {
         row.map_err(|e| match e {
-            nacre_optics::Error::Parse { line, message, .. } => Error::Recipe {
-                path: path.to_path_buf(),
-                line,
-                message,
-            },
-            other => Error::Recipe {
-                path: path.to_path_buf(),
-                line: 0,
-                message: other.to_string(),
-            },
+            nacre_optics::Error::Parse { line, message, .. } => {
+                Error::recipe(path.to_path_buf(), line, message)
+            }
+            other => Error::recipe(path.to_path_buf(), 0, other.to_string()),
         })
     })
 }

@@ -1,106 +1,140 @@
 //! The one error type of `nacre-bake`. Only the `nacre` binary turns it into a message
 //! and an exit status.
+//!
+//! Errors name the inputs that went wrong with [`Param`] and [`Origin`] values (re-exported
+//! from [`nacre_format::param`]), never a command-line flag: `Display` writes the
+//! parameters' neutral names, [`Render`] takes any [`Naming`] (the `nacre` binary's writes
+//! its flags).
 
+use std::fmt;
 use std::path::PathBuf;
 
+pub use nacre_format::param::{Msg, Naming, Neutral, Origin, Param, Piece, Render};
+
 /// Everything that can go wrong while reading recipes, resolving materials, computing and
-/// writing tables. Each message names the flag, file and line concerned.
+/// writing tables. Files, lines, unknown materials, limits and unacceptable values named by
+/// file or line come from the table format ([`nacre_format::Error`]); this type adds the
+/// values of the commands' parameters.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
-    /// An error from the table format (reading or writing tables, resolving materials).
-    #[error(transparent)]
+    /// An error from the table format: reading or writing files and tables, recipes and
+    /// CSV files malformed at a line ([`nacre_format::Error::Parse`]), materials, limits,
+    /// values unacceptable where they came from ([`nacre_format::Error::Invalid`]).
     Format(#[from] nacre_format::Error),
     /// An error from the physics core.
-    #[error(transparent)]
     Optics(#[from] nacre_optics::Error),
-    /// The physics core rejected something that came from a named flag or recipe key.
-    #[error("{context}: {source}")]
-    OpticsIn {
-        /// Flag or `file:line` the value came from.
-        context: String,
-        /// What the core said.
-        source: nacre_optics::Error,
-    },
-    /// A command-line flag's value is malformed or out of range.
-    #[error("{flag} `{value}`: {message}")]
-    Flag {
-        /// The flag, e.g. `--angles`.
-        flag: String,
+    /// A parameter's value is malformed or not acceptable: `ORIGIN `VALUE`: MESSAGE`.
+    Value {
+        /// The parameter the value came from (or a recipe line).
+        origin: Origin,
         /// The value given.
         value: String,
         /// What was expected.
-        message: String,
+        message: Msg,
     },
-    /// A recipe file is malformed.
-    #[error("{}:{line}: {message}", path.display())]
-    Recipe {
-        /// The recipe file.
-        path: PathBuf,
-        /// 1-based line.
-        line: usize,
-        /// What was wrong and what was expected.
-        message: String,
+    /// An angle, one of the values of `origin`, outside (−90°, 90°).
+    Angle {
+        /// The parameter the angles came from.
+        origin: Origin,
+        /// The value given (a range or list).
+        value: String,
+        /// The first angle outside, degrees.
+        angle: f64,
     },
-    /// A material name that is neither a number, a bundled material nor a data file.
-    #[error(
-        "{context}: unknown material `{name}`: expected a number (`1.5`), a complex index (`0.27+2.9i`), a bundled material ({bundled}), a path to a `.yml`/`.csv` file or a refractiveindex.info page SHELF/BOOK/PAGE (with --material-db)"
-    )]
-    UnknownMaterial {
-        /// Flag or `file:line` the name came from.
-        context: String,
-        /// The name given.
-        name: String,
-        /// The bundled names, comma-separated.
-        bundled: String,
+    /// A number outside its accepted range `low..=high`.
+    OutOfRange {
+        /// The parameter.
+        param: Param,
+        /// The value given.
+        value: f64,
+        /// The smallest accepted value.
+        low: f64,
+        /// The largest accepted value.
+        high: f64,
     },
-    /// A refractiveindex.info page (`shelf/book/page`) that the material database does not
-    /// have, or that was asked for with no database set.
-    #[error("{context}: {message}")]
-    MaterialDb {
-        /// Flag or `file:line` the spec came from.
-        context: String,
-        /// The spec given.
-        spec: String,
-        /// The paths looked at, in order.
-        tried: Vec<PathBuf>,
-        /// What was wrong, with the paths tried and how to set the database.
-        message: String,
-    },
-    /// Reading or writing a file failed.
-    #[error("{}: {source}", path.display())]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// The operating-system error.
-        source: std::io::Error,
-    },
-    /// A request larger than the documented limits.
-    #[error("{what}: {count} exceeds the limit of {limit}")]
-    TooLarge {
-        /// What was counted.
-        what: String,
-        /// The requested count.
-        count: u64,
-        /// The limit.
-        limit: u64,
-    },
-    /// A lookup-table image (OpenEXR or PNG atlas) is malformed, does not match the
-    /// expected dimensions, or a table cannot be written in the requested format.
-    #[error("{}: {message}", path.display())]
-    Table {
-        /// The image file.
-        path: PathBuf,
-        /// What was wrong and what was expected.
-        message: String,
-    },
-    /// A value (usually from a recipe or manifest) that is well-formed but not acceptable.
-    #[error("{context}: {message}")]
-    Invalid {
-        /// File, `file:line`, flag or table name concerned.
-        context: String,
-        /// What was wrong and what was expected.
-        message: String,
-    },
+}
+
+impl Error {
+    /// [`Error::Value`].
+    pub fn value(
+        origin: impl Into<Origin>,
+        value: impl Into<String>,
+        message: impl Into<Msg>,
+    ) -> Self {
+        Error::Value {
+            origin: origin.into(),
+            value: value.into(),
+            message: message.into(),
+        }
+    }
+
+    /// A [`nacre_format::Error::Invalid`]: a value unacceptable where it came from.
+    pub fn invalid(context: impl Into<Origin>, message: impl Into<Msg>) -> Self {
+        nacre_format::Error::invalid(context, message).into()
+    }
+
+    /// A [`nacre_format::Error::OpticsIn`]: the physics core rejected a value of `context`.
+    pub fn optics_in(context: impl Into<Origin>, source: nacre_optics::Error) -> Self {
+        nacre_format::Error::OpticsIn {
+            context: context.into(),
+            source,
+        }
+        .into()
+    }
+
+    /// A [`nacre_format::Error::Parse`]: a recipe or CSV file malformed at a 1-based line.
+    pub fn recipe(path: impl Into<PathBuf>, line: usize, message: impl Into<String>) -> Self {
+        nacre_format::Error::Parse {
+            path: path.into(),
+            line,
+            message: message.into(),
+        }
+        .into()
+    }
+}
+
+impl Render for Error {
+    fn render(&self, f: &mut fmt::Formatter<'_>, naming: &dyn Naming) -> fmt::Result {
+        match self {
+            Error::Format(e) => e.render(f, naming),
+            Error::Optics(e) => fmt::Display::fmt(e, f),
+            Error::Value {
+                origin,
+                value,
+                message,
+            } => write!(
+                f,
+                "{} `{value}`: {}",
+                origin.named(naming),
+                message.named(naming)
+            ),
+            Error::Angle {
+                origin,
+                value,
+                angle,
+            } => write!(
+                f,
+                "{} `{value}`: angle {angle} must lie strictly between -90 and 90 degrees",
+                origin.named(naming)
+            ),
+            Error::OutOfRange {
+                param,
+                value,
+                low,
+                high,
+            } => write!(
+                f,
+                "{} `{value}`: expected {low} to {high}",
+                naming.name(*param)
+            ),
+        }
+    }
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        self.render(f, &Neutral)
+    }
 }
 
 /// Shorthand for `Result<T, nacre_bake::Error>`.

@@ -1,7 +1,7 @@
 //! The recipe sections every table kind shares — `[colour]`, `[stack]`, `[output]` — and
 //! the table name, each parsed once here for every kind (`crate::kinds`).
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Origin, Result};
 use nacre_format::materials::resolve;
 use nacre_format::table_io::Precision;
 use nacre_optics::colour::{Colorimeter, Illuminant, Observer, OutputSpace};
@@ -67,7 +67,7 @@ impl OutputSettings {
     /// `png`.
     ///
     /// # Errors
-    /// [`Error::Invalid`] for a `transmittance` that is not `"auto"`, true or false.
+    /// [`nacre_format::Error::Invalid`] for a `transmittance` that is not `"auto"`, true or false.
     pub(crate) fn parse(
         path: &Path,
         output: Option<RawOutput>,
@@ -90,12 +90,10 @@ impl OutputSettings {
             Some(Toggle::Bool(b)) => b,
             Some(Toggle::Word(w)) if w == "auto" => transmits,
             Some(Toggle::Word(w)) => {
-                return Err(Error::Invalid {
-                    context: path.display().to_string(),
-                    message: format!(
-                        "[output] transmittance = \"{w}\": expected \"auto\", true or false"
-                    ),
-                });
+                return Err(Error::invalid(
+                    path.display().to_string(),
+                    format!("[output] transmittance = \"{w}\": expected \"auto\", true or false"),
+                ));
             }
         };
         Ok(OutputSettings {
@@ -114,14 +112,13 @@ fn parse_name<T: std::str::FromStr<Err = nacre_optics::Error>>(
 ) -> Result<T> {
     match value {
         None => Ok(default),
-        Some(s) => s
-            .get_ref()
-            .parse()
-            .map_err(|e: nacre_optics::Error| Error::Recipe {
-                path: path.to_path_buf(),
-                line: line_of(text, s.span().start),
-                message: e.to_string(),
-            }),
+        Some(s) => s.get_ref().parse().map_err(|e: nacre_optics::Error| {
+            Error::recipe(
+                path.to_path_buf(),
+                line_of(text, s.span().start),
+                e.to_string(),
+            )
+        }),
     }
 }
 
@@ -141,36 +138,34 @@ impl RecipeStack {
     /// Resolves `stack` of the recipe `path` (text `text`) for a table of `kind`.
     ///
     /// # Errors
-    /// [`Error::Invalid`] naming the file and line of an ambient without a constant real
-    /// index or a material that cannot be resolved; [`Error::Recipe`] for a negative or
+    /// [`nacre_format::Error::Invalid`] naming the file and line of an ambient without a constant real
+    /// index or a material that cannot be resolved; [`nacre_format::Error::Parse`] for a negative or
     /// non-finite layer thickness.
     pub(crate) fn parse(path: &Path, text: &str, stack: &RawStack, kind: &str) -> Result<Self> {
-        let at = |span: std::ops::Range<usize>| {
-            format!("{}:{}", path.display(), line_of(text, span.start))
+        let at = |span: std::ops::Range<usize>| Origin::Line {
+            path: path.to_path_buf(),
+            line: line_of(text, span.start),
         };
         let base_dir = path.parent();
-        let ambient = resolve(stack.ambient.get_ref(), &at(stack.ambient.span()), base_dir)?;
-        let ambient_index = constant_real_index(&ambient).ok_or_else(|| Error::Invalid {
-            context: at(stack.ambient.span()),
-            message: format!(
+        let ambient = resolve(stack.ambient.get_ref(), at(stack.ambient.span()), base_dir)?;
+        let ambient_index = constant_real_index(&ambient).ok_or_else(|| Error::invalid(at(stack.ambient.span()), format!(
                 "the ambient of a {kind} must have a constant real index (e.g. \"1.0\"), not `{}`",
                 stack.ambient.get_ref()
-            ),
-        })?;
-        let base = resolve(stack.base.get_ref(), &at(stack.base.span()), base_dir)?;
+            )))?;
+        let base = resolve(stack.base.get_ref(), at(stack.base.span()), base_dir)?;
         let mut under = Vec::new();
         let mut under_specs = Vec::new();
         for l in &stack.under {
             let d = *l.thickness_nm.get_ref();
             if !(d >= 0.0 && d.is_finite()) {
-                return Err(Error::Recipe {
-                    path: path.to_path_buf(),
-                    line: line_of(text, l.thickness_nm.span().start),
-                    message: format!("thickness_nm = {d}: must be finite and non-negative"),
-                });
+                return Err(Error::recipe(
+                    path.to_path_buf(),
+                    line_of(text, l.thickness_nm.span().start),
+                    format!("thickness_nm = {d}: must be finite and non-negative"),
+                ));
             }
             under.push(Layer {
-                material: resolve(l.material.get_ref(), &at(l.material.span()), base_dir)?,
+                material: resolve(l.material.get_ref(), at(l.material.span()), base_dir)?,
                 thickness_nm: d,
             });
             under_specs.push((l.material.get_ref().clone(), d));
@@ -235,13 +230,8 @@ pub(crate) fn table_name(path: &Path) -> Result<String> {
                     .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
         })
         .map(str::to_string)
-        .ok_or_else(|| Error::Recipe {
-            path: path.to_path_buf(),
-            line: 1,
-            message:
-                "the recipe's file name (the table name) must use only letters, digits, `-` and `_`"
-                    .into(),
-        })
+        .ok_or_else(|| Error::recipe(path.to_path_buf(), 1, "the recipe's file name (the table name) must use only letters, digits, `-` and `_`"
+                    ))
 }
 
 /// 1-based line of byte offset `at` in `text`.
@@ -255,9 +245,9 @@ pub fn line_of(text: &str, at: usize) -> usize {
 
 /// Converts a `toml` error into a recipe error with its line.
 pub fn toml_error(path: &Path, text: &str, e: &toml::de::Error) -> Error {
-    Error::Recipe {
-        path: path.to_path_buf(),
-        line: e.span().map_or(1, |s| line_of(text, s.start)),
-        message: e.message().trim().to_string(),
-    }
+    Error::recipe(
+        path.to_path_buf(),
+        e.span().map_or(1, |s| line_of(text, s.start)),
+        e.message().trim().to_string(),
+    )
 }

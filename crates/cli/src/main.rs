@@ -9,7 +9,8 @@ use nacre_bake::commands::spectrum;
 use nacre_bake::commands::stack_spec::{StackRecipe, StackSpec};
 use nacre_bake::kinds;
 use nacre_format::atomic::write_atomic;
-use nacre_format::{Manifest, materials, set};
+use nacre_format::msg;
+use nacre_format::{Manifest, Origin, Param, Render, materials, set};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -432,17 +433,17 @@ fn load_stack(args: &StackArgs) -> nacre_bake::Result<(StackSpec, Option<String>
 
 fn run_spectrum(args: &SpectrumArgs) -> Result<()> {
     let (spec, recipe_angles, recipe_wavelengths) = load_stack(&args.stack)?;
-    let range = |flag: &str, given: &Option<String>, recipe: Option<String>, default: &str| {
+    let range = |flag: Param, given: &Option<String>, recipe: Option<String>, default: &str| {
         let (context, text) = match (given, recipe) {
-            (Some(t), _) => (flag.to_string(), t.clone()),
-            (None, Some(t)) => (format!("{flag} (from the recipe)"), t),
-            (None, None) => (flag.to_string(), default.to_string()),
+            (Some(t), _) => (Origin::from(flag), t.clone()),
+            (None, Some(t)) => (msg![flag, " (from the recipe)"].into(), t),
+            (None, None) => (Origin::from(flag), default.to_string()),
         };
-        parse_range(&context, &text)
+        parse_range(context, &text)
     };
-    let angles = range("--angles", &args.angles, recipe_angles, "0:89:1")?;
+    let angles = range(Param::Angles, &args.angles, recipe_angles, "0:89:1")?;
     let wavelengths = range(
-        "--wavelengths",
+        Param::Wavelengths,
         &args.wavelengths,
         recipe_wavelengths,
         "380:780:5",
@@ -589,7 +590,7 @@ fn run_render(args: &RenderArgs) -> Result<()> {
         let start = std::time::Instant::now();
         let out = nacre_runtime::mesh::render_gltf(&ctx, &tables, technique, scene, &options)?;
         for note in &out.notes {
-            eprintln!("note: {note}");
+            eprintln!("note: {}", note.named(&error::Flags));
         }
         let png = out.image.encode_png()?;
         write_atomic(&args.output, |w| w.write_all(&png))?;
@@ -655,10 +656,10 @@ fn run_render_diffraction(
         [] => scene.default_table().to_string(),
         [one] => one.clone(),
         _ => {
-            return Err(nacre_bake::error::Error::Invalid {
-                context: "--tables".into(),
-                message: format!("the {} scene takes one diffraction table", scene.name()),
-            }
+            return Err(nacre_bake::error::Error::invalid(
+                Param::Tables,
+                format!("the {} scene takes one diffraction table", scene.name()),
+            )
             .into());
         }
     };
@@ -672,37 +673,35 @@ fn run_render_diffraction(
     options.validate()?;
     let path = set::resolve_table(&name);
     let manifest = Manifest::read(&path)?;
-    let record =
-        manifest
-            .diffraction()
-            .cloned()
-            .ok_or_else(|| nacre_bake::error::Error::Invalid {
-                context: path.display().to_string(),
-                message: format!(
-                    "table `{}` is a `{}` table; the {} scene needs a diffraction table",
-                    manifest.name,
-                    manifest.kind,
-                    scene.name()
-                ),
-            })?;
+    let record = manifest.diffraction().cloned().ok_or_else(|| {
+        nacre_bake::error::Error::invalid(
+            path.display().to_string(),
+            format!(
+                "table `{}` is a `{}` table; the {} scene needs a diffraction table",
+                manifest.name,
+                manifest.kind,
+                scene.name()
+            ),
+        )
+    })?;
     let layout = DiffractionLayout::of(&record, &path)?;
     let sum = match layout {
         DiffractionLayout::Terms { .. } => {
             let step_nm = args.wavelength_step.unwrap_or(DEFAULT_WAVELENGTH_STEP_NM);
             wavelength_grid(&record, Some(step_nm)).map_err(|_| {
-                nacre_bake::error::Error::Invalid {
-                    context: "--wavelength-step".into(),
-                    message: format!(
+                nacre_bake::error::Error::invalid(
+                    Param::WavelengthStep,
+                    format!(
                         "{step_nm} nm over {}–{} nm (expected 2 to 4096 wavelengths)",
                         record.wavelength_min_nm, record.wavelength_max_nm
                     ),
-                }
+                )
             })?;
             options.technique.wavelength_step_nm = Some(step_nm);
             format!("{step_nm} nm step")
         }
         DiffractionLayout::Integrated { .. } => {
-            refuse_step_for_integrated("--wavelength-step", args.wavelength_step, &manifest)?;
+            refuse_step_for_integrated(Param::WavelengthStep, args.wavelength_step, &manifest)?;
             "integrated".to_string()
         }
     };
@@ -736,16 +735,17 @@ const DEFAULT_WAVELENGTH_STEP_NM: f64 = 10.0;
 
 /// An integrated `diffraction` table's wavelength sum was done at bake time: refuses `flag`
 /// when it was given for one.
-fn refuse_step_for_integrated(flag: &str, step_nm: Option<f64>, manifest: &Manifest) -> Result<()> {
+fn refuse_step_for_integrated(
+    flag: Param,
+    step_nm: Option<f64>,
+    manifest: &Manifest,
+) -> Result<()> {
     match step_nm {
         None => Ok(()),
-        Some(step_nm) => Err(nacre_bake::error::Error::Invalid {
-            context: flag.into(),
-            message: format!(
+        Some(step_nm) => Err(nacre_bake::error::Error::invalid(flag, format!(
                 "{step_nm} nm: table `{}` has the layout \"integrated\", whose wavelength sum was done at bake time (the manifest's grid); the step applies to layout \"terms\" tables only",
                 manifest.name
-            ),
-        }
+            ))
         .into()),
     }
 }
@@ -755,10 +755,10 @@ fn run_render_rough_row(args: &RenderArgs) -> Result<()> {
     use nacre_runtime::rough_reference::{RoughRowOptions, render_rough_row};
     use nacre_runtime::{GpuContext, TableSet, Technique};
     if !(16..=1 << 20).contains(&args.reference_samples) {
-        return Err(nacre_bake::error::Error::Invalid {
-            context: "--reference-samples".into(),
-            message: format!("{} (expected 16 to 1048576)", args.reference_samples),
-        }
+        return Err(nacre_bake::error::Error::invalid(
+            Param::ReferenceSamples,
+            format!("{} (expected 16 to 1048576)", args.reference_samples),
+        )
         .into());
     }
     let technique = Technique::from(args.technique);
@@ -825,7 +825,7 @@ fn run_bench_gpu(args: &BenchGpuArgs) -> Result<()> {
     {
         Some(Ok(DiffractionLayout::Integrated { .. })) => {
             refuse_step_for_integrated(
-                "--diffraction-step",
+                Param::DiffractionStep,
                 args.diffraction_step,
                 &diffraction_manifest,
             )?;
@@ -964,7 +964,7 @@ fn run_conformance(args: &ConformanceArgs) -> Result<()> {
 fn set_material_db(flag: Option<&std::path::Path>) {
     use nacre_format::materials::{MaterialDb, set_database};
     let db = match flag {
-        Some(dir) => Some(MaterialDb::new(dir, "--material-db")),
+        Some(dir) => Some(MaterialDb::new(dir, Param::MaterialDb)),
         None => std::env::var_os("NACRE_MATERIAL_DB")
             .filter(|v| !v.is_empty())
             .map(|dir| MaterialDb::new(PathBuf::from(dir), "NACRE_MATERIAL_DB")),

@@ -8,7 +8,8 @@ use nacre_bake::commands::color::{self, LoadedLut, Method, Point, Quantity};
 use nacre_bake::commands::grid::{parse_range, parse_thickness_nm};
 use nacre_bake::commands::plot::{self, ChartColumns, ImageFormat, SpectrumQuantity};
 use nacre_bake::commands::stack_spec::StackSpec;
-use nacre_bake::error::{Error, Result};
+use nacre_bake::error::{Error, Origin, Param, Result};
+use nacre_format::msg;
 use nacre_optics::Stack;
 use nacre_optics::colour::{Colorimeter, Illuminant, Observer, OutputSpace, RgbSpace};
 use std::path::PathBuf;
@@ -291,11 +292,11 @@ fn case_or_stack(
         let (spec, _, _) = load_stack(stack)?;
         let built = spec.build()?;
         if built.layers().is_empty() {
-            return Err(Error::Flag {
-                flag: "--layer".into(),
-                value: String::new(),
-                message: "this plot varies a film: give at least one --layer".into(),
-            });
+            return Err(Error::value(
+                Param::Layer,
+                String::new(),
+                msg!["this plot varies a film: give at least one ", Param::Layer],
+            ));
         }
         return Ok((built, describe(&spec, true)));
     }
@@ -312,7 +313,7 @@ fn case_or_stack(
 /// A method ready to evaluate: `lut:` tables loaded and checked against the stack,
 /// `fourier:` with the baked table (as `nacre color`).
 fn prepare_method(
-    flag: &str,
+    flag: Param,
     text: &str,
     stack: &Stack,
     colorimeter: &Colorimeter,
@@ -320,11 +321,7 @@ fn prepare_method(
 ) -> Result<(Method, Option<LoadedLut>)> {
     nacre_bake::commands::color_request::prepare_method(text, stack, colorimeter, fourier_table)
         .map_err(|e| match e {
-            Error::Flag { value, message, .. } => Error::Flag {
-                flag: flag.into(),
-                value,
-                message,
-            },
+            Error::Value { value, message, .. } => Error::value(flag, value, message),
             other => other,
         })
 }
@@ -342,15 +339,15 @@ fn run_spectrum(args: &SpectrumPlotArgs) -> Result<()> {
     let quantities = SpectrumQuantity::parse_list(&args.quantities)?;
     let angles = match &args.angles {
         Some(text) => {
-            let a = plot::parse_list("--angles", text)?;
-            plot::check_angles("--angles", text, &a)?;
+            let a = plot::parse_list(Param::Angles, text)?;
+            plot::check_angles(Param::Angles, text, &a)?;
             Some((text.as_str(), a))
         }
         None => None,
     };
     let (title, curves) = match &args.csv {
         Some(path) => {
-            let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            let text = std::fs::read_to_string(path).map_err(|source| nacre_format::Error::Io {
                 path: path.clone(),
                 source,
             })?;
@@ -371,22 +368,22 @@ fn run_spectrum(args: &SpectrumPlotArgs) -> Result<()> {
             let (spec, _, recipe_wavelengths) = load_stack(&args.stack)?;
             let angles = angles.map_or_else(|| vec![0.0, 30.0, 60.0], |(_, a)| a);
             if angles.len() > plot::MAX_CURVES {
-                return Err(Error::Flag {
-                    flag: "--angles".into(),
-                    value: args.angles.clone().unwrap_or_default(),
-                    message: format!(
+                return Err(Error::value(
+                    Param::Angles,
+                    args.angles.clone().unwrap_or_default(),
+                    format!(
                         "{} angles: a spectrum plot shows at most {}",
                         angles.len(),
                         plot::MAX_CURVES
                     ),
-                });
+                ));
             }
             let (flag, text) = match (&args.wavelengths, recipe_wavelengths) {
-                (Some(t), _) => ("--wavelengths".to_string(), t.clone()),
-                (None, Some(t)) => ("--wavelengths (from the recipe)".to_string(), t),
-                (None, None) => ("--wavelengths".to_string(), "380:780:1".to_string()),
+                (Some(t), _) => (Origin::from(Param::Wavelengths), t.clone()),
+                (None, Some(t)) => (msg![Param::Wavelengths, " (from the recipe)"].into(), t),
+                (None, None) => (Origin::from(Param::Wavelengths), "380:780:1".to_string()),
             };
-            let wavelengths = parse_range(&flag, &text)?;
+            let wavelengths = parse_range(flag, &text)?;
             let stack = spec.build()?;
             let curves = plot::spectrum_curves(&stack, &angles, &wavelengths)?;
             (format!("Spectra of {}", describe(&spec, false)), curves)
@@ -403,12 +400,12 @@ fn run_chromaticity(args: &ChromaticityArgs) -> Result<()> {
     let c = reference_colorimeter();
     let (points, parameter, unit, sweep) = match &args.angles {
         Some(text) => {
-            let angles = parse_range("--angles", text)?;
-            plot::check_angles("--angles", text, &angles)?;
+            let angles = parse_range(Param::Angles, text)?;
+            plot::check_angles(Param::Angles, text, &angles)?;
             let d = args
                 .thickness
                 .as_deref()
-                .map(|t| parse_thickness_nm("--thickness", t))
+                .map(|t| parse_thickness_nm(Param::Thickness, t))
                 .transpose()?;
             let d_shown = d.unwrap_or(stack.layers()[0].thickness_nm);
             let points: Vec<Point> = angles
@@ -428,15 +425,15 @@ fn run_chromaticity(args: &ChromaticityArgs) -> Result<()> {
         }
         None => {
             let text = args.thicknesses.as_deref().unwrap_or("0:1000:2");
-            let d = parse_range("--thicknesses", text)?;
+            let d = parse_range(Param::Thicknesses, text)?;
             if let Some(v) = d.iter().find(|v| !(**v >= 0.0)) {
-                return Err(Error::Flag {
-                    flag: "--thicknesses".into(),
-                    value: text.into(),
-                    message: format!("thickness {v} must be non-negative"),
-                });
+                return Err(Error::value(
+                    Param::Thicknesses,
+                    text,
+                    format!("thickness {v} must be non-negative"),
+                ));
             }
-            plot::check_angles("--angle", &args.angle.to_string(), &[args.angle])?;
+            plot::check_angles(Param::Angle, &args.angle.to_string(), &[args.angle])?;
             let points: Vec<Point> = d
                 .iter()
                 .map(|&t| Point {
@@ -454,16 +451,22 @@ fn run_chromaticity(args: &ChromaticityArgs) -> Result<()> {
         }
     };
     if points.len() > plot::MAX_TRAJECTORY_POINTS {
-        return Err(Error::TooLarge {
+        return Err(nacre_format::Error::TooLarge {
             what: "trajectory points".into(),
             count: points.len() as u64,
             limit: plot::MAX_TRAJECTORY_POINTS as u64,
-        });
+        }
+        .into());
     }
     let mut trajectories = Vec::new();
     for text in args.methods.split(',') {
-        let (method, lut) =
-            prepare_method("--methods", text, &stack, &c, args.fourier_table.as_deref())?;
+        let (method, lut) = prepare_method(
+            Param::Methods,
+            text,
+            &stack,
+            &c,
+            args.fourier_table.as_deref(),
+        )?;
         let cm = lut.as_ref().map_or(&c, |l| &l.colorimeter);
         let colours = color::evaluate(
             &stack,
@@ -499,48 +502,49 @@ fn run_chromaticity(args: &ChromaticityArgs) -> Result<()> {
 fn run_chart(args: &ChartArgs) -> Result<()> {
     ImageFormat::from_path(&args.output)?;
     if !(args.exposure > 0.0 && args.exposure.is_finite()) {
-        return Err(Error::Flag {
-            flag: "--exposure".into(),
-            value: args.exposure.to_string(),
-            message: "must be a positive number".into(),
-        });
+        return Err(Error::value(
+            Param::Exposure,
+            args.exposure.to_string(),
+            "must be a positive number",
+        ));
     }
     let (stack, what) = case_or_stack(&args.stack, args.case.as_deref(), "soap")?;
-    let rows = parse_range("--thicknesses", &args.thicknesses)?;
+    let rows = parse_range(Param::Thicknesses, &args.thicknesses)?;
     if let Some(v) = rows.iter().find(|v| !(**v >= 0.0)) {
-        return Err(Error::Flag {
-            flag: "--thicknesses".into(),
-            value: args.thicknesses.clone(),
-            message: format!("thickness {v} must be non-negative"),
-        });
+        return Err(Error::value(
+            Param::Thicknesses,
+            args.thicknesses.clone(),
+            format!("thickness {v} must be non-negative"),
+        ));
     }
     let (columns, kind) = match &args.film_iors {
         Some(text) => {
-            let n = plot::parse_list("--film-iors", text)?;
+            let n = plot::parse_list(Param::FilmIors, text)?;
             if let Some(v) = n.iter().find(|v| !(**v > 0.0)) {
-                return Err(Error::Flag {
-                    flag: "--film-iors".into(),
-                    value: text.clone(),
-                    message: format!("film index {v} must be positive"),
-                });
+                return Err(Error::value(
+                    Param::FilmIors,
+                    text.clone(),
+                    format!("film index {v} must be positive"),
+                ));
             }
-            plot::check_angles("--angle", &args.angle.to_string(), &[args.angle])?;
+            plot::check_angles(Param::Angle, &args.angle.to_string(), &[args.angle])?;
             (n, ChartColumns::FilmIor)
         }
         None => {
             let text = args.angles.as_deref().unwrap_or("0,30,60,80");
-            let a = plot::parse_list("--angles", text)?;
-            plot::check_angles("--angles", text, &a)?;
+            let a = plot::parse_list(Param::Angles, text)?;
+            plot::check_angles(Param::Angles, text, &a)?;
             (a, ChartColumns::Angle)
         }
     };
     let (max_rows, max_cols) = plot::MAX_CHART_CELLS;
     if rows.len() > max_rows || columns.len() > max_cols {
-        return Err(Error::TooLarge {
-            what: format!("chart rows × columns ({} × {})", rows.len(), columns.len()),
+        return Err(nacre_format::Error::TooLarge {
+            what: format!("chart rows × columns ({} × {})", rows.len(), columns.len()).into(),
             count: (rows.len() * columns.len()) as u64,
             limit: (max_rows * max_cols) as u64,
-        });
+        }
+        .into());
     }
     let points: Vec<Point> = rows
         .iter()
@@ -562,7 +566,7 @@ fn run_chart(args: &ChartArgs) -> Result<()> {
     let quantity = Quantity::from(args.quantity);
     let c = reference_colorimeter();
     let (method, lut) = prepare_method(
-        "--method",
+        Param::Method,
         &args.method,
         &stack,
         &c,
@@ -604,16 +608,16 @@ fn run_chart(args: &ChartArgs) -> Result<()> {
 fn run_table(args: &TableArgs) -> Result<()> {
     ImageFormat::from_path(&args.output)?;
     if !(args.exposure > 0.0 && args.exposure.is_finite()) {
-        return Err(Error::Flag {
-            flag: "--exposure".into(),
-            value: args.exposure.to_string(),
-            message: "must be a positive number".into(),
-        });
+        return Err(Error::value(
+            Param::Exposure,
+            args.exposure.to_string(),
+            "must be a positive number",
+        ));
     }
     let film_iors = args
         .film_iors
         .as_deref()
-        .map(|t| plot::parse_list("--film-iors", t))
+        .map(|t| plot::parse_list(Param::FilmIors, t))
         .transpose()?;
     let figure = plot::load_table_plot(
         &args.table,

@@ -65,7 +65,7 @@ pub fn write_files_atomic(dir: &Path, files: &[(String, Vec<u8>)]) -> Result<()>
         let target = dir.join(name);
         if Path::new(name).file_name() != Some(std::ffi::OsStr::new(name)) || target.is_dir() {
             return Err(Error::Invalid {
-                context: target.display().to_string(),
+                context: target.display().to_string().into(),
                 message: "cannot be written: not a plain file name, or a folder is in the way"
                     .into(),
             });

@@ -2,20 +2,23 @@
 //! resolving material references. Each variant carries the values that went wrong; only the
 //! `nacre` binary turns it into a message and an exit status.
 
+use crate::param::{Msg, Naming, Neutral, Origin, Param, Render};
+use std::fmt;
 use std::path::PathBuf;
 
 /// Everything that can go wrong while reading or writing tables and resolving materials.
-/// Each message names the file (and line) concerned.
+/// Each message names the file (and line) or the parameter concerned; `Display`
+/// names parameters neutrally ([`crate::param::Neutral`]), [`Render`] with any naming.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     /// An error from the physics core.
     #[error(transparent)]
     Optics(#[from] nacre_optics::Error),
-    /// The physics core rejected something that came from a named flag or recipe key.
-    #[error("{context}: {source}")]
+    /// The physics core rejected something that came from a parameter or recipe key.
+    #[error("{}", self.named(&Neutral))]
     OpticsIn {
-        /// Flag or `file:line` the value came from.
-        context: String,
+        /// The parameter or `file:line` the value came from.
+        context: Origin,
         /// What the core said.
         source: nacre_optics::Error,
     },
@@ -30,12 +33,10 @@ pub enum Error {
         message: String,
     },
     /// A material name that is neither a number, a bundled material nor a data file.
-    #[error(
-        "{context}: unknown material `{name}`: expected a number (`1.5`), a complex index (`0.27+2.9i`), a bundled material ({bundled}), a path to a `.yml`/`.csv` file or a refractiveindex.info page SHELF/BOOK/PAGE (with --material-db)"
-    )]
+    #[error("{}", self.named(&Neutral))]
     UnknownMaterial {
-        /// Flag or `file:line` the name came from.
-        context: String,
+        /// The parameter or `file:line` the name came from.
+        context: Origin,
         /// The name given.
         name: String,
         /// The bundled names, comma-separated.
@@ -43,16 +44,16 @@ pub enum Error {
     },
     /// A refractiveindex.info page (`shelf/book/page`) that the material database does not
     /// have, or that was asked for with no database set.
-    #[error("{context}: {message}")]
+    #[error("{}", self.named(&Neutral))]
     MaterialDb {
-        /// Flag or `file:line` the spec came from.
-        context: String,
+        /// The parameter or `file:line` the spec came from.
+        context: Origin,
         /// The spec given.
         spec: String,
         /// The paths looked at, in order.
         tried: Vec<PathBuf>,
         /// What was wrong, with the paths tried and how to set the database.
-        message: String,
+        message: Msg,
     },
     /// Reading or writing a file failed.
     #[error("{}: {source}", path.display())]
@@ -63,10 +64,10 @@ pub enum Error {
         source: std::io::Error,
     },
     /// A request larger than the documented limits.
-    #[error("{what}: {count} exceeds the limit of {limit}")]
+    #[error("{}", self.named(&Neutral))]
     TooLarge {
-        /// What was counted.
-        what: String,
+        /// What was counted (it may name parameters).
+        what: Msg,
         /// The requested count.
         count: u64,
         /// The limit.
@@ -111,13 +112,55 @@ pub enum Error {
         expected: &'static str,
     },
     /// A value (usually from a recipe or manifest) that is well-formed but not acceptable.
-    #[error("{context}: {message}")]
+    #[error("{}", self.named(&Neutral))]
     Invalid {
-        /// File, `file:line`, flag or table name concerned.
-        context: String,
+        /// File, `file:line`, parameter or table name concerned.
+        context: Origin,
         /// What was wrong and what was expected.
-        message: String,
+        message: Msg,
     },
+}
+
+impl Error {
+    /// [`Error::Invalid`] with `context` and `message`.
+    pub fn invalid(context: impl Into<Origin>, message: impl Into<Msg>) -> Self {
+        Error::Invalid {
+            context: context.into(),
+            message: message.into(),
+        }
+    }
+}
+
+impl Render for Error {
+    fn render(&self, f: &mut fmt::Formatter<'_>, naming: &dyn Naming) -> fmt::Result {
+        match self {
+            Error::OpticsIn { context, source } => {
+                write!(f, "{}: {source}", context.named(naming))
+            }
+            Error::UnknownMaterial {
+                context,
+                name,
+                bundled,
+            } => write!(
+                f,
+                "{}: unknown material `{name}`: expected a number (`1.5`), a complex index (`0.27+2.9i`), a bundled material ({bundled}), a path to a `.yml`/`.csv` file or a refractiveindex.info page SHELF/BOOK/PAGE (with {})",
+                context.named(naming),
+                naming.name(Param::MaterialDb)
+            ),
+            Error::TooLarge { what, count, limit } => write!(
+                f,
+                "{}: {count} exceeds the limit of {limit}",
+                what.named(naming)
+            ),
+            Error::MaterialDb {
+                context, message, ..
+            }
+            | Error::Invalid { context, message } => {
+                write!(f, "{}: {}", context.named(naming), message.named(naming))
+            }
+            other => fmt::Display::fmt(other, f),
+        }
+    }
 }
 
 /// Shorthand for `Result<T, nacre_format::Error>`.

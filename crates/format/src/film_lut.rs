@@ -221,8 +221,8 @@ impl FilmLut {
 /// Checks the axes of a recipe; `context` names the recipe.
 pub fn validate_axes(axes: &FilmLutAxes, context: &str, max_texels: u64) -> Result<()> {
     let err = |message: String| Error::Invalid {
-        context: context.to_string(),
-        message,
+        context: context.to_string().into(),
+        message: message.into(),
     };
     for (name, count) in [
         ("cos_theta_count", axes.cos_theta_count),
@@ -263,7 +263,7 @@ pub fn validate_axes(axes: &FilmLutAxes, context: &str, max_texels: u64) -> Resu
         .saturating_mul(axes.ior_count as u64);
     if texels > max_texels {
         return Err(Error::TooLarge {
-            what: format!("{context}: texels (cos_theta × opd × film_ior)"),
+            what: format!("{context}: texels (cos_theta × opd × film_ior)").into(),
             count: texels,
             limit: max_texels,
         });

@@ -161,7 +161,8 @@ impl FourierTable {
                     "{} level files for {} levels",
                     paths.len(),
                     axes.level_samples.len()
-                ),
+                )
+                .into(),
             });
         }
         let levels = paths

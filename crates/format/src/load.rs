@@ -61,8 +61,8 @@ impl Manifest {
         let paths: Vec<PathBuf> = (0..levels)
             .map(|k| {
                 let f = exr_level(k).ok_or_else(|| Error::Invalid {
-                    context: manifest_path.display().to_string(),
-                    message: format!("the manifest lists no file for level {k}"),
+                    context: manifest_path.display().to_string().into(),
+                    message: format!("the manifest lists no file for level {k}").into(),
                 })?;
                 let path = dir.join(&f.path);
                 verify_sha256(manifest_path, &path, f)?;
@@ -86,11 +86,11 @@ impl Manifest {
             .ok_or_else(|| self.wrong_kind(manifest_path, "a diffraction table"))?;
         if r.layout != "terms" {
             return Err(Error::Invalid {
-                context: manifest_path.display().to_string(),
+                context: manifest_path.display().to_string().into(),
                 message: format!(
                     "diffraction table `{}` has the layout \"{}\", which stores colours summed over wavelengths, not the Taylor terms",
                     self.name, r.layout
-                ),
+                ).into(),
             });
         }
         let dir = manifest_path.parent().unwrap_or(Path::new("."));
@@ -139,13 +139,13 @@ impl Manifest {
             }
         } else {
             return Err(Error::Invalid {
-                context: manifest_path.display().to_string(),
+                context: manifest_path.display().to_string().into(),
                 message: "the manifest lists no terms file".into(),
             });
         }
         let t = TaylorTerms::from_terms(r.nx, r.ny, r.pitch_um, &terms).map_err(|source| {
             Error::OpticsIn {
-                context: manifest_path.display().to_string(),
+                context: manifest_path.display().to_string().into(),
                 source,
             }
         })?;
@@ -165,8 +165,8 @@ impl Manifest {
         manifest_path: &Path,
     ) -> Result<(DiffractionRecord, IntegratedTable)> {
         let invalid = |message: String| Error::Invalid {
-            context: manifest_path.display().to_string(),
-            message,
+            context: manifest_path.display().to_string().into(),
+            message: message.into(),
         };
         let r = self
             .diffraction()
@@ -198,7 +198,7 @@ impl Manifest {
             )));
         }
         let axis = WarpedAxis::new(s.max_uv, s.gamma, n).map_err(|source| Error::OpticsIn {
-            context: manifest_path.display().to_string(),
+            context: manifest_path.display().to_string().into(),
             source,
         })?;
         let dir = manifest_path.parent().unwrap_or(Path::new("."));
@@ -243,7 +243,7 @@ impl Manifest {
         let table =
             IntegratedTable::from_values(axis, r.taylor_order, values).map_err(|source| {
                 Error::OpticsIn {
-                    context: manifest_path.display().to_string(),
+                    context: manifest_path.display().to_string().into(),
                     source,
                 }
             })?;
@@ -307,7 +307,7 @@ impl LoadedRoughLut {
             }
         };
         let reflectance = load("reflectance")?.ok_or_else(|| Error::Invalid {
-            context: path.display().to_string(),
+            context: path.display().to_string().into(),
             message: "the manifest lists no reflectance EXR or KTX2 file".into(),
         })?;
         let transmittance = load("transmittance")?;

@@ -257,18 +257,20 @@ impl Manifest {
         })?;
         if m.format != MANIFEST_FORMAT {
             return Err(Error::Invalid {
-                context: path.display().to_string(),
-                message: format!("manifest format `{}` is not `{MANIFEST_FORMAT}`", m.format),
+                context: path.display().to_string().into(),
+                message: format!("manifest format `{}` is not `{MANIFEST_FORMAT}`", m.format)
+                    .into(),
             });
         }
         if m.record.kind() != m.kind {
             return Err(Error::Invalid {
-                context: path.display().to_string(),
+                context: path.display().to_string().into(),
                 message: format!(
                     "a `{}` table whose manifest holds the axes of a `{}` table",
                     m.kind,
                     m.record.kind()
-                ),
+                )
+                .into(),
             });
         }
         // Axes a bake could not have written are refused here, before any file is sized
@@ -286,14 +288,14 @@ impl Manifest {
                 && f.max_opd_nm.is_finite();
             if !consistent {
                 return Err(Error::Invalid {
-                    context: format!("{}: fourier", path.display()),
+                    context: format!("{}: fourier", path.display()).into(),
                     message: format!(
                         "samples = {}, level_samples = {:?}, {} level_sigma_nm, max_opd_nm = {}: expected level 0 of `samples` texels, every level 1 to {MAX_FOURIER_SAMPLES} texels with one sigma each, and a positive finite max_opd_nm",
                         f.samples,
                         f.level_samples,
                         f.level_sigma_nm.len(),
                         f.max_opd_nm
-                    ),
+                    ).into(),
                 });
             }
         }
@@ -370,8 +372,8 @@ impl Manifest {
     /// The colorimeter the table was baked with.
     pub fn colorimeter(&self, manifest_path: &Path) -> Result<Colorimeter> {
         let bad = |e: nacre_optics::Error| Error::Invalid {
-            context: manifest_path.display().to_string(),
-            message: e.to_string(),
+            context: manifest_path.display().to_string().into(),
+            message: e.to_string().into(),
         };
         Ok(Colorimeter::new(
             self.observer.parse().map_err(bad)?,

@@ -1,6 +1,6 @@
 //! The bundled material library and the resolution of material specifications.
 //!
-//! A material specification `M` (a `--ambient`/`--layer`/`--substrate` value or a recipe's
+//! A material specification `M` (an `ambient`/`layer`/`substrate` value or a recipe's
 //! `material` string) is, in this order:
 //!
 //! 1. a real index (`1.33`) or a complex index `n+κi` (`0.27+2.9i`);
@@ -9,7 +9,7 @@
 //! 3. a path to a refractiveindex.info `.yml`/`.yaml` file or a `wavelength_nm,n,k` `.csv`
 //!    file (relative paths in a recipe are taken relative to the recipe's folder);
 //! 4. a refractiveindex.info page `shelf/book/page` (`main/Au/Johnson`), looked up in a
-//!    local copy of the database ([`MaterialDb`]; the `nacre` flag `--material-db DIR` or
+//!    local copy of the database ([`MaterialDb`]; the parameter [`Param::MaterialDb`] or
 //!    the environment variable `NACRE_MATERIAL_DB` sets it with [`set_database`]).
 //!
 //! # The refractiveindex.info database layout
@@ -33,6 +33,8 @@
 //! they are embedded into the binary at build time so that `nacre` works from any folder.
 
 use crate::error::{Error, Result};
+use crate::msg;
+use crate::param::{Origin, Param};
 use nacre_optics::Material;
 use std::path::{Path, PathBuf};
 use std::sync::RwLock;
@@ -133,8 +135,9 @@ fn parse_material_text(name: &str, source: &str, text: &str) -> nacre_optics::Re
 pub struct MaterialDb {
     /// The folder given: the repository root or its `database/` folder.
     pub dir: PathBuf,
-    /// Where the setting came from, for messages: `--material-db` or `NACRE_MATERIAL_DB`.
-    pub origin: String,
+    /// Where the setting came from, for messages: the parameter [`Param::MaterialDb`] or an
+    /// environment variable.
+    pub origin: Origin,
 }
 
 /// The process-wide database used by [`resolve`]; None until [`set_database`].
@@ -161,8 +164,8 @@ pub fn database_page(spec: &str) -> Option<(&str, &str, &str)> {
 }
 
 impl MaterialDb {
-    /// A database at `dir`, set by `origin` (a flag or variable name, for messages).
-    pub fn new(dir: impl Into<PathBuf>, origin: impl Into<String>) -> Self {
+    /// A database at `dir`, set by `origin` (a parameter or variable name, for messages).
+    pub fn new(dir: impl Into<PathBuf>, origin: impl Into<Origin>) -> Self {
         MaterialDb {
             dir: dir.into(),
             origin: origin.into(),
@@ -214,10 +217,11 @@ impl MaterialDb {
     }
 
     /// Loads page `spec` = `shelf/book/page`; `context` names where the spec came from.
-    pub fn load(&self, spec: &str, context: &str) -> Result<Material> {
+    pub fn load(&self, spec: &str, context: impl Into<Origin>) -> Result<Material> {
+        let context = context.into();
         let Some((shelf, book, page)) = database_page(spec) else {
             return Err(Error::MaterialDb {
-                context: context.to_string(),
+                context,
                 spec: spec.to_string(),
                 tried: vec![],
                 message:
@@ -228,21 +232,31 @@ impl MaterialDb {
         let (found, tried) = self.locate(shelf, book, page);
         let Some(path) = found else {
             let dir = self.dir.display();
-            let origin = &self.origin;
+            let origin = self.origin.clone();
             let message = if !self.dir.is_dir() {
-                format!("the material database folder {dir} ({origin}) does not exist")
+                msg![
+                    format!("the material database folder {dir} ("),
+                    origin,
+                    ") does not exist"
+                ]
             } else {
-                format!(
-                    "refractiveindex.info page `{spec}` not found in the material database {dir} ({origin}, the database repository or its database/ folder); tried {}",
-                    tried
-                        .iter()
-                        .map(|p| p.display().to_string())
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                )
+                msg![
+                    format!(
+                        "refractiveindex.info page `{spec}` not found in the material database {dir} ("
+                    ),
+                    origin,
+                    format!(
+                        ", the database repository or its database/ folder); tried {}",
+                        tried
+                            .iter()
+                            .map(|p| p.display().to_string())
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    )
+                ]
             };
             return Err(Error::MaterialDb {
-                context: context.to_string(),
+                context,
                 spec: spec.to_string(),
                 tried,
                 message,
@@ -290,9 +304,13 @@ fn catalog_lookup(text: &str, shelf: &str, book: &str, page: &str) -> Option<Str
 }
 
 /// Resolves a material specification (see module docs) with the database set by
-/// [`set_database`]. `context` names where it came from (a flag or `recipe.toml:12`) for
-/// messages; `base_dir` anchors relative paths.
-pub fn resolve(spec: &str, context: &str, base_dir: Option<&Path>) -> Result<Material> {
+/// [`set_database`]. `context` names where it came from (a parameter or `recipe.toml:12`)
+/// for messages; `base_dir` anchors relative paths.
+pub fn resolve(
+    spec: &str,
+    context: impl Into<Origin>,
+    base_dir: Option<&Path>,
+) -> Result<Material> {
     resolve_with(spec, context, base_dir, database().as_ref())
 }
 
@@ -300,20 +318,18 @@ pub fn resolve(spec: &str, context: &str, base_dir: Option<&Path>) -> Result<Mat
 /// error that says how to set one).
 pub fn resolve_with(
     spec: &str,
-    context: &str,
+    context: impl Into<Origin>,
     base_dir: Option<&Path>,
     db: Option<&MaterialDb>,
 ) -> Result<Material> {
+    let context = context.into();
     let spec = spec.trim();
     let looks_numeric = spec
         .chars()
         .next()
         .is_some_and(|c| c.is_ascii_digit() || matches!(c, '.' | '-' | '+'));
     if looks_numeric {
-        return Material::parse_index(spec).map_err(|source| Error::OpticsIn {
-            context: context.to_string(),
-            source,
-        });
+        return Material::parse_index(spec).map_err(|source| Error::OpticsIn { context, source });
     }
     if let Some(b) = bundled(spec) {
         return load_bundled(b);
@@ -329,8 +345,8 @@ pub fn resolve_with(
         };
         // Named with where the spec came from: a recipe line or a flag.
         let text = std::fs::read_to_string(&path).map_err(|source| Error::Invalid {
-            context: context.to_string(),
-            message: format!("cannot read the material file {}: {source}", path.display()),
+            context,
+            message: format!("cannot read the material file {}: {source}", path.display()).into(),
         })?;
         let shown = path.display().to_string();
         return Ok(parse_material_text(spec, &shown, &text)?);
@@ -339,17 +355,21 @@ pub fn resolve_with(
         return match db {
             Some(db) => db.load(spec, context),
             None => Err(Error::MaterialDb {
-                context: context.to_string(),
+                context,
                 spec: spec.to_string(),
                 tried: vec![],
-                message: format!(
-                    "`{spec}` looks like a refractiveindex.info page (SHELF/BOOK/PAGE) but no material database is set: pass --material-db DIR or set NACRE_MATERIAL_DB to a local copy of https://github.com/polyanskiy/refractiveindex.info-database"
-                ),
+                message: msg![
+                    format!(
+                        "`{spec}` looks like a refractiveindex.info page (SHELF/BOOK/PAGE) but no material database is set: pass "
+                    ),
+                    Param::MaterialDb.arg(),
+                    " or set NACRE_MATERIAL_DB to a local copy of https://github.com/polyanskiy/refractiveindex.info-database"
+                ],
             }),
         };
     }
     Err(Error::UnknownMaterial {
-        context: context.to_string(),
+        context,
         name: spec.to_string(),
         bundled: bundled_names(),
     })
@@ -373,24 +393,30 @@ mod tests {
 
     #[test]
     fn resolution_order_and_messages() {
-        assert_eq!(resolve("1.5", "--substrate", None).unwrap().name(), "1.5");
-        assert_eq!(resolve("Gold", "--substrate", None).unwrap().name(), "au");
-        let e = resolve("unobtainium", "--layer", None)
+        assert_eq!(
+            resolve("1.5", Param::Substrate, None).unwrap().name(),
+            "1.5"
+        );
+        assert_eq!(
+            resolve("Gold", Param::Substrate, None).unwrap().name(),
+            "au"
+        );
+        let e = resolve("unobtainium", Param::Layer, None)
             .unwrap_err()
             .to_string();
         assert!(
-            e.starts_with("--layer: unknown material `unobtainium`"),
+            e.starts_with("layer: unknown material `unobtainium`"),
             "{e}"
         );
-        let e = resolve("1.5-0.2i", "--layer", None)
+        let e = resolve("1.5-0.2i", Param::Layer, None)
             .unwrap_err()
             .to_string();
-        assert!(e.starts_with("--layer: invalid refractive index"), "{e}");
-        let e = resolve("missing.yml", "--layer", None)
+        assert!(e.starts_with("layer: invalid refractive index"), "{e}");
+        let e = resolve("missing.yml", Param::Layer, None)
             .unwrap_err()
             .to_string();
         assert!(
-            e.starts_with("--layer: cannot read the material file missing.yml: "),
+            e.starts_with("layer: cannot read the material file missing.yml: "),
             "{e}"
         );
     }
@@ -426,14 +452,14 @@ mod tests {
         );
         // The repository root and its database/ folder both work.
         for root in [dir.path().to_path_buf(), db.clone()] {
-            let db = MaterialDb::new(&root, "--material-db");
+            let db = MaterialDb::new(&root, Param::MaterialDb);
             for (spec, n, k) in [
                 ("main/Au/Johnson", 0.5, 2.0),
                 ("main/Ag/Johnson", 0.1, 3.0),
                 ("main/Cu/Johnson", 0.9, 2.5),
                 ("main/BeAl2O4/Walling-α", 1.7, 0.0),
             ] {
-                let m = resolve_with(spec, "--substrate", None, Some(&db))
+                let m = resolve_with(spec, Param::Substrate, None, Some(&db))
                     .unwrap_or_else(|e| panic!("{spec}: {e}"));
                 assert_eq!(m.name(), spec);
                 let i = m.index_at(550.0).unwrap();
@@ -443,7 +469,7 @@ mod tests {
                 );
             }
             // Bundled names, numbers and paths come first.
-            let au = resolve_with("au", "--substrate", None, Some(&db)).unwrap();
+            let au = resolve_with("au", Param::Substrate, None, Some(&db)).unwrap();
             assert_eq!(au.name(), "au");
             assert!((au.index_at(550.0).unwrap().re - 0.5).abs() > 1e-3);
         }
@@ -456,8 +482,8 @@ mod tests {
             &dir.path().join("database/data/main/Au/nk/Johnson.yml"),
             &page(0.5, 2.0),
         );
-        let db = MaterialDb::new(dir.path(), "--material-db");
-        let e = resolve_with("main/Au/Nobody", "--layer", None, Some(&db)).unwrap_err();
+        let db = MaterialDb::new(dir.path(), Param::MaterialDb);
+        let e = resolve_with("main/Au/Nobody", Param::Layer, None, Some(&db)).unwrap_err();
         let Error::MaterialDb { spec, tried, .. } = &e else {
             panic!("{e:?}");
         };
@@ -466,24 +492,24 @@ mod tests {
         assert!(tried.contains(&dir.path().join("database/data-nk/main/Au/Nobody.yml")));
         let e = e.to_string();
         assert!(
-            e.starts_with("--layer: refractiveindex.info page `main/Au/Nobody` not found"),
+            e.starts_with("layer: refractiveindex.info page `main/Au/Nobody` not found"),
             "{e}"
         );
         assert!(
-            e.contains("--material-db") && e.contains("Nobody.yml"),
+            e.contains("(material_db,") && e.contains("Nobody.yml"),
             "{e}"
         );
         // No database set: say how to set one.
-        let e = resolve_with("main/Au/Johnson", "--layer", None, None)
+        let e = resolve_with("main/Au/Johnson", Param::Layer, None, None)
             .unwrap_err()
             .to_string();
         assert!(
-            e.contains("--material-db DIR") && e.contains("NACRE_MATERIAL_DB"),
+            e.contains("pass material_db or set NACRE_MATERIAL_DB"),
             "{e}"
         );
         // A database folder that does not exist.
         let gone = MaterialDb::new(dir.path().join("nope"), "NACRE_MATERIAL_DB");
-        let e = resolve_with("main/Au/Johnson", "--layer", None, Some(&gone))
+        let e = resolve_with("main/Au/Johnson", Param::Layer, None, Some(&gone))
             .unwrap_err()
             .to_string();
         assert!(

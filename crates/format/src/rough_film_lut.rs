@@ -286,8 +286,8 @@ fn trilinear(table: &Table3, t: [f64; 3], z0: usize, block_count: usize) -> [f64
 /// Checks the axes of a recipe; `context` names the recipe's `[axes]` table.
 pub fn validate_axes(axes: &RoughLutAxes, context: &str, max_texels: u64) -> Result<()> {
     let err = |message: String| Error::Invalid {
-        context: context.to_string(),
-        message,
+        context: context.to_string().into(),
+        message: message.into(),
     };
     for (name, count, least) in [
         ("cos_theta_count", axes.cos_theta_count, 2),
@@ -349,7 +349,7 @@ pub fn validate_axes(axes: &RoughLutAxes, context: &str, max_texels: u64) -> Res
         * axes.alpha_count as u64;
     if texels > max_texels {
         return Err(Error::TooLarge {
-            what: format!("{context}: texels (cos_theta × opd × film_ior × alpha)"),
+            what: format!("{context}: texels (cos_theta × opd × film_ior × alpha)").into(),
             count: texels,
             limit: max_texels,
         });

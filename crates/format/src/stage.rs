@@ -40,7 +40,7 @@ impl StagedTable {
         };
         if out_dir.exists() && !out_dir.is_dir() {
             return Err(Error::Invalid {
-                context: out_dir.display().to_string(),
+                context: out_dir.display().to_string().into(),
                 message: "exists and is not a folder: expected the output folder".into(),
             });
         }

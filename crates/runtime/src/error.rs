@@ -1,5 +1,7 @@
 //! The runtime's error type.
 
+use nacre_format::param::{Msg, Naming, Render};
+use std::fmt;
 use std::path::PathBuf;
 
 /// Everything that can go wrong in `nacre-runtime`.
@@ -75,6 +77,15 @@ pub enum Error {
         /// What is wrong and what was expected.
         message: String,
     },
+    /// A request the runtime refuses, with advice that names parameters (rendered by a
+    /// [`Naming`]: `Display` names them neutrally).
+    #[error("{context}: {message}")]
+    Refused {
+        /// Where.
+        context: String,
+        /// What is wrong and the way out.
+        message: Msg,
+    },
     /// A file could not be read or written.
     #[error("{path}: {source}")]
     Io {
@@ -84,6 +95,18 @@ pub enum Error {
         #[source]
         source: std::io::Error,
     },
+}
+
+impl Render for Error {
+    fn render(&self, f: &mut fmt::Formatter<'_>, naming: &dyn Naming) -> fmt::Result {
+        match self {
+            Error::Table(e) => e.render(f, naming),
+            Error::Refused { context, message } => {
+                write!(f, "{context}: {}", message.named(naming))
+            }
+            other => fmt::Display::fmt(other, f),
+        }
+    }
 }
 
 /// `Result` with [`Error`].

@@ -31,6 +31,9 @@ use crate::shaders::{self, Technique};
 use crate::tables::TableSet;
 use crate::thickness_map::ThicknessMap;
 use bytemuck::{Pod, Zeroable};
+use nacre_format::msg;
+use nacre_format::param::{Msg, Piece};
+use std::sync::Arc;
 
 /// Depth buffer format.
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -150,8 +153,9 @@ pub fn fit_camera(lo: [f32; 3], hi: [f32; 3], aspect: f64) -> Result<FittedCamer
 pub struct MeshRender {
     /// The image.
     pub image: RenderedImage,
-    /// Notes (ignored textures, technique fallbacks), one line each.
-    pub notes: Vec<String>,
+    /// Notes (ignored textures, technique fallbacks), one line each; they may quote an
+    /// error that names parameters (render them with a [`nacre_format::param::Naming`]).
+    pub notes: Vec<Msg>,
 }
 
 fn mesh_pipeline(
@@ -223,25 +227,31 @@ fn lut_material(
     tables: &TableSet,
     material: &MaterialOptions,
     base_colour: [f32; 3],
-) -> std::result::Result<MaterialOptions, String> {
+) -> std::result::Result<MaterialOptions, Msg> {
     let Some(lut) = &tables.film_lut else {
         return Err("no film-lut table is loaded".into());
     };
+    // Errors are kept whole, so that a front end names their parameters its own way.
+    let quoted = |e: Error| Msg::from_pieces(vec![Piece::Nested(Arc::new(e))]);
     let context = format!("{} (base)", lut.manifest_path.display());
     let table_base =
         nacre_format::materials::resolve(&lut.manifest.base, &context, lut.manifest_path.parent())
-            .map_err(|e| e.to_string())?;
+            .map_err(|e| quoted(e.into()))?;
     let table_kind = BaseKind::of(&table_base);
     let mut m = material.clone();
     match (material.base_kind, table_kind) {
         (BaseKind::Dielectric, BaseKind::Dielectric) => {
-            let a = material.base.index_at(550.0).map_err(|e| e.to_string())?;
-            let b = table_base.index_at(550.0).map_err(|e| e.to_string())?;
+            let a = material
+                .base
+                .index_at(550.0)
+                .map_err(|e| quoted(e.into()))?;
+            let b = table_base.index_at(550.0).map_err(|e| quoted(e.into()))?;
             if (a - b).norm() > 1e-3 {
                 return Err(format!(
                     "base index {} differs from the table `{}`'s {}",
                     a.re, lut.name, b.re
-                ));
+                )
+                .into());
             }
         }
         (BaseKind::Metal, BaseKind::Metal) if is_gold_like(base_colour) => {
@@ -251,11 +261,12 @@ fn lut_material(
             return Err(format!(
                 "a metal base needs a table baked on that metal (film-gold for a gold-coloured base), not `{}`",
                 lut.name
-            ));
+            )
+            .into());
         }
-        _ => return Err(format!("the base differs from the table `{}`'s", lut.name)),
+        _ => return Err(format!("the base differs from the table `{}`'s", lut.name).into()),
     }
-    check_film_lut(tables, &m).map_err(|e| e.to_string())?;
+    check_film_lut(tables, &m).map_err(quoted)?;
     Ok(m)
 }
 
@@ -292,21 +303,21 @@ pub fn render_gltf(
     view_options.camera.up = [0.0, 1.0, 0.0];
 
     // Materials: nacre's options and the technique that draws each.
-    let mut notes = scene.notes.clone();
+    let mut notes: Vec<Msg> = scene.notes.iter().map(|n| Msg::from(n.as_str())).collect();
     let mut drawn = Vec::with_capacity(scene.materials.len());
     for gm in &scene.materials {
         let (mut m, material_notes) = gm.material_options()?;
-        notes.extend(material_notes);
+        notes.extend(material_notes.into_iter().map(Msg::from));
         let mut t = technique;
         if technique == Technique::Lut {
             let colour = [gm.base_colour[0], gm.base_colour[1], gm.base_colour[2]];
             match lut_material(tables, &m, colour) {
                 Ok(lm) => m = lm,
                 Err(why) => {
-                    notes.push(format!(
-                        "{}: drawn with fourier instead of lut: {why}",
-                        gm.name
-                    ));
+                    notes.push(msg![
+                        format!("{}: drawn with fourier instead of lut: ", gm.name),
+                        why
+                    ]);
                     t = Technique::Fourier;
                 }
             }
@@ -327,6 +338,7 @@ pub fn render_gltf(
         v
     };
     notes.retain(|n| {
+        let n = n.to_string();
         used.iter()
             .any(|&i| n.starts_with(&format!("{}:", scene.materials[i].name)))
     });

@@ -191,7 +191,7 @@ fn sweeps_render_and_parameters_change_colours() {
                 assert!(
                     out.notes
                         .iter()
-                        .any(|n| n.contains("fourier instead of lut")),
+                        .any(|n| n.to_string().contains("fourier instead of lut")),
                     "{name}: metals fall back to fourier with film-dielectric: {:?}",
                     out.notes
                 );

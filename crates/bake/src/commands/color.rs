@@ -34,10 +34,11 @@
 //! for `--space xyz`).
 
 use crate::commands::spectrum::fmt_sig;
-use crate::error::{Error, Result};
+use crate::error::{Error, Origin, Param, Result};
 use nacre_format::Manifest;
 use nacre_format::film_lut::FilmLut;
 use nacre_format::fourier::FourierTable;
+use nacre_format::msg;
 use nacre_format::set::resolve_table;
 use nacre_format::table_io::Table3;
 use nacre_optics::colour::{Colorimeter, OutputSpace, RgbSpace};
@@ -127,11 +128,7 @@ impl Method {
 impl Method {
     /// Parses `spectral`, `lut:NAME|PATH`, `rgb3`, `samples:N`.
     pub fn parse(text: &str) -> Result<Self> {
-        let err = |message: &str| Error::Flag {
-            flag: "--method".into(),
-            value: text.into(),
-            message: message.into(),
-        };
+        let err = |message: &str| Error::value(Param::Method, text, message);
         match text.trim() {
             "spectral" => Ok(Method::Spectral),
             "rgb3" => Ok(Method::Rgb3),
@@ -235,11 +232,7 @@ pub struct Point {
 /// lines, blank lines, quoted fields, a UTF-8 BOM, CRLF and spaces around fields are
 /// accepted (see [`nacre_optics::csv_rows`]).
 pub fn parse_points(path: &Path, text: &str) -> Result<Vec<Point>> {
-    let perr = |line: usize, message: String| Error::Recipe {
-        path: path.to_path_buf(),
-        line,
-        message,
-    };
+    let perr = |line: usize, message: String| Error::recipe(path.to_path_buf(), line, message);
     let mut out = Vec::new();
     let mut header = false;
     for row in crate::csv_text::rows(path, text) {
@@ -297,11 +290,12 @@ pub fn parse_points(path: &Path, text: &str) -> Result<Vec<Point>> {
             film_ior: Some(n),
         });
         if out.len() > MAX_POINTS {
-            return Err(Error::TooLarge {
-                what: format!("{}: points", path.display()),
+            return Err(nacre_format::Error::TooLarge {
+                what: format!("{}: points", path.display()).into(),
                 count: out.len() as u64,
                 limit: MAX_POINTS as u64,
-            });
+            }
+            .into());
         }
     }
     if !header {
@@ -324,10 +318,13 @@ fn stack_at(stack: &Stack, point: &Point) -> Result<Stack> {
             first.material = Material::constant(format!("{n}"), C64::new(n, 0.0))?;
         }
     } else if point.thickness_nm.is_some() || point.film_ior.is_some() {
-        return Err(Error::Invalid {
-            context: "--points".into(),
-            message: "the stack has no film to override: give at least one --layer".into(),
-        });
+        return Err(Error::invalid(
+            Param::Points,
+            msg![
+                "the stack has no film to override: give at least one ",
+                Param::Layer
+            ],
+        ));
     }
     Ok(Stack::new(
         stack.ambient().clone(),
@@ -376,21 +373,20 @@ impl LoadedLut {
     pub fn load(path: &Path) -> Result<Self> {
         let manifest = Manifest::read(path)?;
         if manifest.film_lut().is_none() {
-            return Err(Error::Invalid {
-                context: path.display().to_string(),
-                message: format!(
+            return Err(Error::invalid(
+                path.display().to_string(),
+                format!(
                     "table `{}` is a `{}` table, not a film-lut",
                     manifest.name, manifest.kind
                 ),
-            });
+            ));
         }
-        let reflectance =
-            manifest
-                .load_table(path, "reflectance")?
-                .ok_or_else(|| Error::Invalid {
-                    context: path.display().to_string(),
-                    message: "the manifest lists no reflectance EXR or KTX2 file".into(),
-                })?;
+        let reflectance = manifest.load_table(path, "reflectance")?.ok_or_else(|| {
+            Error::invalid(
+                path.display().to_string(),
+                "the manifest lists no reflectance EXR or KTX2 file",
+            )
+        })?;
         let transmittance = manifest.load_table(path, "transmittance")?;
         let colorimeter = manifest.colorimeter(path)?;
         Ok(LoadedLut {
@@ -408,22 +404,28 @@ impl LoadedLut {
 
     /// Colour at a point (output space of the table).
     pub fn colour(&self, stack: &Stack, point: &Point, quantity: Quantity) -> Result<[f64; 3]> {
-        let film = stack.layers().first().ok_or_else(|| Error::Invalid {
-            context: "--method lut".into(),
-            message: "a film-lut needs a film: give --layer".into(),
+        let film = stack.layers().first().ok_or_else(|| {
+            Error::invalid(
+                Param::Method.given("lut"),
+                msg!["a film-lut needs a film: give ", Param::Layer],
+            )
         })?;
         let n = match point.film_ior {
             Some(n) => n,
             None => {
                 let n = film.material.index_at(550.0)?;
                 if !film.material.is_constant() || n.im != 0.0 {
-                    return Err(Error::Invalid {
-                        context: "--method lut".into(),
-                        message: format!(
-                            "a film-lut takes a constant real film index; `{}` is dispersive or absorbing (give --points with film_ior)",
-                            film.material.name()
-                        ),
-                    });
+                    return Err(Error::invalid(
+                        Param::Method.given("lut"),
+                        msg![
+                            format!(
+                                "a film-lut takes a constant real film index; `{}` is dispersive or absorbing (give ",
+                                film.material.name()
+                            ),
+                            Param::Points,
+                            " with film_ior)"
+                        ],
+                    ));
                 }
                 n.re
             }
@@ -431,12 +433,12 @@ impl LoadedLut {
         let d = point.thickness_nm.unwrap_or(film.thickness_nm);
         let table = match quantity {
             Quantity::Reflectance => &self.reflectance,
-            Quantity::Transmittance => {
-                self.transmittance.as_ref().ok_or_else(|| Error::Invalid {
-                    context: "--quantity t".into(),
-                    message: format!("table `{}` has no transmittance", self.manifest.name),
-                })?
-            }
+            Quantity::Transmittance => self.transmittance.as_ref().ok_or_else(|| {
+                Error::invalid(
+                    Param::Quantity.given("t"),
+                    format!("table `{}` has no transmittance", self.manifest.name),
+                )
+            })?,
         };
         let cos_theta = point.angle_deg.to_radians().cos();
         Ok(FilmLut::lookup(
@@ -452,15 +454,17 @@ impl LoadedLut {
 /// Errors unless `stack` (film first) matches the ambient, fixed layers and base of the
 /// table `m` at `path`; `method` (`lut`, `rough-lut`) names the flag in messages.
 pub fn check_stack_matches(m: &Manifest, path: &Path, stack: &Stack, method: &str) -> Result<()> {
-    let context = format!("--method {method}:{}", path.display());
+    let context = Param::Method.given(format!("{method}:{}", path.display()));
 
-    let mismatch = |what: &str, ours: String, theirs: &str| Error::Invalid {
-        context: context.clone(),
-        message: format!("the table was baked for {what} `{theirs}`, this stack has `{ours}`"),
+    let mismatch = |what: &str, ours: String, theirs: &str| {
+        Error::invalid(
+            context.clone(),
+            format!("the table was baked for {what} `{theirs}`, this stack has `{ours}`"),
+        )
     };
     let base_dir = path.parent();
     let same = |a: &Material, spec: &str| -> Result<bool> {
-        let b = nacre_format::materials::resolve(spec, &context, base_dir)?;
+        let b = nacre_format::materials::resolve(spec, context.clone(), base_dir)?;
         Ok((0..=20).all(|i| {
             let wl = 380.0 + 20.0 * f64::from(i);
             match (a.index_at(wl), b.index_at(wl)) {
@@ -481,14 +485,14 @@ pub fn check_stack_matches(m: &Manifest, path: &Path, stack: &Stack, method: &st
     }
     let layers = stack.layers();
     if layers.len() != 1 + m.under.len() {
-        return Err(Error::Invalid {
+        return Err(Error::invalid(
             context,
-            message: format!(
+            format!(
                 "the table has one film over {} fixed layer(s); this stack has {} layer(s)",
                 m.under.len(),
                 layers.len()
             ),
-        });
+        ));
     }
     for (l, (spec, d)) in layers[1..].iter().zip(&m.under) {
         if !same(&l.material, spec)? || (l.thickness_nm - d).abs() > 1e-9 {
@@ -504,23 +508,29 @@ pub fn check_stack_matches(m: &Manifest, path: &Path, stack: &Stack, method: &st
 
 /// The first film's thickness (nm) and constant real index at `point` (the point's own
 /// values, else the film's); `context` names the method in errors.
-pub fn film_parameters(stack: &Stack, point: &Point, context: &str) -> Result<(f64, f64)> {
-    let film = stack.layers().first().ok_or_else(|| Error::Invalid {
-        context: context.into(),
-        message: "the method needs a film: give --layer".into(),
+pub fn film_parameters(stack: &Stack, point: &Point, context: &Origin) -> Result<(f64, f64)> {
+    let film = stack.layers().first().ok_or_else(|| {
+        Error::invalid(
+            context.clone(),
+            msg!["the method needs a film: give ", Param::Layer],
+        )
     })?;
     let n = match point.film_ior {
         Some(n) => n,
         None => {
             let n = film.material.index_at(550.0)?;
             if !film.material.is_constant() || n.im != 0.0 {
-                return Err(Error::Invalid {
-                    context: context.into(),
-                    message: format!(
-                        "the table takes a constant real film index; `{}` is dispersive or absorbing (give --points with film_ior)",
-                        film.material.name()
-                    ),
-                });
+                return Err(Error::invalid(
+                    context.clone(),
+                    msg![
+                        format!(
+                            "the table takes a constant real film index; `{}` is dispersive or absorbing (give ",
+                            film.material.name()
+                        ),
+                        Param::Points,
+                        " with film_ior)"
+                    ],
+                ));
             }
             n.re
         }
@@ -551,11 +561,14 @@ pub fn rough_monte_carlo(
                     .im
                     != 0.0
             {
-                return Err(Error::Invalid {
-                    context: "--method rough-mc --quantity t".into(),
-                    message: "transmittance through a rough interface needs a non-absorbing base"
-                        .into(),
-                });
+                return Err(Error::invalid(
+                    msg![
+                        Param::Method.given("rough-mc"),
+                        " ",
+                        Param::Quantity.given("t")
+                    ],
+                    "transmittance through a rough interface needs a non-absorbing base",
+                ));
             }
             let film = nacre_optics::microfacet::FilmTerm::from_stack(&s, colorimeter)?;
             let cos_theta_o = point.angle_deg.to_radians().cos();
@@ -576,17 +589,17 @@ pub fn rough_monte_carlo(
 
 fn check_roughness(alpha: f64) -> Result<()> {
     if alpha.is_nan() {
-        return Err(Error::Invalid {
-            context: "--method rough-lut/rough-mc".into(),
-            message: "needs a roughness: give --roughness ALPHA".into(),
-        });
+        return Err(Error::invalid(
+            Param::Method.given("rough-lut/rough-mc"),
+            msg!["needs a roughness: give ", Param::Roughness.arg()],
+        ));
     }
     if !(alpha > 0.0 && alpha <= 1.0) {
-        return Err(Error::Flag {
-            flag: "--roughness".into(),
-            value: alpha.to_string(),
-            message: "GGX roughness α must lie in (0, 1]".into(),
-        });
+        return Err(Error::value(
+            Param::Roughness,
+            alpha.to_string(),
+            "GGX roughness α must lie in (0, 1]",
+        ));
     }
     Ok(())
 }
@@ -602,11 +615,12 @@ pub fn evaluate(
     lut: Option<&LoadedLut>,
 ) -> Result<Vec<[f64; 3]>> {
     if points.len() > MAX_POINTS {
-        return Err(Error::TooLarge {
+        return Err(nacre_format::Error::TooLarge {
             what: "points".into(),
             count: points.len() as u64,
             limit: MAX_POINTS as u64,
-        });
+        }
+        .into());
     }
     points
         .par_iter()
@@ -622,16 +636,15 @@ pub fn evaluate(
                         Some(t) => t.clone(),
                         None => Arc::new(RoughTable::load(path)?),
                     };
-                    let (d, n) = film_parameters(stack, point, "--method rough-lut")?;
+                    let (d, n) = film_parameters(stack, point, &Param::Method.given("rough-lut"))?;
                     let table = match quantity {
                         Quantity::Reflectance => &t.lut.reflectance,
                         Quantity::Transmittance => {
-                            t.lut.transmittance.as_ref().ok_or_else(|| Error::Invalid {
-                                context: "--quantity t".into(),
-                                message: format!(
-                                    "table `{}` has no transmittance",
-                                    t.manifest.name
-                                ),
+                            t.lut.transmittance.as_ref().ok_or_else(|| {
+                                Error::invalid(
+                                    Param::Quantity.given("t"),
+                                    format!("table `{}` has no transmittance", t.manifest.name),
+                                )
                             })?
                         }
                     };
@@ -682,10 +695,14 @@ pub fn evaluate(
                     let (film, cos_theta, d) = film_on_base(stack, point, colorimeter)?;
                     let transmittance = quantity == Quantity::Transmittance;
                     if transmittance && film.base.iter().any(|b| b.im != 0.0) {
-                        return Err(Error::Invalid {
-                            context: "--method fourier --quantity t".into(),
-                            message: "transmittance needs a non-absorbing (dielectric) base".into(),
-                        });
+                        return Err(Error::invalid(
+                            msg![
+                                Param::Method.given("fourier"),
+                                " ",
+                                Param::Quantity.given("t")
+                            ],
+                            "transmittance needs a non-absorbing (dielectric) base",
+                        ));
                     }
                     let result = match table {
                         Some(t) => film.fourier_colour_with(
@@ -722,12 +739,14 @@ pub fn evaluate(
                 }
                 Method::GaussianFitBelcour2017 => {
                     if quantity == Quantity::Transmittance {
-                        return Err(Error::Invalid {
-                            context: "--method gaussian".into(),
-                            message:
-                                "the Gaussian fit evaluates reflectance only (use --quantity r)"
-                                    .into(),
-                        });
+                        return Err(Error::invalid(
+                            Param::Method.given("gaussian"),
+                            msg![
+                                "the Gaussian fit evaluates reflectance only (use ",
+                                Param::Quantity.given("r"),
+                                ")"
+                            ],
+                        ));
                     }
                     let (film, cos_theta, d) = film_on_base(stack, point, colorimeter)?;
                     // The base enters only through its normal-incidence reflectance F0 (RGB),
@@ -780,15 +799,15 @@ fn film_on_base(
     point: &Point,
     colorimeter: &Colorimeter,
 ) -> Result<(FilmOnBase, f64, f64)> {
-    let context = || "--method fourier/gaussian".to_string();
+    let context = || Param::Method.given("fourier/gaussian");
     if stack.layers().len() != 1 {
-        return Err(Error::Invalid {
-            context: context(),
-            message: format!(
+        return Err(Error::invalid(
+            context(),
+            format!(
                 "needs exactly one film on a base; the stack has {} layers",
                 stack.layers().len()
             ),
-        });
+        ));
     }
     let film = &stack.layers()[0];
     let n_film = match point.film_ior {
@@ -796,26 +815,26 @@ fn film_on_base(
         None => {
             let n = film.material.index_at(550.0)?;
             if !film.material.is_constant() || n.im != 0.0 {
-                return Err(Error::Invalid {
-                    context: context(),
-                    message: format!(
+                return Err(Error::invalid(
+                    context(),
+                    format!(
                         "needs a constant real film index; `{}` is dispersive or absorbing",
                         film.material.name()
                     ),
-                });
+                ));
             }
             n.re
         }
     };
     let ambient = stack.ambient().index_at(550.0)?;
     if !stack.ambient().is_constant() {
-        return Err(Error::Invalid {
-            context: context(),
-            message: format!(
+        return Err(Error::invalid(
+            context(),
+            format!(
                 "needs a constant ambient index; `{}` is dispersive",
                 stack.ambient().name()
             ),
-        });
+        ));
     }
     let weights = colorimeter.weights_1nm();
     let centroid_nm: [f64; 3] = std::array::from_fn(|j| {

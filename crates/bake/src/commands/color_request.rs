@@ -5,8 +5,9 @@
 
 use crate::commands::color::{self, LoadedLut, Method, Point, Quantity};
 use crate::commands::grid::parse_range;
-use crate::error::{Error, Result};
+use crate::error::{Error, Param, Result};
 use nacre_format::fourier::FourierTable;
+use nacre_format::msg;
 use nacre_format::{Manifest, set};
 use nacre_optics::Stack;
 use nacre_optics::colour::Colorimeter;
@@ -62,12 +63,12 @@ pub struct Prepared {
 /// the stack's film.
 pub fn angle_points(text: Option<String>) -> Result<Vec<Point>> {
     let text = text.unwrap_or_else(|| DEFAULT_ANGLES.into());
-    let angles = parse_range("--angles", &text)?;
+    let angles = parse_range(Param::Angles, &text)?;
     if let Some(a) = angles.iter().find(|a| !(a.abs() < 90.0)) {
-        return Err(Error::Flag {
-            flag: "--angles".into(),
+        return Err(Error::Angle {
+            origin: Param::Angles.into(),
             value: text,
-            message: format!("angle {a} must lie strictly between -90 and 90 degrees"),
+            angle: *a,
         });
     }
     Ok(angles
@@ -82,7 +83,7 @@ pub fn angle_points(text: Option<String>) -> Result<Vec<Point>> {
 
 /// Reads a points CSV ([`color::parse_points`]).
 pub fn read_points(path: &Path) -> Result<Vec<Point>> {
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+    let text = std::fs::read_to_string(path).map_err(|source| nacre_format::Error::Io {
         path: path.to_path_buf(),
         source,
     })?;
@@ -102,27 +103,31 @@ pub fn prepare(stack: &Stack, method: Method, req: &ColorRequest) -> Result<Prep
     match (method.is_rough(), req.roughness) {
         (true, Some(alpha)) => {
             if !(alpha > 0.0 && alpha <= 1.0) {
-                return Err(Error::Flag {
-                    flag: "--roughness".into(),
-                    value: alpha.to_string(),
-                    message: "GGX roughness α must lie in (0, 1]".into(),
-                });
+                return Err(Error::value(
+                    Param::Roughness,
+                    alpha.to_string(),
+                    "GGX roughness α must lie in (0, 1]",
+                ));
             }
             method = method.with_roughness(alpha);
         }
         (true, None) => {
-            return Err(Error::Flag {
-                flag: "--method".into(),
-                value: req.method.to_string(),
-                message: "needs --roughness ALPHA (GGX α, 0 < α ≤ 1)".into(),
-            });
+            return Err(Error::value(
+                Param::Method,
+                req.method.to_string(),
+                msg!["needs ", Param::Roughness.arg(), " (GGX α, 0 < α ≤ 1)"],
+            ));
         }
         (false, Some(alpha)) => {
-            return Err(Error::Flag {
-                flag: "--roughness".into(),
-                value: alpha.to_string(),
-                message: "applies only to --method rough-lut:NAME and rough-mc".into(),
-            });
+            return Err(Error::value(
+                Param::Roughness,
+                alpha.to_string(),
+                msg![
+                    "applies only to ",
+                    Param::Method.given("rough-lut:NAME"),
+                    " and rough-mc"
+                ],
+            ));
         }
         (false, None) => {}
     }
@@ -132,30 +137,30 @@ pub fn prepare(stack: &Stack, method: Method, req: &ColorRequest) -> Result<Prep
             color::check_stack_matches(&table.manifest, path, stack, "rough-lut")?;
             let m = &table.manifest;
             for (flag, given, baked) in [
-                ("--observer", &given[0], &m.observer),
-                ("--illuminant", &given[1], &m.illuminant),
-                ("--space", &given[2], &m.space),
+                (Param::Observer, &given[0], &m.observer),
+                (Param::Illuminant, &given[1], &m.illuminant),
+                (Param::Space, &given[2], &m.space),
             ] {
                 if let Some(g) = given
                     && !g.eq_ignore_ascii_case(baked)
                 {
-                    return Err(Error::Flag {
-                        flag: flag.into(),
-                        value: g.clone(),
-                        message: format!("table `{}` was baked for `{baked}`", m.name),
-                    });
+                    return Err(Error::value(
+                        flag,
+                        g.clone(),
+                        format!("table `{}` was baked for `{baked}`", m.name),
+                    ));
                 }
             }
             let a = &table.lut.axes;
             if !(*alpha >= a.alpha_min && *alpha <= a.alpha_max) {
-                return Err(Error::Flag {
-                    flag: "--roughness".into(),
-                    value: alpha.to_string(),
-                    message: format!(
+                return Err(Error::value(
+                    Param::Roughness,
+                    alpha.to_string(),
+                    format!(
                         "table `{}` covers GGX α {} to {}",
                         m.name, a.alpha_min, a.alpha_max
                     ),
-                });
+                ));
             }
             let c = table.colorimeter.clone();
             method = Method::RoughLut {
@@ -170,46 +175,42 @@ pub fn prepare(stack: &Stack, method: Method, req: &ColorRequest) -> Result<Prep
             lut.check_stack(path, stack)?;
             let m = &lut.manifest;
             for (flag, given, table) in [
-                ("--observer", &given[0], &m.observer),
-                ("--illuminant", &given[1], &m.illuminant),
-                ("--space", &given[2], &m.space),
+                (Param::Observer, &given[0], &m.observer),
+                (Param::Illuminant, &given[1], &m.illuminant),
+                (Param::Space, &given[2], &m.space),
             ] {
                 if let Some(g) = given
                     && !g.eq_ignore_ascii_case(table)
                 {
-                    return Err(Error::Flag {
-                        flag: flag.into(),
-                        value: g.clone(),
-                        message: format!("table `{}` was baked for `{table}`", m.name),
-                    });
+                    return Err(Error::value(
+                        flag,
+                        g.clone(),
+                        format!("table `{}` was baked for `{table}`", m.name),
+                    ));
                 }
             }
             let c = lut.colorimeter.clone();
             (Some(lut), c)
         }
         _ => {
-            fn flag_err(flag: &'static str, v: &str) -> impl FnOnce(nacre_optics::Error) -> Error {
+            fn flag_err(flag: Param, v: &str) -> impl FnOnce(nacre_optics::Error) -> Error {
                 let v = v.to_string();
-                move |e| Error::Flag {
-                    flag: flag.into(),
-                    value: v,
-                    message: e.to_string(),
-                }
+                move |e| Error::value(flag, v, e.to_string())
             }
             let o = given[0].clone().unwrap_or_else(|| "1931".into());
             let i = given[1].clone().unwrap_or_else(|| "d65".into());
             let s = given[2].clone().unwrap_or_else(|| "srgb".into());
             let c = Colorimeter::new(
-                o.parse().map_err(flag_err("--observer", &o))?,
-                i.parse().map_err(flag_err("--illuminant", &i))?,
-                s.parse().map_err(flag_err("--space", &s))?,
+                o.parse().map_err(flag_err(Param::Observer, &o))?,
+                i.parse().map_err(flag_err(Param::Illuminant, &i))?,
+                s.parse().map_err(flag_err(Param::Space, &s))?,
             );
             if method == Method::Rgb3 && s == "xyz" {
-                return Err(Error::Flag {
-                    flag: "--method".into(),
-                    value: "rgb3".into(),
-                    message: "rgb3 gives RGB directly: choose an RGB --space".into(),
-                });
+                return Err(Error::value(
+                    Param::Method,
+                    "rgb3",
+                    msg!["rgb3 gives RGB directly: choose an RGB ", Param::Space],
+                ));
             }
             if let Method::Fourier(h, sigma, None) = &method
                 && wants_baked_fourier(req.method)
@@ -329,16 +330,13 @@ pub fn load_fourier_table(given: Option<&str>, colorimeter: &Colorimeter) -> Res
                     }
                 }
             }
-            found.ok_or_else(|| Error::Invalid {
-                context: "--method fourier".into(),
-                message: format!(
-                    "no fourier table for observer {}, illuminant {}, space {} in {}: bake one (kind = \"fourier\") and pass --fourier-table, or use fourier-exact:",
+            found.ok_or_else(|| Error::invalid(Param::Method.given("fourier"), msg![format!(
+                    "no fourier table for observer {}, illuminant {}, space {} in {}: bake one (kind = \"fourier\") and pass ",
                     settings.0,
                     settings.1,
                     settings.2,
                     dir.display()
-                ),
-            })?
+                ), Param::FourierTable, ", or use fourier-exact:"]))?
         }
     };
     let manifest = Manifest::read(&path)?;
@@ -348,9 +346,9 @@ pub fn load_fourier_table(given: Option<&str>, colorimeter: &Colorimeter) -> Res
         manifest.space.clone(),
     ) != settings
     {
-        return Err(Error::Invalid {
-            context: format!("--fourier-table {}", path.display()),
-            message: format!(
+        return Err(Error::invalid(
+            Param::FourierTable.given(path.display().to_string()),
+            format!(
                 "the table was baked for observer {}, illuminant {}, space {}; this run uses {}, {}, {}",
                 manifest.observer,
                 manifest.illuminant,
@@ -359,7 +357,7 @@ pub fn load_fourier_table(given: Option<&str>, colorimeter: &Colorimeter) -> Res
                 settings.1,
                 settings.2
             ),
-        });
+        ));
     }
     Ok(manifest.load_fourier(&path)?)
 }

@@ -8,10 +8,11 @@
 //! half-float values, as the default tables).
 
 use crate::commands::color::{self, Method, Point, Quantity};
-use crate::error::{Error, Result};
+use crate::error::{Error, Param, Result};
 use crate::kinds::film_lut::FilmLutJob;
 use nacre_format::atomic::write_atomic;
 use nacre_format::film_lut::{FilmLut, FilmLutAxes};
+use nacre_format::msg;
 use nacre_optics::colour::{Colorimeter, Illuminant, Observer, OutputSpace, RgbSpace};
 use nacre_optics::colour::{delta_e_2000, xyz_to_lab};
 use nacre_optics::fourier::Harmonics;
@@ -94,7 +95,7 @@ pub fn compare(
         OutputSpace::Rgb(RgbSpace::Srgb),
     );
     let air = Material::constant("1.0", C64::new(1.0, 0.0))?;
-    let base = nacre_format::materials::resolve(case.base, "--case", None)?;
+    let base = nacre_format::materials::resolve(case.base, Param::Case, None)?;
     let film = Material::constant(format!("{}", case.film_ior), C64::new(case.film_ior, 0.0))?;
     let stack = Stack::new(
         air.clone(),
@@ -243,9 +244,11 @@ pub fn write_png(
     let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
     let (w, h) = (1400u32, 900u32);
     let mut buf = vec![0u8; (w * h * 3) as usize];
-    let draw_err = |e: String| Error::Invalid {
-        context: path.display().to_string(),
-        message: format!("drawing the plot failed: {e}"),
+    let draw_err = |e: String| {
+        Error::invalid(
+            path.display().to_string(),
+            format!("drawing the plot failed: {e}"),
+        )
     };
     {
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
@@ -324,17 +327,16 @@ pub fn write_png(
 
 /// The named case of [`CASES`] (`--case`).
 pub fn case_named(name: &str) -> Result<&'static Case> {
-    CASES
-        .iter()
-        .find(|c| c.name == name)
-        .ok_or_else(|| Error::Flag {
-            flag: "--case".into(),
-            value: name.into(),
-            message: format!(
+    CASES.iter().find(|c| c.name == name).ok_or_else(|| {
+        Error::value(
+            Param::Case,
+            name,
+            format!(
                 "expected one of {}",
                 CASES.iter().map(|c| c.name).collect::<Vec<_>>().join(", ")
             ),
-        })
+        )
+    })
 }
 
 /// Most angle × thickness points of one comparison.
@@ -344,29 +346,30 @@ pub const MAX_POINTS: u64 = 200_000;
 /// `--thicknesses`): angles strictly between -90 and 90 degrees, thicknesses
 /// non-negative, at most [`MAX_POINTS`] points.
 pub fn grid(angles_text: &str, thicknesses_text: &str) -> Result<(Vec<f64>, Vec<f64>)> {
-    let angles = crate::commands::grid::parse_range("--angles", angles_text)?;
+    let angles = crate::commands::grid::parse_range(Param::Angles, angles_text)?;
     if let Some(a) = angles.iter().find(|a| !(a.abs() < 90.0)) {
-        return Err(Error::Flag {
-            flag: "--angles".into(),
+        return Err(Error::Angle {
+            origin: Param::Angles.into(),
             value: angles_text.into(),
-            message: format!("angle {a} must lie strictly between -90 and 90 degrees"),
+            angle: *a,
         });
     }
-    let thicknesses = crate::commands::grid::parse_range("--thicknesses", thicknesses_text)?;
+    let thicknesses = crate::commands::grid::parse_range(Param::Thicknesses, thicknesses_text)?;
     if let Some(d) = thicknesses.iter().find(|d| !(**d >= 0.0)) {
-        return Err(Error::Flag {
-            flag: "--thicknesses".into(),
-            value: thicknesses_text.into(),
-            message: format!("thickness {d} must be non-negative"),
-        });
+        return Err(Error::value(
+            Param::Thicknesses,
+            thicknesses_text,
+            format!("thickness {d} must be non-negative"),
+        ));
     }
     let points = angles.len() as u64 * thicknesses.len() as u64;
     if points > MAX_POINTS {
-        return Err(Error::TooLarge {
-            what: "--angles × --thicknesses points".into(),
+        return Err(nacre_format::Error::TooLarge {
+            what: msg![Param::Angles, " × ", Param::Thicknesses, " points"],
             count: points,
             limit: MAX_POINTS,
-        });
+        }
+        .into());
     }
     Ok((angles, thicknesses))
 }
@@ -379,7 +382,7 @@ pub fn write(
     thicknesses: &[f64],
     results: &[MethodResult],
 ) -> Result<()> {
-    std::fs::create_dir_all(dir).map_err(|source| Error::Io {
+    std::fs::create_dir_all(dir).map_err(|source| nacre_format::Error::Io {
         path: dir.to_path_buf(),
         source,
     })?;

@@ -243,10 +243,10 @@ pub fn colorimeter() -> Colorimeter {
 /// is refused before any work.
 pub fn write(dir: &Path, size: GridSize) -> Result<Conformance> {
     if dir.exists() && !dir.is_dir() {
-        return Err(Error::Invalid {
-            context: dir.display().to_string(),
-            message: "exists and is not a folder: -o takes the output folder".into(),
-        });
+        return Err(Error::invalid(
+            dir.display().to_string(),
+            "exists and is not a folder: -o takes the output folder",
+        ));
     }
     let set = compute(Grid::new(size))?;
     write_files_atomic(dir, &set.files()?)?;
@@ -408,9 +408,11 @@ impl Conformance {
         let g = &self.grid;
         let (w, h) = (1400u32, 860u32);
         let mut buf = vec![0u8; (w * h * 3) as usize];
-        let draw_err = |e: String| Error::Invalid {
-            context: name.to_string(),
-            message: format!("drawing the swatches failed: {e}"),
+        let draw_err = |e: String| {
+            Error::invalid(
+                name.to_string(),
+                format!("drawing the swatches failed: {e}"),
+            )
         };
         let angle_index = |a: f64| {
             g.angles_deg

@@ -6,9 +6,10 @@
 
 use crate::commands::grid::parse_range;
 use crate::commands::spectrum::fmt_sig;
-use crate::error::{Error, Result};
+use crate::error::{Error, Msg, Origin, Param, Result};
 use crate::kinds::diffraction::HeightSource;
 use crate::kinds::diffraction_integrated::DEFAULT_INTEGRATED_SAMPLES;
+use nacre_format::msg;
 use nacre_format::{Manifest, set};
 use nacre_optics::C64;
 use nacre_optics::colour::Colorimeter;
@@ -46,15 +47,12 @@ pub struct SurfaceSpec {
     pub coherence: Option<String>,
 }
 
-fn flag(flag: &str, value: &str, message: impl Into<String>) -> Error {
-    Error::Flag {
-        flag: flag.into(),
-        value: value.into(),
-        message: message.into(),
-    }
+fn flag(origin: impl Into<Origin>, value: &str, message: impl Into<Msg>) -> Error {
+    Error::value(origin, value, message)
 }
 
-pub(crate) fn positive(name: &str, text: &str) -> Result<f64> {
+/// Parses a finite positive number of micrometres; errors name `name`.
+pub(crate) fn positive(name: Param, text: &str) -> Result<f64> {
     text.trim()
         .parse::<f64>()
         .ok()
@@ -68,14 +66,15 @@ pub(crate) fn positive(name: &str, text: &str) -> Result<f64> {
         })
 }
 
-pub fn angles(name: &str, text: &str) -> Result<Vec<f64>> {
+/// Parses a range of angles, degrees, each strictly between -90 and 90; errors name `name`.
+pub fn angles(name: Param, text: &str) -> Result<Vec<f64>> {
     let v = parse_range(name, text)?;
     if let Some(a) = v.iter().find(|a| !(a.abs() < 90.0)) {
-        return Err(flag(
-            name,
-            text,
-            format!("angle {a} must lie strictly between -90 and 90 degrees"),
-        ));
+        return Err(Error::Angle {
+            origin: name.into(),
+            value: text.into(),
+            angle: *a,
+        });
     }
     Ok(v)
 }
@@ -95,8 +94,9 @@ pub struct Loaded {
     pub colorimeter: Colorimeter,
     pub wavelengths: Vec<f64>,
     pub fresnel: FresnelTerm,
-    /// What the evaluator came from (`--table NAME`, `--layout integrated`), for messages.
-    pub context: String,
+    /// What the evaluator came from (the table, the integrated layout, the height field),
+    /// for messages.
+    pub context: Origin,
 }
 
 impl Loaded {
@@ -108,11 +108,8 @@ impl Loaded {
         let c = &self.colorimeter;
         match &self.evaluator {
             Evaluator::Terms(surface) => {
-                let grid =
-                    SpectralGrid::new(c, &self.wavelengths).map_err(|source| Error::OpticsIn {
-                        context: "--wavelengths".into(),
-                        source,
-                    })?;
+                let grid = SpectralGrid::new(c, &self.wavelengths)
+                    .map_err(|source| Error::optics_in(Param::Wavelengths, source))?;
                 Ok(par_map_pairs(directions, &|wi, wr| {
                     let rho: Vec<f64> = self
                         .wavelengths
@@ -145,10 +142,10 @@ pub struct Source<'a> {
 }
 
 fn parse_wavelengths(text: &str) -> Result<Vec<f64>> {
-    let wavelengths = parse_range("--wavelengths", text)?;
+    let wavelengths = parse_range(Param::Wavelengths, text)?;
     if let Some(l) = wavelengths.iter().find(|l| !(**l >= 360.0 && **l <= 830.0)) {
         return Err(flag(
-            "--wavelengths",
+            Param::Wavelengths,
             text,
             format!("wavelength {l} nm is outside 360-830 nm"),
         ));
@@ -172,24 +169,28 @@ pub fn load(src: &Source, directions: &[([f64; 3], [f64; 3])]) -> Result<Loaded>
         None | Some("terms") => false,
         Some("integrated") => true,
         Some(other) => {
-            return Err(flag("--layout", other, "expected `terms` or `integrated`"));
+            return Err(flag(
+                Param::Layout,
+                other,
+                "expected `terms` or `integrated`",
+            ));
         }
     };
     if integrated_samples.is_some() && !integrated_wanted {
         return Err(flag(
-            "--integrated-samples",
+            Param::IntegratedSamples,
             &integrated_samples.unwrap_or(0).to_string(),
-            "applies to --layout integrated only",
+            msg!["applies to ", Param::Layout.given("integrated"), " only"],
         ));
     }
     let fresnel = match src.fresnel {
         None => FresnelTerm::Unity,
         Some(text) => {
             let m = nacre_optics::Material::parse_index(text)
-                .map_err(|e| flag("--fresnel", text, e.to_string()))?;
+                .map_err(|e| flag(Param::Fresnel, text, e.to_string()))?;
             let n: C64 = m
                 .index_at(550.0)
-                .map_err(|e| flag("--fresnel", text, e.to_string()))?;
+                .map_err(|e| flag(Param::Fresnel, text, e.to_string()))?;
             FresnelTerm::Index(n)
         }
     };
@@ -214,30 +215,29 @@ pub fn load(src: &Source, directions: &[([f64; 3], [f64; 3])]) -> Result<Loaded>
         let s = pick(src.colour[2], &table_colour[2], "srgb");
         Ok(Colorimeter::new(
             o.parse()
-                .map_err(|e: nacre_optics::Error| flag("--observer", &o, e.to_string()))?,
+                .map_err(|e: nacre_optics::Error| flag(Param::Observer, &o, e.to_string()))?,
             i.parse()
-                .map_err(|e: nacre_optics::Error| flag("--illuminant", &i, e.to_string()))?,
+                .map_err(|e: nacre_optics::Error| flag(Param::Illuminant, &i, e.to_string()))?,
             s.parse()
-                .map_err(|e: nacre_optics::Error| flag("--space", &s, e.to_string()))?,
+                .map_err(|e: nacre_optics::Error| flag(Param::Space, &s, e.to_string()))?,
         ))
     };
     let (terms, sigma_s, table_colour, context, wavelengths) = match (surface, table) {
         (_, Some(name)) => {
             let path = set::resolve_table(name);
             let manifest = Manifest::read(&path)?;
-            let record = manifest
-                .diffraction()
-                .cloned()
-                .ok_or_else(|| Error::Invalid {
-                    context: path.display().to_string(),
-                    message: format!(
+            let record = manifest.diffraction().cloned().ok_or_else(|| {
+                Error::invalid(
+                    path.display().to_string(),
+                    format!(
                         "table `{}` is a `{}` table, not a diffraction table",
                         manifest.name, manifest.kind
                     ),
-                })?;
+                )
+            })?;
             if let Some(l) = layout {
                 return Err(flag(
-                    "--layout",
+                    Param::Layout,
                     l,
                     format!(
                         "applies to height fields; table `{name}` has the layout \"{}\"",
@@ -253,18 +253,22 @@ pub fn load(src: &Source, directions: &[([f64; 3], [f64; 3])]) -> Result<Loaded>
             let wavelengths = match (src.wavelengths, integrated) {
                 (Some(text), true) => {
                     let w = parse_wavelengths(text)?;
-                    if w != parse_range("--wavelengths", &table_grid)? {
+                    if w != parse_range(Param::Wavelengths, &table_grid)? {
                         return Err(flag(
-                            "--wavelengths",
+                            Param::Wavelengths,
                             text,
-                            format!(
-                                "table `{name}` has the integrated layout: its colours are summed over {table_grid} nm (leave --wavelengths out)"
-                            ),
+                            msg![
+                                format!(
+                                    "table `{name}` has the integrated layout: its colours are summed over {table_grid} nm (leave "
+                                ),
+                                Param::Wavelengths,
+                                " out)"
+                            ],
                         ));
                     }
                     w
                 }
-                (None, true) => parse_range("--wavelengths", &table_grid)?,
+                (None, true) => parse_range(Param::Wavelengths, &table_grid)?,
                 (text, false) => parse_wavelengths(text.unwrap_or(src.default_wavelengths))?,
             };
             let wl_min = wavelengths.iter().copied().fold(f64::INFINITY, f64::min);
@@ -272,7 +276,7 @@ pub fn load(src: &Source, directions: &[([f64; 3], [f64; 3])]) -> Result<Loaded>
             if wl_min < record.wavelength_min_nm - 1e-9 || wl_max > record.wavelength_max_nm + 1e-9
             {
                 return Err(flag(
-                    "--wavelengths",
+                    Param::Wavelengths,
                     src.wavelengths.unwrap_or(src.default_wavelengths),
                     format!(
                         "table `{name}` serves {}-{} nm",
@@ -286,19 +290,26 @@ pub fn load(src: &Source, directions: &[([f64; 3], [f64; 3])]) -> Result<Loaded>
                 .fold(0.0, f64::max);
             if max_polar_deg > record.max_angle_deg + 1e-9 || max_uv > record.max_uv * (1.0 + 1e-9)
             {
-                return Err(Error::Invalid {
-                    context: "--incidence/--views".into(),
-                    message: format!(
+                return Err(Error::invalid(
+                    msg![Param::Incidence, "/", Param::Views],
+                    format!(
                         "light or view reaches {max_polar_deg:.2}° from the normal; table `{name}` serves light and view within {}° (|u|, |v| ≤ {:.4})",
                         record.max_angle_deg, record.max_uv
                     ),
-                });
+                ));
             }
             if coherence.is_some() || pitch.is_some() || samples.is_some() {
                 return Err(flag(
-                    "--table",
+                    Param::Table,
                     name,
-                    "--coherence, --pitch and --samples come from the table",
+                    msg![
+                        Param::Coherence,
+                        ", ",
+                        Param::Pitch,
+                        " and ",
+                        Param::Samples,
+                        " come from the table"
+                    ],
                 ));
             }
             let c = [
@@ -312,17 +323,17 @@ pub fn load(src: &Source, directions: &[([f64; 3], [f64; 3])]) -> Result<Loaded>
                 for (given, flag_name, same) in [
                     (
                         src.colour[0],
-                        "--observer",
+                        Param::Observer,
                         colorimeter.observer() == baked.observer(),
                     ),
                     (
                         src.colour[1],
-                        "--illuminant",
+                        Param::Illuminant,
                         colorimeter.illuminant() == baked.illuminant(),
                     ),
                     (
                         src.colour[2],
-                        "--space",
+                        Param::Space,
                         colorimeter.space() == baked.space(),
                     ),
                 ] {
@@ -345,7 +356,7 @@ pub fn load(src: &Source, directions: &[([f64; 3], [f64; 3])]) -> Result<Loaded>
                     colorimeter,
                     wavelengths,
                     fresnel,
-                    context: format!("--table {name}"),
+                    context: Param::Table.given(name),
                 });
             }
             let (record, terms) = manifest.load_diffraction(&path)?;
@@ -353,7 +364,7 @@ pub fn load(src: &Source, directions: &[([f64; 3], [f64; 3])]) -> Result<Loaded>
                 terms,
                 record.sigma_s_um,
                 c,
-                format!("--table {name}"),
+                Param::Table.given(name),
                 wavelengths,
             )
         }
@@ -362,10 +373,10 @@ pub fn load(src: &Source, directions: &[([f64; 3], [f64; 3])]) -> Result<Loaded>
                 parse_wavelengths(src.wavelengths.unwrap_or(src.default_wavelengths))?;
             let wl_min = wavelengths.iter().copied().fold(f64::INFINITY, f64::min);
             let coherence_um = match coherence {
-                Some(t) => positive("--coherence", t)?,
+                Some(t) => positive(Param::Coherence, t)?,
                 None => DEFAULT_COHERENCE_DIAMETER_UM,
             };
-            let pitch_um = pitch.map(|t| positive("--pitch", t)).transpose()?;
+            let pitch_um = pitch.map(|t| positive(Param::Pitch, t)).transpose()?;
             let scale = height_scale
                 .trim()
                 .parse::<f64>()
@@ -373,22 +384,26 @@ pub fn load(src: &Source, directions: &[([f64; 3], [f64; 3])]) -> Result<Loaded>
                 .filter(|v| v.is_finite() && *v >= 0.0)
                 .ok_or_else(|| {
                     flag(
-                        "--height-scale",
+                        Param::HeightScale,
                         height_scale,
                         "expected a finite non-negative number of micrometres",
                     )
                 })?;
             if samples == Some(0) {
-                return Err(flag("--samples", "0", "expected at least 1"));
+                return Err(flag(Param::Samples, "0", "expected at least 1"));
             }
-            let source = HeightSource::parse("FILE|SPEC", text)?;
-            let field = source.load(text, "--pitch", coherence_um, pitch_um, samples, scale)?;
+            let source = HeightSource::parse(Param::Surface, text)?;
+            let field = source.load(
+                &text.into(),
+                &Param::Pitch.into(),
+                coherence_um,
+                pitch_um,
+                samples,
+                scale,
+            )?;
             let x = max_phase(&field, wl_min, w_max);
-            let (order, bound) =
-                taylor_order_for(x, TAYLOR_TOLERANCE).map_err(|source| Error::OpticsIn {
-                    context: text.to_string(),
-                    source,
-                })?;
+            let (order, bound) = taylor_order_for(x, TAYLOR_TOLERANCE)
+                .map_err(|source| Error::optics_in(text.to_string(), source))?;
             eprintln!(
                 "nacre: {}x{} samples at {} µm, Taylor order N = {order} (remainder bound {bound:.1e} at max |k w h| = {x:.3}), 4σ_s = {coherence_um} µm",
                 field.nx(),
@@ -399,36 +414,41 @@ pub fn load(src: &Source, directions: &[([f64; 3], [f64; 3])]) -> Result<Loaded>
                 TaylorTerms::compute(&field, order),
                 coherence_um / 4.0,
                 [None, None, None],
-                text.to_string(),
+                Origin::from(text),
                 wavelengths,
             )
         }
-        (None, None) => unreachable!("clap requires FILE|SPEC or --table"),
+        (None, None) => {
+            return Err(Error::invalid(
+                msg![Param::Surface, ", ", Param::Table],
+                "give a height field or a table",
+            ));
+        }
     };
     let wl_min = wavelengths.iter().copied().fold(f64::INFINITY, f64::min);
-    let surface = DiffractionSurface::new(terms, sigma_s).map_err(|source| Error::OpticsIn {
-        context: context.clone(),
-        source,
-    })?;
-    surface
-        .check_sampling(wl_min, max_uv)
-        .map_err(|source| Error::OpticsIn {
-            context: format!("{context} with --views/--incidence and --wavelengths"),
+    let surface = DiffractionSurface::new(terms, sigma_s)
+        .map_err(|source| Error::optics_in(context.clone(), source))?;
+    surface.check_sampling(wl_min, max_uv).map_err(|source| {
+        Error::optics_in(
+            msg![
+                context.clone(),
+                " with ",
+                Param::Views,
+                "/",
+                Param::Incidence,
+                " and ",
+                Param::Wavelengths
+            ],
             source,
-        })?;
+        )
+    })?;
     let colorimeter = colorimeter_of(table_colour)?;
     let evaluator = if integrated_wanted {
         let n = integrated_samples.unwrap_or(DEFAULT_INTEGRATED_SAMPLES);
-        let axis =
-            WarpedAxis::new(max_uv.clamp(1e-3, 2.0), 3.0, n).map_err(|source| Error::OpticsIn {
-                context: "--integrated-samples".into(),
-                source,
-            })?;
-        let grid =
-            SpectralGrid::new(&colorimeter, &wavelengths).map_err(|source| Error::OpticsIn {
-                context: "--wavelengths".into(),
-                source,
-            })?;
+        let axis = WarpedAxis::new(max_uv.clamp(1e-3, 2.0), 3.0, n)
+            .map_err(|source| Error::optics_in(Param::IntegratedSamples, source))?;
+        let grid = SpectralGrid::new(&colorimeter, &wavelengths)
+            .map_err(|source| Error::optics_in(Param::Wavelengths, source))?;
         eprintln!(
             "nacre: integrated table of {} x {n} texels x {} layers over |u|, |v| <= {:.4}",
             n / 2,
@@ -450,7 +470,7 @@ pub fn load(src: &Source, directions: &[([f64; 3], [f64; 3])]) -> Result<Loaded>
         wavelengths,
         fresnel,
         context: if integrated_wanted {
-            "--layout integrated".into()
+            Param::Layout.given("integrated")
         } else {
             context
         },
@@ -458,7 +478,7 @@ pub fn load(src: &Source, directions: &[([f64; 3], [f64; 3])]) -> Result<Loaded>
 }
 
 /// Parses an incidence angle θ_i, degrees, strictly between -90 and 90; errors name `name`.
-pub fn incidence(name: &str, text: &str) -> Result<f64> {
+pub fn incidence(name: Param, text: &str) -> Result<f64> {
     text.trim()
         .parse::<f64>()
         .ok()
@@ -537,17 +557,21 @@ impl ViewsOutput {
 /// Evaluates a `nacre diffraction` request: checks the angles, loads the surface and
 /// computes colours or spectra.
 pub fn evaluate_views(req: &ViewsRequest) -> Result<ViewsOutput> {
-    let incidence = incidence("--incidence", req.incidence)?;
-    let views = angles("--views", req.views)?;
+    let incidence = incidence(Param::Incidence, req.incidence)?;
+    let views = angles(Param::Views, req.views)?;
     let directions: Vec<_> = views
         .iter()
         .map(|&v| nacre_optics::diffraction::in_plane_directions(incidence, v))
         .collect();
     if req.source.surface.layout.as_deref().map(str::trim) == Some("integrated") && !req.color {
         return Err(flag(
-            "--layout",
+            Param::Layout,
             "integrated",
-            "the integrated layout holds colours summed over wavelengths: add --color, or use the terms layout for per-wavelength reflectance",
+            msg![
+                "the integrated layout holds colours summed over wavelengths: add ",
+                Param::Color,
+                ", or use the terms layout for per-wavelength reflectance"
+            ],
         ));
     }
     let loaded = load(&req.source, &directions)?;
@@ -556,10 +580,14 @@ pub fn evaluate_views(req: &ViewsRequest) -> Result<ViewsOutput> {
         return Ok(ViewsOutput::Colours { views, colours });
     }
     let Evaluator::Terms(surface) = &loaded.evaluator else {
-        return Err(Error::Invalid {
-            context: loaded.context.clone(),
-            message: "the integrated layout holds colours summed over wavelengths, not spectra: add --color, or use a terms table for per-wavelength reflectance".into(),
-        });
+        return Err(Error::invalid(
+            loaded.context.clone(),
+            msg![
+                "the integrated layout holds colours summed over wavelengths, not spectra: add ",
+                Param::Color,
+                ", or use a terms table for per-wavelength reflectance"
+            ],
+        ));
     };
     let sweep = ViewSweep {
         surface,
@@ -595,7 +623,7 @@ pub struct MapRequest<'a> {
 
 /// Computes the diffraction map of a `nacre plot diffraction` request, titled.
 pub fn map(req: &MapRequest) -> Result<DiffractionMap> {
-    let incidence = incidence("--incidence", req.incidence)?;
+    let incidence = incidence(Param::Incidence, req.incidence)?;
     let max_view = req
         .max_view
         .trim()
@@ -604,17 +632,18 @@ pub fn map(req: &MapRequest) -> Result<DiffractionMap> {
         .filter(|a| *a > 0.0 && *a < 90.0)
         .ok_or_else(|| {
             flag(
-                "--max-view",
+                Param::MaxView,
                 req.max_view,
                 "expected an angle in degrees strictly between 0 and 90",
             )
         })?;
     if !(16..=1024).contains(&req.cells) {
-        return Err(flag(
-            "--cells",
-            &req.cells.to_string(),
-            "expected 16 to 1024",
-        ));
+        return Err(Error::OutOfRange {
+            param: Param::Cells,
+            value: req.cells as f64,
+            low: 16.0,
+            high: 1024.0,
+        });
     }
     let exposure = match req.exposure.trim() {
         "auto" => None,
@@ -622,7 +651,7 @@ pub fn map(req: &MapRequest) -> Result<DiffractionMap> {
             t.parse::<f64>()
                 .ok()
                 .filter(|v| v.is_finite() && *v > 0.0)
-                .ok_or_else(|| flag("--exposure", t, "expected a positive number or `auto`"))?,
+                .ok_or_else(|| flag(Param::Exposure, t, "expected a positive number or `auto`"))?,
         ),
     };
     // The extreme view directions: the rim of the disc.
@@ -651,13 +680,8 @@ pub fn map(req: &MapRequest) -> Result<DiffractionMap> {
         .unwrap_or_default();
     let map = match &loaded.evaluator {
         Evaluator::Terms(surface) => {
-            let grid =
-                SpectralGrid::new(&loaded.colorimeter, &loaded.wavelengths).map_err(|source| {
-                    Error::OpticsIn {
-                        context: "--wavelengths".into(),
-                        source,
-                    }
-                })?;
+            let grid = SpectralGrid::new(&loaded.colorimeter, &loaded.wavelengths)
+                .map_err(|source| Error::optics_in(Param::Wavelengths, source))?;
             DiffractionMap::compute(
                 String::new(),
                 surface,

@@ -1,6 +1,6 @@
 //! Parsing of sampling ranges (`START:END:STEP`) and film thicknesses (`635`, `635nm`).
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Origin, Result};
 
 /// Most samples one axis may have.
 pub const MAX_AXIS_SAMPLES: usize = 1_000_000;
@@ -10,13 +10,10 @@ pub const MAX_AXIS_SAMPLES: usize = 1_000_000;
 const GRID_SCALE: f64 = 1e9;
 
 /// Parses `START:END:STEP` (inclusive of END when it falls on the grid, within 1e-9 of a
-/// step) or a single value `X`. Errors name `flag`.
-pub fn parse_range(flag: &str, text: &str) -> Result<Vec<f64>> {
-    let err = |message: String| Error::Flag {
-        flag: flag.to_string(),
-        value: text.to_string(),
-        message,
-    };
+/// step) or a single value `X`. Errors name `origin` (a parameter or a recipe line).
+pub fn parse_range(origin: impl Into<Origin>, text: &str) -> Result<Vec<f64>> {
+    let origin = origin.into();
+    let err = |message: String| Error::value(origin.clone(), text, message);
     let parts: Vec<&str> = text.split(':').map(str::trim).collect();
     let num = |s: &str, what: &str| -> Result<f64> {
         s.parse::<f64>()
@@ -58,7 +55,8 @@ pub fn parse_range(flag: &str, text: &str) -> Result<Vec<f64>> {
 
 /// Parses a thickness in nanometres: `635`, `635nm`, `635 nm`, or micrometres `1.2um`/`1.2µm`.
 /// Errors (naming `context`) for malformed, negative or non-finite values.
-pub fn parse_thickness_nm(context: &str, text: &str) -> Result<f64> {
+pub fn parse_thickness_nm(context: impl Into<Origin>, text: &str) -> Result<f64> {
+    let context = context.into();
     let t = text.trim();
     let lower = t.to_ascii_lowercase();
     let (number, scale) = if let Some(v) = lower.strip_suffix("nm") {
@@ -70,11 +68,7 @@ pub fn parse_thickness_nm(context: &str, text: &str) -> Result<f64> {
     } else {
         (lower.as_str(), 1.0)
     };
-    let err = |message: &str| Error::Flag {
-        flag: context.to_string(),
-        value: text.to_string(),
-        message: message.to_string(),
-    };
+    let err = |message: &str| Error::value(context.clone(), text, message);
     let v = number.trim().parse::<f64>().map_err(|_| {
         err("thickness must be a number of nanometres, e.g. `635` or `635nm` (or `1.2um`)")
     })?;
@@ -88,25 +82,29 @@ pub fn parse_thickness_nm(context: &str, text: &str) -> Result<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::error::Param;
 
     #[test]
     fn ranges() {
-        assert_eq!(parse_range("--a", "0:89:1").unwrap().len(), 90);
-        assert_eq!(parse_range("--w", "380:780:5").unwrap().len(), 81);
-        let v = parse_range("--w", "380:381:0.1").unwrap();
+        assert_eq!(parse_range(Param::Angles, "0:89:1").unwrap().len(), 90);
+        assert_eq!(
+            parse_range(Param::Wavelengths, "380:780:5").unwrap().len(),
+            81
+        );
+        let v = parse_range(Param::Wavelengths, "380:381:0.1").unwrap();
         assert_eq!(v.len(), 11);
         assert_eq!(v[1], 380.1);
         assert_eq!(v[10], 381.0);
-        assert_eq!(parse_range("--a", "45").unwrap(), vec![45.0]);
+        assert_eq!(parse_range(Param::Angles, "45").unwrap(), vec![45.0]);
         assert_eq!(
-            parse_range("--a", "0:10:3").unwrap(),
+            parse_range(Param::Angles, "0:10:3").unwrap(),
             vec![0.0, 3.0, 6.0, 9.0]
         );
         assert_eq!(
-            parse_range("--a", "0:60:30").unwrap(),
+            parse_range(Param::Angles, "0:60:30").unwrap(),
             vec![0.0, 30.0, 60.0]
         );
-        assert_eq!(parse_range("--a", "0:1:0.1").unwrap()[3], 0.3);
+        assert_eq!(parse_range(Param::Angles, "0:1:0.1").unwrap()[3], 0.3);
         for bad in [
             "",
             "a:b:c",
@@ -118,20 +116,20 @@ mod tests {
             "0:inf:1",
             "1:2:3:4",
         ] {
-            let e = parse_range("--angles", bad).unwrap_err().to_string();
-            assert!(e.starts_with("--angles `"), "{bad}: {e}");
+            let e = parse_range(Param::Angles, bad).unwrap_err().to_string();
+            assert!(e.starts_with("angles `"), "{bad}: {e}");
         }
     }
 
     #[test]
     fn thicknesses() {
-        assert_eq!(parse_thickness_nm("--layer", "635").unwrap(), 635.0);
-        assert_eq!(parse_thickness_nm("--layer", "635nm").unwrap(), 635.0);
-        assert_eq!(parse_thickness_nm("--layer", "635 nm").unwrap(), 635.0);
-        assert_eq!(parse_thickness_nm("--layer", "1.2um").unwrap(), 1200.0);
-        assert_eq!(parse_thickness_nm("--layer", "0").unwrap(), 0.0);
+        assert_eq!(parse_thickness_nm(Param::Layer, "635").unwrap(), 635.0);
+        assert_eq!(parse_thickness_nm(Param::Layer, "635nm").unwrap(), 635.0);
+        assert_eq!(parse_thickness_nm(Param::Layer, "635 nm").unwrap(), 635.0);
+        assert_eq!(parse_thickness_nm(Param::Layer, "1.2um").unwrap(), 1200.0);
+        assert_eq!(parse_thickness_nm(Param::Layer, "0").unwrap(), 0.0);
         for bad in ["-5", "abc", "nan", "inf", "5mm", ""] {
-            assert!(parse_thickness_nm("--layer", bad).is_err(), "{bad}");
+            assert!(parse_thickness_nm(Param::Layer, bad).is_err(), "{bad}");
         }
     }
 }

@@ -6,7 +6,7 @@
 //! factor), and absorptance A = 1 − R − T. One row per (angle, wavelength), angle-major.
 
 use crate::commands::grid::MAX_AXIS_SAMPLES;
-use crate::error::{Error, Result};
+use crate::error::{Error, Param, Result};
 use nacre_optics::{Power, Stack};
 use std::io::Write;
 
@@ -35,39 +35,39 @@ pub fn fmt_sig(v: f64) -> String {
 pub fn compute(stack: &Stack, angles_deg: &[f64], wavelengths_nm: &[f64]) -> Result<Vec<Power>> {
     let rows = angles_deg.len() as u64 * wavelengths_nm.len() as u64;
     if rows > MAX_ROWS {
-        return Err(Error::TooLarge {
+        return Err(nacre_format::Error::TooLarge {
             what: "rows (angles × wavelengths)".into(),
             count: rows,
             limit: MAX_ROWS,
-        });
+        }
+        .into());
     }
     debug_assert!(angles_deg.len() <= MAX_AXIS_SAMPLES);
     for &a in angles_deg {
         if !(a.abs() < 90.0) {
-            return Err(Error::Flag {
-                flag: "--angles".into(),
-                value: format!("{a}"),
-                message: "incidence angles must lie strictly between −90° and 90°".into(),
-            });
+            return Err(Error::value(
+                Param::Angles,
+                format!("{a}"),
+                "incidence angles must lie strictly between −90° and 90°",
+            ));
         }
     }
     for &w in wavelengths_nm {
         if !(w > 0.0) {
-            return Err(Error::Flag {
-                flag: "--wavelengths".into(),
-                value: format!("{w}"),
-                message: "wavelengths must be positive (vacuum nm)".into(),
-            });
+            return Err(Error::value(
+                Param::Wavelengths,
+                format!("{w}"),
+                "wavelengths must be positive (vacuum nm)",
+            ));
         }
     }
     stack
         .sweep(angles_deg, wavelengths_nm)
         .map_err(|source| match source {
             nacre_optics::Error::WavelengthOutOfRange { .. }
-            | nacre_optics::Error::AbsorbingAmbient { .. } => Error::OpticsIn {
-                context: "--wavelengths".into(),
-                source,
-            },
+            | nacre_optics::Error::AbsorbingAmbient { .. } => {
+                Error::optics_in(Param::Wavelengths, source)
+            }
             other => other.into(),
         })
 }

@@ -1,4 +1,4 @@
-//! Stack descriptions, from flags (`--ambient`, `--layer M@THICKNESS`, `--substrate`) or
+//! Stack descriptions, from parameters (`ambient`, `layer` `M@THICKNESS`, `substrate`) or
 //! from a recipe file.
 //!
 //! # Stack recipe format (TOML)
@@ -18,7 +18,7 @@
 //! Relative material paths are resolved from the recipe's folder. Unknown keys are errors.
 
 use crate::commands::grid::parse_thickness_nm;
-use crate::error::{Error, Result};
+use crate::error::{Error, Origin, Param, Result};
 use crate::recipe::{line_of, toml_error};
 use nacre_format::materials::resolve;
 use nacre_optics::{Layer, Stack};
@@ -37,8 +37,8 @@ pub const DEFAULT_LAYER: (&str, f64) = ("water", 400.0);
 pub struct MaterialRef {
     /// The spec text.
     pub spec: String,
-    /// `--flag` or `file:line`.
-    pub context: String,
+    /// The parameter or `file:line`.
+    pub context: Origin,
 }
 
 /// A stack described by material specs, before the materials are loaded.
@@ -61,44 +61,47 @@ impl StackSpec {
         layers: &[String],
         substrate: Option<&str>,
     ) -> Result<Self> {
-        let flag = |spec: &str, context: &str| MaterialRef {
+        let flag = |spec: &str, context: Origin| MaterialRef {
             spec: spec.to_string(),
-            context: context.to_string(),
+            context,
         };
         let layers = if ambient.is_none() && layers.is_empty() && substrate.is_none() {
-            vec![(flag(DEFAULT_LAYER.0, "default stack"), DEFAULT_LAYER.1)]
+            vec![(
+                flag(DEFAULT_LAYER.0, "default stack".into()),
+                DEFAULT_LAYER.1,
+            )]
         } else {
             layers
                 .iter()
                 .map(|text| {
-                    let (m, d) = text.rsplit_once('@').ok_or_else(|| Error::Flag {
-                        flag: "--layer".into(),
-                        value: text.clone(),
-                        message: "expected MATERIAL@THICKNESS, e.g. `water@400nm`".into(),
+                    let (m, d) = text.rsplit_once('@').ok_or_else(|| {
+                        Error::value(
+                            Param::Layer,
+                            text.clone(),
+                            "expected MATERIAL@THICKNESS, e.g. `water@400nm`",
+                        )
                     })?;
                     if m.trim().is_empty() {
-                        return Err(Error::Flag {
-                            flag: "--layer".into(),
-                            value: text.clone(),
-                            message: "the material before `@` is empty".into(),
-                        });
+                        return Err(Error::value(
+                            Param::Layer,
+                            text.clone(),
+                            "the material before `@` is empty",
+                        ));
                     }
-                    let d = parse_thickness_nm("--layer", d).map_err(|e| match e {
-                        Error::Flag { message, .. } => Error::Flag {
-                            flag: "--layer".into(),
-                            value: text.clone(),
-                            message,
-                        },
+                    let d = parse_thickness_nm(Param::Layer, d).map_err(|e| match e {
+                        Error::Value { message, .. } => {
+                            Error::value(Param::Layer, text.clone(), message)
+                        }
                         other => other,
                     })?;
-                    Ok((flag(m, "--layer"), d))
+                    Ok((flag(m, Param::Layer.into()), d))
                 })
                 .collect::<Result<_>>()?
         };
         Ok(StackSpec {
-            ambient: flag(ambient.unwrap_or(DEFAULT_MEDIUM), "--ambient"),
+            ambient: flag(ambient.unwrap_or(DEFAULT_MEDIUM), Param::Ambient.into()),
             layers,
-            substrate: flag(substrate.unwrap_or(DEFAULT_MEDIUM), "--substrate"),
+            substrate: flag(substrate.unwrap_or(DEFAULT_MEDIUM), Param::Substrate.into()),
             base_dir: None,
         })
     }
@@ -106,7 +109,7 @@ impl StackSpec {
     /// Loads the materials and builds the stack.
     pub fn build(&self) -> Result<Stack> {
         let base = self.base_dir.as_deref();
-        let load = |m: &MaterialRef| resolve(&m.spec, &m.context, base);
+        let load = |m: &MaterialRef| resolve(&m.spec, m.context.clone(), base);
         let ambient = load(&self.ambient)?;
         let layers = self
             .layers
@@ -119,10 +122,8 @@ impl StackSpec {
             })
             .collect::<Result<Vec<_>>>()?;
         let substrate = load(&self.substrate)?;
-        Stack::new(ambient, layers, substrate).map_err(|source| Error::OpticsIn {
-            context: self.ambient.context.clone(),
-            source,
-        })
+        Stack::new(ambient, layers, substrate)
+            .map_err(|source| Error::optics_in(self.ambient.context.clone(), source))
     }
 }
 
@@ -158,7 +159,7 @@ pub struct StackRecipe {
 impl StackRecipe {
     /// Reads a stack recipe file.
     pub fn read(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+        let text = std::fs::read_to_string(path).map_err(|source| nacre_format::Error::Io {
             path: path.to_path_buf(),
             source,
         })?;
@@ -169,8 +170,9 @@ impl StackRecipe {
     /// material paths.
     pub fn parse(path: &Path, text: &str) -> Result<Self> {
         let raw: RawStackRecipe = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
-        let at = |span: std::ops::Range<usize>| {
-            format!("{}:{}", path.display(), line_of(text, span.start))
+        let at = |span: std::ops::Range<usize>| Origin::Line {
+            path: path.to_path_buf(),
+            line: line_of(text, span.start),
         };
         let mref = |s: &Spanned<String>| MaterialRef {
             spec: s.get_ref().clone(),
@@ -178,17 +180,17 @@ impl StackRecipe {
         };
         let default = |what: &str| MaterialRef {
             spec: DEFAULT_MEDIUM.into(),
-            context: format!("{} ({what} default)", path.display()),
+            context: format!("{} ({what} default)", path.display()).into(),
         };
         let mut layers = Vec::with_capacity(raw.layers.len());
         for layer in &raw.layers {
             let d = *layer.thickness_nm.get_ref();
             if !(d >= 0.0 && d.is_finite()) {
-                return Err(Error::Recipe {
-                    path: path.to_path_buf(),
-                    line: line_of(text, layer.thickness_nm.span().start),
-                    message: format!("thickness_nm = {d}: must be finite and non-negative"),
-                });
+                return Err(Error::recipe(
+                    path.to_path_buf(),
+                    line_of(text, layer.thickness_nm.span().start),
+                    format!("thickness_nm = {d}: must be finite and non-negative"),
+                ));
             }
             layers.push((mref(&layer.material), d));
         }
@@ -235,7 +237,7 @@ mod tests {
             let e = StackSpec::from_flags(None, &[bad.into()], None)
                 .unwrap_err()
                 .to_string();
-            assert!(e.starts_with("--layer `"), "{bad}: {e}");
+            assert!(e.starts_with("layer `"), "{bad}: {e}");
         }
     }
 

@@ -55,12 +55,13 @@
 //! `integrated_samples`, `integrated_gamma`, `integrated_tolerance`) is documented in
 //! [`crate::kinds::diffraction_integrated`].
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Origin, Result};
 pub use crate::kinds::diffraction_recipe::DiffractionRecipe;
 use crate::kinds::{KindEntry, TableRecipe};
 use crate::recipe::{RawColour, line_of, parse_colour, table_name, toml_error};
 use nacre_format::diffraction::{DiffractionRecord, SIGN_CONVENTION};
 use nacre_format::manifest::{AxisRecord, KindRecord, Manifest, TableKind};
+use nacre_format::msg;
 use nacre_format::table_io::{Precision, Table3};
 use nacre_optics::C64;
 use nacre_optics::colour::Colorimeter;
@@ -117,14 +118,11 @@ pub enum SyntheticSpec {
 impl SyntheticSpec {
     /// Parses `sine:PERIOD_UM:AMPLITUDE_UM`, `blazed:PERIOD_UM:HEIGHT_UM`, `cd[:SEED]` or
     /// `bumps:RADIUS_UM:HEIGHT_UM:FILL[:SEED]`; `None` when `text` names none of these
-    /// kinds (it may be a file). Errors name `context` (a flag or `file:line`).
-    pub fn parse(context: &str, text: &str) -> Result<Option<Self>> {
+    /// kinds (it may be a file). Errors name `context` (a parameter or `file:line`).
+    pub fn parse(context: impl Into<Origin>, text: &str) -> Result<Option<Self>> {
+        let context = context.into();
         let parts: Vec<&str> = text.trim().split(':').map(str::trim).collect();
-        let err = |message: String| Error::Flag {
-            flag: context.to_string(),
-            value: text.to_string(),
-            message,
-        };
+        let err = |message: String| Error::value(context.clone(), text, message);
         let num = |s: &str, what: &str, positive: bool| -> Result<f64> {
             s.parse::<f64>()
                 .ok()
@@ -173,21 +171,18 @@ impl SyntheticSpec {
     /// `samples` (per axis; along x for gratings) overrides the patch size.
     ///
     /// # Errors
-    /// [`Error::OpticsIn`] naming `context` for out-of-range parameters;
-    /// [`Error::TooLarge`] beyond [`MAX_AXIS`] samples per axis.
+    /// [`nacre_format::Error::OpticsIn`] naming `context` for out-of-range parameters;
+    /// [`nacre_format::Error::TooLarge`] beyond [`MAX_AXIS`] samples per axis.
     pub fn generate(
         &self,
-        context: &str,
+        context: &Origin,
         coherence_diameter_um: f64,
         pitch_um: Option<f64>,
         samples: Option<usize>,
     ) -> Result<HeightField> {
-        let core = |source| Error::OpticsIn {
-            context: context.to_string(),
-            source,
-        };
-        let too_large = |n: usize| Error::TooLarge {
-            what: format!("{context}: samples per axis"),
+        let core = |source| Error::optics_in(context.clone(), source);
+        let too_large = |n: usize| nacre_format::Error::TooLarge {
+            what: format!("{context}: samples per axis").into(),
             count: n as u64,
             limit: MAX_AXIS as u64,
         };
@@ -206,7 +201,7 @@ impl SyntheticSpec {
                 let nx = samples
                     .unwrap_or_else(|| (periods * period_um / pitch).round().max(1.0) as usize);
                 if nx > MAX_AXIS * MAX_AXIS {
-                    return Err(too_large(nx));
+                    return Err(too_large(nx).into());
                 }
                 match *self {
                     SyntheticSpec::Sine {
@@ -257,16 +252,16 @@ fn auto_samples(l: f64, pitch_um: Option<f64>, samples: Option<usize>) -> usize 
 /// `pitch_um` µm per sample and heights scaled by `height_scale_um`.
 ///
 /// # Errors
-/// [`Error::Io`]; [`Error::Table`] (PNG, JPEG, EXR) or [`Error::Recipe`] (CSV, with the line)
-/// naming the file for malformed content; [`Error::OpticsIn`] for a bad pitch.
+/// [`nacre_format::Error::Io`]; [`nacre_format::Error::Table`] (PNG, JPEG, EXR) or [`nacre_format::Error::Parse`] (CSV, with the line)
+/// naming the file for malformed content; [`nacre_format::Error::OpticsIn`] for a bad pitch.
 pub fn read_height_field(path: &Path, pitch_um: f64, height_scale_um: f64) -> Result<HeightField> {
     if !(height_scale_um.is_finite() && height_scale_um >= 0.0) {
-        return Err(Error::Invalid {
-            context: path.display().to_string(),
-            message: format!("height scale {height_scale_um} µm must be finite and non-negative"),
-        });
+        return Err(Error::invalid(
+            path.display().to_string(),
+            format!("height scale {height_scale_um} µm must be finite and non-negative"),
+        ));
     }
-    let bytes = std::fs::read(path).map_err(|source| Error::Io {
+    let bytes = std::fs::read(path).map_err(|source| nacre_format::Error::Io {
         path: path.to_path_buf(),
         source,
     })?;
@@ -281,19 +276,21 @@ pub fn read_height_field(path: &Path, pitch_um: f64, height_scale_um: f64) -> Re
         "exr" => decode_exr(path, &bytes)?,
         "csv" | "txt" => decode_csv(path, &bytes)?,
         _ => {
-            return Err(Error::Table {
+            return Err(nacre_format::Error::Table {
                 path: path.to_path_buf(),
                 message: "unknown height-field format: expected a .png, .jpg, .exr or .csv file"
                     .into(),
-            });
+            }
+            .into());
         }
     };
     if nx > MAX_AXIS || ny > MAX_AXIS {
-        return Err(Error::TooLarge {
-            what: format!("{}: samples per axis", path.display()),
+        return Err(nacre_format::Error::TooLarge {
+            what: format!("{}: samples per axis", path.display()).into(),
             count: nx.max(ny) as u64,
             limit: MAX_AXIS as u64,
-        });
+        }
+        .into());
     }
     HeightField::new(
         nx,
@@ -301,17 +298,15 @@ pub fn read_height_field(path: &Path, pitch_um: f64, height_scale_um: f64) -> Re
         pitch_um,
         values.into_iter().map(|v| v * height_scale_um).collect(),
     )
-    .map_err(|source| Error::OpticsIn {
-        context: path.display().to_string(),
-        source,
-    })
+    .map_err(|source| Error::optics_in(path.display().to_string(), source))
 }
 
 fn table_err(path: &Path, message: String) -> Error {
-    Error::Table {
+    nacre_format::Error::Table {
         path: path.to_path_buf(),
         message,
     }
+    .into()
 }
 
 /// Greyscale picture (PNG 8 or 16 bits, JPEG 8 bits), read with the `image` crate:
@@ -435,11 +430,7 @@ fn decode_exr(path: &Path, bytes: &[u8]) -> Result<(usize, usize, Vec<f64>)> {
 /// the end of a row), blank lines, quoted fields, a UTF-8 BOM, CRLF and spaces around
 /// fields are accepted (see [`nacre_optics::csv_rows`]).
 fn decode_csv(path: &Path, bytes: &[u8]) -> Result<(usize, usize, Vec<f64>)> {
-    let bad = |line: usize, message: String| Error::Recipe {
-        path: path.to_path_buf(),
-        line,
-        message,
-    };
+    let bad = |line: usize, message: String| Error::recipe(path.to_path_buf(), line, message);
     let text = std::str::from_utf8(bytes).map_err(|e| bad(1, format!("not UTF-8 text: {e}")))?;
     let mut values = Vec::new();
     let (mut nx, mut ny) = (0, 0);
@@ -496,7 +487,7 @@ pub enum HeightSource {
 
 impl HeightSource {
     /// A synthetic spec when `text` parses as one, else a file path.
-    pub fn parse(context: &str, text: &str) -> Result<Self> {
+    pub fn parse(context: impl Into<Origin>, text: &str) -> Result<Self> {
         Ok(match SyntheticSpec::parse(context, text)? {
             Some(s) => HeightSource::Synthetic(s),
             None => HeightSource::File(PathBuf::from(text)),
@@ -508,8 +499,8 @@ impl HeightSource {
     #[allow(clippy::too_many_arguments)]
     pub fn load(
         &self,
-        context: &str,
-        pitch_context: &str,
+        context: &Origin,
+        pitch_context: &Origin,
         coherence_diameter_um: f64,
         pitch_um: Option<f64>,
         samples: Option<usize>,
@@ -520,11 +511,15 @@ impl HeightSource {
                 s.generate(context, coherence_diameter_um, pitch_um, samples)
             }
             HeightSource::File(path) => {
-                let pitch = pitch_um.ok_or_else(|| Error::Invalid {
-                    context: path.display().to_string(),
-                    message: format!(
-                        "a height-field file needs its sample pitch in µm ({pitch_context})"
-                    ),
+                let pitch = pitch_um.ok_or_else(|| {
+                    Error::invalid(
+                        path.display().to_string(),
+                        msg![
+                            "a height-field file needs its sample pitch in µm (",
+                            pitch_context.clone(),
+                            ")"
+                        ],
+                    )
                 })?;
                 read_height_field(path, pitch, height_scale_um)
             }
@@ -582,10 +577,8 @@ impl DiffractionRecipe {
         let at = |span: std::ops::Range<usize>| {
             format!("{}:{}", path.display(), line_of(&text, span.start))
         };
-        let bad = |span: std::ops::Range<usize>, message: String| Error::Recipe {
-            path: path.to_path_buf(),
-            line: line_of(&text, span.start),
-            message,
+        let bad = |span: std::ops::Range<usize>, message: String| {
+            Error::recipe(path.to_path_buf(), line_of(&text, span.start), message)
         };
         let d = raw.diffraction.unwrap_or(RawDiffraction {
             layout: None,
@@ -649,11 +642,9 @@ impl DiffractionRecipe {
             Some(s) => (format!("{} wavelengths", at(s.span())), s.get_ref().clone()),
             None => ("wavelengths".into(), "380:780:5".into()),
         };
-        let wavelengths = crate::commands::grid::parse_range(&wl_context, &wl_text)?;
-        SpectralGrid::new(&colorimeter, &wavelengths).map_err(|source| Error::OpticsIn {
-            context: wl_context.clone(),
-            source,
-        })?;
+        let wavelengths = crate::commands::grid::parse_range(wl_context.clone(), &wl_text)?;
+        SpectralGrid::new(&colorimeter, &wavelengths)
+            .map_err(|source| Error::optics_in(wl_context.clone(), source))?;
         let max_angle = match &d.max_angle_deg {
             None => 45.0,
             Some(s) if *s.get_ref() > 0.0 && *s.get_ref() < 90.0 => *s.get_ref(),
@@ -677,7 +668,7 @@ impl DiffractionRecipe {
         let hf = raw.height_field.get_ref();
         let (source_span, source_text, source) = match (&hf.synthetic, &hf.file) {
             (Some(s), None) => {
-                let spec = SyntheticSpec::parse(&format!("{} synthetic", at(s.span())), s.get_ref())?
+                let spec = SyntheticSpec::parse(format!("{} synthetic", at(s.span())), s.get_ref())?
                     .ok_or_else(|| bad(s.span(), format!("synthetic = \"{}\": expected sine:PERIOD_UM:AMPLITUDE_UM, blazed:PERIOD_UM:HEIGHT_UM, cd[:SEED] or bumps:RADIUS_UM:HEIGHT_UM:FILL[:SEED]", s.get_ref())))?;
                 (s.span(), s.get_ref().clone(), HeightSource::Synthetic(spec))
             }
@@ -724,8 +715,8 @@ impl DiffractionRecipe {
             ));
         }
         let field = source.load(
-            &at(source_span.clone()),
-            &format!("{} pitch_um", at(raw.height_field.span())),
+            &at(source_span.clone()).into(),
+            &format!("{} pitch_um", at(raw.height_field.span())).into(),
             coherence,
             pitch,
             samples,
@@ -739,10 +730,7 @@ impl DiffractionRecipe {
             max_angle,
             tolerance,
         )
-        .map_err(|source| Error::OpticsIn {
-            context: at(source_span),
-            source,
-        })?;
+        .map_err(|source| Error::optics_in(at(source_span), source))?;
         if integrated_layout {
             let settings = crate::kinds::diffraction_integrated::IntegratedSettings::parse(
                 &bad,
@@ -754,13 +742,13 @@ impl DiffractionRecipe {
             record.layout = "integrated".into();
             record.integrated = Some(settings.record(&record));
         } else if record.f32_rounding_bound > tolerance {
-            return Err(Error::Invalid {
-                context: path.display().to_string(),
-                message: format!(
+            return Err(Error::invalid(
+                path.display().to_string(),
+                format!(
                     "max |k w h| = {:.3}: the Taylor sum of f32 terms could err by {:.2e} (2^-24 e^{{|kwh|}}), above taylor_tolerance {tolerance:e}; the structure is too tall for a terms table at {} nm",
                     record.max_phase, record.f32_rounding_bound, record.wavelength_min_nm
                 ),
-            });
+            ));
         }
         Ok(DiffractionRecipe {
             name,
@@ -1014,22 +1002,23 @@ impl TableRecipe for DiffractionRecipe {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::error::Param;
 
     #[test]
     fn specs_parse_and_name_the_flag() {
         assert_eq!(
-            SyntheticSpec::parse("--x", "sine:1.6:0.05").unwrap(),
+            SyntheticSpec::parse(Param::Surface, "sine:1.6:0.05").unwrap(),
             Some(SyntheticSpec::Sine {
                 period_um: 1.6,
                 amplitude_um: 0.05
             })
         );
         assert_eq!(
-            SyntheticSpec::parse("--x", "cd").unwrap(),
+            SyntheticSpec::parse(Param::Surface, "cd").unwrap(),
             Some(SyntheticSpec::Cd { seed: 1 })
         );
         assert_eq!(
-            SyntheticSpec::parse("--x", "bumps:0.5:0.1:0.3:9").unwrap(),
+            SyntheticSpec::parse(Param::Surface, "bumps:0.5:0.1:0.3:9").unwrap(),
             Some(SyntheticSpec::Bumps {
                 radius_um: 0.5,
                 height_um: 0.1,
@@ -1037,7 +1026,10 @@ mod tests {
                 seed: 9
             })
         );
-        assert_eq!(SyntheticSpec::parse("--x", "snake.png").unwrap(), None);
+        assert_eq!(
+            SyntheticSpec::parse(Param::Surface, "snake.png").unwrap(),
+            None
+        );
         for bad in [
             "sine:0:0.1",
             "sine:1.6",
@@ -1046,10 +1038,10 @@ mod tests {
             "bumps:1:1",
             "sine:1:-0.1",
         ] {
-            let e = SyntheticSpec::parse("--surface", bad)
+            let e = SyntheticSpec::parse(Param::Surface, bad)
                 .unwrap_err()
                 .to_string();
-            assert!(e.starts_with("--surface `"), "{bad}: {e}");
+            assert!(e.starts_with("surface `"), "{bad}: {e}");
         }
     }
 

@@ -224,7 +224,7 @@ fn sig4(v: f64) -> f64 {
 /// returns the manifest path.
 ///
 /// # Errors
-/// [`Error::Invalid`] naming the recipe when the measured error exceeds the tolerance
+/// [`nacre_format::Error::Invalid`] naming the recipe when the measured error exceeds the tolerance
 /// (nothing written) or the recipe is not of the layout "integrated"; write errors.
 pub fn bake(
     recipe: &DiffractionRecipe,
@@ -234,19 +234,16 @@ pub fn bake(
     let mut r = recipe.record.clone();
     let context = recipe.path.display().to_string();
     let Some(mut s) = r.integrated.clone() else {
-        return Err(Error::Invalid {
+        return Err(Error::invalid(
             context,
-            message: format!(
+            format!(
                 "layout \"{}\": expected a recipe with layout = \"integrated\"",
                 r.layout
             ),
-        });
+        ));
     };
     let c = &recipe.colorimeter;
-    let optics = |source| Error::OpticsIn {
-        context: context.clone(),
-        source,
-    };
+    let optics = |source| Error::optics_in(context.clone(), source);
     let terms = TaylorTerms::compute(&recipe.field, r.taylor_order);
     let surface = DiffractionSurface::new(terms, r.sigma_s_um).map_err(optics)?;
     let grid = SpectralGrid::new(c, &recipe.wavelengths_nm).map_err(optics)?;
@@ -286,9 +283,9 @@ pub fn bake(
                 s.samples_v
             )
         };
-        return Err(Error::Invalid {
+        return Err(Error::invalid(
             context,
-            message: format!(
+            format!(
                 "the integrated layout's reconstruction error {:.3e} (in units of the specular white, channel {}: terms layout {:.4e}, integrated {:.4e}) at light θ = {ti}°, φ = {pi}° and view θ = {tr}°, φ = {pr}° exceeds integrated_tolerance {}; {cause}",
                 e.max_error,
                 channel_names[e.channel],
@@ -296,7 +293,7 @@ pub fn bake(
                 e.integrated[e.channel],
                 s.tolerance
             ),
-        });
+        ));
     }
     r.integrated = Some(s.clone());
     write_files(recipe, &r, &s, &table, out_dir)

@@ -39,7 +39,7 @@
 //! `RGBA16F`; a `fourier` table gives one `NAME.ktx2`, a 2-D array `RGBA32F` texture with
 //! every mip level: see [`nacre_format::ktx2`]). Every file is written atomically; the manifest last.
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::kinds::{KindEntry, TableRecipe};
 use crate::recipe::{
     OutputSettings, RawColour, RawOutput, RawStack, RecipeStack, line_of, parse_colour, table_name,
@@ -109,7 +109,7 @@ pub struct FilmLutRecipe {
 impl FilmLutRecipe {
     /// Reads and validates a recipe (nothing is computed yet).
     pub fn read(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+        let text = std::fs::read_to_string(path).map_err(|source| nacre_format::Error::Io {
             path: path.to_path_buf(),
             source,
         })?;

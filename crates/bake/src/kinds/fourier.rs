@@ -71,10 +71,8 @@ impl FourierRecipe {
             toml::from_str(&text).map_err(|e| toml_error(path, &text, &e))?;
         let colorimeter = parse_colour(path, &text, raw.colour)?;
         let f = &raw.fourier;
-        let bad = |span: std::ops::Range<usize>, message: String| Error::Recipe {
-            path: path.to_path_buf(),
-            line: line_of(&text, span.start),
-            message,
+        let bad = |span: std::ops::Range<usize>, message: String| {
+            Error::recipe(path.to_path_buf(), line_of(&text, span.start), message)
         };
         let samples = *f.samples.get_ref();
         if !(64..=MAX_FOURIER_SAMPLES).contains(&samples) {

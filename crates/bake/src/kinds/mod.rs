@@ -66,7 +66,7 @@ pub const REGISTRY: &[KindEntry] = &[
 
 /// Reads a recipe of any kind, dispatching on its `kind`.
 pub fn read_recipe(path: &Path) -> Result<Box<dyn TableRecipe>> {
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+    let text = std::fs::read_to_string(path).map_err(|source| nacre_format::Error::Io {
         path: path.to_path_buf(),
         source,
     })?;
@@ -76,7 +76,7 @@ pub fn read_recipe(path: &Path) -> Result<Box<dyn TableRecipe>> {
 /// Parses recipe text of any kind; `path` names it and anchors relative material paths.
 ///
 /// # Errors
-/// [`Error::Recipe`] naming the line of a missing or unknown `kind`, else the kind's own
+/// [`nacre_format::Error::Parse`] naming the line of a missing or unknown `kind`, else the kind's own
 /// errors.
 pub fn parse_recipe(path: &Path, text: String) -> Result<Box<dyn TableRecipe>> {
     #[derive(Deserialize)]
@@ -93,14 +93,14 @@ pub fn parse_recipe(path: &Path, text: String) -> Result<Box<dyn TableRecipe>> {
                 .map(|e| format!("`{}`", e.kind.name()))
                 .collect();
             let (last, rest) = names.split_last().expect("the registry is not empty");
-            Err(Error::Recipe {
-                path: path.to_path_buf(),
-                line: line_of(&text, kind.kind.span().start),
-                message: format!(
+            Err(Error::recipe(
+                path.to_path_buf(),
+                line_of(&text, kind.kind.span().start),
+                format!(
                     "unknown table kind `{name}`: expected {} or {last}",
                     rest.join(", ")
                 ),
-            })
+            ))
         }
     }
 }

@@ -443,13 +443,13 @@ impl RoughRecipe {
         let base_eta = if transmittance {
             let nb = base.index_at(REFRACTION_WAVELENGTH_NM)?;
             if nb.im != 0.0 || !(nb.re > 0.0) {
-                return Err(Error::Invalid {
-                    context: at(raw.stack.base.span()),
-                    message: format!(
+                return Err(Error::invalid(
+                    at(raw.stack.base.span()),
+                    format!(
                         "transmittance through a rough interface needs a non-absorbing base; `{}` has index {nb} at {REFRACTION_WAVELENGTH_NM} nm (set [output] transmittance = false)",
                         raw.stack.base.get_ref()
                     ),
-                });
+                ));
             }
             Some(nb.re / ambient_index)
         } else {

@@ -15,6 +15,8 @@ use crate::render::{Camera, EnvironmentTextures, FilmEval, Light, ViewUniform, v
 use crate::shaders;
 use bytemuck::{Pod, Zeroable};
 use nacre_format::diffraction::DiffractionRecord;
+use nacre_format::msg;
+use nacre_format::param::Param;
 use nacre_optics::diffraction::FresnelTerm;
 use std::path::PathBuf;
 use std::str::FromStr;
@@ -470,7 +472,7 @@ impl ScenePass {
     /// the cap. Other adapters and integrated tables (a few dozen iterations) always pass.
     ///
     /// # Errors
-    /// [`Error::Invalid`] naming the way out (a coarser step, fewer samples, the fast layout).
+    /// [`Error::Refused`] naming the way out (a coarser step, fewer samples, the fast layout).
     pub fn check_loop_cap(&self, ctx: &GpuContext, diffracted: u64, what: &str) -> Result<()> {
         let Some(binding) = self.technique() else {
             return Ok(());
@@ -479,12 +481,22 @@ impl ScenePass {
         let specular = u64::from(u.wavelength_count) * (u64::from(u.order) + 3);
         let needed = diffracted * binding.loop_iterations_per_colour() + specular;
         if ctx.info.name.contains("llvmpipe") && needed > LLVMPIPE_LOOP_LIMIT * 3 / 4 {
-            return Err(Error::Invalid {
+            return Err(Error::Refused {
                 context: format!("the diffraction {what} pass on {}", ctx.info.name),
-                message: format!(
-                    "needs about {needed} shader loop iterations per pixel ({diffracted} diffracted lights × {} wavelengths), more than llvmpipe allows with margin (it stops every shader invocation after {LLVMPIPE_LOOP_LIMIT} and would draw a wrong picture): use a coarser --wavelength-step (--diffraction-step in bench-gpu), fewer --env-samples, or a table in the layout \"integrated\" (e.g. --tables cd-tracks-fast)",
-                    u.wavelength_count
-                ),
+                message: msg![
+                    format!(
+                        "needs about {needed} shader loop iterations per pixel ({diffracted} diffracted lights × {} wavelengths), more than llvmpipe allows with margin (it stops every shader invocation after {LLVMPIPE_LOOP_LIMIT} and would draw a wrong picture): use a coarser ",
+                        u.wavelength_count
+                    ),
+                    Param::WavelengthStep,
+                    " (",
+                    Param::DiffractionStep,
+                    " in bench-gpu), fewer ",
+                    Param::EnvSamples,
+                    ", or a table in the layout \"integrated\" (e.g. ",
+                    Param::Tables.given("cd-tracks-fast"),
+                    ")"
+                ],
             });
         }
         Ok(())

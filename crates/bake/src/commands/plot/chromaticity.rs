@@ -15,14 +15,10 @@ pub struct Trajectory {
 pub fn parse_gamuts(text: &str) -> Result<Vec<RgbSpace>> {
     let mut out = Vec::new();
     for item in text.split(',') {
-        let s: RgbSpace = item.trim().parse().map_err(|_| Error::Flag {
-            flag: "--gamut".into(),
-            value: text.into(),
-            message: format!(
+        let s: RgbSpace = item.trim().parse().map_err(|_| Error::value(Param::Gamut, text, format!(
                 "unknown gamut `{}`: expected any of srgb, p3, rec2020, acescg, separated by commas",
                 item.trim()
-            ),
-        })?;
+            )))?;
         if !out.contains(&s) {
             out.push(s);
         }

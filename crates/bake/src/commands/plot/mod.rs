@@ -36,7 +36,7 @@
 
 use crate::commands::color::{LoadedLut, Quantity};
 use crate::commands::grid::parse_range;
-use crate::error::{Error, Result};
+use crate::error::{Error, Param, Result};
 use nacre_format::Manifest;
 use nacre_format::atomic::write_atomic;
 use nacre_format::film_lut::{FilmLut, FilmLutAxes, MIN_COS_THETA};
@@ -99,11 +99,11 @@ impl ImageFormat {
         match ext.as_deref() {
             Some("png") => Ok(ImageFormat::Png),
             Some("svg") => Ok(ImageFormat::Svg),
-            _ => Err(Error::Flag {
-                flag: "-o/--output".into(),
-                value: path.display().to_string(),
-                message: "the image format follows the extension: expected a file name ending in .png or .svg".into(),
-            }),
+            _ => Err(Error::value(
+                Param::Output,
+                path.display().to_string(),
+                "the image format follows the extension: expected a file name ending in .png or .svg",
+            )),
         }
     }
 
@@ -130,10 +130,7 @@ pub fn render(figure: &impl Figure, format: ImageFormat) -> Result<Vec<u8>> {
     // Registering twice is harmless; a failure only means no text.
     let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
     let (w, h) = figure.size();
-    let err = |e: String| Error::Invalid {
-        context: "nacre plot".into(),
-        message: format!("drawing the plot failed: {e}"),
-    };
+    let err = |e: String| Error::invalid("nacre plot", format!("drawing the plot failed: {e}"));
     match format {
         ImageFormat::Png => {
             let mut buf = vec![0u8; w as usize * h as usize * 3];
@@ -290,22 +287,18 @@ fn ramp(t: f64) -> RGBColor {
 
 /// Parses a comma-separated list whose items are values or `START:END:STEP` ranges
 /// (`0,30,60`, `0:60:30`, `0:20:10,45`), in the order given. Errors name `flag`.
-pub fn parse_list(flag: &str, text: &str) -> Result<Vec<f64>> {
+pub fn parse_list(flag: Param, text: &str) -> Result<Vec<f64>> {
     let mut out = Vec::new();
     for part in text.split(',') {
         if part.trim().is_empty() {
-            return Err(Error::Flag {
-                flag: flag.into(),
-                value: text.into(),
-                message: "empty item: expected values or START:END:STEP ranges separated by commas, e.g. 0,30,60".into(),
-            });
+            return Err(Error::value(
+                flag,
+                text,
+                "empty item: expected values or START:END:STEP ranges separated by commas, e.g. 0,30,60",
+            ));
         }
         out.extend(parse_range(flag, part).map_err(|e| match e {
-            Error::Flag { message, .. } => Error::Flag {
-                flag: flag.into(),
-                value: text.into(),
-                message,
-            },
+            Error::Value { message, .. } => Error::value(flag, text, message),
             other => other,
         })?);
     }
@@ -313,12 +306,12 @@ pub fn parse_list(flag: &str, text: &str) -> Result<Vec<f64>> {
 }
 
 /// Checks that every angle lies strictly between −90° and 90°.
-pub fn check_angles(flag: &str, text: &str, angles_deg: &[f64]) -> Result<()> {
+pub fn check_angles(flag: Param, text: &str, angles_deg: &[f64]) -> Result<()> {
     match angles_deg.iter().find(|a| !(a.abs() < 90.0)) {
-        Some(a) => Err(Error::Flag {
-            flag: flag.into(),
+        Some(a) => Err(Error::Angle {
+            origin: flag.into(),
             value: text.into(),
-            message: format!("angle {a} must lie strictly between -90 and 90 degrees"),
+            angle: *a,
         }),
         None => Ok(()),
     }
@@ -589,7 +582,7 @@ mod tests {
         );
         for bad in ["a.jpg", "a", "-", "png"] {
             let e = ImageFormat::from_path(Path::new(bad)).unwrap_err();
-            assert!(e.to_string().starts_with("-o/--output `"), "{e}");
+            assert!(e.to_string().starts_with("output `"), "{e}");
         }
     }
 
@@ -611,16 +604,16 @@ mod tests {
     #[test]
     fn lists_and_ranges() {
         assert_eq!(
-            parse_list("--angles", "0,30,60").unwrap(),
+            parse_list(Param::Angles, "0,30,60").unwrap(),
             vec![0.0, 30.0, 60.0]
         );
         assert_eq!(
-            parse_list("--angles", "0:20:10, 45").unwrap(),
+            parse_list(Param::Angles, "0:20:10, 45").unwrap(),
             vec![0.0, 10.0, 20.0, 45.0]
         );
         for bad in ["", "0,,3", "a", "0:10"] {
-            let e = parse_list("--angles", bad).unwrap_err().to_string();
-            assert!(e.starts_with(&format!("--angles `{bad}`")), "{e}");
+            let e = parse_list(Param::Angles, bad).unwrap_err().to_string();
+            assert!(e.starts_with(&format!("angles `{bad}`")), "{e}");
         }
         assert_eq!(nice_ceiling(0.17), 0.2);
         assert_eq!(nice_ceiling(1.0), 1.0);

@@ -71,14 +71,10 @@ impl SpectrumQuantity {
             let q = Self::ALL
                 .iter()
                 .find(|q| q.name().to_ascii_lowercase().replace('_', "") == key)
-                .ok_or_else(|| Error::Flag {
-                    flag: "--quantities".into(),
-                    value: text.into(),
-                    message: format!(
+                .ok_or_else(|| Error::value(Param::Quantities, text, format!(
                         "unknown quantity `{}`: expected any of R, T, A, R_s, R_p, T_s, T_p, separated by commas",
                         item.trim()
-                    ),
-                })?;
+                    )))?;
             if !out.contains(q) {
                 out.push(*q);
             }
@@ -124,11 +120,7 @@ pub fn spectrum_curves(
 /// row; blank lines and `#` comments skipped) into one curve per angle, in the order the
 /// angles first appear, each sorted by wavelength. Errors name `path` and the line.
 pub fn read_spectrum_csv(path: &Path, text: &str) -> Result<Vec<SpectrumCurve>> {
-    let perr = |line: usize, message: String| Error::Recipe {
-        path: path.to_path_buf(),
-        line,
-        message,
-    };
+    let perr = |line: usize, message: String| Error::recipe(path.to_path_buf(), line, message);
     let names: Vec<&str> = crate::commands::spectrum::HEADER.split(',').collect();
     let mut header = false;
     let mut curves: Vec<SpectrumCurve> = Vec::new();
@@ -234,15 +226,17 @@ pub fn select_curves(
                     .iter()
                     .find(|c| (c.angle_deg - a).abs() < 1e-9)
                     .cloned()
-                    .ok_or_else(|| Error::Flag {
-                        flag: "--angles".into(),
-                        value: text.into(),
-                        message: format!(
-                            "angle {a} is not in {} (it has {} angle(s): {})",
-                            path.display(),
-                            curves.len(),
-                            summarise(&curves.iter().map(|c| c.angle_deg).collect::<Vec<_>>())
-                        ),
+                    .ok_or_else(|| {
+                        Error::value(
+                            Param::Angles,
+                            text,
+                            format!(
+                                "angle {a} is not in {} (it has {} angle(s): {})",
+                                path.display(),
+                                curves.len(),
+                                summarise(&curves.iter().map(|c| c.angle_deg).collect::<Vec<_>>())
+                            ),
+                        )
                     })
             })
             .collect(),
@@ -288,20 +282,17 @@ impl SpectrumPlot {
         quantities: Vec<SpectrumQuantity>,
     ) -> Result<Self> {
         if curves.len() > MAX_CURVES {
-            return Err(Error::Flag {
-                flag: "--angles".into(),
-                value: summarise(&curves.iter().map(|c| c.angle_deg).collect::<Vec<_>>()),
-                message: format!(
+            return Err(Error::value(
+                Param::Angles,
+                summarise(&curves.iter().map(|c| c.angle_deg).collect::<Vec<_>>()),
+                format!(
                     "{} angles: a spectrum plot shows at most {MAX_CURVES}",
                     curves.len()
                 ),
-            });
+            ));
         }
         if curves.is_empty() || quantities.is_empty() {
-            return Err(Error::Invalid {
-                context: "nacre plot spectrum".into(),
-                message: "nothing to draw".into(),
-            });
+            return Err(Error::invalid("nacre plot spectrum", "nothing to draw"));
         }
         Ok(SpectrumPlot {
             title,

@@ -311,15 +311,15 @@ pub fn default_table_names() -> Vec<String> {
 pub fn load_table_plot(name_or_path: &str, options: &TableOptions) -> Result<TablePlot> {
     let path = resolve_table(name_or_path);
     if !path.is_file() {
-        return Err(Error::Flag {
-            flag: "TABLE".into(),
-            value: name_or_path.into(),
-            message: format!(
+        return Err(Error::value(
+            "TABLE",
+            name_or_path,
+            format!(
                 "no such table ({} does not exist): expected a default-set table ({}) or the path to a table manifest (.json)",
                 path.display(),
                 default_table_names().join(", ")
             ),
-        });
+        ));
     }
     let manifest = Manifest::read(&path)?;
     if manifest.fourier().is_some() {
@@ -328,11 +328,11 @@ pub fn load_table_plot(name_or_path: &str, options: &TableOptions) -> Result<Tab
         let max_opd_nm = match options.max_opd_nm {
             Some(v) if v > 0.0 && v.is_finite() => v.min(table.axes.max_opd_nm),
             Some(v) => {
-                return Err(Error::Flag {
-                    flag: "--max-opd".into(),
-                    value: format!("{v}"),
-                    message: "must be a positive number of nanometres".into(),
-                });
+                return Err(Error::value(
+                    Param::MaxOpd,
+                    format!("{v}"),
+                    "must be a positive number of nanometres",
+                ));
             }
             None => FourierPlot::auto_range(&table),
         };
@@ -355,10 +355,12 @@ pub fn load_table_plot(name_or_path: &str, options: &TableOptions) -> Result<Tab
     let (table, what) = match options.quantity {
         Quantity::Reflectance => (lut.reflectance, "reflectance"),
         Quantity::Transmittance => (
-            lut.transmittance.ok_or_else(|| Error::Flag {
-                flag: "--quantity".into(),
-                value: "t".into(),
-                message: format!("table `{}` holds no transmittance", manifest.name),
+            lut.transmittance.ok_or_else(|| {
+                Error::value(
+                    Param::Quantity,
+                    "t",
+                    format!("table `{}` holds no transmittance", manifest.name),
+                )
             })?,
             "transmittance",
         ),
@@ -369,14 +371,14 @@ pub fn load_table_plot(name_or_path: &str, options: &TableOptions) -> Result<Tab
                 .iter()
                 .find(|n| !(**n >= axes.ior_min - 1e-9 && **n <= axes.ior_max + 1e-9))
             {
-                return Err(Error::Flag {
-                    flag: "--film-iors".into(),
-                    value: format!("{n}"),
-                    message: format!(
+                return Err(Error::value(
+                    Param::FilmIors,
+                    format!("{n}"),
+                    format!(
                         "outside the table's film index range {}–{}",
                         axes.ior_min, axes.ior_max
                     ),
-                });
+                ));
             }
             v.clone()
         }
@@ -387,11 +389,11 @@ pub fn load_table_plot(name_or_path: &str, options: &TableOptions) -> Result<Tab
             .collect(),
     };
     if film_iors.is_empty() || film_iors.len() > MAX_SLICES {
-        return Err(Error::Flag {
-            flag: "--film-iors".into(),
-            value: summarise(&film_iors),
-            message: format!("expected 1 to {MAX_SLICES} film indices"),
-        });
+        return Err(Error::value(
+            Param::FilmIors,
+            summarise(&film_iors),
+            format!("expected 1 to {MAX_SLICES} film indices"),
+        ));
     }
     let under: String = manifest
         .under
