@@ -416,7 +416,7 @@ fn ggx_albedo(n_dot_v: f32, alpha: f32) -> f32 {
 // ─── Film ────────────────────────────────────────────────────────────────────────────────
 
 // The technique's input for incidence cos θ and the point's thickness statistics.
-fn material_film_input(cos_theta: f32, thickness_nm: f32, sigma_thickness_nm: f32) -> FilmInput {
+fn material_film_input(cos_theta: f32, thickness_nm: f32, sigma_thickness_nm: f32, variation: f32) -> FilmInput {
     let p = material_params;
     var input: FilmInput;
     input.cos_theta_i = cos_theta;
@@ -424,6 +424,7 @@ fn material_film_input(cos_theta: f32, thickness_nm: f32, sigma_thickness_nm: f3
     input.film_ior = p.film_ior;
     input.sigma_thickness_nm = sigma_thickness_nm;
     input.ambient_ior = p.ambient_ior;
+    input.variation = variation;
     input.base_ior = p.base_ior;
     input.base_kappa = p.base_kappa;
     return input;
@@ -486,6 +487,9 @@ struct SurfacePoint {
     thickness_nm: f32,
     // Std. dev. of d inside the pixel, nm.
     sigma_thickness_nm: f32,
+    // The thickness map's spatial variation s = 2g − 1 ∈ [−1, 1] (film_stack moves its lower
+    // films by it: d_j + r_j s; 0 where no map is sampled).
+    variation: f32,
 }
 
 // What the surface sends towards the viewer, and what it lets through.
@@ -552,7 +556,7 @@ fn material_shade(s: SurfacePoint) -> ShadeResult {
             let density = PI * f32(MATERIAL_LOBE_SAMPLES) * ggx_distribution(m.z, alpha);
             lobe_alpha = MATERIAL_LOBE_FIS_SCALE * sqrt(wo.z * (1.0 + lambda_o) / max(density, 1e-30));
         }
-        let film = material_weight_film(film_colour(material_film_input(cos_theta, s.thickness_nm, s.sigma_thickness_nm)), cos_theta);
+        let film = material_weight_film(film_colour(material_film_input(cos_theta, s.thickness_nm, s.sigma_thickness_nm, s.variation)), cos_theta);
         if k == 0u {
             film_v = film;
         } else if k <= light_evaluations {

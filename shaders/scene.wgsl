@@ -210,6 +210,7 @@ fn scene_radiance(pixel: vec2<f32>) -> vec3<f32> {
         if k == 0u {
             surface.normal = hit.normal;
             surface.thickness_nm = thickness_nm;
+            surface.variation = 2.0 * moments.x - 1.0;
         } else {
             // The back wall, seen from inside: its normal faces the centre, its thickness comes
             // from the map at its own point (with the front's footprint).
@@ -218,6 +219,7 @@ fn scene_radiance(pixel: vec2<f32>) -> vec3<f32> {
             let m = scene_sample_thickness(n_back, n_back, dp_dx, dp_dy);
             surface.normal = -n_back;
             surface.thickness_nm = material_thickness_nm(m.x, n_back.y);
+            surface.variation = 2.0 * m.x - 1.0;
         }
         let shade = material_shade(surface);
         radiance += throughput * shade.radiance;

@@ -27,6 +27,7 @@ pub enum TechniqueArg {
     Lut,
     Fourier,
     Spectral,
+    Stack,
 }
 
 impl From<TechniqueArg> for nacre_runtime::Technique {
@@ -35,6 +36,7 @@ impl From<TechniqueArg> for nacre_runtime::Technique {
             TechniqueArg::Lut => nacre_runtime::Technique::Lut,
             TechniqueArg::Fourier => nacre_runtime::Technique::Fourier,
             TechniqueArg::Spectral => nacre_runtime::Technique::Spectral,
+            TechniqueArg::Stack => nacre_runtime::Technique::Stack,
         }
     }
 }

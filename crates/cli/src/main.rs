@@ -145,7 +145,10 @@ deviation), fourier-exact:… (the same with exact transforms), gaussian (the gl
 KHR_materials_iridescence Gaussian-fit approximation), rough-lut:NAME|PATH with --roughness
 ALPHA (the directional albedo of the rough GGX film lobe from a baked rough-film-lut table),
 rough-mc[:N] with --roughness ALPHA (its Monte Carlo reference, N samples per point,
-default 2^20; the largest standard error is printed on stderr).
+default 2^20; the largest standard error is printed on stderr), stack | stack:N (the GPU
+technique film_stack for any stack of 1 to 8 films: a few wavelengths uniform in
+wavenumber with weights fitted to the colour-matching functions, the count chosen from the
+stack's optical thickness, or N of them).
 
 Examples:
   # colour of a 400 nm soap film over angle, exact
@@ -177,7 +180,7 @@ struct ColorArgs {
     /// film's thickness and real index.
     #[arg(long, value_name = "FILE.csv")]
     points: Option<PathBuf>,
-    /// spectral | lut:NAME|PATH | rgb3 | samples:N.
+    /// spectral | lut:NAME|PATH | rgb3 | samples:N | fourier:… | stack[:N] | … (below).
     #[arg(long, default_value = "spectral")]
     method: String,
     /// The fourier table for fourier:… methods: a default-set name or a manifest path
@@ -310,7 +313,9 @@ struct RenderArgs {
     /// snake-ridges; cd-tracks-fast is the integrated table of the CD].
     #[arg(long = "tables", value_name = "NAME|PATH")]
     tables: Vec<String>,
-    /// Technique: lut, fourier or spectral.
+    /// Technique: lut, fourier, spectral, or stack (a multilayer stack per pixel from
+    /// --ambient/--layer/--substrate or --recipe: the top film follows the scene's thickness
+    /// map around its own thickness, the others move by their --relative thickness).
     #[arg(long, value_enum, default_value = "lut")]
     technique: TechniqueArg,
     /// Image width, pixels (1 to 8192).
@@ -332,9 +337,18 @@ struct RenderArgs {
     /// Harmonics M of the fourier technique (0 = automatic) [default: 3].
     #[arg(long, value_name = "M")]
     harmonics: Option<u32>,
-    /// Wavelengths N of the spectral technique (1 to 4096) [default: 30].
+    /// Wavelengths N of the spectral technique (1 to 4096) [default: 30]; with --technique
+    /// stack a fixed rule of N (1 to 256) [default: chosen per pixel].
     #[arg(long, value_name = "N")]
     wavelengths: Option<usize>,
+    /// The stack of --technique stack.
+    #[command(flatten)]
+    stack: StackArgs,
+    /// --technique stack: each film's relative thickness r, nm (repeat once per film, top
+    /// first): film j spans d_j ± r_j over the thickness map (the top film's own r too)
+    /// [default: 0 for every film].
+    #[arg(long = "relative", value_name = "NM")]
+    relative: Vec<f64>,
     /// Diffraction scenes: wavelength step of the colour sum, nm, over the table's range (the
     /// table's own step, 5 nm for the default set, is the CPU's grid); layout "terms" only
     /// (an integrated table's sum is fixed at bake time) [default: 10].
@@ -564,6 +578,27 @@ fn run_render(args: &RenderArgs) -> Result<()> {
     }
     if let Some(n) = args.wavelengths {
         options.spectral_samples = n;
+    }
+    if technique == Technique::Stack {
+        let (spec, _, _) = load_stack(&args.stack)?;
+        let stack = spec.build()?;
+        let relative = if args.relative.is_empty() {
+            vec![0.0; stack.layers().len()]
+        } else {
+            args.relative.clone()
+        };
+        if let (Some(top), Some(r)) = (stack.layers().first(), relative.first()) {
+            options.material.thickness = nacre_runtime::render::ThicknessMapping::Svt {
+                average_nm: top.thickness_nm as f32,
+                relative_nm: *r as f32,
+            };
+            options.material.drain_nm = 0.0;
+        }
+        options.stack = nacre_runtime::bindings::StackSetup {
+            stack,
+            relative_nm: relative,
+            samples: args.wavelengths,
+        };
     }
     // Check the settings and read every input before starting the GPU: bad input fails fast.
     options.validate()?;
@@ -864,6 +899,9 @@ fn run_bench_gpu(args: &BenchGpuArgs) -> Result<()> {
         BenchPass::Film(Technique::Lut),
         BenchPass::Film(Technique::Fourier),
         BenchPass::Film(Technique::Spectral),
+        BenchPass::Stack(2),
+        BenchPass::Stack(4),
+        BenchPass::Stack(8),
         BenchPass::Diffraction,
     ];
     let results = run_bench_with_diffraction(

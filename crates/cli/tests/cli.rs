@@ -181,6 +181,46 @@ fn bad_input_exits_2_with_a_message_and_keeps_existing_output() {
     assert!(stderr(&o).contains("no/such/dir/out.csv"), "{}", stderr(&o));
 }
 
+/// `--method stack` (the GPU technique's CPU twin) against the exact reference on a
+/// three-film stack with a 10 nm silver film, and a points file overriding the top film.
+#[test]
+fn color_stack_method_is_close_to_spectral() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let run = |method: &str| {
+        let o = nacre(
+            &[
+                "color",
+                "--layer",
+                "mgf2@110",
+                "--layer",
+                "ag@10",
+                "--layer",
+                "1.9@180",
+                "--substrate",
+                "ag",
+                "--angles",
+                "0:80:9",
+                "--method",
+                method,
+            ],
+            d,
+        );
+        assert!(o.status.success(), "{method}: {}", stderr(&o));
+        csv_numbers(&String::from_utf8(o.stdout).unwrap())
+    };
+    let exact = run("spectral");
+    for method in ["stack", "stack:64"] {
+        let got = run(method);
+        assert_eq!(got.len(), exact.len());
+        for (g, x) in got.iter().zip(&exact) {
+            for c in 3..9 {
+                assert!((g[c] - x[c]).abs() < 0.01, "{method}: {g:?} vs {x:?}");
+            }
+        }
+    }
+}
+
 #[test]
 fn color_methods_and_info() {
     let dir = tempfile::tempdir().unwrap();
@@ -265,6 +305,7 @@ fn color_and_bake_bad_input() {
     let cases: &[(&[&str], &str)] = &[
         (&["color", "--method", "foo"], "--method `foo`"),
         (&["color", "--method", "samples:0"], "samples:N"),
+        (&["color", "--method", "stack:0"], "stack:N"),
         (&["color", "--method", "lut:nope.json"], "nope.json"),
         (
             &[

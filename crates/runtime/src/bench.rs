@@ -12,7 +12,7 @@
 //! otherwise from the wall-clock time of submit + wait, per frame. The median over the
 //! measured frames is reported, after warm-up frames that are discarded.
 
-use crate::bindings::{TechniqueBinding, TechniqueOptions};
+use crate::bindings::{StackSetup, TechniqueBinding, TechniqueOptions};
 use crate::context::BufferInitExt;
 use crate::context::GpuContext;
 use crate::diffraction::{DiffractionOptions, DiffractionTables, ScenePass};
@@ -33,6 +33,9 @@ pub enum BenchPass {
     /// The `diffraction` technique (the table's layout, "terms" or "integrated") for one
     /// directional light per pixel.
     Diffraction,
+    /// `film_stack` with a dielectric stack of this many films
+    /// ([`StackSetup::alternating`]), the rule ladder.
+    Stack(usize),
 }
 
 impl BenchPass {
@@ -45,6 +48,10 @@ impl BenchPass {
             BenchPass::Film(Technique::Spectral) => "film_spectral",
             BenchPass::Film(Technique::Stack) => "film_stack",
             BenchPass::Diffraction => "diffraction",
+            BenchPass::Stack(2) => "film_stack, 2 films",
+            BenchPass::Stack(4) => "film_stack, 4 films",
+            BenchPass::Stack(8) => "film_stack, 8 films",
+            BenchPass::Stack(_) => "film_stack, N films",
         }
     }
 }
@@ -230,10 +237,28 @@ pub fn run_bench_with_diffraction(
                 &options.technique,
                 &colorimeter,
             )?),
+            BenchPass::Stack(films) => {
+                let technique = TechniqueOptions {
+                    stack: StackSetup::alternating(films)?,
+                    ..options.technique.clone()
+                };
+                Some(TechniqueBinding::new(
+                    ctx,
+                    tables,
+                    Technique::Stack,
+                    &technique,
+                    &colorimeter,
+                )?)
+            }
         };
         let (source, table_layout, table_group) = match (&binding, pass) {
             (Some(b), BenchPass::Film(t)) => (
                 shaders::film_pipeline(t.module(), &["bench"])?,
+                &b.layout,
+                &b.bind_group,
+            ),
+            (Some(b), BenchPass::Stack(_)) => (
+                shaders::film_pipeline(Technique::Stack.module(), &["bench"])?,
                 &b.layout,
                 &b.bind_group,
             ),

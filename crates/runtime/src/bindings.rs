@@ -164,6 +164,40 @@ impl Default for StackSetup {
     }
 }
 
+impl StackSetup {
+    /// A dielectric stack of `films` (1 to 8) films in air on glass (n 1.5), alternating
+    /// n 1.38 (100 nm) and n 2.3 (60 nm), every film below the top varying by ±20 nm: the
+    /// stacks `nacre bench-gpu` times.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] for a film count outside 1 to 8.
+    pub fn alternating(films: usize) -> Result<StackSetup> {
+        if !(1..=nacre_optics::few_wavelengths::MAX_STACK_FILMS).contains(&films) {
+            return Err(Error::Invalid {
+                context: "film_stack".into(),
+                message: format!("{films} films (expected 1 to 8)"),
+            });
+        }
+        let constant = |n: f64| {
+            nacre_optics::Material::constant(format!("{n}"), nacre_optics::C64::new(n, 0.0))
+                .expect("a real index above zero is a valid material")
+        };
+        let layers = (0..films)
+            .map(|j| nacre_optics::Layer {
+                material: constant(if j % 2 == 0 { 1.38 } else { 2.3 }),
+                thickness_nm: if j % 2 == 0 { 100.0 } else { 60.0 },
+            })
+            .collect();
+        Ok(StackSetup {
+            stack: nacre_optics::Stack::new(constant(1.0), layers, constant(1.5))?,
+            relative_nm: (0..films)
+                .map(|j| if j == 0 { 0.0 } else { 20.0 })
+                .collect(),
+            samples: None,
+        })
+    }
+}
+
 /// Group 1 of `film_stack` for `setup`: the nodes of every rule, every medium's index at
 /// every node and the uniform ([`StackEvaluation`](nacre_optics::few_wavelengths::StackEvaluation)
 /// holds the same numbers in f64 for the CPU twin).

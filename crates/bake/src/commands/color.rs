@@ -42,6 +42,7 @@ use nacre_format::msg;
 use nacre_format::set::resolve_table;
 use nacre_format::table_io::Table3;
 use nacre_optics::colour::{Colorimeter, OutputSpace, RgbSpace};
+use nacre_optics::few_wavelengths::StackEvaluation;
 use nacre_optics::fourier::{FilmOnBase, Harmonics, gltf_iridescence};
 use nacre_optics::spectral::sample_weights;
 use nacre_optics::{C64, Layer, Material, SpectralRule, Stack};
@@ -100,6 +101,11 @@ pub enum Method {
         /// Samples per point.
         samples: usize,
     },
+    /// The real-time multilayer evaluation of the GPU technique `film_stack`
+    /// ([`nacre_optics::few_wavelengths::StackEvaluation`]): the few-wavelength rule ladder,
+    /// its count chosen from the stack's OPD (`stack`), or a fixed rule of N nodes
+    /// (`stack:N`).
+    Stack(Option<usize>),
 }
 
 /// A loaded `rough-film-lut` table.
@@ -166,6 +172,13 @@ impl Method {
                         return Err(err("expected lut:NAME or lut:PATH/TO/MANIFEST.json"));
                     }
                     Ok(Method::Lut(resolve_table(name)))
+                } else if t == "stack" {
+                    Ok(Method::Stack(None))
+                } else if let Some(n) = t.strip_prefix("stack:") {
+                    match n.parse::<usize>() {
+                        Ok(n @ 1..=256) => Ok(Method::Stack(Some(n))),
+                        _ => Err(err("stack:N needs a whole number N from 1 to 256")),
+                    }
                 } else if let Some(n) = t.strip_prefix("samples:") {
                     match n.parse::<usize>() {
                         Ok(n @ 1..=10_000) => Ok(Method::Samples(n)),
@@ -200,7 +213,7 @@ impl Method {
                     Ok(Method::Fourier(harmonics, sigma, None))
                 } else {
                     Err(err(
-                        "expected spectral, lut:NAME|PATH, rgb3, samples:N, fourier:M[:SIGMA_NM], fourier:auto[:SIGMA_NM], fourier-exact:…, gaussian, rough-lut:NAME|PATH or rough-mc[:N]",
+                        "expected spectral, lut:NAME|PATH, rgb3, samples:N, fourier:M[:SIGMA_NM], fourier:auto[:SIGMA_NM], fourier-exact:…, gaussian, rough-lut:NAME|PATH, rough-mc[:N], stack or stack:N",
                     ))
                 }
             }
@@ -622,10 +635,45 @@ pub fn evaluate(
         }
         .into());
     }
+    // The stack technique's rules and indices, prepared once for the stack's own films (a
+    // point that overrides the top film's index prepares its own).
+    let stack_eval = match method {
+        Method::Stack(n) => {
+            let relative = vec![0.0; stack.layers().len()];
+            Some(
+                StackEvaluation::new(colorimeter, stack, &relative, *n)
+                    .map_err(|e| Error::optics_in(Param::Method.given("stack"), e))?,
+            )
+        }
+        _ => None,
+    };
     points
         .par_iter()
         .map(|point| -> Result<[f64; 3]> {
             match method {
+                Method::Stack(n) => {
+                    let own = stack_eval.as_ref().expect("prepared above");
+                    let fresh;
+                    let eval = if point.film_ior.is_some() {
+                        let s = stack_at(stack, point)?;
+                        let relative = vec![0.0; s.layers().len()];
+                        fresh = StackEvaluation::new(colorimeter, &s, &relative, *n)
+                            .map_err(|e| Error::optics_in(Param::Method.given("stack"), e))?;
+                        &fresh
+                    } else {
+                        own
+                    };
+                    let angle = point.angle_deg;
+                    if !(angle.abs() < 90.0) {
+                        return Err(nacre_optics::Error::InvalidAngle { angle_deg: angle }.into());
+                    }
+                    let top = point.thickness_nm.unwrap_or(stack.layers()[0].thickness_nm);
+                    let (r, t) = eval.colour(angle.to_radians().cos(), top, 0.0);
+                    Ok(match quantity {
+                        Quantity::Reflectance => r,
+                        Quantity::Transmittance => t,
+                    })
+                }
                 Method::Lut(_) => {
                     let lut = lut.expect("lut loaded by the caller");
                     lut.colour(stack, point, quantity)
