@@ -180,11 +180,12 @@ fn film_colour(raw: FilmInput) -> FilmOutput {
         var tau_p = t_p[films];
         for (var jj = 0u; jj < films; jj++) {
             let m = films - 1u - jj;
-            // Film m + 1 (medium m + 1): e^{iδ} and e^{2iδ}, phases in cycles reduced first.
+            // Film m + 1 (medium m + 1): e^{iδ} (phase in cycles reduced first) and
+            // e^{2iδ} = (e^{iδ})², as stack.rs forms it.
             let qf = q[m + 1u];
             let x = safe_div(thickness[m], node.wavelength_nm);
             let e1 = c_exp_i_cycles(x * qf.x) * exp(-TWO_PI * x * qf.y);
-            let e2 = c_exp_i_cycles(2.0 * x * qf.x) * exp(-2.0 * TWO_PI * x * qf.y);
+            let e2 = c_mul(e1, e1);
             let gs = c_mul(gamma_s, e2);
             let gp = c_mul(gamma_p, e2);
             let den_s = c_inv(vec2<f32>(1.0, 0.0) + c_mul(r_s[m], gs));
