@@ -158,7 +158,7 @@ bool nacre_f32_is_nan(float x) {
 }
 
 bool3 nacre_vec3_is_finite(float3 v) {
-    return (asuint(v) & (uint3)0x7f800000u != (uint3)0x7f800000u);
+    return (asuint(v) & (uint3)0x7f800000u) != (uint3)0x7f800000u;
 }
 
 // x when finite, else `fallback`.

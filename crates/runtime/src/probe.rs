@@ -242,94 +242,114 @@ pub fn run_spirv_probe(
         count: None,
     };
     let output_size = u64::from(count) * 32;
-    let (output, readback) = ctx.checked("running the SPIR-V probe", || {
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("SPIR-V probe"),
-            source: wgpu::ShaderSource::SpirV(words.as_slice().into()),
-        });
-        let empty = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("SPIR-V probe (empty group 0)"),
-            entries: &[],
-        });
-        let io_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("SPIR-V probe inputs and outputs"),
-            entries: &[
-                buffer_entry(0, wgpu::BufferBindingType::Storage { read_only: true }),
-                buffer_entry(1, wgpu::BufferBindingType::Uniform),
-                buffer_entry(2, wgpu::BufferBindingType::Storage { read_only: false }),
-            ],
-        });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("SPIR-V probe"),
-            bind_group_layouts: &[Some(&empty), Some(probe.tables.0), Some(&io_layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("SPIR-V probe"),
-            layout: Some(&layout),
-            module: &module,
-            entry_point: Some(probe.entry_point),
-            compilation_options: Default::default(),
-            cache: None,
-        });
-        let inputs = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("SPIR-V probe inputs"),
-            contents: input_bytes,
-            usage: wgpu::BufferUsages::STORAGE,
-        });
-        let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("SPIR-V probe count"),
-            contents: bytemuck::bytes_of(&[count, 0, 0, 0]),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let output = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("SPIR-V probe outputs"),
-            size: output_size,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        let readback = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("SPIR-V probe readback"),
-            size: output_size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let empty_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("SPIR-V probe (empty group 0)"),
-            layout: &empty,
-            entries: &[],
-        });
-        let io_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("SPIR-V probe inputs and outputs"),
-            layout: &io_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: inputs.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: uniform.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: output.as_entire_binding(),
-                },
-            ],
-        });
-        let mut encoder = device.create_command_encoder(&Default::default());
-        {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&pipeline);
-            pass.set_bind_group(0, &empty_group, &[]);
-            pass.set_bind_group(1, probe.tables.1, &[]);
-            pass.set_bind_group(2, &io_group, &[]);
-            pass.dispatch_workgroups(count.div_ceil(SPIRV_PROBE_WORKGROUP), 1, 1);
-        }
-        encoder.copy_buffer_to_buffer(&output, 0, &readback, 0, output_size);
-        ctx.queue.submit([encoder.finish()]);
-        (output, readback)
-    })?;
+    let (output, readback) = ctx.checked(
+        "running the SPIR-V probe",
+        || -> Result<(wgpu::Buffer, wgpu::Buffer)> {
+            // naga's SPIR-V front end panics on some valid modules (e.g. naga 30 on an
+            // `OpImageFetch` of a 2-D array image when no 2-component integer vector type was
+            // declared): a panic there is reported as an error, not passed on.
+            let module = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                    label: Some("SPIR-V probe"),
+                    source: wgpu::ShaderSource::SpirV(words.as_slice().into()),
+                })
+            }))
+            .map_err(|panic| {
+                let message = panic
+                    .downcast_ref::<&str>()
+                    .map(|s| s.to_string())
+                    .or_else(|| panic.downcast_ref::<String>().cloned())
+                    .unwrap_or_else(|| "a panic without a message".into());
+                Error::Gpu {
+                    context: "SPIR-V probe: naga's SPIR-V front end".into(),
+                    message,
+                }
+            });
+            let module = module?;
+            let empty = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("SPIR-V probe (empty group 0)"),
+                entries: &[],
+            });
+            let io_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("SPIR-V probe inputs and outputs"),
+                entries: &[
+                    buffer_entry(0, wgpu::BufferBindingType::Storage { read_only: true }),
+                    buffer_entry(1, wgpu::BufferBindingType::Uniform),
+                    buffer_entry(2, wgpu::BufferBindingType::Storage { read_only: false }),
+                ],
+            });
+            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("SPIR-V probe"),
+                bind_group_layouts: &[Some(&empty), Some(probe.tables.0), Some(&io_layout)],
+                immediate_size: 0,
+            });
+            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("SPIR-V probe"),
+                layout: Some(&layout),
+                module: &module,
+                entry_point: Some(probe.entry_point),
+                compilation_options: Default::default(),
+                cache: None,
+            });
+            let inputs = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("SPIR-V probe inputs"),
+                contents: input_bytes,
+                usage: wgpu::BufferUsages::STORAGE,
+            });
+            let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("SPIR-V probe count"),
+                contents: bytemuck::bytes_of(&[count, 0, 0, 0]),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            let output = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("SPIR-V probe outputs"),
+                size: output_size,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            let readback = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("SPIR-V probe readback"),
+                size: output_size,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let empty_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("SPIR-V probe (empty group 0)"),
+                layout: &empty,
+                entries: &[],
+            });
+            let io_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("SPIR-V probe inputs and outputs"),
+                layout: &io_layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: inputs.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: uniform.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: output.as_entire_binding(),
+                    },
+                ],
+            });
+            let mut encoder = device.create_command_encoder(&Default::default());
+            {
+                let mut pass = encoder.begin_compute_pass(&Default::default());
+                pass.set_pipeline(&pipeline);
+                pass.set_bind_group(0, &empty_group, &[]);
+                pass.set_bind_group(1, probe.tables.1, &[]);
+                pass.set_bind_group(2, &io_group, &[]);
+                pass.dispatch_workgroups(count.div_ceil(SPIRV_PROBE_WORKGROUP), 1, 1);
+            }
+            encoder.copy_buffer_to_buffer(&output, 0, &readback, 0, output_size);
+            ctx.queue.submit([encoder.finish()]);
+            Ok((output, readback))
+        },
+    )??;
     let bytes = gpu::read_buffer(ctx, &readback, "reading the SPIR-V probe's outputs")?;
     drop(output);
     let floats: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&bytes);

@@ -151,13 +151,17 @@ fn every_wgsl_function_constant_and_struct_has_its_counterpart() {
                 let got = constants
                     .get(&key)
                     .unwrap_or_else(|| panic!("{path}: no `{key}` for {module}.wgsl's `{name}`"));
-                assert_eq!(*got, value, "{path}: {key} = {got}, {module}.wgsl says {value}");
+                assert_eq!(
+                    *got, value,
+                    "{path}: {key} = {got}, {module}.wgsl says {value}"
+                );
             }
             for s in names_after(&wgsl, "struct ") {
                 let ours = format!("Nacre{s}");
                 let expected = struct_fields(&wgsl, s, true).unwrap();
-                let got = struct_fields(lib, &ours, false)
-                    .unwrap_or_else(|| panic!("{path}: no `struct {ours}` for {module}.wgsl's `{s}`"));
+                let got = struct_fields(lib, &ours, false).unwrap_or_else(|| {
+                    panic!("{path}: no `struct {ours}` for {module}.wgsl's `{s}`")
+                });
                 assert_eq!(got, expected, "{path}: fields of {ours}");
             }
         }
@@ -185,7 +189,11 @@ fn each_wgsl_symbol_table_is_in_both_libraries() {
             end += 1;
         }
         let table = &lines[start..end];
-        assert!(table.len() > 3, "{module}.wgsl: symbol table of {} lines", table.len());
+        assert!(
+            table.len() > 3,
+            "{module}.wgsl: symbol table of {} lines",
+            table.len()
+        );
         for (path, lib) in &libs {
             let block = table.join("\n");
             assert!(
@@ -215,14 +223,12 @@ fn glslang(name: &str, source: &str, args: &[&str], extra: &[(&str, &str)]) {
     if !args.is_empty() {
         command.arg("-o").arg(dir.join("out.spv"));
     }
-    let output = command
-        .output()
-        .unwrap_or_else(|e| {
-            panic!(
-                "running glslangValidator ({e}): the engine-library tests need it — install \
+    let output = command.output().unwrap_or_else(|e| {
+        panic!(
+            "running glslangValidator ({e}): the engine-library tests need it — install \
                  glslang-tools (`apt-get install glslang-tools`; scripts/test.sh does)"
-            )
-        });
+        )
+    });
     let _ = std::fs::remove_dir_all(&dir);
     assert!(
         output.status.success(),
@@ -302,7 +308,12 @@ fn the_hlsl_library_and_the_shader_graph_entry_points_compile() {
          float3 e = nacre_rough_lut_sample(lut_r, lut_s, rough_params, 0.5, 0.2, 300.0, 1.4);\n\
          return float4(a.reflectance + a.transmittance + b.reflectance + b.transmittance + e, 1.0);\n}}\n"
     );
-    glslang("plain.hlsl", &plain, &["-D", "-V", "-e", "main", "-S", "frag"], &[]);
+    glslang(
+        "plain.hlsl",
+        &plain,
+        &["-D", "-V", "-e", "main", "-S", "frag"],
+        &[],
+    );
     // Shader Graph declares these in Packages/com.unity.shadergraph/ShaderGraphLibrary/Texture.hlsl
     // (fields `tex` and `samplerstate`); stand-ins with the same fields.
     let shim = "struct UnityTexture3D { Texture3D<float4> tex; SamplerState samplerstate; };\n\

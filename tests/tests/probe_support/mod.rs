@@ -85,4 +85,3 @@ pub fn random_points(seed: u64, count: usize, d_max: f64) -> Vec<(f64, f64, f64)
         })
         .collect()
 }
-
