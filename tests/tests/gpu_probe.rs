@@ -4,11 +4,10 @@
 //!
 //! A missing adapter fails these tests: they never skip.
 
-use nacre_bake::commands::color::{self, Method, Point, Quantity};
+use nacre_bake::commands::color::{Method, Quantity};
 use nacre_format::Manifest;
 use nacre_format::film_lut::FilmLut;
 use nacre_format::materials;
-use nacre_format::set::default_baked_dir;
 use nacre_optics::fourier::Harmonics;
 use nacre_optics::{C64, Material};
 use nacre_runtime::bindings::{SpectralSetup, TechniqueBinding, TechniqueOptions};
@@ -20,47 +19,8 @@ use std::sync::Arc;
 mod support;
 use support::ctx;
 
-/// Deterministic uniform numbers in [0, 1).
-struct Lcg(u64);
-impl Lcg {
-    fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
-fn input(cos_theta: f64, d: f64, n: f64, sigma: f64, ambient: f64, base: C64) -> FilmInput {
-    FilmInput {
-        cos_theta_i: cos_theta as f32,
-        thickness_nm: d as f32,
-        film_ior: n as f32,
-        sigma_thickness_nm: sigma as f32,
-        ambient_ior: ambient as f32,
-        base_ior: [base.re as f32; 3],
-        base_kappa: [base.im as f32; 3],
-        ..Default::default()
-    }
-}
-
-fn manifest(name: &str) -> std::path::PathBuf {
-    default_baked_dir().join(format!("{name}.json"))
-}
-
-fn max_diff(a: &[[f64; 3]], b: &[[f32; 3]]) -> (f64, usize) {
-    let mut worst = (0.0f64, 0usize);
-    for (i, (x, y)) in a.iter().zip(b).enumerate() {
-        for c in 0..3 {
-            let d = (x[c] - f64::from(y[c])).abs();
-            if d.is_nan() || d > worst.0 {
-                worst = (d, i);
-            }
-        }
-    }
-    worst
-}
+mod probe_support;
+use probe_support::{Lcg, cpu_colours, input, manifest, max_diff, random_points};
 
 #[test]
 fn film_lut_matches_the_cpu_lookup() {
@@ -116,42 +76,6 @@ fn film_lut_matches_the_cpu_lookup() {
             assert!(worst <= 2e-3, "{name} T: {worst:e} at {:?}", points[at]);
         }
     }
-}
-
-/// CPU colours of `method` for one film (ambient 1.0) on `base` at the given points.
-fn cpu_colours(
-    method: &Method,
-    base: &Material,
-    points: &[(f64, f64, f64)],
-    quantity: Quantity,
-    colorimeter: &nacre_optics::colour::Colorimeter,
-) -> Vec<[f64; 3]> {
-    let ambient = Material::constant("1.0", C64::new(1.0, 0.0)).unwrap();
-    let film = Material::constant("1.5", C64::new(1.5, 0.0)).unwrap();
-    let stack = color::film_stack(ambient, film, 100.0, vec![], base.clone()).unwrap();
-    let pts: Vec<Point> = points
-        .iter()
-        .map(|&(c, d, n)| Point {
-            angle_deg: c.clamp(0.0, 1.0).acos().to_degrees(),
-            thickness_nm: Some(d),
-            film_ior: Some(n),
-        })
-        .collect();
-    color::evaluate(&stack, &pts, method, colorimeter, quantity, None).unwrap()
-}
-
-fn random_points(seed: u64, count: usize, d_max: f64) -> Vec<(f64, f64, f64)> {
-    let mut rng = Lcg(seed);
-    (0..count)
-        .map(|_| {
-            let angle = rng.next() * 85.0;
-            (
-                angle.to_radians().cos(),
-                rng.next() * d_max,
-                1.2 + rng.next() * 1.2,
-            )
-        })
-        .collect()
 }
 
 #[test]

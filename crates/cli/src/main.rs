@@ -63,6 +63,22 @@ enum Command {
     /// extension's parameter space (CSV), the glTF approximation's error, swatch charts.
     #[command(after_help = CONFORMANCE_EXAMPLES)]
     Conformance(ConformanceArgs),
+    /// Write one quantity of a film-lut or rough-film-lut table as a raw 3-D texture for a
+    /// game engine (RGBA half floats, little-endian, x fastest, then y, then z) with a JSON
+    /// sidecar (dimensions, format, axes, mappings, shader parameters); docs/engines/.
+    #[command(after_help = EXPORT_EXAMPLES)]
+    Export {
+        /// A default-set table name (e.g. soap-film) or a manifest path.
+        #[arg(long, value_name = "NAME|PATH")]
+        table: String,
+        /// reflectance or transmittance.
+        #[arg(long, default_value = "reflectance")]
+        quantity: String,
+        /// The raw file to write (e.g. soap-film.reflectance.raw); the sidecar is the same
+        /// path with extension .json. Both are written atomically.
+        #[arg(long, value_name = "PATH")]
+        out: std::path::PathBuf,
+    },
     /// Print a baked table's manifest as JSON.
     Info {
         /// A default-set table name (e.g. film-dielectric) or a manifest path.
@@ -245,6 +261,12 @@ struct CompareArgs {
     #[arg(short = 'o', long = "output", value_name = "DIR")]
     output: PathBuf,
 }
+
+const EXPORT_EXAMPLES: &str = "\
+Examples:
+  nacre export --table soap-film --quantity reflectance --out soap-film.reflectance.raw
+  nacre export --table rough-film-dielectric --quantity transmittance --out rough.t.raw
+Loading the raw file in Unity, Unreal and three.js: docs/engines/.";
 
 const RENDER_EXAMPLES: &str = "\
 Scenes: sphere (a film of index 1.9 on a black glazed dielectric; on gold with --tables
@@ -1022,6 +1044,24 @@ fn run(cli: Cli) -> Result<()> {
         Command::Conformance(args) => run_conformance(&args),
         Command::Render(args) => run_render(&args),
         Command::BenchGpu(args) => run_bench_gpu(&args),
+        Command::Export {
+            table,
+            quantity,
+            out,
+        } => {
+            let path = set::resolve_table(&table);
+            let texture = nacre_format::export::export_raw(&path, &quantity)?;
+            let sidecar = nacre_format::export::write_raw(&out, &texture)?;
+            eprintln!(
+                "nacre export: {} ({} × {} × {} RGBA16F) and {}",
+                out.display(),
+                texture.width,
+                texture.height,
+                texture.depth,
+                sidecar.display()
+            );
+            Ok(())
+        }
         Command::Info { table } => {
             let path = set::resolve_table(&table);
             let manifest = Manifest::read(&path)?;

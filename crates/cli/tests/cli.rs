@@ -933,3 +933,82 @@ fn color_rough_methods() {
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("base"), "{}", stderr(&o));
 }
+
+/// `nacre export` writes a raw RGBA16F 3-D texture and its sidecar that read back as the
+/// table's texels; bad input exits 2 naming the flag or file and writes nothing.
+#[test]
+fn export_writes_a_raw_texture_and_sidecar() {
+    let dir = tempfile::tempdir().unwrap();
+    let table = nacre_format::set::default_baked_dir().join("soap-film.json");
+    let table_arg = table.to_str().unwrap();
+    let o = nacre(
+        &[
+            "export",
+            "--table",
+            table_arg,
+            "--quantity",
+            "transmittance",
+            "--out",
+            "t.raw",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let bytes = std::fs::read(dir.path().join("t.raw")).unwrap();
+    let sidecar: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("t.json")).unwrap()).unwrap();
+    let m = nacre_format::Manifest::read(&table).unwrap();
+    let t = m.load_table(&table, "transmittance").unwrap().unwrap();
+    assert_eq!(sidecar["width"], t.nx);
+    assert_eq!(sidecar["height"], t.ny);
+    assert_eq!(sidecar["depth"], t.nz);
+    assert_eq!(sidecar["format"], "rgba16f-le");
+    assert_eq!(bytes.len(), t.nx * t.ny * t.nz * 8);
+    for z in 0..t.nz {
+        for y in (0..t.ny).step_by(7) {
+            for x in 0..t.nx {
+                let o = 8 * ((z * t.ny + y) * t.nx + x);
+                let want = t.texel(x, y, z);
+                for c in 0..3 {
+                    let h = half::f16::from_le_bytes([bytes[o + 2 * c], bytes[o + 2 * c + 1]]);
+                    assert_eq!(
+                        h,
+                        half::f16::from_f32(want[c]),
+                        "texel ({x}, {y}, {z}) channel {c}"
+                    );
+                }
+            }
+        }
+    }
+    for (args, names) in [
+        (
+            vec!["export", "--table", "no-such-table", "--out", "x.raw"],
+            "no-such-table",
+        ),
+        (
+            vec![
+                "export",
+                "--table",
+                table_arg,
+                "--quantity",
+                "albedo",
+                "--out",
+                "x.raw",
+            ],
+            "--quantity",
+        ),
+        (
+            vec!["export", "--table", "fourier-srgb", "--out", "x.raw"],
+            "--table",
+        ),
+        (
+            vec!["export", "--table", table_arg, "--out", "x.json"],
+            "--out",
+        ),
+    ] {
+        let o = nacre(&args, dir.path());
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(names), "{args:?}: {}", stderr(&o));
+        assert!(!dir.path().join("x.raw").exists() && !dir.path().join("x.json").exists());
+    }
+}

@@ -19,6 +19,7 @@
 pub mod atomic;
 pub mod diffraction;
 pub mod error;
+pub mod export;
 pub mod film_lut;
 pub mod fourier;
 pub mod kind;

@@ -167,3 +167,191 @@ pub fn run_probe(
         })
         .collect())
 }
+
+/// Invocations per workgroup (x) that a [`run_spirv_probe`] entry point declares.
+pub const SPIRV_PROBE_WORKGROUP: u32 = 64;
+
+/// The SPIR-V magic number (SPIR-V specification §3.1), first word of every module.
+const SPIRV_MAGIC: u32 = 0x0723_0203;
+
+/// A compute probe compiled outside nacre — SPIR-V from `glslangValidator -V` for a GLSL or
+/// HLSL consumer of the engine libraries (`shaders/glsl/nacre.glsl`,
+/// `shaders/hlsl/nacre.hlsl`) — run through naga's SPIR-V front end on the same device as
+/// the WGSL techniques.
+pub struct SpirvProbe<'a> {
+    /// The module's bytes (little-endian words, as glslang writes them).
+    pub spirv: &'a [u8],
+    /// Its compute entry point, `local_size_x` = [`SPIRV_PROBE_WORKGROUP`].
+    pub entry_point: &'a str,
+    /// Group 1: the tables as the probe declares them (layout and bind group).
+    pub tables: (&'a wgpu::BindGroupLayout, &'a wgpu::BindGroup),
+}
+
+/// Runs `probe` over `count` inputs of `input_bytes.len() / count` bytes each and returns two
+/// `vec4<f32>` per input. The bindings (group 0 is empty):
+///
+/// | group | binding | type | holds |
+/// |---|---|---|---|
+/// | 1 | any | the probe's own | [`SpirvProbe::tables`] |
+/// | 2 | 0 | `storage, read` | the inputs (`input_bytes`) |
+/// | 2 | 1 | `uniform` (16 bytes) | `u32` count, then padding |
+/// | 2 | 2 | `storage, read_write` | `array<vec4<f32>>`: index 2i and 2i + 1 for input i |
+///
+/// Errors: bytes that are not a SPIR-V module ([`Error::Invalid`]), a module naga or the
+/// device rejects, or a layout it does not fit ([`Error::Gpu`]).
+pub fn run_spirv_probe(
+    ctx: &GpuContext,
+    probe: &SpirvProbe<'_>,
+    input_bytes: &[u8],
+    count: u32,
+) -> Result<Vec<[[f32; 4]; 2]>> {
+    let invalid = |message: String| Error::Invalid {
+        context: "SPIR-V probe".into(),
+        message,
+    };
+    if probe.spirv.len() < 20 || !probe.spirv.len().is_multiple_of(4) {
+        return Err(invalid(format!(
+            "{} bytes: not a SPIR-V module (a whole number of words, header of 5)",
+            probe.spirv.len()
+        )));
+    }
+    let words: Vec<u32> = probe
+        .spirv
+        .chunks_exact(4)
+        .map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]))
+        .collect();
+    if words[0] != SPIRV_MAGIC {
+        return Err(invalid(format!(
+            "first word {:#010x} is not the SPIR-V magic number {SPIRV_MAGIC:#010x}",
+            words[0]
+        )));
+    }
+    if count == 0 {
+        return Ok(Vec::new());
+    }
+    let device = &ctx.device;
+    let stage = wgpu::ShaderStages::COMPUTE;
+    let buffer_entry = |binding, ty| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: stage,
+        ty: wgpu::BindingType::Buffer {
+            ty,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    };
+    let output_size = u64::from(count) * 32;
+    let (output, readback) = ctx.checked(
+        "running the SPIR-V probe",
+        || -> Result<(wgpu::Buffer, wgpu::Buffer)> {
+            // naga's SPIR-V front end panics on some valid modules (e.g. naga 30 on an
+            // `OpImageFetch` of a 2-D array image when no 2-component integer vector type was
+            // declared): a panic there is reported as an error, not passed on.
+            let module = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                    label: Some("SPIR-V probe"),
+                    source: wgpu::ShaderSource::SpirV(words.as_slice().into()),
+                })
+            }))
+            .map_err(|panic| {
+                let message = panic
+                    .downcast_ref::<&str>()
+                    .map(|s| s.to_string())
+                    .or_else(|| panic.downcast_ref::<String>().cloned())
+                    .unwrap_or_else(|| "a panic without a message".into());
+                Error::Gpu {
+                    context: "SPIR-V probe: naga's SPIR-V front end".into(),
+                    message,
+                }
+            });
+            let module = module?;
+            let empty = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("SPIR-V probe (empty group 0)"),
+                entries: &[],
+            });
+            let io_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("SPIR-V probe inputs and outputs"),
+                entries: &[
+                    buffer_entry(0, wgpu::BufferBindingType::Storage { read_only: true }),
+                    buffer_entry(1, wgpu::BufferBindingType::Uniform),
+                    buffer_entry(2, wgpu::BufferBindingType::Storage { read_only: false }),
+                ],
+            });
+            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("SPIR-V probe"),
+                bind_group_layouts: &[Some(&empty), Some(probe.tables.0), Some(&io_layout)],
+                immediate_size: 0,
+            });
+            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("SPIR-V probe"),
+                layout: Some(&layout),
+                module: &module,
+                entry_point: Some(probe.entry_point),
+                compilation_options: Default::default(),
+                cache: None,
+            });
+            let inputs = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("SPIR-V probe inputs"),
+                contents: input_bytes,
+                usage: wgpu::BufferUsages::STORAGE,
+            });
+            let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("SPIR-V probe count"),
+                contents: bytemuck::bytes_of(&[count, 0, 0, 0]),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            let output = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("SPIR-V probe outputs"),
+                size: output_size,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            let readback = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("SPIR-V probe readback"),
+                size: output_size,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let empty_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("SPIR-V probe (empty group 0)"),
+                layout: &empty,
+                entries: &[],
+            });
+            let io_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("SPIR-V probe inputs and outputs"),
+                layout: &io_layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: inputs.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: uniform.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: output.as_entire_binding(),
+                    },
+                ],
+            });
+            let mut encoder = device.create_command_encoder(&Default::default());
+            {
+                let mut pass = encoder.begin_compute_pass(&Default::default());
+                pass.set_pipeline(&pipeline);
+                pass.set_bind_group(0, &empty_group, &[]);
+                pass.set_bind_group(1, probe.tables.1, &[]);
+                pass.set_bind_group(2, &io_group, &[]);
+                pass.dispatch_workgroups(count.div_ceil(SPIRV_PROBE_WORKGROUP), 1, 1);
+            }
+            encoder.copy_buffer_to_buffer(&output, 0, &readback, 0, output_size);
+            ctx.queue.submit([encoder.finish()]);
+            Ok((output, readback))
+        },
+    )??;
+    let bytes = gpu::read_buffer(ctx, &readback, "reading the SPIR-V probe's outputs")?;
+    drop(output);
+    let floats: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&bytes);
+    Ok(floats.chunks_exact(2).map(|p| [p[0], p[1]]).collect())
+}

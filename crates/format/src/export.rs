@@ -1,0 +1,293 @@
+//! Raw 3-D textures for game engines (`nacre export`): one quantity of a `film-lut` or
+//! `rough-film-lut` table as the bytes a 3-D texture upload takes, and a JSON sidecar that
+//! says how to read them and how to sample them.
+//!
+//! Layout of the `.raw` file (docs/engines/ show the upload per engine):
+//!
+//! * texel format RGBA, four IEEE 754 binary16 ("half") values per texel, little-endian,
+//!   8 bytes per texel; R, G, B the table's colour (rounded to nearest half), A = 1;
+//! * texel order x fastest, then y, then z: byte offset of texel (x, y, z) =
+//!   8 · ((z · height + y) · width + x) — slice z is the table's z-th slice, its first row
+//!   is y = 0. This is the order of OpenGL/WebGL `texImage3D` (three.js `Data3DTexture`),
+//!   Unity `Texture3D.SetPixelData` and a D3D/Vulkan 3-D upload with tightly packed rows;
+//! * axes: film-lut x = cos θ, y = Δ, z = film index n; rough-film-lut x = cos θ_o, y = Δ,
+//!   z = i_α · count(n_f) + i_n (α-major blocks). Texel i of an axis of `count` texels holds
+//!   t = i / (count − 1) and is sampled at u = (t (count − 1) + 0.5) / count (texel
+//!   centres), with linear filtering and clamp-to-edge addressing, as the WGSL, GLSL and
+//!   HLSL lookups do.
+//!
+//! The sidecar (`.json` beside the `.raw`) holds `width`, `height`, `depth`, `format`
+//! (`"rgba16f-le"`), `texel_order`, the table's kind, name, quantity and axes record as the
+//! manifest stores them, the mappings as text, and `shader_params`: the fields of the
+//! libraries' parameter struct (`NacreFilmLutParams` / `NacreRoughLutParams`).
+
+use crate::TableKind;
+use crate::atomic::write_files_atomic;
+use crate::error::{Error, Result};
+use crate::load::LoadedRoughLut;
+use crate::manifest::Manifest;
+use crate::table_io::Table3;
+use serde_json::json;
+use std::path::{Path, PathBuf};
+
+/// Bytes per texel of the raw layout (RGBA × binary16).
+pub const BYTES_PER_TEXEL: usize = 8;
+
+/// One quantity of a table as a raw RGBA16F 3-D texture and its sidecar.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RawTexture3d {
+    /// Texels along x.
+    pub width: usize,
+    /// Texels along y.
+    pub height: usize,
+    /// Texels along z (slices).
+    pub depth: usize,
+    /// `width · height · depth · 8` bytes in the [module](self)'s layout.
+    pub bytes: Vec<u8>,
+    /// The JSON sidecar.
+    pub sidecar: serde_json::Value,
+}
+
+/// The raw bytes of `table`: RGBA binary16 little-endian, x fastest, A = 1.
+pub fn rgba16f_bytes(table: &Table3) -> Vec<u8> {
+    let one = half::f16::from_f32(1.0).to_le_bytes();
+    let mut bytes = Vec::with_capacity(table.data.len() / 3 * BYTES_PER_TEXEL);
+    for rgb in table.data.chunks_exact(3) {
+        for &v in rgb {
+            bytes.extend_from_slice(&half::f16::from_f32(v).to_le_bytes());
+        }
+        bytes.extend_from_slice(&one);
+    }
+    bytes
+}
+
+/// Reads `quantity` (`reflectance` or `transmittance`) of the `film-lut` or `rough-film-lut`
+/// table whose manifest is `manifest_path` and lays it out as a raw 3-D texture.
+///
+/// Errors: an unreadable manifest or table file (naming it), another kind of table or a
+/// quantity the table lacks ([`Error::Invalid`] with context `--table` or `--quantity`).
+pub fn export_raw(manifest_path: &Path, quantity: &str) -> Result<RawTexture3d> {
+    let manifest = Manifest::read(manifest_path)?;
+    if !matches!(quantity, "reflectance" | "transmittance") {
+        return Err(Error::Invalid {
+            context: "--quantity".into(),
+            message: format!("`{quantity}`: expected `reflectance` or `transmittance`"),
+        });
+    }
+    let missing = || Error::Invalid {
+        context: "--quantity".into(),
+        message: format!(
+            "table `{}` ({}) has no {quantity}",
+            manifest.name,
+            manifest_path.display()
+        ),
+    };
+    let texel_centres = "texel i of an axis of count texels holds t = i/(count − 1), \
+                         sampled at u = (t (count − 1) + 0.5)/count; linear filtering, clamp to edge";
+    let (table, axes, mapping, params) = match manifest.kind {
+        TableKind::FilmLut => {
+            let axes = manifest
+                .film_lut()
+                .cloned()
+                .ok_or_else(|| manifest.wrong_kind(manifest_path, "a film-lut"))?;
+            let table = manifest
+                .load_table(manifest_path, quantity)?
+                .ok_or_else(missing)?;
+            let has_t = manifest
+                .load_table(manifest_path, "transmittance")?
+                .is_some();
+            let params = json!({
+                "cos_theta_count": axes.cos_theta_count,
+                "opd_count": axes.opd_count,
+                "ior_count": axes.ior_count,
+                "thickness_min_nm": axes.thickness_min_nm,
+                "thickness_max_nm": axes.thickness_max_nm,
+                "ior_min": axes.ior_min,
+                "ior_max": axes.ior_max,
+                "ambient_index": axes.ambient_index,
+                "has_transmittance": u32::from(has_t),
+            });
+            let mapping = json!({
+                "x": "t_x = sqrt(cos θ)",
+                "y": "t_y = Δ/Δ_max, Δ = 2 d sqrt(n² − n₀² sin²θ), Δ_max = 2 thickness_max_nm ior_max",
+                "z": "t_z = sqrt((q(n) − q(ior_min))/(q(ior_max) − q(ior_min))), q(n) = sqrt(n² − n₀² sin²θ)",
+                "texel_centres": texel_centres,
+            });
+            (table, serde_json::to_value(&axes), mapping, params)
+        }
+        TableKind::RoughFilmLut => {
+            let loaded = LoadedRoughLut::load(manifest_path)?;
+            let axes = loaded.lut.axes.clone();
+            let has_t = loaded.lut.transmittance.is_some();
+            let table = match quantity {
+                "reflectance" => loaded.lut.reflectance,
+                _ => loaded.lut.transmittance.ok_or_else(missing)?,
+            };
+            let params = json!({
+                "cos_theta_count": axes.cos_theta_count,
+                "opd_count": axes.opd_count,
+                "ior_count": axes.ior_count,
+                "alpha_count": axes.alpha_count,
+                "thickness_max_nm": axes.thickness_max_nm,
+                "ior_min": axes.ior_min,
+                "ior_max": axes.ior_max,
+                "alpha_min": axes.alpha_min,
+                "alpha_max": axes.alpha_max,
+                "ambient_index": axes.ambient_index,
+                "has_transmittance": u32::from(has_t),
+            });
+            let mapping = json!({
+                "x": "t_x = sqrt(cos θ_o)",
+                "y": "t_y = Δ/Δ_max, Δ = 2 d q(n_f, c_ref), c_ref = cos θ_o + (2α − α²)(0.7 − 0.8 cos θ_o), per α block",
+                "z": "slice = i_α · ior_count + i_n; t_n = sqrt((n_f − ior_min)/(ior_max − ior_min)), t_α = ln(α/alpha_min)/ln(alpha_max/alpha_min)",
+                "texel_centres": texel_centres,
+            });
+            (table, serde_json::to_value(&axes), mapping, params)
+        }
+        other => {
+            return Err(Error::Invalid {
+                context: "--table".into(),
+                message: format!(
+                    "table `{}` ({}) is a `{other}` table; export writes 3-D textures of \
+                     `film-lut` and `rough-film-lut` tables",
+                    manifest.name,
+                    manifest_path.display()
+                ),
+            });
+        }
+    };
+    let axes = axes.map_err(|e| Error::Invalid {
+        context: manifest_path.display().to_string(),
+        message: format!("axes do not serialise: {e}"),
+    })?;
+    let sidecar = json!({
+        "format": "rgba16f-le",
+        "bytes_per_texel": BYTES_PER_TEXEL,
+        "width": table.nx,
+        "height": table.ny,
+        "depth": table.nz,
+        "texel_order": "x fastest, then y, then z: byte offset 8·((z·height + y)·width + x); RGBA binary16 little-endian, A = 1",
+        "table": manifest.name,
+        "kind": manifest.kind.to_string(),
+        "quantity": quantity,
+        "axes": axes,
+        "mapping": mapping,
+        "shader_params": params,
+    });
+    Ok(RawTexture3d {
+        width: table.nx,
+        height: table.ny,
+        depth: table.nz,
+        bytes: rgba16f_bytes(&table),
+        sidecar,
+    })
+}
+
+/// The sidecar path of a raw file: the same path with extension `json`.
+pub fn sidecar_path(raw_path: &Path) -> PathBuf {
+    raw_path.with_extension("json")
+}
+
+/// Writes `texture` to `raw_path` and its sidecar beside it ([`sidecar_path`]) as one atomic
+/// unit. Errors: a `raw_path` without a file name or ending in `.json` (it would be its own
+/// sidecar; context `--out`), or the write itself.
+pub fn write_raw(raw_path: &Path, texture: &RawTexture3d) -> Result<PathBuf> {
+    let invalid = |message: &str| Error::Invalid {
+        context: "--out".into(),
+        message: format!("{}: {message}", raw_path.display()),
+    };
+    let name = raw_path
+        .file_name()
+        .and_then(|n| n.to_str())
+        .ok_or_else(|| invalid("needs a file name (UTF-8)"))?;
+    if raw_path.extension().is_some_and(|e| e == "json") {
+        return Err(invalid(
+            "ends in .json, the sidecar's extension (use e.g. .raw)",
+        ));
+    }
+    let sidecar = sidecar_path(raw_path);
+    let sidecar_name = sidecar
+        .file_name()
+        .and_then(|n| n.to_str())
+        .ok_or_else(|| invalid("needs a file name (UTF-8)"))?
+        .to_string();
+    let dir = match raw_path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let mut json = serde_json::to_vec_pretty(&texture.sidecar).expect("JSON values serialise");
+    json.push(b'\n');
+    write_files_atomic(
+        dir,
+        &[
+            (name.to_string(), texture.bytes.clone()),
+            (sidecar_name, json),
+        ],
+    )?;
+    Ok(sidecar)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::set::default_baked_dir;
+
+    fn texel(bytes: &[u8], t: &RawTexture3d, x: usize, y: usize, z: usize) -> [f32; 4] {
+        let o = BYTES_PER_TEXEL * ((z * t.height + y) * t.width + x);
+        let h =
+            |i: usize| half::f16::from_le_bytes([bytes[o + 2 * i], bytes[o + 2 * i + 1]]).to_f32();
+        [h(0), h(1), h(2), h(3)]
+    }
+
+    #[test]
+    fn film_lut_round_trips_through_the_raw_layout() {
+        let path = default_baked_dir().join("soap-film.json");
+        let m = Manifest::read(&path).unwrap();
+        for quantity in ["reflectance", "transmittance"] {
+            let table = m.load_table(&path, quantity).unwrap().unwrap();
+            let raw = export_raw(&path, quantity).unwrap();
+            assert_eq!(
+                (raw.width, raw.height, raw.depth),
+                (table.nx, table.ny, table.nz)
+            );
+            assert_eq!(
+                raw.bytes.len(),
+                table.nx * table.ny * table.nz * BYTES_PER_TEXEL
+            );
+            for (x, y, z) in [
+                (0, 0, 0),
+                (table.nx - 1, 3, 1),
+                (5, table.ny - 1, table.nz - 1),
+            ] {
+                let got = texel(&raw.bytes, &raw, x, y, z);
+                let want = table.texel(x, y, z);
+                for c in 0..3 {
+                    assert_eq!(
+                        got[c],
+                        half::f16::from_f32(want[c]).to_f32(),
+                        "{quantity} ({x}, {y}, {z})"
+                    );
+                }
+                assert_eq!(got[3], 1.0);
+            }
+            assert_eq!(raw.sidecar["width"], table.nx);
+            assert_eq!(raw.sidecar["shader_params"]["has_transmittance"], 1);
+        }
+    }
+
+    #[test]
+    fn wrong_kinds_quantities_and_outputs_are_errors() {
+        let dir = default_baked_dir();
+        let e = export_raw(&dir.join("fourier-srgb.json"), "reflectance").unwrap_err();
+        assert!(e.to_string().contains("--table"), "{e}");
+        let e = export_raw(&dir.join("film-gold.json"), "transmittance").unwrap_err();
+        assert!(e.to_string().contains("--quantity"), "{e}");
+        let e = export_raw(&dir.join("soap-film.json"), "albedo").unwrap_err();
+        assert!(e.to_string().contains("--quantity"), "{e}");
+        let e = export_raw(&dir.join("no-such-table.json"), "reflectance").unwrap_err();
+        assert!(e.to_string().contains("no-such-table.json"), "{e}");
+        let raw = export_raw(&dir.join("soap-film.json"), "reflectance").unwrap();
+        let e = write_raw(Path::new("out.json"), &raw).unwrap_err();
+        assert!(e.to_string().contains("--out"), "{e}");
+    }
+}
