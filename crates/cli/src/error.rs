@@ -38,6 +38,7 @@ pub fn flag(param: Param) -> &'static str {
         Param::Surface => "FILE|SPEC",
         Param::Table => "--table",
         Param::Tables => "--tables",
+        Param::Out => "--out",
         Param::Layout => "--layout",
         Param::IntegratedSamples => "--integrated-samples",
         Param::Pitch => "--pitch",

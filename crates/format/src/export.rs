@@ -70,17 +70,18 @@ pub fn export_raw(manifest_path: &Path, quantity: &str) -> Result<RawTexture3d> 
     let manifest = Manifest::read(manifest_path)?;
     if !matches!(quantity, "reflectance" | "transmittance") {
         return Err(Error::Invalid {
-            context: "--quantity".into(),
-            message: format!("`{quantity}`: expected `reflectance` or `transmittance`"),
+            context: crate::param::Param::Quantity.into(),
+            message: format!("`{quantity}`: expected `reflectance` or `transmittance`").into(),
         });
     }
     let missing = || Error::Invalid {
-        context: "--quantity".into(),
+        context: crate::param::Param::Quantity.into(),
         message: format!(
             "table `{}` ({}) has no {quantity}",
             manifest.name,
             manifest_path.display()
-        ),
+        )
+        .into(),
     };
     let texel_centres = "texel i of an axis of count texels holds t = i/(count − 1), \
                          sampled at u = (t (count − 1) + 0.5)/count; linear filtering, clamp to edge";
@@ -146,19 +147,20 @@ pub fn export_raw(manifest_path: &Path, quantity: &str) -> Result<RawTexture3d> 
         }
         other => {
             return Err(Error::Invalid {
-                context: "--table".into(),
+                context: crate::param::Param::Table.into(),
                 message: format!(
                     "table `{}` ({}) is a `{other}` table; export writes 3-D textures of \
                      `film-lut` and `rough-film-lut` tables",
                     manifest.name,
                     manifest_path.display()
-                ),
+                )
+                .into(),
             });
         }
     };
     let axes = axes.map_err(|e| Error::Invalid {
-        context: manifest_path.display().to_string(),
-        message: format!("axes do not serialise: {e}"),
+        context: manifest_path.display().to_string().into(),
+        message: format!("axes do not serialise: {e}").into(),
     })?;
     let sidecar = json!({
         "format": "rgba16f-le",
@@ -190,11 +192,11 @@ pub fn sidecar_path(raw_path: &Path) -> PathBuf {
 
 /// Writes `texture` to `raw_path` and its sidecar beside it ([`sidecar_path`]) as one atomic
 /// unit. Errors: a `raw_path` without a file name or ending in `.json` (it would be its own
-/// sidecar; context `--out`), or the write itself.
+/// sidecar; the `out` parameter), or the write itself.
 pub fn write_raw(raw_path: &Path, texture: &RawTexture3d) -> Result<PathBuf> {
     let invalid = |message: &str| Error::Invalid {
-        context: "--out".into(),
-        message: format!("{}: {message}", raw_path.display()),
+        context: crate::param::Param::Out.into(),
+        message: format!("{}: {message}", raw_path.display()).into(),
     };
     let name = raw_path
         .file_name()

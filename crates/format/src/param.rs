@@ -131,6 +131,8 @@ params! {
     EnvSamples => "env_samples",
     /// Monte Carlo samples of a reference.
     ReferenceSamples => "reference_samples",
+    /// The file an export writes.
+    Out => "out",
 }
 
 impl Param {
