@@ -162,7 +162,7 @@ type StructLayout = (&'static str, u32, &'static [(&'static str, u32)]);
 /// reproduce (see the layout comments in the `.wgsl` files).
 #[test]
 fn uniform_layouts_match_the_documented_ones() {
-    let expected: [StructLayout; 5] = [
+    let expected: [StructLayout; 7] = [
         (
             "FilmInput",
             64,
@@ -172,7 +172,7 @@ fn uniform_layouts_match_the_documented_ones() {
                 ("film_ior", 8),
                 ("sigma_thickness_nm", 12),
                 ("ambient_ior", 16),
-                ("_pad0", 20),
+                ("variation", 20),
                 ("_pad1", 24),
                 ("_pad2", 28),
                 ("base_ior", 32),
@@ -229,6 +229,34 @@ fn uniform_layouts_match_the_documented_ones() {
             16,
             &[("count", 0), ("_pad0", 4), ("_pad1", 8), ("_pad2", 12)],
         ),
+        (
+            "StackNode",
+            32,
+            &[
+                ("wavelength_nm", 0),
+                ("_pad0", 4),
+                ("_pad1", 8),
+                ("_pad2", 12),
+                ("weight", 16),
+            ],
+        ),
+        (
+            "StackParams",
+            288,
+            &[
+                ("films", 0),
+                ("dispersive", 4),
+                ("rule_count", 8),
+                ("fixed", 12),
+                ("base_count", 16),
+                ("count_per_opd_nm", 20),
+                ("finesse", 24),
+                ("_pad0", 28),
+                ("rule_offset", 32),
+                ("rule_size", 96),
+                ("layers", 160),
+            ],
+        ),
     ];
     let modules: Vec<naga::Module> = Technique::ALL
         .iter()
@@ -257,6 +285,9 @@ fn uniform_layouts_match_the_documented_ones() {
         assert_eq!(actual, members, "{struct_name}: member offsets");
         assert_eq!(actual_span, span, "{struct_name}: size");
     }
+    // The host mirrors of film_stack's structs.
+    assert_eq!(std::mem::size_of::<nacre_runtime::params::StackNode>(), 32);
+    assert_eq!(std::mem::size_of::<nacre_runtime::params::StackParams>(), 288);
 }
 
 #[test]
