@@ -117,6 +117,36 @@ impl fmt::Display for CliError {
 
 impl std::error::Error for CliError {}
 
+impl CliError {
+    /// True when the error is a write into a closed pipe (`nacre spectrum | head`): the
+    /// reader has what it wanted, and Unix tools end quietly then.
+    pub fn is_broken_pipe(&self) -> bool {
+        let mut next: Option<&(dyn std::error::Error + 'static)> = Some(match self {
+            CliError::Bake(e) => e,
+            CliError::Format(e) => e,
+            CliError::Runtime(e) => e,
+        });
+        let broken = |io: &std::io::Error| io.kind() == std::io::ErrorKind::BrokenPipe;
+        while let Some(e) = next {
+            if let Some(io) = e.downcast_ref::<std::io::Error>() {
+                if broken(io) {
+                    return true;
+                }
+                // An error wrapped into an I/O error (the CSV writer's): look inside it.
+                next = io
+                    .get_ref()
+                    .map(|inner| inner as &(dyn std::error::Error + 'static));
+            } else if let Some(c) = e.downcast_ref::<csv::Error>() {
+                // The CSV writer keeps the I/O error in its kind, not as a source.
+                return matches!(c.kind(), csv::ErrorKind::Io(io) if broken(io));
+            } else {
+                next = e.source();
+            }
+        }
+        false
+    }
+}
+
 impl From<nacre_bake::Error> for CliError {
     fn from(e: nacre_bake::Error) -> Self {
         CliError::Bake(e)
@@ -144,6 +174,58 @@ mod tests {
         let mut seen = std::collections::HashSet::new();
         for &p in Param::ALL {
             assert!(seen.insert(flag(p)), "{p:?}: {} twice", flag(p));
+        }
+    }
+}
+
+#[cfg(test)]
+mod pipe_tests {
+    use super::*;
+
+    #[test]
+    fn broken_pipes_are_found_through_wrappers() {
+        let io = || std::io::Error::from(std::io::ErrorKind::BrokenPipe);
+        let direct = CliError::Format(nacre_format::Error::Io {
+            path: "-".into(),
+            source: io(),
+        });
+        let mut chain = String::new();
+        let mut next: Option<&(dyn std::error::Error + 'static)> = match &direct {
+            CliError::Format(e) => Some(e),
+            _ => None,
+        };
+        while let Some(e) = next {
+            chain.push_str(&format!("[{e:?}] "));
+            next = e.source();
+        }
+        assert!(direct.is_broken_pipe(), "{chain}");
+        // The CSV writer's error inside an I/O error of kind Other.
+        let csv_error = {
+            let mut w = csv::Writer::from_writer(Failing);
+            w.write_record(["a"])
+                .and_then(|()| w.flush().map_err(csv::Error::from))
+        }
+        .unwrap_err();
+        let wrapped = CliError::Format(nacre_format::Error::Io {
+            path: "-".into(),
+            source: std::io::Error::other(csv_error),
+        });
+        assert!(wrapped.is_broken_pipe(), "{wrapped:?}");
+        let other = CliError::Format(nacre_format::Error::Io {
+            path: "-".into(),
+            source: std::io::Error::from(std::io::ErrorKind::PermissionDenied),
+        });
+        assert!(!other.is_broken_pipe());
+    }
+
+    /// A writer whose reader has gone.
+    struct Failing;
+    impl std::io::Write for Failing {
+        fn write(&mut self, _: &[u8]) -> std::io::Result<usize> {
+            Err(std::io::ErrorKind::BrokenPipe.into())
+        }
+        fn flush(&mut self) -> std::io::Result<()> {
+            Err(std::io::ErrorKind::BrokenPipe.into())
         }
     }
 }

@@ -1092,6 +1092,8 @@ fn main() -> ExitCode {
     };
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
+        // `nacre spectrum | head`: the reader closed the pipe; end quietly.
+        Err(e) if e.is_broken_pipe() => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("nacre: error: {e}");
             ExitCode::from(2)

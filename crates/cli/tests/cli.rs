@@ -1012,3 +1012,33 @@ fn export_writes_a_raw_texture_and_sidecar() {
         assert!(!dir.path().join("x.raw").exists() && !dir.path().join("x.json").exists());
     }
 }
+
+/// `nacre spectrum | head`: a reader that closes the pipe early ends the command quietly
+/// (status 0, nothing on stderr), as Unix tools do.
+#[test]
+fn a_closed_pipe_ends_quietly() {
+    use std::io::Read;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_nacre"))
+        .args([
+            "spectrum",
+            "--angles",
+            "0:89:0.05",
+            "--wavelengths",
+            "380:780:1",
+        ])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut first = [0u8; 64];
+    child
+        .stdout
+        .as_mut()
+        .unwrap()
+        .read_exact(&mut first)
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    assert!(out.status.success(), "{:?}: {}", out.status, stderr(&out));
+    assert!(out.stderr.is_empty(), "{}", stderr(&out));
+}

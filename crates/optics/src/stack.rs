@@ -96,9 +96,10 @@ impl Power {
     pub fn T(&self) -> f64 {
         0.5 * (self.T_s + self.T_p)
     }
-    /// Unpolarised absorptance A = 1 − R − T.
+    /// Unpolarised absorptance A = 1 − R − T, never below 0: for a lossless stack R + T is 1
+    /// up to rounding, and the difference can come out as −10⁻¹⁶.
     pub fn A(&self) -> f64 {
-        1.0 - self.R() - self.T()
+        (1.0 - self.R() - self.T()).max(0.0)
     }
 }
 

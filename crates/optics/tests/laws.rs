@@ -226,3 +226,28 @@ fn sweeps_are_deterministic_across_thread_counts() {
     };
     assert_eq!(run(1), run(3));
 }
+
+/// Absorptance is never negative: lossless stacks have R + T = 1 up to rounding, and
+/// A = 1 − R − T is reported as 0 there, not −10⁻¹⁶ (issue 16 §5).
+#[test]
+fn absorptance_is_never_negative() {
+    let stack = Stack::new(
+        medium(1.0, 0.0),
+        vec![film(1.33, 0.0, 400.0), film(2.3, 0.0, 87.0)],
+        medium(1.52, 0.0),
+    )
+    .unwrap();
+    let mut negative_before_clamp = 0;
+    for a in 0..90 {
+        for w in 380..=780 {
+            let p = power(&stack, f64::from(a), f64::from(w));
+            assert!(p.A() >= 0.0, "A = {} at {a}°, {w} nm", p.A());
+            assert!(p.A() < 1e-12);
+            if 1.0 - p.R() - p.T() < 0.0 {
+                negative_before_clamp += 1;
+            }
+        }
+    }
+    // The clamp is not idle: rounding does go below zero on this sweep.
+    assert!(negative_before_clamp > 0);
+}

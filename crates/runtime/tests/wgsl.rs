@@ -287,7 +287,10 @@ fn uniform_layouts_match_the_documented_ones() {
     }
     // The host mirrors of film_stack's structs.
     assert_eq!(std::mem::size_of::<nacre_runtime::params::StackNode>(), 32);
-    assert_eq!(std::mem::size_of::<nacre_runtime::params::StackParams>(), 288);
+    assert_eq!(
+        std::mem::size_of::<nacre_runtime::params::StackParams>(),
+        288
+    );
 }
 
 #[test]
