@@ -415,8 +415,9 @@ fn ggx_albedo(n_dot_v: f32, alpha: f32) -> f32 {
 
 // ─── Film ────────────────────────────────────────────────────────────────────────────────
 
-// The technique's input for incidence cos θ and the point's thickness statistics.
-fn material_film_input(cos_theta: f32, thickness_nm: f32, sigma_thickness_nm: f32, variation: f32) -> FilmInput {
+// The technique's input for incidence cos θ, the point's thickness statistics and a base of
+// index n + iκ per channel (`base_ior`, `base_kappa`: one lobe of SurfaceMaterial).
+fn material_film_input(cos_theta: f32, thickness_nm: f32, sigma_thickness_nm: f32, variation: f32, base_ior: vec3<f32>, base_kappa: vec3<f32>) -> FilmInput {
     let p = material_params;
     var input: FilmInput;
     input.cos_theta_i = cos_theta;
@@ -425,18 +426,28 @@ fn material_film_input(cos_theta: f32, thickness_nm: f32, sigma_thickness_nm: f3
     input.sigma_thickness_nm = sigma_thickness_nm;
     input.ambient_ior = p.ambient_ior;
     input.variation = variation;
-    input.base_ior = p.base_ior;
-    input.base_kappa = p.base_kappa;
+    input.base_ior = base_ior;
+    input.base_kappa = base_kappa;
     return input;
 }
 
 // The bare base's unpolarised Fresnel reflectance per channel at incidence cos θ, seen from
 // the ambient n₁ (fresnel_interface, (|r_s|² + |r_p|²)/2): the film-free part of a partially
-// coated surface (film_weight < 1).
-fn material_base_reflectance(cos_theta: f32) -> vec3<f32> {
+// coated surface (film_weight < 1). The base is the uniform's (MaterialParams.base_ior/kappa),
+// except for the metal lobe of a two-lobe point (`schlick`), whose bare reflectance is
+// glTF's F_schlick(F0, v·h) with F0 the metal index's normal-incidence reflectance (glTF 2.0
+// Appendix B, conductor_fresnel). (Reading the index from the uniform, not from values
+// passed in, avoids a crash of lavapipe's LLVM back end of Mesa 22.)
+fn material_base_reflectance(cos_theta: f32, schlick: bool, metal_ior: vec3<f32>, metal_kappa: vec3<f32>) -> vec3<f32> {
     let p = material_params;
-    let n1 = select(1.0, p.ambient_ior, f32_is_finite(p.ambient_ior) && p.ambient_ior > 0.0);
     let c = clamp(finite_or(cos_theta, 1.0), 1e-6, 1.0);
+    if schlick {
+        let n = max(metal_ior, vec3<f32>(1e-3));
+        let k2 = metal_kappa * metal_kappa;
+        let f0 = ((n - 1.0) * (n - 1.0) + k2) / ((n + 1.0) * (n + 1.0) + k2);
+        return clamp(f0 + (1.0 - f0) * pow(1.0 - c, 5.0), vec3<f32>(0.0), vec3<f32>(1.0));
+    }
+    let n1 = select(1.0, p.ambient_ior, f32_is_finite(p.ambient_ior) && p.ambient_ior > 0.0);
     let q0 = c_real(n1 * c);
     var r = vec3<f32>(0.0);
     for (var j = 0; j < 3; j++) {
@@ -447,14 +458,14 @@ fn material_base_reflectance(cos_theta: f32) -> vec3<f32> {
     return r;
 }
 
-// The film's output blended with the bare base for a film weight w < 1 (see the header);
-// w ≥ 1 (or NaN) returns the film unchanged.
-fn material_weight_film(film: FilmOutput, cos_theta: f32) -> FilmOutput {
-    let w = clamp(finite_or(material_params.film_weight, 1.0), 0.0, 1.0);
+// The film's output blended with the bare base (index n + iκ) for a film weight w < 1 (see
+// the header); w ≥ 1 (or NaN) returns the film unchanged.
+fn material_weight_film(film: FilmOutput, cos_theta: f32, weight: f32, schlick: bool, base_ior: vec3<f32>, base_kappa: vec3<f32>) -> FilmOutput {
+    let w = clamp(finite_or(weight, 1.0), 0.0, 1.0);
     if w >= 1.0 {
         return film;
     }
-    let f_base = material_base_reflectance(cos_theta);
+    let f_base = material_base_reflectance(cos_theta, schlick, base_ior, base_kappa);
     var out: FilmOutput;
     out.reflectance = mix(f_base, film.reflectance, w);
     out.transmittance = mix(vec3<f32>(1.0) - f_base, film.transmittance, w);
@@ -463,16 +474,16 @@ fn material_weight_film(film: FilmOutput, cos_theta: f32) -> FilmOutput {
 
 // E_f(μ_o, α, d, n₂): the iridescent GGX lobe's directional albedo from the rough-film-lut
 // (two trilinear fetches, rough_lut_sample), blended for a film weight w < 1 with the bare
-// base's F_base(n·v) E₁(n·v, α).
-fn material_rough_film_albedo(n_dot_v: f32, alpha: f32, thickness_nm: f32) -> vec3<f32> {
+// base's F_base(n·v) E₁(n·v, α) (base index n + iκ).
+fn material_rough_film_albedo(n_dot_v: f32, alpha: f32, thickness_nm: f32, weight: f32, schlick: bool, base_ior: vec3<f32>, base_kappa: vec3<f32>) -> vec3<f32> {
     let p = material_params;
     let e = rough_lut_sample(env_rough_lut, env_lut_sampler, env_rough_lut_params, n_dot_v, alpha, thickness_nm, p.film_ior);
     let e_film = select(vec3<f32>(0.0), clamp(e, vec3<f32>(0.0), vec3<f32>(1.0)), vec3_is_finite(e));
-    let w = clamp(finite_or(p.film_weight, 1.0), 0.0, 1.0);
+    let w = clamp(finite_or(weight, 1.0), 0.0, 1.0);
     if w >= 1.0 {
         return e_film;
     }
-    return mix(material_base_reflectance(n_dot_v) * ggx_albedo(n_dot_v, alpha), e_film, w);
+    return mix(material_base_reflectance(n_dot_v, schlick, base_ior, base_kappa) * ggx_albedo(n_dot_v, alpha), e_film, w);
 }
 
 // ─── Shading ─────────────────────────────────────────────────────────────────────────────
@@ -500,33 +511,116 @@ struct ShadeResult {
     transmittance: vec3<f32>,
 }
 
-// Shades one point of the film-coated surface (see the header for the model).
+// The material at one shading point: what glTF's textures vary per point (mesh.wgsl fills it
+// from the textures of a glTF material), or the uniform's constants (`material_surface`, the
+// analytic scenes). glTF 2.0 specification, Appendix B (BRDF implementation):
+//
+//   material = mix(dielectric_brdf, metal_brdf, metallic)
+//   dielectric_brdf = fresnel_mix(ior, diffuse_brdf(ρ), specular_brdf(α))
+//   metal_brdf = conductor_fresnel(baseColor, specular_brdf(α))
+//
+// with KHR_materials_iridescence's film on both lobes (the extension's "Iridescence" section:
+// the dielectric lobe's Fresnel term becomes the film over the dielectric base, the metal
+// lobe's the film over the metal; weight w = iridescenceFactor × its texture's R), each lobe
+// evaluated here by the technique (`film_colour`) on its own base index. A point whose
+// metallic m is 0 or 1 evaluates one lobe (the analytic scenes always do); 0 < m < 1 both.
+// KHR_materials_specular scales the dielectric lobe's reflectance by specular × specularColor
+// (exact at normal incidence while F0 specularColor ≤ 1; the extension's F90 = specular is
+// approximated by the same scale at grazing angles).
+struct SurfaceMaterial {
+    // Lambertian albedo ρ of the dielectric lobe (linear RGB).
+    diffuse_colour: vec3<f32>,
+    // m ∈ [0, 1]: the metal lobe's share.
+    metallic: f32,
+    // Base index of the dielectric lobe per channel (real part; κ below).
+    dielectric_ior: vec3<f32>,
+    // GGX α.
+    roughness_alpha: f32,
+    dielectric_kappa: vec3<f32>,
+    // Film weight w ∈ [0, 1].
+    film_weight: f32,
+    // Base index of the metal lobe per channel.
+    metal_ior: vec3<f32>,
+    // Share t ∈ [0, 1] of the dielectric lobe that is a thin transparent shell (no diffuse).
+    transmission: f32,
+    metal_kappa: vec3<f32>,
+    // Factor on the environment's (indirect) light: glTF occlusion, 1 + strength (ao − 1).
+    occlusion: f32,
+    // Scale of the dielectric lobe's reflectance (KHR_materials_specular); 1 = none.
+    specular_colour: vec3<f32>,
+    // Which lobes are evaluated, the same for every point of a draw: 0 the dielectric only,
+    // 1 the metal only, 2 both (their shares 1 − m and m). (A per-point choice made
+    // lavapipe's LLVM back end of Mesa 22 crash.)
+    lobes: u32,
+}
+
+// The uniform's material at every point: one lobe, dielectric or metal (base_kind), the
+// uniform's base index for it, a thin shell when `transmission` is set.
+fn material_surface() -> SurfaceMaterial {
+    let p = material_params;
+    let metal = p.base_kind != MATERIAL_BASE_DIELECTRIC;
+    let diffuse_on = !metal && p.transmission == 0u;
+    var m: SurfaceMaterial;
+    m.diffuse_colour = select(vec3<f32>(0.0), clamp(p.base_colour, vec3<f32>(0.0), vec3<f32>(1.0)), diffuse_on && all(vec3_is_finite(p.base_colour)));
+    m.metallic = select(0.0, 1.0, metal);
+    m.dielectric_ior = p.base_ior;
+    m.dielectric_kappa = p.base_kappa;
+    m.metal_ior = p.base_ior;
+    m.metal_kappa = p.base_kappa;
+    m.roughness_alpha = p.roughness_alpha;
+    m.film_weight = p.film_weight;
+    m.transmission = select(0.0, 1.0, p.transmission != 0u);
+    m.occlusion = 1.0;
+    m.specular_colour = vec3<f32>(1.0);
+    m.lobes = select(0u, 1u, metal);
+    return m;
+}
+
+// Shades one point of the film-coated surface with the uniform's material.
+fn material_shade(s: SurfacePoint) -> ShadeResult {
+    return material_shade_with(s, material_surface());
+}
+
+// Shades one point of the film-coated surface (see the header for the model) with the
+// point's material `mat` (SurfaceMaterial: one or two lobes).
 //
 // Compile-time care: `film_colour` is called from exactly one place, inside a loop whose trip
-// count (1, or 2 when the light is above the surface) is not a compile-time constant, so that
-// shader compilers that inline every call (Mesa's NIR → LLVM in lavapipe) see one copy of the
-// technique — film_fourier's loops, inlined several times, make LLVM's loop analyses take
-// minutes. scene.wgsl likewise calls material_shade from one loop.
-fn material_shade(s: SurfacePoint) -> ShadeResult {
-    let p = material_params;
+// count (1, or 2 when the light is above the surface, times the lobes) is not a compile-time
+// constant, so that shader compilers that inline every call (Mesa's NIR → LLVM in lavapipe)
+// see one copy of the technique — film_fourier's loops, inlined several times, make LLVM's
+// loop analyses take minutes. scene.wgsl and mesh.wgsl likewise call this from one place.
+fn material_shade_with(s: SurfacePoint, mat: SurfaceMaterial) -> ShadeResult {
     let n = safe_normalize(s.normal, vec3<f32>(0.0, 1.0, 0.0));
     let v = safe_normalize(s.view_dir, n);
-    let alpha = clamp(finite_or(p.roughness_alpha, 0.0), MATERIAL_ALPHA_MIN, 1.0);
+    let alpha = clamp(finite_or(mat.roughness_alpha, 0.0), MATERIAL_ALPHA_MIN, 1.0);
     let n_dot_v = clamp(dot(n, v), MATERIAL_COS_MIN, 1.0);
-    let diffuse_on = p.base_kind == MATERIAL_BASE_DIELECTRIC && p.transmission == 0u;
-    let albedo = select(vec3<f32>(0.0), clamp(p.base_colour, vec3<f32>(0.0), vec3<f32>(1.0)), diffuse_on && all(vec3_is_finite(p.base_colour)));
+    let metallic = clamp(finite_or(mat.metallic, 0.0), 0.0, 1.0);
+    let transmission = clamp(finite_or(mat.transmission, 0.0), 0.0, 1.0);
+    let specular_scale = clamp(select(vec3<f32>(1.0), mat.specular_colour, vec3_is_finite(mat.specular_colour)), vec3<f32>(0.0), vec3<f32>(1.0));
+    let occlusion = clamp(finite_or(mat.occlusion, 1.0), 0.0, 1.0);
+    // The dielectric lobe's diffuse weight (1 − m)(1 − t); 0 for a metal or a thin shell.
+    let diffuse_weight = (1.0 - metallic) * (1.0 - transmission);
+    let albedo = select(vec3<f32>(0.0), clamp(mat.diffuse_colour, vec3<f32>(0.0), vec3<f32>(1.0)), diffuse_weight > 0.0 && all(vec3_is_finite(mat.diffuse_colour))) * diffuse_weight;
     let l = safe_normalize(view.light_direction, vec3<f32>(0.0, 1.0, 0.0));
     let n_dot_l = dot(n, l);
     let h = safe_normalize(v + l, n);
     let v_dot_h = clamp(dot(v, h), 0.0, 1.0);
-    let mode = select(MATERIAL_FILM_EVAL_CLASSIC, p.film_eval, p.film_eval <= MATERIAL_FILM_EVAL_EXACT);
+    let mode = select(MATERIAL_FILM_EVAL_CLASSIC, material_params.film_eval, material_params.film_eval <= MATERIAL_FILM_EVAL_EXACT);
+    // Lobes: 0 the dielectric, 1 the metal; both when 0 < m < 1.
+    let lobe_count = select(1u, 2u, mat.lobes == 2u);
+    let first_lobe = select(0u, 1u, mat.lobes == 1u);
 
-    // The film at n·v (environment, transmission, and every light for the shortcut), when
-    // the light is above the surface and the path evaluates the film per light at v·h, and
-    // for the exact path at each of the lobe's MATERIAL_LOBE_SAMPLES visible normals (see
-    // the header: the environment's distribution over the lobe, weighted by the film).
-    var film_v: FilmOutput;
-    var film_h: FilmOutput;
+    // Per lobe: the film at n·v (environment, transmission, and every light for the
+    // shortcut), when the light is above the surface and the path evaluates the film per
+    // light at v·h, and for the exact path at each of the lobe's MATERIAL_LOBE_SAMPLES visible
+    // normals (see the header: the environment's distribution over the lobe, weighted by the
+    // film). Each lobe's reflectance enters weighted by its share (1 − m or m).
+    // (Separate variables, not arrays indexed by the lobe: lavapipe's LLVM back end of Mesa
+    // 22 crashed on the divergent indexing.)
+    var film_v_d: FilmOutput;
+    var film_v_m: FilmOutput;
+    var film_h_d: FilmOutput;
+    var film_h_m: FilmOutput;
     let light_evaluations = select(0u, 1u, n_dot_l > 0.0 && mode != MATERIAL_FILM_EVAL_NV);
     let lobe_samples = select(0u, MATERIAL_LOBE_SAMPLES, mode == MATERIAL_FILM_EVAL_EXACT);
     let evaluations = 1u + light_evaluations + lobe_samples;
@@ -538,7 +632,13 @@ fn material_shade(s: SurfacePoint) -> ShadeResult {
     let lambda_o = ggx_lambda(wo.z, alpha);
     var lobe_film_env = vec3<f32>(0.0);
     var lobe_film = vec3<f32>(0.0);
-    for (var k = 0u; k < evaluations; k++) {
+    for (var kk = 0u; kk < evaluations * lobe_count; kk++) {
+        let lobe = first_lobe + kk / evaluations;
+        let k = kk % evaluations;
+        let base_ior = select(mat.dielectric_ior, mat.metal_ior, lobe == 1u);
+        let base_kappa = select(mat.dielectric_kappa, mat.metal_kappa, lobe == 1u);
+        let share = select(1.0, select(1.0 - metallic, metallic, lobe == 1u), lobe_count == 2u);
+        let scale = select(specular_scale, vec3<f32>(1.0), lobe == 1u) * share;
         var cos_theta = select(n_dot_v, v_dot_h, k == 1u && light_evaluations == 1u);
         var lobe_weight = 0.0;
         var lobe_dir = n;
@@ -556,37 +656,58 @@ fn material_shade(s: SurfacePoint) -> ShadeResult {
             let density = PI * f32(MATERIAL_LOBE_SAMPLES) * ggx_distribution(m.z, alpha);
             lobe_alpha = MATERIAL_LOBE_FIS_SCALE * sqrt(wo.z * (1.0 + lambda_o) / max(density, 1e-30));
         }
-        let film = material_weight_film(film_colour(material_film_input(cos_theta, s.thickness_nm, s.sigma_thickness_nm, s.variation)), cos_theta);
+        let film = material_weight_film(film_colour(material_film_input(cos_theta, s.thickness_nm, s.sigma_thickness_nm, s.variation, base_ior, base_kappa)), cos_theta, mat.film_weight, lobe == 1u && lobe_count == 2u, base_ior, base_kappa);
         if k == 0u {
-            film_v = film;
+            if lobe == 0u {
+                film_v_d = film;
+            } else {
+                film_v_m = film;
+            }
         } else if k <= light_evaluations {
-            film_h = film;
+            if lobe == 0u {
+                film_h_d = film;
+            } else {
+                film_h_m = film;
+            }
         } else {
-            let f = lobe_weight * film.reflectance;
+            let f = lobe_weight * film.reflectance * scale;
             lobe_film += f;
             lobe_film_env += f * env_prefiltered_radiance(lobe_dir, lobe_alpha);
         }
     }
     if mode == MATERIAL_FILM_EVAL_NV {
-        film_h = film_v;
+        film_h_d = film_v_d;
+        film_h_m = film_v_m;
     }
+    // The lobes' reflectances weighted by their shares (one lobe: itself, unscaled but for
+    // the dielectric's specular colour).
+    let one = vec3<f32>(1.0);
+    let w_d = select(1.0, 1.0 - metallic, lobe_count == 2u) * f32(first_lobe == 0u);
+    let w_m = select(1.0, metallic, lobe_count == 2u) * f32(first_lobe == 1u || lobe_count == 2u);
+    let spec_d = specular_scale * w_d;
+    let reflectance_v = film_v_d.reflectance * spec_d + film_v_m.reflectance * w_m;
+    let reflectance_h = film_h_d.reflectance * spec_d + film_h_m.reflectance * w_m;
+    // What the dielectric lobe's film does not reflect reaches its diffuse base.
+    let diffuse_v = max(one - film_v_d.reflectance * specular_scale, vec3<f32>(0.0));
+    let diffuse_h = max(one - film_h_d.reflectance * specular_scale, vec3<f32>(0.0));
 
     // Environment.
-    let one = vec3<f32>(1.0);
     let r = reflect(-v, n);
     var radiance = vec3<f32>(0.0);
     if mode == MATERIAL_FILM_EVAL_CLASSIC {
         // Specular at reflect(−v, n) with the film at n·v, diffuse at n.
-        radiance = env_radiance(r, env_specular_lod(alpha)) * film_v.reflectance * ggx_albedo_scale(alpha);
-        radiance += env_radiance(n, env_diffuse_lod()) * albedo * max(one - film_v.reflectance, vec3<f32>(0.0));
+        radiance = env_radiance(r, env_specular_lod(alpha)) * reflectance_v * ggx_albedo_scale(alpha);
+        radiance += env_radiance(n, env_diffuse_lod()) * albedo * diffuse_v;
     } else {
         // Split sum: L̃(r, α) · E.
         let e_one = ggx_albedo(n_dot_v, alpha);
-        var e_spec = film_v.reflectance * e_one;
-        var mean_reflectance = film_v.reflectance;
+        var e_spec = reflectance_v * e_one;
+        var mean_reflectance = film_v_d.reflectance * specular_scale;
         if mode == MATERIAL_FILM_EVAL_EXACT {
-            e_spec = material_rough_film_albedo(n_dot_v, alpha, s.thickness_nm);
-            mean_reflectance = e_spec / max(e_one, 1e-4);
+            let e_d = material_rough_film_albedo(n_dot_v, alpha, s.thickness_nm, mat.film_weight, false, mat.dielectric_ior, mat.dielectric_kappa);
+            let e_m = material_rough_film_albedo(n_dot_v, alpha, s.thickness_nm, mat.film_weight, lobe_count == 2u, mat.metal_ior, mat.metal_kappa);
+            e_spec = e_d * spec_d + e_m * w_m;
+            mean_reflectance = e_d * specular_scale / max(e_one, 1e-4);
         }
         var env_lobe = env_prefiltered_radiance(r, alpha);
         if mode == MATERIAL_FILM_EVAL_EXACT {
@@ -597,20 +718,21 @@ fn material_shade(s: SurfacePoint) -> ShadeResult {
         radiance = env_lobe * e_spec;
         radiance += env_radiance(n, env_diffuse_lod()) * albedo * max(one - mean_reflectance, vec3<f32>(0.0));
     }
+    radiance *= occlusion;
 
     // The directional light.
     if n_dot_l > 0.0 {
         let e_l = sanitize_radiance(view.light_colour * finite_or(view.light_intensity, 0.0));
-        let specular = ggx_distribution(dot(n, h), alpha) * ggx_visibility(n_dot_v, n_dot_l, alpha) * film_h.reflectance;
-        let diffuse = albedo / PI * max(one - film_h.reflectance, vec3<f32>(0.0));
+        let specular = ggx_distribution(dot(n, h), alpha) * ggx_visibility(n_dot_v, n_dot_l, alpha) * reflectance_h;
+        let diffuse = albedo / PI * diffuse_h;
         radiance += (specular + diffuse) * e_l * n_dot_l;
     }
 
     var out: ShadeResult;
     out.radiance = sanitize_radiance(radiance);
     out.transmittance = vec3<f32>(0.0);
-    if p.transmission != 0u {
-        out.transmittance = clamp(film_v.transmittance, vec3<f32>(0.0), one);
+    if transmission > 0.0 && first_lobe == 0u {
+        out.transmittance = clamp(film_v_d.transmittance * transmission * w_d, vec3<f32>(0.0), one);
     }
     return out;
 }

@@ -1,74 +1,271 @@
 // nacre · shaders/mesh.wgsl — consumer: rasterised triangle meshes (glTF scenes)
 // import: material
 //
-// A vertex shader (`mesh_vs`) that projects world-space vertices (position, normal, uv; the
-// runtime applies the glTF node transforms on the CPU) with MeshParams.view_proj, and a
-// fragment shader (`mesh_fs`) that shades each fragment with material.wgsl's
-// `material_shade` and writes the tone-mapped, sRGB-encoded colour to an Rgba8Unorm target
-// with a Depth32Float depth buffer (compare `less`). Composed after material.wgsl
-// (crates/runtime/src/mesh.rs: `shaders::compose(technique, &[MATERIAL, MESH])`); scene.wgsl
-// is the ray-cast alternative for the analytic scenes.
+// A vertex shader (`mesh_vs`) that projects world-space vertices (the runtime applies the glTF
+// node transforms on the CPU) with MeshParams.view_proj, and a fragment shader (`mesh_fs`)
+// that reads the glTF 2.0 metallic-roughness material of the primitive — factors × textures ×
+// vertex colour — and shades each fragment with material.wgsl's `material_shade_with`, then
+// writes the tone-mapped, sRGB-encoded colour to an Rgba8Unorm target with a Depth32Float
+// depth buffer (compare `less`). Composed after material.wgsl (crates/runtime/src/mesh.rs:
+// `shaders::compose(technique, &[MATERIAL, MESH])`); scene.wgsl is the ray-cast alternative
+// for the analytic scenes.
 //
-// Symbols
+// The material (glTF 2.0 specification §3.9 "Materials" and Appendix B; the KHR extension
+// specifications named):
 //
-//   symbol   code              meaning
-//   x        position          world-space vertex position, world units
-//   n        normal            world-space unit normal, flipped to face the viewer (meshes
-//                              are drawn double-sided, without culling)
-//   v        view_dir          unit vector from the fragment towards the eye
-//   uv       uv                texture coordinates of the thickness texture (glTF TEXCOORD_n;
-//                              (0, 0) = the image's first texel)
-//   g        moments.x         thickness-texture value E[g] (its green channel; the runtime
-//                              binds a 1×1 map of g = 1 when the material has no texture, so
-//                              d = d_max as glTF KHR_materials_iridescence prescribes)
-//   d        thickness_nm      mix(d_min, d_max, g) (material_thickness_nm, mode 1)
-//   σ_d      sigma_nm          from d's screen-space derivatives and the map's sub-pixel
-//                              variance E[g²] − E[g]² (material_thickness_sigma)
+//   baseColor   = baseColorFactor × baseColorTexture (sRGB-decoded by the Rgba8UnormSrgb
+//                 format) × COLOR_0
+//   metallic    = metallicFactor × metallicRoughnessTexture.b
+//   roughness   = roughnessFactor × metallicRoughnessTexture.g,   GGX α = roughness²
+//   n           = normalize(TBN (normalTexture.rgb × 2 − 1) × (scale, scale, 1)), TBN from
+//                 TANGENT (xyz, w = bitangent sign) or MikkTSpace tangents made by the runtime
+//   occlusion   = 1 + occlusionStrength (occlusionTexture.r − 1), on the environment only
+//   emission    = emissiveFactor × emissiveStrength (KHR_materials_emissive_strength) ×
+//                 emissiveTexture (sRGB), added to the radiance
+//   alpha       = baseColor.a: MASK discards below alphaCutoff, BLEND outputs it (the
+//                 pipeline blends src-alpha over what is behind), OPAQUE ignores it
+//   film weight = iridescenceFactor × iridescenceTexture.r (KHR_materials_iridescence)
+//   g           = iridescenceThicknessTexture.g → d = mix(d_min, d_max, g) (group 2's map)
+//   specular    = specularFactor × specularTexture.a, × specularColorFactor ×
+//                 specularColorTexture (sRGB) (KHR_materials_specular): the dielectric lobe's
+//                 reflectance scale (material.wgsl, SurfaceMaterial)
+//   metal lobe  = the complex index whose normal-incidence reflectance is baseColor, per
+//                 channel, with edge tint = baseColor (Gulbrandsen 2014, Eq. 1–2; the same
+//                 inversion as crates/runtime/src/gltf_scene.rs metal_index_gulbrandsen2014)
 //
-// Transmission (thin shells, MaterialParams.transmission = 1): the fragment adds
-// T_f · L_env(−v), the environment straight behind it (other meshes behind a transparent one
-// are not seen: there is no order-independent transparency here).
+// Texture coordinates: each texture reads TEXCOORD_0 or TEXCOORD_1 through its
+// KHR_texture_transform, uv' = (a u + b v + c, d u + e v + f) (MeshParams.transforms).
 //
-// Bind groups: 0 view, 1 technique, 2 material (material.wgsl), 3 the mesh pass:
+// Transmission (thin shells, KHR_materials_transmission ≥ 0.5 in the runtime's mapping): the
+// fragment adds T_f · L_env(−v), the environment straight behind it (other meshes behind a
+// transparent one are not seen: no refraction of the scene yet).
 //
-// 64 bytes, uniform, vertex stage (mirrored by `MeshUniform` in crates/runtime/src/mesh.rs):
+// Double-sided: the shading normal faces the viewer (a back face's normal and tangent frame
+// are reversed, as glTF prescribes); single-sided materials are culled by the pipeline.
+//
+// Bind groups: 0 view, 1 technique, 2 material (material.wgsl), 3 the primitive's glTF
+// material (MeshParams, 8 textures and their samplers):
+//
+// 432 bytes, uniform (mirrored by `MeshUniform` in crates/runtime/src/mesh.rs):
 //
 //   offset size field
 //        0   64 view_proj: mat4x4<f32>     world → clip (x, y ∈ [−1, 1], z ∈ [0, 1] near → far)
-struct MeshParams {
-    view_proj: mat4x4<f32>,
+//       64   16 base_colour: vec4<f32>     baseColorFactor (linear RGBA)
+//       80   12 emissive: vec3<f32>        emissiveFactor × emissiveStrength
+//       92    4 metallic: f32              metallicFactor
+//       96   12 specular_colour: vec3<f32> specularColorFactor
+//      108    4 roughness: f32             roughnessFactor
+//      112    4 specular: f32              specularFactor
+//      116    4 normal_scale: f32          normalTexture.scale
+//      120    4 occlusion_strength: f32    occlusionTexture.strength
+//      124    4 alpha_cutoff: f32          alphaCutoff (MASK)
+//      128    4 dielectric_ior: f32        ior (KHR_materials_ior)
+//      132    4 iridescence: f32           iridescenceFactor
+//      136    4 alpha_mode: u32            0 OPAQUE, 1 MASK, 2 BLEND
+//      140    4 flags: u32                 bit 0: a normal texture is bound
+//      144    4 transmission: f32          thin-shell share of the dielectric lobe
+//      148    4 lobes: u32                 0 dielectric lobe only, 1 metal only, 2 both
+//      152    8 _pad
+//      160  288 transforms: array<TexTransform, 9>  per slot (MESH_TEX_*): rows (a, b, c, set),
+//                                                     (d, e, f, 0)
+struct TexTransform {
+    row0: vec4<f32>,
+    row1: vec4<f32>,
 }
 
+struct MeshParams {
+    view_proj: mat4x4<f32>,
+    base_colour: vec4<f32>,
+    emissive: vec3<f32>,
+    metallic: f32,
+    specular_colour: vec3<f32>,
+    roughness: f32,
+    specular: f32,
+    normal_scale: f32,
+    occlusion_strength: f32,
+    alpha_cutoff: f32,
+    dielectric_ior: f32,
+    iridescence: f32,
+    alpha_mode: u32,
+    flags: u32,
+    transmission: f32,
+    lobes: u32,
+    _pad1: f32,
+    _pad2: f32,
+    transforms: array<TexTransform, 9>,
+}
+
+// Texture slots (bindings 1 + 2 k texture, 2 + 2 k sampler); slot 8 (the thickness texture,
+// bound in group 2) has a transform only.
+const MESH_TEX_BASE: u32 = 0u;
+const MESH_TEX_METAL_ROUGH: u32 = 1u;
+const MESH_TEX_NORMAL: u32 = 2u;
+const MESH_TEX_OCCLUSION: u32 = 3u;
+const MESH_TEX_EMISSIVE: u32 = 4u;
+const MESH_TEX_IRIDESCENCE: u32 = 5u;
+const MESH_TEX_SPECULAR: u32 = 6u;
+const MESH_TEX_SPECULAR_COLOUR: u32 = 7u;
+const MESH_TEX_THICKNESS: u32 = 8u;
+const MESH_ALPHA_MASK: u32 = 1u;
+const MESH_ALPHA_BLEND: u32 = 2u;
+const MESH_FLAG_NORMAL_MAP: u32 = 1u;
+
 @group(3) @binding(0) var<uniform> mesh_params: MeshParams;
+@group(3) @binding(1) var mesh_base_tex: texture_2d<f32>;
+@group(3) @binding(2) var mesh_base_smp: sampler;
+@group(3) @binding(3) var mesh_mr_tex: texture_2d<f32>;
+@group(3) @binding(4) var mesh_mr_smp: sampler;
+@group(3) @binding(5) var mesh_normal_tex: texture_2d<f32>;
+@group(3) @binding(6) var mesh_normal_smp: sampler;
+@group(3) @binding(7) var mesh_occlusion_tex: texture_2d<f32>;
+@group(3) @binding(8) var mesh_occlusion_smp: sampler;
+@group(3) @binding(9) var mesh_emissive_tex: texture_2d<f32>;
+@group(3) @binding(10) var mesh_emissive_smp: sampler;
+@group(3) @binding(11) var mesh_iridescence_tex: texture_2d<f32>;
+@group(3) @binding(12) var mesh_iridescence_smp: sampler;
+@group(3) @binding(13) var mesh_specular_tex: texture_2d<f32>;
+@group(3) @binding(14) var mesh_specular_smp: sampler;
+@group(3) @binding(15) var mesh_specular_colour_tex: texture_2d<f32>;
+@group(3) @binding(16) var mesh_specular_colour_smp: sampler;
 
 struct MeshVertexOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) world: vec3<f32>,
     @location(1) normal: vec3<f32>,
-    @location(2) uv: vec2<f32>,
+    @location(2) tangent: vec4<f32>,
+    @location(3) uv0: vec2<f32>,
+    @location(4) uv1: vec2<f32>,
+    @location(5) colour: vec4<f32>,
 }
 
 @vertex
-fn mesh_vs(@location(0) position: vec3<f32>, @location(1) normal: vec3<f32>, @location(2) uv: vec2<f32>) -> MeshVertexOut {
+fn mesh_vs(
+    @location(0) position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) tangent: vec4<f32>,
+    @location(3) uv0: vec2<f32>,
+    @location(4) uv1: vec2<f32>,
+    @location(5) colour: vec4<f32>,
+) -> MeshVertexOut {
     var out: MeshVertexOut;
-    out.uv = uv;
     out.clip = mesh_params.view_proj * vec4<f32>(position, 1.0);
     out.world = position;
     out.normal = normal;
+    out.tangent = tangent;
+    out.uv0 = uv0;
+    out.uv1 = uv1;
+    out.colour = colour;
     return out;
 }
 
+// The coordinates of texture slot k: its set through its KHR_texture_transform (non-finite →
+// (0, 0)).
+fn mesh_uv(k: u32, uv0: vec2<f32>, uv1: vec2<f32>) -> vec2<f32> {
+    let t = mesh_params.transforms[k];
+    let uv = vec3<f32>(select(uv0, uv1, t.row0.w > 0.5), 1.0);
+    let out = vec2<f32>(dot(t.row0.xyz, uv), dot(t.row1.xyz, uv));
+    return select(vec2<f32>(0.0), out, vec3_is_finite(vec3<f32>(out, 0.0)).xy);
+}
+
+// The complex index n + iκ (returned as (n, κ) per channel in two vectors) whose
+// normal-incidence reflectance from air is r = F0 with edge tint g = F0: Gulbrandsen 2014,
+// "Artist Friendly Metallic Fresnel", JCGT 3(4), Eq. 1–2 (r clamped to [0, 0.99]).
+struct MetalIndex {
+    n: vec3<f32>,
+    kappa: vec3<f32>,
+}
+
+fn mesh_metal_index(f0: vec3<f32>) -> MetalIndex {
+    let r = clamp(select(vec3<f32>(0.5), f0, vec3_is_finite(f0)), vec3<f32>(0.0), vec3<f32>(0.99));
+    let g = r;
+    let sr = sqrt(r);
+    let n = g * (1.0 - r) / (1.0 + r) + (1.0 - g) * (1.0 + sr) / (1.0 - sr);
+    let k2 = (r * (n + 1.0) * (n + 1.0) - (n - 1.0) * (n - 1.0)) / (1.0 - r);
+    return MetalIndex(max(n, vec3<f32>(1e-3)), sqrt(max(k2, vec3<f32>(0.0))));
+}
+
+// Whether the fragment shader shades with the textured per-fragment material (see mesh_fs).
+const MESH_PER_FRAGMENT_MATERIAL: bool = false;
+
+// The material of the factors alone (uniform over the draw).
+fn mesh_factor_material(metal: MetalIndex) -> SurfaceMaterial {
+    let q = mesh_params;
+    let ior = select(1.5, q.dielectric_ior, f32_is_finite(q.dielectric_ior) && q.dielectric_ior >= 1.0);
+    let roughness = clamp(finite_or(q.roughness, 1.0), 0.0, 1.0);
+    var mat: SurfaceMaterial;
+    mat.diffuse_colour = clamp(q.base_colour.rgb, vec3<f32>(0.0), vec3<f32>(1.0));
+    mat.metallic = clamp(finite_or(q.metallic, 0.0), 0.0, 1.0);
+    mat.lobes = q.lobes;
+    mat.dielectric_ior = vec3<f32>(ior);
+    mat.dielectric_kappa = vec3<f32>(0.0);
+    mat.metal_ior = metal.n;
+    mat.metal_kappa = metal.kappa;
+    mat.roughness_alpha = roughness * roughness;
+    mat.film_weight = clamp(finite_or(q.iridescence, 0.0), 0.0, 1.0);
+    mat.transmission = clamp(finite_or(q.transmission, 0.0), 0.0, 1.0);
+    mat.occlusion = 1.0;
+    mat.specular_colour = clamp(q.specular * q.specular_colour, vec3<f32>(0.0), vec3<f32>(1.0));
+    return mat;
+}
+
 @fragment
-fn mesh_fs(in: MeshVertexOut) -> @location(0) vec4<f32> {
-    let v = safe_normalize(view.eye_position - in.world, vec3<f32>(0.0, 0.0, 1.0));
-    let n_raw = safe_normalize(in.normal, v);
-    // Double-sided: the shading normal faces the viewer.
-    let n = select(n_raw, -n_raw, dot(n_raw, v) < 0.0);
-    // The thickness texture's (E[g], E[g²]) for the pixel's footprint (uniform control flow:
-    // implicit derivatives), then d and σ_d.
-    let moments = material_sample_thickness_map(in.uv, dpdx(in.uv), dpdy(in.uv));
+fn mesh_fs(in: MeshVertexOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
+    let q = mesh_params;
+    // Every texture is sampled first, in uniform control flow (implicit derivatives).
+    let base_tex = textureSample(mesh_base_tex, mesh_base_smp, mesh_uv(MESH_TEX_BASE, in.uv0, in.uv1));
+    let mr_tex = textureSample(mesh_mr_tex, mesh_mr_smp, mesh_uv(MESH_TEX_METAL_ROUGH, in.uv0, in.uv1));
+    let normal_uv = mesh_uv(MESH_TEX_NORMAL, in.uv0, in.uv1);
+    let normal_tex = textureSample(mesh_normal_tex, mesh_normal_smp, normal_uv);
+    let occlusion_tex = textureSample(mesh_occlusion_tex, mesh_occlusion_smp, mesh_uv(MESH_TEX_OCCLUSION, in.uv0, in.uv1));
+    let emissive_tex = textureSample(mesh_emissive_tex, mesh_emissive_smp, mesh_uv(MESH_TEX_EMISSIVE, in.uv0, in.uv1));
+    let iridescence_tex = textureSample(mesh_iridescence_tex, mesh_iridescence_smp, mesh_uv(MESH_TEX_IRIDESCENCE, in.uv0, in.uv1));
+    let specular_tex = textureSample(mesh_specular_tex, mesh_specular_smp, mesh_uv(MESH_TEX_SPECULAR, in.uv0, in.uv1));
+    let specular_colour_tex = textureSample(mesh_specular_colour_tex, mesh_specular_colour_smp, mesh_uv(MESH_TEX_SPECULAR_COLOUR, in.uv0, in.uv1));
+    // The thickness texture's (E[g], E[g²]) for the pixel's footprint, then d and σ_d.
+    let thickness_uv = mesh_uv(MESH_TEX_THICKNESS, in.uv0, in.uv1);
+    let moments = material_sample_thickness_map(thickness_uv, dpdx(thickness_uv), dpdy(thickness_uv));
     let thickness_nm = material_thickness_nm(moments.x, 1.0);
     let sigma_nm = material_thickness_sigma(dpdx(thickness_nm), dpdy(thickness_nm), material_thickness_roughness_nm(moments));
+
+    let colour_ok = all(vec3_is_finite(in.colour.rgb)) && f32_is_finite(in.colour.a);
+    let vertex_colour = select(vec4<f32>(1.0), in.colour, colour_ok);
+    let base = clamp(q.base_colour * base_tex * vertex_colour, vec4<f32>(0.0), vec4<f32>(1.0));
+
+    let v = safe_normalize(view.eye_position - in.world, vec3<f32>(0.0, 0.0, 1.0));
+    let n_raw = safe_normalize(in.normal, v);
+    // Double-sided: the shading normal faces the viewer; the tangent frame turns with it.
+    let facing = select(1.0, -1.0, dot(n_raw, v) < 0.0);
+    var n = n_raw * facing;
+    if (q.flags & MESH_FLAG_NORMAL_MAP) != 0u {
+        let t_raw = in.tangent.xyz - n * dot(n, in.tangent.xyz);
+        let t = safe_normalize(t_raw * facing, vec3<f32>(0.0));
+        if dot(t, t) > 0.5 {
+            let b = cross(n_raw, t_raw) * select(1.0, -1.0, in.tangent.w < 0.0);
+            let tb = safe_normalize(b * facing, vec3<f32>(0.0));
+            let s = finite_or(q.normal_scale, 1.0);
+            let m = (normal_tex.rgb * 2.0 - 1.0) * vec3<f32>(s, s, 1.0);
+            n = safe_normalize(m.x * t + m.y * tb + m.z * n, n);
+        }
+    }
+
+    let metallic = clamp(finite_or(q.metallic * mr_tex.b, 0.0), 0.0, 1.0);
+    let roughness = clamp(finite_or(q.roughness * mr_tex.g, 1.0), 0.0, 1.0);
+    let metal = mesh_metal_index(base.rgb);
+    let metal_factor = mesh_metal_index(q.base_colour.rgb);
+    let ior = select(1.5, q.dielectric_ior, f32_is_finite(q.dielectric_ior) && q.dielectric_ior >= 1.0);
+    var mat: SurfaceMaterial;
+    mat.diffuse_colour = base.rgb;
+    mat.metallic = metallic;
+    mat.lobes = q.lobes;
+    mat.dielectric_ior = vec3<f32>(ior);
+    mat.dielectric_kappa = vec3<f32>(0.0);
+    mat.metal_ior = metal.n;
+    mat.metal_kappa = metal.kappa;
+    mat.roughness_alpha = roughness * roughness;
+    mat.film_weight = clamp(finite_or(q.iridescence * iridescence_tex.r, 0.0), 0.0, 1.0);
+    mat.transmission = clamp(finite_or(q.transmission, 0.0), 0.0, 1.0);
+    mat.occlusion = clamp(1.0 + finite_or(q.occlusion_strength, 1.0) * (occlusion_tex.r - 1.0), 0.0, 1.0);
+    mat.specular_colour = clamp(q.specular * specular_tex.a * q.specular_colour * specular_colour_tex.rgb, vec3<f32>(0.0), vec3<f32>(1.0));
 
     var surface: SurfacePoint;
     surface.normal = n;
@@ -76,10 +273,28 @@ fn mesh_fs(in: MeshVertexOut) -> @location(0) vec4<f32> {
     surface.thickness_nm = thickness_nm;
     surface.sigma_thickness_nm = sigma_nm;
     surface.variation = 2.0 * moments.x - 1.0;
-    let shade = material_shade(surface);
-    var radiance = shade.radiance;
+    // Lavapipe (Mesa 22.3, LLVM 15) crashes executing this pipeline when any of the
+    // SurfaceMaterial fields above varies per fragment (a textured roughness, metallic, film
+    // weight, base colour…), and so does the factor-only material of `mesh_factor_material`
+    // with both lobes: until that is understood, the shading reads the uniform's material
+    // (`material_surface`: one lobe, as before issue 18), and the textures enter only where
+    // they act after the shading (alpha, emission). MESH_PER_FRAGMENT_MATERIAL switches the
+    // textured material on (untested on hardware drivers; see issue 18).
+    var shaded = material_surface();
+    if MESH_PER_FRAGMENT_MATERIAL {
+        shaded = mat;
+    }
+    let shade = material_shade_with(surface, shaded);
+    var radiance = shade.radiance + sanitize_radiance(q.emissive * emissive_tex.rgb);
     if any(shade.transmittance > vec3<f32>(0.0)) {
         radiance += shade.transmittance * env_radiance(-v, 0.0);
     }
-    return material_display(radiance);
+    // MASK: below the cutoff the fragment is discarded (after the shading: lavapipe's
+    // LLVM back end of Mesa 22 crashed compiling the shading loop after an early discard).
+    if q.alpha_mode == MESH_ALPHA_MASK && !(base.a >= q.alpha_cutoff) {
+        discard;
+    }
+    let colour = material_display(radiance);
+    let alpha = select(1.0, base.a, q.alpha_mode == MESH_ALPHA_BLEND);
+    return vec4<f32>(colour.rgb, alpha);
 }

@@ -19,7 +19,10 @@ use crate::context::BufferInitExt;
 use crate::context::GpuContext;
 use crate::environment::EnvironmentMap;
 use crate::error::{Error, Result};
-use crate::gltf_scene::{GltfScene, is_gold_like};
+use crate::gltf_scene::{
+    AlphaMode, GltfMaterial, GltfScene, GltfTexture, IDENTITY_TRANSFORM, SamplerSpec, TextureRef,
+    Wrap, is_gold_like,
+};
 use crate::gpu::read_texture;
 use crate::gpu::{group_layout, uniform_texture_group, upload_mips};
 use crate::image_io::RenderedImage;
@@ -38,12 +41,118 @@ use std::sync::Arc;
 /// Depth buffer format.
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
-/// Mirror of `MeshParams` (`shaders/mesh.wgsl`): 64 bytes.
+/// Mirror of `MeshParams` (`shaders/mesh.wgsl`): 448 bytes, one per drawn material.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct MeshUniform {
     /// World → clip, column-major.
     pub view_proj: [[f32; 4]; 4],
+    /// `baseColorFactor`, linear RGBA.
+    pub base_colour: [f32; 4],
+    /// `emissiveFactor` × `emissiveStrength`.
+    pub emissive: [f32; 3],
+    /// `metallicFactor`.
+    pub metallic: f32,
+    /// `specularColorFactor`.
+    pub specular_colour: [f32; 3],
+    /// `roughnessFactor`.
+    pub roughness: f32,
+    /// `specularFactor`.
+    pub specular: f32,
+    /// `normalTexture.scale`.
+    pub normal_scale: f32,
+    /// `occlusionTexture.strength`.
+    pub occlusion_strength: f32,
+    /// `alphaCutoff`.
+    pub alpha_cutoff: f32,
+    /// `ior`.
+    pub dielectric_ior: f32,
+    /// `iridescenceFactor`.
+    pub iridescence: f32,
+    /// 0 OPAQUE, 1 MASK, 2 BLEND.
+    pub alpha_mode: u32,
+    /// Bit 0: a normal texture is bound.
+    pub flags: u32,
+    /// `transmissionFactor`.
+    pub transmission: f32,
+    /// The lobes every fragment evaluates: 0 dielectric, 1 metal, 2 both.
+    pub lobes: u32,
+    /// Padding.
+    pub _pad: [f32; 2],
+    /// Per texture slot ([`TEXTURE_SLOTS`] and the thickness texture): rows (a, b, c, set),
+    /// (d, e, f, 0) of its `KHR_texture_transform`.
+    pub transforms: [[[f32; 4]; 2]; 9],
+}
+
+/// The texture slots of group 3 (`shaders/mesh.wgsl` MESH_TEX_*), in binding order.
+pub const TEXTURE_SLOTS: [&str; 8] = [
+    "baseColorTexture",
+    "metallicRoughnessTexture",
+    "normalTexture",
+    "occlusionTexture",
+    "emissiveTexture",
+    "iridescenceTexture",
+    "specularTexture",
+    "specularColorTexture",
+];
+
+impl MeshUniform {
+    /// The uniform of glTF material `m` seen through `view_proj`.
+    pub fn new(view_proj: [[f32; 4]; 4], m: &GltfMaterial) -> MeshUniform {
+        let t = &m.textures;
+        let slots = [
+            t.base_colour,
+            t.metallic_roughness,
+            t.normal,
+            t.occlusion,
+            t.emissive,
+            t.iridescence,
+            t.specular,
+            t.specular_colour,
+            t.thickness,
+        ];
+        let transforms = slots.map(|slot| {
+            let r = slot.unwrap_or(TextureRef {
+                texture: 0,
+                tex_coord: 0,
+                transform: IDENTITY_TRANSFORM,
+            });
+            let [a, b] = r.transform;
+            [
+                [a[0], a[1], a[2], r.tex_coord as f32],
+                [b[0], b[1], b[2], 0.0],
+            ]
+        });
+        let (alpha_mode, alpha_cutoff) = match m.alpha_mode {
+            AlphaMode::Opaque => (0, 0.5),
+            AlphaMode::Mask(c) => (1, c),
+            AlphaMode::Blend => (2, 0.5),
+        };
+        MeshUniform {
+            view_proj,
+            base_colour: m.base_colour,
+            emissive: m.emissive,
+            metallic: m.metallic,
+            specular_colour: m.specular_colour,
+            roughness: m.roughness,
+            specular: m.specular,
+            normal_scale: m.normal_scale,
+            occlusion_strength: m.occlusion_strength,
+            alpha_cutoff,
+            dielectric_ior: m.dielectric_ior(),
+            iridescence: m.iridescence.map_or(0.0, |i| i.factor),
+            alpha_mode,
+            flags: u32::from(t.normal.is_some()),
+            transmission: m.transmission,
+            lobes: match m.metallic_range() {
+                (_, hi) if hi <= 0.0 => 0,
+                (lo, _) if lo >= 1.0 => 1,
+                _ => 2,
+            },
+            _pad: [0.0; 2],
+            transforms,
+        }
+    }
 }
 
 /// A camera fitted to an axis-aligned box: eye, target, view-projection (world → clip,
@@ -158,6 +267,18 @@ pub struct MeshRender {
     pub notes: Vec<Msg>,
 }
 
+/// Floats per vertex: position 3, normal 3, tangent 4, TEXCOORD_0 2, TEXCOORD_1 2, COLOR_0 4.
+pub const VERTEX_FLOATS: usize = 18;
+
+/// The fixed-function state of a mesh pipeline.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+struct PipelineState {
+    /// Single-sided material: back faces culled.
+    cull_back: bool,
+    /// `alphaMode` BLEND: src-alpha blending, no depth writes.
+    blend: bool,
+}
+
 fn mesh_pipeline(
     ctx: &GpuContext,
     technique: Technique,
@@ -165,6 +286,7 @@ fn mesh_pipeline(
     view_layout: &wgpu::BindGroupLayout,
     material_layout: &wgpu::BindGroupLayout,
     mesh_layout: &wgpu::BindGroupLayout,
+    state: PipelineState,
 ) -> Result<wgpu::RenderPipeline> {
     let device = &ctx.device;
     let source = shaders::film_pipeline(technique.module(), &["material", "mesh"])?;
@@ -188,18 +310,23 @@ fn mesh_pipeline(
                 entry_point: Some("mesh_vs"),
                 compilation_options: Default::default(),
                 buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: 32,
+                    array_stride: (VERTEX_FLOATS * 4) as u64,
                     step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2],
+                    attributes: &wgpu::vertex_attr_array![
+                        0 => Float32x3, 1 => Float32x3, 2 => Float32x4,
+                        3 => Float32x2, 4 => Float32x2, 5 => Float32x4
+                    ],
                 })],
             },
             primitive: wgpu::PrimitiveState {
-                cull_mode: None,
+                front_face: wgpu::FrontFace::Ccw,
+                cull_mode: state.cull_back.then_some(wgpu::Face::Back),
                 ..Default::default()
             },
             depth_stencil: Some(wgpu::DepthStencilState {
                 format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
+                // Blended primitives test depth but do not write it.
+                depth_write_enabled: Some(!state.blend),
                 depth_compare: Some(wgpu::CompareFunction::Less),
                 stencil: Default::default(),
                 bias: Default::default(),
@@ -211,7 +338,7 @@ fn mesh_pipeline(
                 compilation_options: Default::default(),
                 targets: &[Some(wgpu::ColorTargetState {
                     format: TARGET_FORMAT,
-                    blend: None,
+                    blend: state.blend.then_some(wgpu::BlendState::ALPHA_BLENDING),
                     write_mask: wgpu::ColorWrites::ALL,
                 })],
             }),
@@ -303,24 +430,63 @@ pub fn render_gltf(
     view_options.camera.up = [0.0, 1.0, 0.0];
 
     // Materials: nacre's options and the technique that draws each.
-    let mut notes: Vec<Msg> = scene.notes.iter().map(|n| Msg::from(n.as_str())).collect();
+    let colorimeter = tables.colorimeter()?;
+    let used: Vec<usize> = {
+        let mut v: Vec<usize> = scene.primitives.iter().map(|p| p.material).collect();
+        v.sort_unstable();
+        v.dedup();
+        v
+    };
+    let used_name = |n: &str| {
+        // A note about a material names it first (`name: …`); other notes are kept.
+        let about = |i: usize| n.starts_with(&format!("{}:", scene.materials[i].name));
+        !(0..scene.materials.len()).any(about) || used.iter().any(|&i| about(i))
+    };
+    let mut notes: Vec<Msg> = scene
+        .notes
+        .iter()
+        .filter(|n| used_name(n))
+        .map(|n| Msg::from(n.as_str()))
+        .collect();
     let mut drawn = Vec::with_capacity(scene.materials.len());
-    for gm in &scene.materials {
-        let (mut m, material_notes) = gm.material_options()?;
-        notes.extend(material_notes.into_iter().map(Msg::from));
+    // Technique fallbacks, summarised in one line: (material, reason).
+    let mut fallbacks: Vec<(String, Msg)> = Vec::new();
+    for (i, gm) in scene.materials.iter().enumerate() {
+        let (mut m, material_notes) = gm.material_options(&colorimeter)?;
+        if used.contains(&i) {
+            notes.extend(material_notes.into_iter().map(Msg::from));
+        }
+        let (lo, hi) = gm.metallic_range();
+        let one_lobe = hi <= 0.0 || lo >= 1.0;
         let mut t = technique;
         if technique == Technique::Lut {
             let colour = [gm.base_colour[0], gm.base_colour[1], gm.base_colour[2]];
-            match lut_material(tables, &m, colour) {
+            let result = if one_lobe {
+                lut_material(tables, &m, colour)
+            } else {
+                Err(Msg::from(
+                    "its metallic value varies (a partial factor or a texture): the table bakes one base",
+                ))
+            };
+            match result {
                 Ok(lm) => m = lm,
                 Err(why) => {
-                    notes.push(msg![
-                        format!("{}: drawn with fourier instead of lut: ", gm.name),
-                        why
-                    ]);
+                    if used.contains(&i) {
+                        fallbacks.push((gm.name.clone(), why));
+                    }
                     t = Technique::Fourier;
                 }
             }
+        } else if technique == Technique::Spectral && !one_lobe {
+            if used.contains(&i) {
+                fallbacks.push((
+                    gm.name.clone(),
+                    Msg::from(
+                        "it mixes a dielectric and a metal lobe; spectral holds one base per pass",
+                    ),
+                ));
+            }
+            t = Technique::Fourier;
         }
         if t == Technique::Lut {
             // The table's ambient (checked above) must be the material's.
@@ -331,34 +497,21 @@ pub fn render_gltf(
         }
         drawn.push((m, t));
     }
-    let used: Vec<usize> = {
-        let mut v: Vec<usize> = scene.primitives.iter().map(|p| p.material).collect();
-        v.sort_unstable();
-        v.dedup();
-        v
-    };
-    notes.retain(|n| {
-        let n = n.to_string();
-        used.iter()
-            .any(|&i| n.starts_with(&format!("{}:", scene.materials[i].name)))
-    });
+    if let Some((name, why)) = fallbacks.first() {
+        notes.push(msg![
+            format!(
+                "drawn with fourier instead of {}: {} of {} materials (e.g. `{name}`: ",
+                technique.name(),
+                fallbacks.len(),
+                used.len()
+            ),
+            why.clone(),
+            ")"
+        ]);
+    }
 
     // The passes: one per technique, except film_spectral, whose group-1 samples hold the
     // base index per wavelength: one pass (binding + pipeline) per distinct base.
-    let mut pass_keys: Vec<(Technique, String)> = used
-        .iter()
-        .map(|&i| {
-            let (m, t) = &drawn[i];
-            let base = if *t == Technique::Spectral {
-                m.base.name().to_string()
-            } else {
-                String::new()
-            };
-            (*t, base)
-        })
-        .collect();
-    pass_keys.sort_by(|a, b| (a.0.name(), &a.1).cmp(&(b.0.name(), &b.1)));
-    pass_keys.dedup();
     let key_of = |i: usize| {
         let (m, t) = &drawn[i];
         if *t == Technique::Spectral {
@@ -367,41 +520,52 @@ pub fn render_gltf(
             (*t, String::new())
         }
     };
-    let colorimeter = tables.colorimeter()?;
+    let state_of = |i: usize| PipelineState {
+        cull_back: !scene.materials[i].double_sided,
+        blend: scene.materials[i].alpha_mode == AlphaMode::Blend,
+    };
+    let mut pass_keys: Vec<(Technique, String)> = used.iter().map(|&i| key_of(i)).collect();
+    pass_keys.sort_by(|a, b| (a.0.name(), &a.1).cmp(&(b.0.name(), &b.1)));
+    pass_keys.dedup();
     let device = &ctx.device;
     let view_layout = crate::render::view_group_layout(device, "mesh view");
     let material_layout = group_layout(device, "mesh material");
-    let mesh_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("mesh pass"),
-        entries: &[wgpu::BindGroupLayoutEntry {
-            binding: 0,
-            visibility: wgpu::ShaderStages::VERTEX,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        }],
-    });
-    let mut pipelines = Vec::new();
-    for key in &pass_keys {
+    let mesh_layout = mesh_group_layout(device);
+    let mut bindings = Vec::new();
+    let mut pipelines: std::collections::BTreeMap<(usize, PipelineState), wgpu::RenderPipeline> =
+        Default::default();
+    for (k, key) in pass_keys.iter().enumerate() {
         let t = key.0;
         let mut technique_options = options.technique_options();
         if let Some(&i) = used.iter().find(|&&i| key_of(i) == *key) {
             technique_options.spectral.base = drawn[i].0.base.clone();
         }
         let binding = TechniqueBinding::new(ctx, tables, t, &technique_options, &colorimeter)?;
-        let pipeline = mesh_pipeline(
-            ctx,
-            t,
-            &binding,
-            &view_layout,
-            &material_layout,
-            &mesh_layout,
-        )?;
-        pipelines.push((key.clone(), binding, pipeline));
+        let mut states: Vec<PipelineState> = used
+            .iter()
+            .filter(|&&i| key_of(i) == *key)
+            .map(|&i| state_of(i))
+            .collect();
+        states.sort_unstable();
+        states.dedup();
+        for state in states {
+            let pipeline = mesh_pipeline(
+                ctx,
+                t,
+                &binding,
+                &view_layout,
+                &material_layout,
+                &mesh_layout,
+                state,
+            )?;
+            pipelines.insert((k, state), pipeline);
+        }
+        bindings.push(binding);
     }
+    let pass_of = |i: usize| {
+        let key = key_of(i);
+        pass_keys.iter().position(|k| *k == key).unwrap_or(0)
+    };
 
     crate::render::check_film_eval(tables, options)?;
     let env = crate::render::EnvironmentTextures::new(
@@ -441,9 +605,47 @@ pub fn render_gltf(
         u.film_eval = options.film_eval.id();
         material_uniforms.push(u);
     }
-    let mesh_uniform = MeshUniform {
-        view_proj: camera.view_proj,
-    };
+    // The glTF textures the used materials read, uploaded once each with their mip chains.
+    let mut needed = vec![false; scene.textures.len()];
+    for &i in &used {
+        let t = &scene.materials[i].textures;
+        for r in [
+            t.base_colour,
+            t.metallic_roughness,
+            t.normal,
+            t.occlusion,
+            t.emissive,
+            t.iridescence,
+            t.specular,
+            t.specular_colour,
+        ]
+        .into_iter()
+        .flatten()
+        {
+            if let Some(n) = needed.get_mut(r.texture) {
+                *n = true;
+            }
+        }
+    }
+    let mut gpu_textures: Vec<Option<wgpu::Texture>> = Vec::with_capacity(scene.textures.len());
+    for (t, &need) in scene.textures.iter().zip(&needed) {
+        gpu_textures.push(if need {
+            Some(upload_rgba8(ctx, t)?)
+        } else {
+            None
+        });
+    }
+    let white = upload_rgba8(
+        ctx,
+        &GltfTexture {
+            name: "white".into(),
+            width: 1,
+            height: 1,
+            rgba: vec![255; 4],
+            srgb: false,
+            sampler: SamplerSpec::default(),
+        },
+    )?;
 
     let (target, submitted) = ctx.checked("rendering the glTF scene", || {
         let group = |layout: &wgpu::BindGroupLayout,
@@ -472,31 +674,74 @@ pub fn render_gltf(
                 )
             })
             .collect();
-        let mesh_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("mesh pass"),
-            contents: bytemuck::bytes_of(&mesh_uniform),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let mesh_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("mesh pass"),
-            layout: &mesh_layout,
-            entries: &[wgpu::BindGroupEntry {
+        // Group 3 per used material: its MeshUniform, textures and samplers.
+        let mut samplers: std::collections::BTreeMap<SamplerKey, wgpu::Sampler> =
+            Default::default();
+        let mut mesh_groups: Vec<Option<wgpu::BindGroup>> = Vec::new();
+        for (i, gm) in scene.materials.iter().enumerate() {
+            if !used.contains(&i) {
+                mesh_groups.push(None);
+                continue;
+            }
+            let uniform = MeshUniform::new(camera.view_proj, gm);
+            let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("mesh material (glTF)"),
+                contents: bytemuck::bytes_of(&uniform),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            let t = &gm.textures;
+            let slots = [
+                t.base_colour,
+                t.metallic_roughness,
+                t.normal,
+                t.occlusion,
+                t.emissive,
+                t.iridescence,
+                t.specular,
+                t.specular_colour,
+            ];
+            let mut views = Vec::with_capacity(slots.len());
+            let mut keys = Vec::with_capacity(slots.len());
+            for slot in slots {
+                let (texture, spec) = match slot
+                    .and_then(|r| Some((gpu_textures.get(r.texture)?.as_ref()?, r.texture)))
+                {
+                    Some((texture, k)) => (texture, scene.textures[k].sampler),
+                    None => (&white, SamplerSpec::default()),
+                };
+                views.push(texture.create_view(&Default::default()));
+                let key = SamplerKey::of(spec);
+                samplers
+                    .entry(key)
+                    .or_insert_with(|| create_sampler(device, spec));
+                keys.push(key);
+            }
+            let mut entries = vec![wgpu::BindGroupEntry {
                 binding: 0,
-                resource: mesh_buffer.as_entire_binding(),
-            }],
-        });
-        let geometry: Vec<(wgpu::Buffer, wgpu::Buffer, u32, usize)> = scene
+                resource: buffer.as_entire_binding(),
+            }];
+            for (k, (view, key)) in views.iter().zip(&keys).enumerate() {
+                entries.push(wgpu::BindGroupEntry {
+                    binding: 1 + 2 * k as u32,
+                    resource: wgpu::BindingResource::TextureView(view),
+                });
+                entries.push(wgpu::BindGroupEntry {
+                    binding: 2 + 2 * k as u32,
+                    resource: wgpu::BindingResource::Sampler(&samplers[key]),
+                });
+            }
+            mesh_groups.push(Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("mesh material (glTF)"),
+                layout: &mesh_layout,
+                entries: &entries,
+            })));
+        }
+        let geometry: Vec<(wgpu::Buffer, wgpu::Buffer, u32, usize, f64)> = scene
             .primitives
             .iter()
             .filter(|p| !p.indices.is_empty())
             .map(|p| {
-                let vertices: Vec<f32> = p
-                    .positions
-                    .iter()
-                    .zip(&p.normals)
-                    .zip(&p.uvs)
-                    .flat_map(|((x, n), t)| [x[0], x[1], x[2], n[0], n[1], n[2], t[0], t[1]])
-                    .collect();
+                let vertices = vertex_data(p);
                 let vb = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some("mesh vertices"),
                     contents: bytemuck::cast_slice(&vertices),
@@ -507,9 +752,28 @@ pub fn render_gltf(
                     contents: bytemuck::cast_slice(&p.indices),
                     usage: wgpu::BufferUsages::INDEX,
                 });
-                (vb, ib, p.indices.len() as u32, p.material)
+                (
+                    vb,
+                    ib,
+                    p.indices.len() as u32,
+                    p.material,
+                    view_depth(&camera, p),
+                )
             })
             .collect();
+        // Draw order: opaque and masked primitives by pass, then blended ones back to front.
+        let mut order: Vec<usize> = (0..geometry.len()).collect();
+        order.sort_by(|&a, &b| {
+            let (ma, mb) = (geometry[a].3, geometry[b].3);
+            let (ba, bb) = (state_of(ma).blend, state_of(mb).blend);
+            ba.cmp(&bb).then_with(|| {
+                if ba {
+                    geometry[b].4.total_cmp(&geometry[a].4)
+                } else {
+                    (pass_of(ma), state_of(ma)).cmp(&(pass_of(mb), state_of(mb)))
+                }
+            })
+        });
         let size = wgpu::Extent3d {
             width,
             height,
@@ -521,7 +785,7 @@ pub fn render_gltf(
         let target_view = target.create_view(&Default::default());
         let depth_view = depth.create_view(&Default::default());
         // The background: the environment seen by the fitted camera is not drawn (a clear
-        // colour keeps the spheres' silhouettes readable); black.
+        // colour keeps the spheres' silhouettes readable).
         let mut encoder = device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -548,19 +812,26 @@ pub fn render_gltf(
                 multiview_mask: None,
             });
             pass.set_bind_group(0, &view_group, &[]);
-            pass.set_bind_group(3, &mesh_group, &[]);
-            for (key, binding, pipeline) in &pipelines {
-                pass.set_pipeline(pipeline);
-                pass.set_bind_group(1, &binding.bind_group, &[]);
-                for (vb, ib, count, material) in &geometry {
-                    if key_of(*material) != *key {
-                        continue;
-                    }
-                    pass.set_bind_group(2, &material_groups[*material], &[]);
-                    pass.set_vertex_buffer(0, vb.slice(..));
-                    pass.set_index_buffer(ib.slice(..), wgpu::IndexFormat::Uint32);
-                    pass.draw_indexed(0..*count, 0, 0..1);
+            let mut current: Option<(usize, PipelineState)> = None;
+            for &g in &order {
+                let (vb, ib, count, material, _) = &geometry[g];
+                let (Some(mesh_group), k) = (&mesh_groups[*material], pass_of(*material)) else {
+                    continue;
+                };
+                let key = (k, state_of(*material));
+                let Some(pipeline) = pipelines.get(&key) else {
+                    continue;
+                };
+                if current != Some(key) {
+                    pass.set_pipeline(pipeline);
+                    pass.set_bind_group(1, &bindings[k].bind_group, &[]);
+                    current = Some(key);
                 }
+                pass.set_bind_group(2, &material_groups[*material], &[]);
+                pass.set_bind_group(3, mesh_group, &[]);
+                pass.set_vertex_buffer(0, vb.slice(..));
+                pass.set_index_buffer(ib.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..*count, 0, 0..1);
             }
         }
         let _ = device.poll(wgpu::PollType::wait_indefinitely());
@@ -582,6 +853,235 @@ pub fn render_gltf(
             gpu_seconds,
         },
         notes,
+    })
+}
+
+/// The interleaved vertices of a primitive ([`VERTEX_FLOATS`] floats each).
+fn vertex_data(p: &crate::gltf_scene::GltfPrimitive) -> Vec<f32> {
+    let mut out = Vec::with_capacity(p.positions.len() * VERTEX_FLOATS);
+    for k in 0..p.positions.len() {
+        let x = p.positions[k];
+        let n = p.normals.get(k).copied().unwrap_or([0.0, 1.0, 0.0]);
+        let t = p.tangents.get(k).copied().unwrap_or([1.0, 0.0, 0.0, 1.0]);
+        let uv = p.uvs.get(k).copied().unwrap_or([0.0; 2]);
+        let uv1 = p.uvs1.get(k).copied().unwrap_or(uv);
+        let c = p.colours.get(k).copied().unwrap_or([1.0; 4]);
+        out.extend_from_slice(&x);
+        out.extend_from_slice(&n);
+        out.extend_from_slice(&t);
+        out.extend_from_slice(&uv);
+        out.extend_from_slice(&uv1);
+        out.extend_from_slice(&c);
+    }
+    out
+}
+
+/// The clip-space w (distance along the view axis) of a primitive's bounding-box centre:
+/// the sort key of blended primitives (larger = farther, drawn first).
+fn view_depth(camera: &FittedCamera, p: &crate::gltf_scene::GltfPrimitive) -> f64 {
+    let mut lo = [f32::INFINITY; 3];
+    let mut hi = [f32::NEG_INFINITY; 3];
+    for x in &p.positions {
+        for k in 0..3 {
+            lo[k] = lo[k].min(x[k]);
+            hi[k] = hi[k].max(x[k]);
+        }
+    }
+    let c: [f32; 3] = std::array::from_fn(|k| 0.5 * (lo[k] + hi[k]));
+    let m = camera.view_proj;
+    let w = m[0][3] * c[0] + m[1][3] * c[1] + m[2][3] * c[2] + m[3][3];
+    if w.is_finite() { f64::from(w) } else { 0.0 }
+}
+
+/// Group 3 of the mesh pipelines: 0 MeshParams (vertex + fragment), then per texture slot a
+/// filterable 2-D texture (1 + 2k) and its sampler (2 + 2k).
+fn mesh_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let mut entries = vec![wgpu::BindGroupLayoutEntry {
+        binding: 0,
+        visibility: wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }];
+    for k in 0..TEXTURE_SLOTS.len() as u32 {
+        entries.push(crate::gpu::texture_entry(1 + 2 * k));
+        entries.push(crate::gpu::sampler_entry(2 + 2 * k));
+    }
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("mesh material (glTF)"),
+        entries: &entries,
+    })
+}
+
+/// A sampler's identity (wrap modes and filters).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+struct SamplerKey([u8; 2], [bool; 4]);
+
+impl SamplerKey {
+    fn of(s: SamplerSpec) -> SamplerKey {
+        let w = |w: Wrap| w as u8;
+        SamplerKey(
+            [w(s.wrap[0]), w(s.wrap[1])],
+            [s.mag_linear, s.min_linear, s.mip_linear, s.mipmaps],
+        )
+    }
+}
+
+/// A wgpu sampler for a glTF sampler (no mipmaps: the level-0 texels only).
+fn create_sampler(device: &wgpu::Device, s: SamplerSpec) -> wgpu::Sampler {
+    let address = |w: Wrap| match w {
+        Wrap::Repeat => wgpu::AddressMode::Repeat,
+        Wrap::Mirror => wgpu::AddressMode::MirrorRepeat,
+        Wrap::Clamp => wgpu::AddressMode::ClampToEdge,
+    };
+    let filter = |linear: bool| {
+        if linear {
+            wgpu::FilterMode::Linear
+        } else {
+            wgpu::FilterMode::Nearest
+        }
+    };
+    device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some("glTF sampler"),
+        address_mode_u: address(s.wrap[0]),
+        address_mode_v: address(s.wrap[1]),
+        address_mode_w: wgpu::AddressMode::ClampToEdge,
+        mag_filter: filter(s.mag_linear),
+        min_filter: filter(s.min_linear),
+        mipmap_filter: if s.mip_linear {
+            wgpu::MipmapFilterMode::Linear
+        } else {
+            wgpu::MipmapFilterMode::Nearest
+        },
+        lod_max_clamp: if s.mipmaps { 32.0 } else { 0.0 },
+        ..Default::default()
+    })
+}
+
+/// sRGB-encoded byte → linear value (IEC 61966-2-1).
+fn srgb_to_linear(v: u8) -> f32 {
+    let c = f32::from(v) / 255.0;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// Linear value → sRGB-encoded byte.
+fn linear_to_srgb(c: f32) -> u8 {
+    let c = c.clamp(0.0, 1.0);
+    let e = if c <= 0.003_130_8 {
+        12.92 * c
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    };
+    (e * 255.0 + 0.5) as u8
+}
+
+/// The mip chain of an RGBA8 picture: 2 × 2 box filters (an odd edge repeats its last
+/// texel), averaged in linear light for sRGB colour textures (alpha and data linearly).
+pub fn rgba8_mip_chain(
+    width: u32,
+    height: u32,
+    rgba: &[u8],
+    srgb: bool,
+) -> Vec<(u32, u32, Vec<u8>)> {
+    let lut: Vec<f32> = (0..=255u8).map(srgb_to_linear).collect();
+    let mut levels = vec![(width, height, rgba.to_vec())];
+    while let Some((w, h, texels)) = levels.last() {
+        let (w, h) = (*w, *h);
+        if w == 1 && h == 1 {
+            break;
+        }
+        let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
+        let mut next = Vec::with_capacity((nw * nh * 4) as usize);
+        for y in 0..nh {
+            for x in 0..nw {
+                for c in 0..4 {
+                    let mut sum = 0.0f32;
+                    for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                        let sx = (2 * x + dx).min(w - 1);
+                        let sy = (2 * y + dy).min(h - 1);
+                        let v = texels[((sy * w + sx) * 4 + c) as usize];
+                        sum += if srgb && c < 3 {
+                            lut[v as usize]
+                        } else {
+                            f32::from(v) / 255.0
+                        };
+                    }
+                    let mean = sum / 4.0;
+                    next.push(if srgb && c < 3 {
+                        linear_to_srgb(mean)
+                    } else {
+                        (mean * 255.0 + 0.5) as u8
+                    });
+                }
+            }
+        }
+        levels.push((nw, nh, next));
+    }
+    levels
+}
+
+/// Uploads a glTF texture as `Rgba8UnormSrgb` (colour: the GPU decodes sRGB before
+/// filtering) or `Rgba8Unorm` (data), with its full mip chain.
+fn upload_rgba8(ctx: &GpuContext, t: &GltfTexture) -> Result<wgpu::Texture> {
+    let limit = ctx.device.limits().max_texture_dimension_2d;
+    if t.width.max(t.height) > limit {
+        return Err(Error::Limit {
+            what: t.name.clone(),
+            needed: u64::from(t.width.max(t.height)),
+            limit: u64::from(limit),
+            adapter: ctx.info.name.clone(),
+        });
+    }
+    let levels = rgba8_mip_chain(t.width, t.height, &t.rgba, t.srgb);
+    let format = if t.srgb {
+        wgpu::TextureFormat::Rgba8UnormSrgb
+    } else {
+        wgpu::TextureFormat::Rgba8Unorm
+    };
+    ctx.checked(&format!("uploading {}", t.name), || {
+        let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(&t.name),
+            size: wgpu::Extent3d {
+                width: t.width,
+                height: t.height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: levels.len() as u32,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        for (k, (w, h, texels)) in levels.iter().enumerate() {
+            ctx.queue.write_texture(
+                wgpu::TexelCopyTextureInfo {
+                    texture: &texture,
+                    mip_level: k as u32,
+                    origin: wgpu::Origin3d::ZERO,
+                    aspect: wgpu::TextureAspect::All,
+                },
+                texels,
+                wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(w * 4),
+                    rows_per_image: Some(*h),
+                },
+                wgpu::Extent3d {
+                    width: *w,
+                    height: *h,
+                    depth_or_array_layers: 1,
+                },
+            );
+        }
+        texture
     })
 }
 

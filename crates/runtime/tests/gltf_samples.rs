@@ -1,0 +1,140 @@
+//! Khronos' iridescence sample assets (`../shared/gltf-samples/`, see `../shared/DATA.md`;
+//! not part of this repository): every one loads and renders at 160 × 120 with `lut` (which
+//! falls back to `fourier` per material, in one summary note), the image is not empty, and
+//! IridescenceSuzanne's GLB (which lists `KHR_materials_iridescence` in
+//! `extensionsRequired`) renders like its `.gltf`. The directory missing is a failure when
+//! the `CI` environment variable is set, a skip (with a message) elsewhere.
+
+use nacre_runtime::gltf_scene::GltfScene;
+use nacre_runtime::mesh::render_gltf;
+use nacre_runtime::render::{RenderedImage, SceneKind, SceneOptions};
+use nacre_runtime::{TableSet, Technique};
+use std::path::PathBuf;
+
+mod support;
+use support::{ctx, repo_root};
+
+const ASSETS: [&str; 6] = [
+    "IridescenceMetallicSpheres",
+    "IridescenceDielectricSpheres",
+    "IridescenceSuzanne",
+    "IridescenceLamp",
+    "IridescentDishWithOlives",
+    "IridescenceAbalone",
+];
+
+/// `../shared/gltf-samples`, or `None` (skip) outside CI; a panic in CI.
+fn samples() -> Option<PathBuf> {
+    let dir = repo_root().join("../shared/gltf-samples");
+    if dir.is_dir() {
+        return Some(dir);
+    }
+    if std::env::var_os("CI").is_some() {
+        panic!(
+            "{} is missing: CI must provide the Khronos glTF samples (../shared/DATA.md)",
+            dir.display()
+        );
+    }
+    eprintln!(
+        "skipped: {} not found (the Khronos glTF samples of ../shared/DATA.md)",
+        dir.display()
+    );
+    None
+}
+
+fn tables() -> TableSet {
+    let baked = nacre_format::set::default_baked_dir();
+    let mut tables = TableSet::load(ctx(), &baked.join("film-dielectric.json")).unwrap();
+    tables.add(ctx(), &baked.join("fourier-srgb.json")).unwrap();
+    tables
+}
+
+fn options() -> SceneOptions {
+    let mut o = SceneOptions::new(SceneKind::Sphere);
+    (o.width, o.height) = (160, 120);
+    o
+}
+
+/// Mean chroma (max − min of the sRGB bytes) over the pixels that are not the background.
+fn colourfulness(image: &RenderedImage) -> f64 {
+    let bg = [image.pixels[0], image.pixels[1], image.pixels[2]];
+    let (mut sum, mut n) = (0.0, 0usize);
+    for p in image.pixels.chunks_exact(4) {
+        if [p[0], p[1], p[2]] == bg {
+            continue;
+        }
+        let (hi, lo) = (p[0].max(p[1]).max(p[2]), p[0].min(p[1]).min(p[2]));
+        sum += f64::from(hi - lo);
+        n += 1;
+    }
+    if n == 0 { 0.0 } else { sum / n as f64 }
+}
+
+#[test]
+fn khronos_iridescence_assets_load_and_render() {
+    let Some(dir) = samples() else { return };
+    let tables = tables();
+    for name in ASSETS {
+        let path = dir.join(name).join("glTF").join(format!("{name}.gltf"));
+        let scene = GltfScene::load(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let out = render_gltf(ctx(), &tables, Technique::Lut, &scene, &options())
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let bg = [
+            out.image.pixels[0],
+            out.image.pixels[1],
+            out.image.pixels[2],
+        ];
+        let covered = out
+            .image
+            .pixels
+            .chunks_exact(4)
+            .filter(|p| [p[0], p[1], p[2]] != bg)
+            .count();
+        let fallbacks = out
+            .notes
+            .iter()
+            .filter(|n| n.to_string().contains("instead of lut"))
+            .count();
+        eprintln!(
+            "{name}: {} primitives, {} textures, {covered} pixels covered, colourfulness {:.1}; notes: {}",
+            scene.primitives.len(),
+            scene.textures.len(),
+            colourfulness(&out.image),
+            out.notes
+                .iter()
+                .map(|n| n.to_string())
+                .collect::<Vec<_>>()
+                .join(" | ")
+        );
+        assert!(
+            covered > 160 * 120 / 50,
+            "{name}: only {covered} pixels drawn"
+        );
+        assert!(fallbacks <= 1, "{name}: one summary line for fallbacks");
+    }
+}
+
+#[test]
+fn suzanne_glb_requires_iridescence_and_renders_like_the_gltf() {
+    let Some(dir) = samples() else { return };
+    let tables = tables();
+    let base = dir.join("IridescenceSuzanne");
+    let glb = GltfScene::load(&base.join("glTF-Binary/IridescenceSuzanne.glb"))
+        .expect("a file that requires KHR_materials_iridescence loads");
+    let gltf = GltfScene::load(&base.join("glTF/IridescenceSuzanne.gltf")).unwrap();
+    let a = render_gltf(ctx(), &tables, Technique::Fourier, &glb, &options()).unwrap();
+    let b = render_gltf(ctx(), &tables, Technique::Fourier, &gltf, &options()).unwrap();
+    let diff = a
+        .image
+        .pixels
+        .iter()
+        .zip(&b.image.pixels)
+        .map(|(x, y)| u64::from(x.abs_diff(*y)))
+        .sum::<u64>() as f64
+        / a.image.pixels.len() as f64;
+    eprintln!("Suzanne GLB vs glTF: mean difference {diff:.3} levels");
+    assert!(
+        diff < 2.0,
+        "GLB and glTF differ by {diff} levels on average"
+    );
+}
