@@ -535,7 +535,8 @@ impl GltfMaterial {
             m.base = Material::constant(format!("{ior}"), C64::new(f64::from(ior), 0.0))
                 .map_err(crate::Error::from)?;
             m.base_kind = BaseKind::Dielectric;
-            m.transmission = clamp01(self.transmission) > 0.0;
+            // A thin shell when transmissionFactor ≥ 0.5 (the uniform has no partial share).
+            m.transmission = clamp01(self.transmission) >= 0.5;
             m.base_colour = rgb;
         }
         m.validate().map_err(|e| Error::Invalid {
