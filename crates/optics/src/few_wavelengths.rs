@@ -578,11 +578,15 @@ mod tests_support {
         )
     }
 
-    fn metal(name: &str) -> Material {
+    /// A bundled material (tables/materials).
+    pub fn metal(name: &str) -> Material {
         let text = match name {
             "au" => include_str!("../../../tables/materials/au.yml"),
             "ag" => include_str!("../../../tables/materials/ag.yml"),
             "cr" => include_str!("../../../tables/materials/cr.yml"),
+            "mgf2" => include_str!("../../../tables/materials/mgf2.yml"),
+            "tio2" => include_str!("../../../tables/materials/tio2.yml"),
+            "bk7" => include_str!("../../../tables/materials/bk7.yml"),
             _ => include_str!("../../../tables/materials/al.yml"),
         };
         Material::from_refractiveindex_yaml(name, name, text).unwrap()
@@ -857,6 +861,162 @@ mod tests {
             let rule = FewWavelengthRule::new(&c, n);
             let (fp, fm) = errors(rule.wavelengths_nm(), rule.weights());
             eprintln!("{n:4} {up:11.3} {um:7.3} {fp:12.3} {fm:7.3}");
+        }
+    }
+
+    /// A stack with every film scaled by `scale` (issue 17 §6: d_j(x) = a(x) d_j⁰).
+    fn scaled(stack: &Stack, scale: f64) -> Stack {
+        let layers = stack
+            .layers()
+            .iter()
+            .map(|l| crate::Layer {
+                material: l.material.clone(),
+                thickness_nm: l.thickness_nm * scale,
+            })
+            .collect();
+        Stack::new(stack.ambient().clone(), layers, stack.substrate().clone()).unwrap()
+    }
+
+    /// The exact (spectral) reflectance colour of `stack` at incidence cosine `cos_theta`.
+    fn exact_colour(c: &Colorimeter, stack: &Stack, cos_theta: f64) -> [f64; 3] {
+        let angle = cos_theta.clamp(0.0, 1.0).acos().to_degrees().min(89.9);
+        let rule = SpectralRule::new(c, stack.max_opd_nm(None));
+        reflectance_colour(stack, angle, rule.wavelengths_nm(), rule.weights())
+    }
+
+    /// Issue 17 §6's other candidate: a 2-D table over (cos θ, a) for a stack whose films all
+    /// follow one map, d_j = a d_j⁰ with a ∈ `scale_range`. Texels: x = t, cos θ = t² (the
+    /// film-lut mapping), `cos_count` of them; y = a uniform, `scale_count`; each texel the
+    /// exact colour. (Texels uniform in sin²θ instead, which spreads the films' phase evenly,
+    /// are 5–50× worse: the Fresnel terms change fastest near grazing, where t² puts texels.)
+    /// Returns ΔE2000 (mean, p95, max) of the bilinear lookup against the exact
+    /// colour at `points` random (θ ∈ 0–85°, a) points.
+    fn scale_table_errors(
+        stack: &Stack,
+        scale_range: (f64, f64),
+        cos_count: usize,
+        scale_count: usize,
+        points: usize,
+    ) -> (f64, f64, f64) {
+        let c = colorimeter();
+        let (a_lo, a_hi) = scale_range;
+        let scale_at = |j: usize| a_lo + (a_hi - a_lo) * j as f64 / (scale_count - 1) as f64;
+        let table: Vec<[f64; 3]> = (0..scale_count * cos_count)
+            .into_par_iter()
+            .map(|k| {
+                let (j, i) = (k / cos_count, k % cos_count);
+                let t = i as f64 / (cos_count - 1) as f64;
+                exact_colour(&c, &scaled(stack, scale_at(j)), t * t)
+            })
+            .collect();
+        let mut rng = Rng(17);
+        let samples: Vec<(f64, f64)> = (0..points)
+            .map(|_| {
+                let angle = 85.0 * rng.next();
+                (angle.to_radians().cos(), a_lo + (a_hi - a_lo) * rng.next())
+            })
+            .collect();
+        let mut errors: Vec<f64> = samples
+            .par_iter()
+            .map(|&(cos_theta, a)| {
+                let x = cos_theta.sqrt() * (cos_count - 1) as f64;
+                let y = (a - a_lo) / (a_hi - a_lo) * (scale_count - 1) as f64;
+                let (i, j) = (
+                    (x.floor() as usize).min(cos_count - 2),
+                    (y.floor() as usize).min(scale_count - 2),
+                );
+                let (fx, fy) = (x - i as f64, y - j as f64);
+                let texel = |ii: usize, jj: usize| table[jj * cos_count + ii];
+                let looked: [f64; 3] = std::array::from_fn(|ch| {
+                    let bottom = texel(i, j)[ch] * (1.0 - fx) + texel(i + 1, j)[ch] * fx;
+                    let top = texel(i, j + 1)[ch] * (1.0 - fx) + texel(i + 1, j + 1)[ch] * fx;
+                    bottom * (1.0 - fy) + top * fy
+                });
+                delta_e(&c, looked, exact_colour(&c, &scaled(stack, a), cos_theta))
+            })
+            .collect();
+        let mean = errors.iter().sum::<f64>() / errors.len() as f64;
+        let (p95, max) = p95_max(std::mem::take(&mut errors));
+        (mean, p95, max)
+    }
+
+    fn constant(n: f64) -> crate::Material {
+        crate::Material::constant(format!("{n}"), crate::C64::new(n, 0.0)).unwrap()
+    }
+
+    fn layer(material: crate::Material, thickness_nm: f64) -> crate::Layer {
+        crate::Layer {
+            material,
+            thickness_nm,
+        }
+    }
+
+    /// The three scenes' stacks (README), each with the range of its common scale a.
+    fn scale_scenes() -> Vec<(&'static str, Stack, (f64, f64))> {
+        vec![
+            (
+                "oil slick: 1.4@350 | 1.33@350 | 1.635, a 0–2",
+                Stack::new(
+                    constant(1.0),
+                    vec![layer(constant(1.4), 350.0), layer(constant(1.33), 350.0)],
+                    constant(1.635),
+                )
+                .unwrap(),
+                (0.0, 2.0),
+            ),
+            (
+                "AR lens: mgf2@95 | tio2@105 | mgf2@25 | tio2@12 | bk7, a 0.9–1.1",
+                Stack::new(
+                    constant(1.0),
+                    vec![
+                        layer(metal("mgf2"), 95.0),
+                        layer(metal("tio2"), 105.0),
+                        layer(metal("mgf2"), 25.0),
+                        layer(metal("tio2"), 12.0),
+                    ],
+                    metal("bk7"),
+                )
+                .unwrap(),
+                (0.9, 1.1),
+            ),
+            (
+                "filter: cr@8 | 1.46@190 | al, a 0.4–1.6",
+                Stack::new(
+                    constant(1.0),
+                    vec![layer(metal("cr"), 8.0), layer(constant(1.46), 190.0)],
+                    metal("al"),
+                )
+                .unwrap(),
+                (0.4, 1.6),
+            ),
+        ]
+    }
+
+    /// A (cos θ, a) table of 64 × 256 texels meets the stack targets (ΔE2000 p95 ≤ 0.3,
+    /// max ≤ 1.0) on the oil slick with both layers following one map (a ∈ 0–2: each layer
+    /// 0–700 nm, OPD up to ≈ 3.8 µm).
+    #[test]
+    fn a_scale_table_meets_the_stack_targets_on_the_oil_slick() {
+        let (name, stack, range) = scale_scenes().swap_remove(0);
+        let (mean, p95, max) = scale_table_errors(&stack, range, 64, 256, 200);
+        assert!(
+            p95 <= 0.3 && max <= 1.0,
+            "{name}: mean {mean} p95 {p95} max {max}"
+        );
+    }
+
+    /// The (cos θ, a) table's error against its size, for the three scenes. `cargo test
+    /// --release -p nacre-optics --lib few_wavelengths -- --ignored --nocapture`.
+    #[test]
+    #[ignore = "a sweep that prints the scale table's error against its size"]
+    fn scale_table_error_against_size() {
+        for (name, stack, range) in scale_scenes() {
+            eprintln!("{name}");
+            eprintln!("  cos × a     mean    p95     max");
+            for (nc, na) in [(32, 128), (32, 256), (64, 128), (64, 256), (128, 256)] {
+                let (mean, p95, max) = scale_table_errors(&stack, range, nc, na, 400);
+                eprintln!("  {nc:3} × {na:3} {mean:7.3} {p95:7.3} {max:7.3}");
+            }
         }
     }
 }
