@@ -75,7 +75,8 @@ fn mesh_fs(in: MeshVertexOut) -> @location(0) vec4<f32> {
     surface.view_dir = v;
     surface.thickness_nm = thickness_nm;
     surface.sigma_thickness_nm = sigma_nm;
-    surface.variation = 2.0 * moments.x - 1.0;
+    // The texture's one channel drives every film.
+    surface.variation = vec3<f32>(2.0 * moments.x - 1.0);
     let shade = material_shade(surface);
     var radiance = shade.radiance;
     if any(shade.transmittance > vec3<f32>(0.0)) {

@@ -350,7 +350,9 @@ struct RenderArgs {
     /// row 0 = zenith) [default: tables/env/studio.exr].
     #[arg(long, value_name = "FILE")]
     env: Option<PathBuf>,
-    /// Greyscale thickness map (8- or 16-bit PNG) [default: built-in swirls].
+    /// Thickness map, 8- or 16-bit PNG or JPEG: greyscale, or with --technique stack RGB,
+    /// one channel per film (--layer-channel) [default: built-in swirls, channels R, G, B
+    /// three phases of one pattern].
     #[arg(long, value_name = "FILE.png")]
     thickness_map: Option<PathBuf>,
     /// Exposure in EV stops (radiance × 2^EV before tone mapping).
@@ -371,6 +373,11 @@ struct RenderArgs {
     /// [default: 0 for every film].
     #[arg(long = "relative", value_name = "NM")]
     relative: Vec<f64>,
+    /// --technique stack: the thickness-map channel each film follows (repeat once per film,
+    /// top first; the top film's is r): one map for every film, or one channel per film
+    /// (the thesis's SVT per layer) [default: r for every film].
+    #[arg(long = "layer-channel", value_name = "C", value_enum)]
+    layer_channels: Vec<choices::ChannelArg>,
     /// Diffraction scenes: wavelength step of the colour sum, nm, over the table's range (the
     /// table's own step, 5 nm for the default set, is the CPU's grid); layout "terms" only
     /// (an integrated table's sum is fixed at bake time) [default: 10].
@@ -619,6 +626,7 @@ fn run_render(args: &RenderArgs) -> Result<()> {
         options.stack = nacre_runtime::bindings::StackSetup {
             stack,
             relative_nm: relative,
+            channels: args.layer_channels.iter().map(|c| c.index()).collect(),
             samples: args.wavelengths,
         };
     }
@@ -631,7 +639,7 @@ fn run_render(args: &RenderArgs) -> Result<()> {
         nacre_runtime::render::EnvironmentMap::load(path)?;
     }
     if let Some(path) = &options.thickness_map {
-        nacre_runtime::render::ThicknessMap::load_png(path)?;
+        nacre_runtime::render::ThicknessMap::load_for(path, technique)?;
     }
     let gltf = match &args.gltf {
         Some(path) => Some(nacre_runtime::gltf_scene::GltfScene::load(path)?),

@@ -303,6 +303,7 @@ pub struct StackEvaluation {
     indices: Vec<Vec<crate::C64>>,
     thickness_nm: Vec<f64>,
     relative_nm: Vec<f64>,
+    channels: Vec<usize>,
     opd_factors: Vec<f64>,
     finesse: f64,
     dispersive: bool,
@@ -395,6 +396,7 @@ impl StackEvaluation {
             indices,
             thickness_nm: stack.thicknesses_nm(),
             relative_nm: relative_nm.to_vec(),
+            channels: vec![0; films],
             opd_factors,
             finesse: finesse_factor(&at_550),
             dispersive,
@@ -441,22 +443,58 @@ impl StackEvaluation {
         self.dispersive
     }
 
+    /// The same stack with film j's thickness following channel `channels[j]` of the
+    /// thickness map (0 = R or grey, 1 = G, 2 = B; one per film; the top film's must be 0:
+    /// its thickness is the pixel's, from channel 0): the thesis's SVT with one map channel
+    /// per layer (Sussenbach 2013 §4.2). Without it every film follows channel 0.
+    ///
+    /// # Errors
+    /// [`crate::Error::OutOfRange`] for a count other than one per film, a channel above 2
+    /// or a top film's channel other than 0.
+    pub fn with_channels(mut self, channels: &[usize]) -> crate::Result<Self> {
+        if channels.len() != self.thickness_nm.len() {
+            return Err(crate::Error::OutOfRange {
+                what: "map channels given",
+                value: channels.len() as f64,
+                expected: "one per film",
+            });
+        }
+        if channels.first().is_some_and(|&c| c != 0) {
+            return Err(crate::Error::OutOfRange {
+                what: "top film's map channel",
+                value: channels[0] as f64,
+                expected: "0 (R): the top film's thickness is the pixel's",
+            });
+        }
+        if let Some(&c) = channels.iter().find(|&&c| c > 2) {
+            return Err(crate::Error::OutOfRange {
+                what: "map channel",
+                value: c as f64,
+                expected: "0 (R), 1 (G) or 2 (B)",
+            });
+        }
+        self.channels = channels.to_vec();
+        Ok(self)
+    }
+
+    /// Film j's map channel (0 = R, 1 = G, 2 = B; [`StackEvaluation::with_channels`]).
+    pub fn channels(&self) -> &[usize] {
+        &self.channels
+    }
+
     /// The films' thicknesses at a pixel: the top film `top_thickness_nm`, film j ≥ 2
-    /// max(0, d_j⁰ + r_j s), s = `variation` clamped to [−1, 1] (NaN → 0); thicknesses
-    /// sanitised as the GPU's FilmInput (NaN or ≤ 0 → 0, at most 10⁶ nm).
-    pub fn thicknesses_at(&self, top_thickness_nm: f64, variation: f64) -> Vec<f64> {
+    /// max(0, d_j⁰ + r_j s_c), s_c = `variation[c]` for film j's channel c, clamped to
+    /// [−1, 1] (NaN → 0); thicknesses sanitised as the GPU's FilmInput (NaN or ≤ 0 → 0, at
+    /// most 10⁶ nm).
+    pub fn thicknesses_at(&self, top_thickness_nm: f64, variation: [f64; 3]) -> Vec<f64> {
         let clean = |d: f64| if d > 0.0 { d.min(1e6) } else { 0.0 };
-        let s = if variation.is_nan() {
-            0.0
-        } else {
-            variation.clamp(-1.0, 1.0)
-        };
+        let s = variation.map(|v| if v.is_nan() { 0.0 } else { v.clamp(-1.0, 1.0) });
         (0..self.thickness_nm.len())
             .map(|j| {
                 if j == 0 {
                     clean(top_thickness_nm)
                 } else {
-                    clean(self.thickness_nm[j] + self.relative_nm[j] * s)
+                    clean(self.thickness_nm[j] + self.relative_nm[j] * s[self.channels[j]])
                 }
             })
             .collect()
@@ -489,7 +527,7 @@ impl StackEvaluation {
         &self,
         cos_theta_i: f64,
         top_thickness_nm: f64,
-        variation: f64,
+        variation: [f64; 3],
     ) -> ([f64; 3], [f64; 3]) {
         let c = if cos_theta_i.is_nan() {
             1.0
@@ -742,6 +780,41 @@ mod tests {
         }
     }
 
+    /// Every film below the top follows its own map channel (the thesis's SVT with one
+    /// channel per layer); a wrong channel list is refused.
+    #[test]
+    fn films_follow_their_map_channels() {
+        let c = colorimeter();
+        let mut rng = Rng(9);
+        let (stack, _) = loop {
+            let (s, a) = random_stack(&mut rng);
+            if s.layers().len() >= 3 {
+                break (s, a);
+            }
+        };
+        let films = stack.layers().len();
+        let relative: Vec<f64> = (0..films).map(|j| 10.0 * j as f64).collect();
+        let eval = StackEvaluation::new(&c, &stack, &relative, None).unwrap();
+        let channels: Vec<usize> = (0..films).map(|j| j % 3).collect();
+        let eval = eval.with_channels(&channels).unwrap();
+        assert_eq!(eval.channels(), channels.as_slice());
+        let s = [0.25, -0.5, 1.0];
+        let d = eval.thicknesses_at(40.0, s);
+        assert_eq!(d[0], 40.0);
+        for j in 1..films {
+            let want = (stack.layers()[j].thickness_nm + 10.0 * j as f64 * s[j % 3]).max(0.0);
+            assert_eq!(d[j], want, "film {j}");
+        }
+        // One channel per film, each 0 to 2, the top film's 0.
+        assert!(eval.clone().with_channels(&channels[1..]).is_err());
+        let mut top = channels.clone();
+        top[0] = 1;
+        assert!(eval.clone().with_channels(&top).is_err());
+        let mut bad = channels.clone();
+        bad[1] = 3;
+        assert!(eval.with_channels(&bad).is_err());
+    }
+
     /// The evaluation is the stack at the pixel's thicknesses through the ladder's rule;
     /// bad inputs are refused or sanitised.
     #[test]
@@ -762,15 +835,15 @@ mod tests {
             }
             let moved =
                 Stack::new(stack.ambient().clone(), layers, stack.substrate().clone()).unwrap();
-            let d = eval.thicknesses_at(top, 0.5);
+            let d = eval.thicknesses_at(top, [0.5; 3]);
             let rule = &eval.rules()[eval.rule_index(&d)];
             let want = reflectance_colour(&moved, angle, rule.wavelengths_nm(), rule.weights());
-            let (got, t) = eval.colour(cos, top, 0.5);
+            let (got, t) = eval.colour(cos, top, [0.5; 3]);
             for k in 0..3 {
                 assert!((got[k] - want[k]).abs() < 1e-9, "{got:?} {want:?}");
                 assert!(t[k].is_finite());
             }
-            let (nan, _) = eval.colour(f64::NAN, f64::NAN, f64::NAN);
+            let (nan, _) = eval.colour(f64::NAN, f64::NAN, [f64::NAN; 3]);
             assert!(nan.iter().all(|x| x.is_finite()));
         }
         let (stack, _) = random_stack(&mut Rng(9));

@@ -484,6 +484,7 @@ fn thickness_texture(
         width: width as usize,
         height: height as usize,
         values,
+        green_blue: None,
     })
 }
 

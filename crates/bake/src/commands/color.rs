@@ -668,7 +668,7 @@ pub fn evaluate(
                         return Err(nacre_optics::Error::InvalidAngle { angle_deg: angle }.into());
                     }
                     let top = point.thickness_nm.unwrap_or(stack.layers()[0].thickness_nm);
-                    let (r, t) = eval.colour(angle.to_radians().cos(), top, 0.0);
+                    let (r, t) = eval.colour(angle.to_radians().cos(), top, [0.0; 3]);
                     Ok(match quantity {
                         Quantity::Reflectance => r,
                         Quantity::Transmittance => t,
