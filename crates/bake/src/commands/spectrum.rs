@@ -33,7 +33,53 @@ pub fn fmt_sig(v: f64) -> String {
 
 /// Computes the table (checks the size limit and the angles first).
 pub fn compute(stack: &Stack, angles_deg: &[f64], wavelengths_nm: &[f64]) -> Result<Vec<Power>> {
-    let rows = angles_deg.len() as u64 * wavelengths_nm.len() as u64;
+    check_axes(angles_deg, wavelengths_nm, 1)?;
+    stack
+        .sweep(angles_deg, wavelengths_nm)
+        .map_err(optics_error)
+}
+
+/// The table over a third axis, film `layer`'s thickness (1-based, top film = 1; the other
+/// films keep theirs): [`Stack::sweep_thickness`], element
+/// `(a * wavelengths.len() + w) * thicknesses.len() + d`, after the checks of [`compute`]
+/// (the size limit counts every thickness).
+pub fn compute_thickness(
+    stack: &Stack,
+    layer: usize,
+    angles_deg: &[f64],
+    wavelengths_nm: &[f64],
+    thicknesses_nm: &[f64],
+) -> Result<Vec<Power>> {
+    check_axes(angles_deg, wavelengths_nm, thicknesses_nm.len() as u64)?;
+    for &d in thicknesses_nm {
+        if !(d >= 0.0 && d.is_finite()) {
+            return Err(Error::value(
+                Param::Thicknesses,
+                format!("{d}"),
+                "thickness must be finite and non-negative",
+            ));
+        }
+    }
+    if layer == 0 || layer > stack.layers().len() {
+        return Err(Error::optics_in(
+            Param::Layer,
+            nacre_optics::Error::NoSuchLayer {
+                layer,
+                count: stack.layers().len(),
+            },
+        ));
+    }
+    stack
+        .sweep_thickness(layer, angles_deg, wavelengths_nm, thicknesses_nm)
+        .map_err(optics_error)
+}
+
+/// The size limit (`per_row` values per (angle, wavelength)), the angles and the
+/// wavelengths of a table.
+fn check_axes(angles_deg: &[f64], wavelengths_nm: &[f64], per_row: u64) -> Result<()> {
+    let rows = (angles_deg.len() as u64)
+        .saturating_mul(wavelengths_nm.len() as u64)
+        .saturating_mul(per_row);
     if rows > MAX_ROWS {
         return Err(nacre_format::Error::TooLarge {
             what: "rows (angles × wavelengths)".into(),
@@ -61,15 +107,19 @@ pub fn compute(stack: &Stack, angles_deg: &[f64], wavelengths_nm: &[f64]) -> Res
             ));
         }
     }
-    stack
-        .sweep(angles_deg, wavelengths_nm)
-        .map_err(|source| match source {
-            nacre_optics::Error::WavelengthOutOfRange { .. }
-            | nacre_optics::Error::AbsorbingAmbient { .. } => {
-                Error::optics_in(Param::Wavelengths, source)
-            }
-            other => other.into(),
-        })
+    Ok(())
+}
+
+/// Errors of a sweep: a wavelength outside a material's data or an absorbing ambient are
+/// said to come from the wavelengths.
+fn optics_error(source: nacre_optics::Error) -> Error {
+    match source {
+        nacre_optics::Error::WavelengthOutOfRange { .. }
+        | nacre_optics::Error::AbsorbingAmbient { .. } => {
+            Error::optics_in(Param::Wavelengths, source)
+        }
+        other => other.into(),
+    }
 }
 
 /// Writes the CSV table.
