@@ -11,7 +11,7 @@ use nacre_bake::commands::spectrum as spectrum_cmd;
 use nacre_bake::error::{Error, Param};
 use nacre_optics::Power;
 use numpy::ndarray::{Array, IxDyn};
-use numpy::{IntoPyArray, PyArrayDyn, PyReadonlyArray1};
+use numpy::{IntoPyArray, PyArrayDyn, PyReadonlyArray1, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
@@ -32,41 +32,66 @@ fn vec_of(a: &PyReadonlyArray1<'_, f64>) -> Vec<f64> {
     a.as_array().to_vec()
 }
 
-/// The seven columns of a spectrum, `R_s, R_p, R, T_s, T_p, T, A`, from the powers
-/// ([`Power::R`], [`Power::T`], [`Power::A`]), filled in parallel.
-fn columns(powers: &[Power]) -> [Vec<f64>; 7] {
-    const CHUNK: usize = 1 << 14;
-    let n = powers.len();
-    let mut cols: [Vec<f64>; 7] = std::array::from_fn(|_| vec![0.0; n]);
-    let [r_s, r_p, r, t_s, t_p, t, a] = &mut cols;
-    (
-        powers.par_chunks(CHUNK),
-        r_s.par_chunks_mut(CHUNK),
-        r_p.par_chunks_mut(CHUNK),
-        r.par_chunks_mut(CHUNK),
-        t_s.par_chunks_mut(CHUNK),
-        t_p.par_chunks_mut(CHUNK),
-        t.par_chunks_mut(CHUNK),
-        a.par_chunks_mut(CHUNK),
-    )
-        .into_par_iter()
-        .for_each(|(p, r_s, r_p, r, t_s, t_p, t, a)| {
-            for (i, p) in p.iter().enumerate() {
-                r_s[i] = p.R_s;
-                r_p[i] = p.R_p;
-                r[i] = p.R();
-                t_s[i] = p.T_s;
-                t_p[i] = p.T_p;
-                t[i] = p.T();
-                a[i] = p.A();
-            }
-        });
-    cols
+// A `Power` is four `f64` (`#[repr(C)]`: R_s, R_p, T_s, T_p).
+const _: () = assert!(
+    std::mem::size_of::<Power>() == 4 * std::mem::size_of::<f64>()
+        && std::mem::align_of::<Power>() == std::mem::align_of::<f64>()
+);
+
+/// The powers as `4 n` floats (R_s, R_p, T_s, T_p per element), without copying.
+fn powers_as_floats(powers: Vec<Power>) -> Vec<f64> {
+    let mut powers = std::mem::ManuallyDrop::new(powers);
+    let (ptr, len, cap) = (powers.as_mut_ptr(), powers.len(), powers.capacity());
+    // SAFETY: `Power` is `#[repr(C)]` with four `f64` fields, no padding (size and
+    // alignment asserted above), so `cap` powers are `4 cap` floats in the same allocation
+    // with the same layout (size 32 cap, alignment 8); the original vector is not dropped.
+    unsafe { Vec::from_raw_parts(ptr.cast::<f64>(), 4 * len, 4 * cap) }
+}
+
+/// Unpolarised reflectance, transmittance and absorptance ([`Power::R`], [`Power::T`],
+/// [`Power::A`]) of an array of powers whose last axis holds (R_s, R_p, T_s, T_p): three
+/// arrays of the other axes' shape.
+#[pyfunction]
+pub fn unpolarised<'py>(
+    py: Python<'py>,
+    powers: PyReadonlyArrayDyn<'py, f64>,
+) -> PyResult<Vec<Bound<'py, PyArrayDyn<f64>>>> {
+    let shape = powers.shape().to_vec();
+    let (last, rest) = shape.split_last().unzip();
+    if last != Some(&4) {
+        return Err(bake_err(Error::value(
+            "powers",
+            format!("{shape:?}"),
+            "expected an array whose last axis holds R_s, R_p, T_s, T_p",
+        )));
+    }
+    let values = powers.as_array();
+    let floats: Vec<f64> = match values.as_slice() {
+        Some(s) => s.to_vec(),
+        None => values.iter().copied().collect(),
+    };
+    let (r, t, a) = py.detach(|| {
+        let p: Vec<Power> = floats
+            .chunks_exact(4)
+            .map(|c| Power {
+                R_s: c[0],
+                R_p: c[1],
+                T_s: c[2],
+                T_p: c[3],
+            })
+            .collect();
+        let r = p.par_iter().map(Power::R).collect();
+        let t = p.par_iter().map(Power::T).collect();
+        let a = p.par_iter().map(Power::A).collect();
+        (r, t, a)
+    });
+    let rest = rest.unwrap_or(&[]);
+    Ok(vec![array(py, rest, r), array(py, rest, t), array(py, rest, a)])
 }
 
 /// Reflectance and transmittance of `stack` over angle × wavelength (× thickness of film
-/// `layer` when `thickness_nm` is given): the arrays `R_s, R_p, R, T_s, T_p, T, A` of shape
-/// (angles, wavelengths[, thicknesses]). The computation of `nacre spectrum`
+/// `layer` when `thickness_nm` is given): one array of shape (angles, wavelengths[,
+/// thicknesses], 4) holding R_s, R_p, T_s, T_p (the sweep's own memory, not copied). The computation of `nacre spectrum`
 /// ([`spectrum_cmd::compute`], [`spectrum_cmd::compute_thickness`]).
 #[pyfunction]
 #[pyo3(signature = (stack, angles_deg, wavelengths_nm, thickness_nm=None, layer=1))]
@@ -77,7 +102,7 @@ pub fn spectrum<'py>(
     wavelengths_nm: PyReadonlyArray1<'py, f64>,
     thickness_nm: Option<PyReadonlyArray1<'py, f64>>,
     layer: usize,
-) -> PyResult<Vec<Bound<'py, PyArrayDyn<f64>>>> {
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     let angles = vec_of(&angles_deg);
     let wavelengths = vec_of(&wavelengths_nm);
     let thicknesses = thickness_nm.as_ref().map(vec_of);
@@ -86,16 +111,17 @@ pub fn spectrum<'py>(
     if let Some(d) = &thicknesses {
         shape.push(d.len());
     }
-    let cols = py
+    shape.push(4);
+    let powers = py
         .detach(|| -> Result<_> {
             let powers = match &thicknesses {
                 None => spectrum_cmd::compute(&s, &angles, &wavelengths)?,
                 Some(d) => spectrum_cmd::compute_thickness(&s, layer, &angles, &wavelengths, d)?,
             };
-            Ok(columns(&powers))
+            Ok(powers_as_floats(powers))
         })
         .map_err(bake_err)?;
-    Ok(cols.into_iter().map(|c| array(py, &shape, c)).collect())
+    Ok(array(py, &shape, powers))
 }
 
 /// The points of `color`: each angle, with the first film's thickness and real index

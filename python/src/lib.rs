@@ -23,6 +23,7 @@ fn _nacre(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<table::PyTable>()?;
     m.add_function(wrap_pyfunction!(compute::spectrum, m)?)?;
     m.add_function(wrap_pyfunction!(compute::color, m)?)?;
+    m.add_function(wrap_pyfunction!(compute::unpolarised, m)?)?;
     m.add_function(wrap_pyfunction!(compute::bake, m)?)?;
     m.add_function(wrap_pyfunction!(compute::conformance, m)?)?;
     m.add_function(wrap_pyfunction!(bundled_materials, m)?)?;

@@ -69,37 +69,80 @@ def _axis(values: ArrayLike, name: str) -> FloatArray:
     return a.reshape(-1)
 
 
-@dataclass(frozen=True, eq=False)
 class Spectrum(Mapping[str, FloatArray]):
-    """Reflectance and transmittance of a stack; each array has shape
-    (angles, wavelengths) or (angles, wavelengths, thicknesses).
+    """Reflectance and transmittance of a stack over (angles, wavelengths) or (angles,
+    wavelengths, thicknesses): each quantity is an array of that shape.
 
-    Also a read-only mapping: ``s["R"]`` is ``s.R``; keys are the columns of
-    ``nacre spectrum``'s CSV after ``angle_deg,wavelength_nm``.
+    ``R_s``, ``R_p``, ``T_s``, ``T_p`` are views into :attr:`powers` (the sweep's own
+    memory, handed over without a copy); ``R``, ``T`` and ``A`` are computed on first use
+    by the library's definitions. Also a read-only mapping: ``s["R"]`` is ``s.R``, keys are
+    the columns of ``nacre spectrum``'s CSV after ``angle_deg,wavelength_nm``.
     """
 
-    angles_deg: FloatArray
-    """Incidence angles in the ambient, degrees."""
-    wavelengths_nm: FloatArray
-    """Vacuum wavelengths, nm."""
-    thickness_nm: Optional[FloatArray]
-    """The swept film's thicknesses, nm (None: the stack's own)."""
-    R_s: FloatArray
-    """Reflectance, s polarisation."""
-    R_p: FloatArray
-    """Reflectance, p polarisation."""
-    R: FloatArray
-    """Unpolarised reflectance (R_s + R_p)/2."""
-    T_s: FloatArray
-    """Transmittance into the substrate, s polarisation."""
-    T_p: FloatArray
-    """Transmittance into the substrate, p polarisation."""
-    T: FloatArray
-    """Unpolarised transmittance (T_s + T_p)/2."""
-    A: FloatArray
-    """Absorptance 1 − R − T (never below 0)."""
-
     _KEYS = ("R_s", "R_p", "R", "T_s", "T_p", "T", "A")
+
+    def __init__(
+        self,
+        angles_deg: FloatArray,
+        wavelengths_nm: FloatArray,
+        thickness_nm: Optional[FloatArray],
+        powers: FloatArray,
+    ) -> None:
+        self.angles_deg = angles_deg
+        """Incidence angles in the ambient, degrees."""
+        self.wavelengths_nm = wavelengths_nm
+        """Vacuum wavelengths, nm."""
+        self.thickness_nm = thickness_nm
+        """The swept film's thicknesses, nm (None: the stack's own)."""
+        self.powers = powers
+        """R_s, R_p, T_s, T_p along the last axis: shape (..., 4)."""
+        self._unpolarised: Optional[Tuple[FloatArray, FloatArray, FloatArray]] = None
+
+    @property
+    def shape(self) -> Tuple[int, ...]:
+        """(angles, wavelengths) or (angles, wavelengths, thicknesses)."""
+        return tuple(self.powers.shape[:-1])
+
+    @property
+    def R_s(self) -> FloatArray:
+        """Reflectance, s polarisation."""
+        return self.powers[..., 0]
+
+    @property
+    def R_p(self) -> FloatArray:
+        """Reflectance, p polarisation."""
+        return self.powers[..., 1]
+
+    @property
+    def T_s(self) -> FloatArray:
+        """Transmittance into the substrate, s polarisation."""
+        return self.powers[..., 2]
+
+    @property
+    def T_p(self) -> FloatArray:
+        """Transmittance into the substrate, p polarisation."""
+        return self.powers[..., 3]
+
+    def _rta(self) -> Tuple[FloatArray, FloatArray, FloatArray]:
+        if self._unpolarised is None:
+            r, t, a = _nacre.unpolarised(self.powers)
+            self._unpolarised = (r, t, a)
+        return self._unpolarised
+
+    @property
+    def R(self) -> FloatArray:
+        """Unpolarised reflectance (R_s + R_p)/2."""
+        return self._rta()[0]
+
+    @property
+    def T(self) -> FloatArray:
+        """Unpolarised transmittance (T_s + T_p)/2."""
+        return self._rta()[1]
+
+    @property
+    def A(self) -> FloatArray:
+        """Absorptance 1 − R − T in the films (never below 0)."""
+        return self._rta()[2]
 
     def __getitem__(self, key: str) -> FloatArray:
         if key not in self._KEYS:
@@ -111,6 +154,9 @@ class Spectrum(Mapping[str, FloatArray]):
 
     def __len__(self) -> int:
         return len(self._KEYS)
+
+    def __repr__(self) -> str:
+        return f"Spectrum(shape={self.shape})"
 
 
 def spectrum(
@@ -133,8 +179,8 @@ def spectrum(
     d = None if thickness_nm is None else _axis(thickness_nm, "thickness_nm")
     if isinstance(layer, bool) or not isinstance(layer, (int, np.integer)) or layer < 1:
         raise NacreError(f"layer `{layer}`: expected a film number, 1 for the top film")
-    cols = _nacre.spectrum(stack, a, w, d, int(layer))
-    return Spectrum(a, w, d, *cols)
+    powers = _nacre.spectrum(stack, a, w, d, int(layer))
+    return Spectrum(a, w, d, powers)
 
 
 @dataclass(frozen=True, eq=False)

@@ -68,6 +68,9 @@ def spectrum(
     wavelengths_nm: NDArray[np.float64],
     thickness_nm: Optional[NDArray[np.float64]] = None,
     layer: int = 1,
+) -> NDArray[np.float64]: ...
+def unpolarised(
+    powers: NDArray[np.float64],
 ) -> List[NDArray[np.float64]]: ...
 def color(
     stack: Stack,

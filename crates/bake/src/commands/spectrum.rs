@@ -34,6 +34,7 @@ pub fn fmt_sig(v: f64) -> String {
 /// Computes the table (checks the size limit and the angles first).
 pub fn compute(stack: &Stack, angles_deg: &[f64], wavelengths_nm: &[f64]) -> Result<Vec<Power>> {
     check_axes(angles_deg, wavelengths_nm, 1)?;
+    check_phases(stack, None, wavelengths_nm)?;
     stack
         .sweep(angles_deg, wavelengths_nm)
         .map_err(optics_error)
@@ -69,6 +70,8 @@ pub fn compute_thickness(
             },
         ));
     }
+    let thickest = thicknesses_nm.iter().copied().fold(0.0, f64::max);
+    check_phases(stack, Some((layer, thickest)), wavelengths_nm)?;
     stack
         .sweep_thickness(layer, angles_deg, wavelengths_nm, thicknesses_nm)
         .map_err(optics_error)
@@ -108,6 +111,47 @@ fn check_axes(angles_deg: &[f64], wavelengths_nm: &[f64], per_row: u64) -> Resul
         }
     }
     Ok(())
+}
+
+/// Refuses films whose phase overflows: a film of thickness d and index ñ under an ambient
+/// n₀ has the phase 2π ñ cos θ d / λ with |ñ cos θ| ≤ |ñ| + n₀, and a phase beyond f64
+/// (a 10³⁰⁰ nm film at 10⁻³⁰⁰ nm) would make the sweep return NaN. `swept` is the film
+/// (1-based) whose thickness a sweep varies, with its largest thickness.
+fn check_phases(stack: &Stack, swept: Option<(usize, f64)>, wavelengths_nm: &[f64]) -> Result<()> {
+    for &wavelength_nm in wavelengths_nm {
+        let indices = stack.indices_at(wavelength_nm).map_err(optics_error)?;
+        let ambient = indices[0].norm();
+        for (j, layer) in stack.layers().iter().enumerate() {
+            let d = match swept {
+                Some((k, d)) if k == j + 1 => d,
+                _ => layer.thickness_nm,
+            };
+            let phase =
+                2.0 * std::f64::consts::PI * (indices[j + 1].norm() + ambient) * d / wavelength_nm;
+            if !phase.is_finite() {
+                return Err(Error::invalid(
+                    Param::Wavelengths,
+                    format!(
+                        "film {} (`{}`, {} nm) at {} nm: its phase 2π ñ d / λ overflows; the film is too thick for the wavelength",
+                        j + 1,
+                        layer.material.name(),
+                        short(d),
+                        short(wavelength_nm)
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// `v` for a message: plain (`400`, `0.5`) in [10⁻⁴, 10¹⁵), else scientific (`1e300`).
+fn short(v: f64) -> String {
+    if v == 0.0 || (1e-4..1e15).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
 }
 
 /// Errors of a sweep: a wavelength outside a material's data or an absorbing ambient are
