@@ -177,3 +177,32 @@ def nacre_repo():
     import pathlib
 
     return pathlib.Path(__file__).resolve().parents[2]
+
+
+def test_the_gil_is_released_while_nacre_computes():
+    """Another Python thread keeps running while nacre computes: the longest pause the main
+    thread sees during a computation is far shorter than the computation (with the GIL held
+    in native code, it would wait for all of it)."""
+    import threading
+    import time
+
+    d = np.linspace(0.0, 2000.0, 1500)
+
+    def work():
+        return nacre.color(SOAP, 30.0, d)
+
+    t0 = time.perf_counter()
+    work()
+    alone = time.perf_counter() - t0
+    done = threading.Event()
+    worker = threading.Thread(target=lambda: (work(), done.set()))
+    worker.start()
+    last = time.perf_counter()
+    longest = 0.0
+    while not done.is_set():
+        now = time.perf_counter()
+        longest = max(longest, now - last)
+        last = now
+    worker.join()
+    assert alone > 0.05, alone
+    assert longest < 0.5 * alone, (longest, alone)
