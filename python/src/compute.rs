@@ -86,7 +86,11 @@ pub fn unpolarised<'py>(
         (r, t, a)
     });
     let rest = rest.unwrap_or(&[]);
-    Ok(vec![array(py, rest, r), array(py, rest, t), array(py, rest, a)])
+    Ok(vec![
+        array(py, rest, r),
+        array(py, rest, t),
+        array(py, rest, a),
+    ])
 }
 
 /// Reflectance and transmittance of `stack` over angle × wavelength (× thickness of film

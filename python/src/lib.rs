@@ -31,9 +31,12 @@ fn _nacre(m: &Bound<'_, PyModule>) -> PyResult<()> {
     Ok(())
 }
 
+/// A bundled material: name, description and the range of its data, nm.
+type BundledRow = (&'static str, &'static str, (f64, f64));
+
 /// The bundled materials: `(name, description, (min_nm, max_nm))`, as `nacre materials`.
 #[pyfunction]
-fn bundled_materials() -> PyResult<Vec<(&'static str, &'static str, (f64, f64))>> {
+fn bundled_materials() -> PyResult<Vec<BundledRow>> {
     nacre_format::materials::BUNDLED
         .iter()
         .map(|b| {
