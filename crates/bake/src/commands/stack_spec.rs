@@ -20,7 +20,7 @@
 use crate::commands::grid::parse_thickness_nm;
 use crate::error::{Error, Origin, Param, Result};
 use crate::recipe::{line_of, toml_error};
-use nacre_format::materials::resolve;
+use nacre_format::materials::{MaterialDb, database, resolve_with};
 use nacre_optics::{Layer, Stack};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -106,10 +106,17 @@ impl StackSpec {
         })
     }
 
-    /// Loads the materials and builds the stack.
+    /// Loads the materials and builds the stack, with the material database set by
+    /// [`nacre_format::materials::set_database`].
     pub fn build(&self) -> Result<Stack> {
+        self.build_with(database().as_ref())
+    }
+
+    /// Loads the materials and builds the stack, reading `shelf/book/page` materials from
+    /// `db` (None: such specs are an error that says how to set a database).
+    pub fn build_with(&self, db: Option<&MaterialDb>) -> Result<Stack> {
         let base = self.base_dir.as_deref();
-        let load = |m: &MaterialRef| resolve(&m.spec, m.context.clone(), base);
+        let load = |m: &MaterialRef| resolve_with(&m.spec, m.context.clone(), base, db);
         let ambient = load(&self.ambient)?;
         let layers = self
             .layers
