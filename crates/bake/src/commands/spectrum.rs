@@ -65,6 +65,8 @@ pub fn compute(stack: &Stack, angles_deg: &[f64], wavelengths_nm: &[f64]) -> Res
         .sweep(angles_deg, wavelengths_nm)
         .map_err(|source| match source {
             nacre_optics::Error::WavelengthOutOfRange { .. }
+            | nacre_optics::Error::NonPhysicalIndex { .. }
+            | nacre_optics::Error::NoPhysicalIndex { .. }
             | nacre_optics::Error::AbsorbingAmbient { .. } => {
                 Error::optics_in(Param::Wavelengths, source)
             }
