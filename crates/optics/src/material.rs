@@ -16,6 +16,18 @@
 //! [`Error::WavelengthOutOfRange`] naming the material and its range: nothing is
 //! extrapolated.
 //!
+//! # Imperfect pages (refractiveindex.info YAML)
+//!
+//! A page is usable wherever its data are sound (docs/materials.md gives the policy and
+//! the whole-database figures). Wavelengths in µm become nm exactly as written
+//! ([`um_to_nm`]). Rows out of order are sorted; rows repeating a wavelength are merged (the
+//! mean of their values); an n ≤ 0 or a κ < 0 is skipped, the row's other value kept. The
+//! material covers n's range; κ is 0 outside κ's own table. A second entry giving n (or κ)
+//! is ignored. A formula's non-physical stretches are cut off its range's ends, or refused
+//! inside it ([`Error::NoPhysicalIndex`], [`Material::gaps_nm`]). Each repair is a
+//! [`MaterialWarning`] naming file and line ([`Material::warnings`]). A page without n, and
+//! text that is not the format, stay errors. `wavelength_nm,n,k` CSV files stay strict.
+//!
 //! # Dispersion formulas (refractiveindex.info numbering; λ in µm, C₁… the coefficients)
 //!
 //! | type | formula |
