@@ -8,9 +8,13 @@
 //!    such as `gold` or `sio2` are accepted);
 //! 3. a path to a refractiveindex.info `.yml`/`.yaml` file or a `wavelength_nm,n,k` `.csv`
 //!    file (relative paths in a recipe are taken relative to the recipe's folder);
-//! 4. a refractiveindex.info page `shelf/book/page` (`main/Au/Johnson`), looked up in a
-//!    local copy of the database ([`MaterialDb`]; the parameter [`Param::MaterialDb`] or
-//!    the environment variable `NACRE_MATERIAL_DB` sets it with [`set_database`]).
+//! 4. a refractiveindex.info page `shelf/book/page` (`main/Au/Johnson`, also on shelves
+//!    whose name starts with a digit, `3d/metals/aluminium`), looked up in a local copy of
+//!    the database ([`MaterialDb`]; the parameter [`Param::MaterialDb`] or the environment
+//!    variable `NACRE_MATERIAL_DB` sets it with [`set_database`]).
+//!
+//! What the readers repaired or set aside in a file or page (docs/materials.md) is kept for
+//! [`take_warnings`], each warning once per process.
 //!
 //! # The refractiveindex.info database layout
 //!

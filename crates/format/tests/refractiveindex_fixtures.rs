@@ -170,7 +170,7 @@ fn a_formula_non_physical_inside_its_range_is_refused_there_by_name() {
         panic!("{:?}", m.gaps_nm())
     };
     // Formula 1 with a pole at C₅ = 6.591946 µm: n² < 0 just below it.
-    assert!(from_nm > 6400.0 && from_nm < 6591.946 && to_nm >= 6591.946 && to_nm < 6592.0);
+    assert!((6400.0..6591.946).contains(&from_nm) && (6591.946..6592.0).contains(&to_nm));
     assert_eq!(
         kinds(&m),
         [(

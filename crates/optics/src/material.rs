@@ -1023,6 +1023,9 @@ pub fn um_to_nm(token: &str) -> Option<f64> {
     parse_finite(&format!("{mantissa}e{}", exponent + 3))
 }
 
+/// A wavelength interval, nm: (from, to).
+type Range = (f64, f64);
+
 /// Where a formula is physical over `range` (nm): the usable range (the stated one with any
 /// non-physical ends cut off) and the non-physical open intervals inside it. None when it
 /// is physical nowhere. The range is sampled at [`FORMULA_SCAN_POINTS`] points, each edge
@@ -1030,7 +1033,7 @@ pub fn um_to_nm(token: &str) -> Option<f64> {
 fn formula_gaps(
     physical: &dyn Fn(f64) -> bool,
     range: (f64, f64),
-) -> Option<((f64, f64), Vec<(f64, f64)>)> {
+) -> Option<(Range, Vec<Range>)> {
     let (lo, hi) = range;
     let last = FORMULA_SCAN_POINTS - 1;
     let at = |i: usize| match i {
@@ -1520,7 +1523,7 @@ DATA:
             panic!("{:?}", m.gaps_nm())
         };
         assert!(
-            a <= 2f64.sqrt() * 1e3 && a > 1414.2 && b >= 2000.0 && b < 2000.01,
+            a <= 2f64.sqrt() * 1e3 && a > 1414.2 && (2000.0..2000.01).contains(&b),
             "{a} {b}"
         );
         m.index_at(a).unwrap();
