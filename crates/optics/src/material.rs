@@ -1030,10 +1030,7 @@ type Range = (f64, f64);
 /// non-physical ends cut off) and the non-physical open intervals inside it. None when it
 /// is physical nowhere. The range is sampled at [`FORMULA_SCAN_POINTS`] points, each edge
 /// found by bisection and moved to a short decimal on the physical side.
-fn formula_gaps(
-    physical: &dyn Fn(f64) -> bool,
-    range: (f64, f64),
-) -> Option<(Range, Vec<Range>)> {
+fn formula_gaps(physical: &dyn Fn(f64) -> bool, range: (f64, f64)) -> Option<(Range, Vec<Range>)> {
     let (lo, hi) = range;
     let last = FORMULA_SCAN_POINTS - 1;
     let at = |i: usize| match i {
