@@ -159,6 +159,8 @@ fn short(v: f64) -> String {
 fn optics_error(source: nacre_optics::Error) -> Error {
     match source {
         nacre_optics::Error::WavelengthOutOfRange { .. }
+        | nacre_optics::Error::NonPhysicalIndex { .. }
+        | nacre_optics::Error::NoPhysicalIndex { .. }
         | nacre_optics::Error::AbsorbingAmbient { .. } => {
             Error::optics_in(Param::Wavelengths, source)
         }
