@@ -30,3 +30,6 @@ if ! command -v glslangValidator >/dev/null 2>&1; then
 fi
 
 cargo test --workspace --locked
+
+# The Python package: a fresh virtual environment, `pip install ./python`, pytest.
+bash scripts/test_python.sh

@@ -73,7 +73,8 @@ const BRANCH_TOLERANCE: f32 = 1.1920929e-5;
 //       12    4 sigma_thickness_nm: f32
 //       16    4 ambient_ior: f32
 //       20    4 variation: f32
-//       24    8 _pad1, _pad2: f32
+//       24    4 variation_g: f32
+//       28    4 variation_b: f32
 //       32   12 base_ior: vec3<f32>
 //       44    4 _pad3: f32
 //       48   12 base_kappa: vec3<f32>
@@ -89,11 +90,12 @@ struct FilmInput {
     sigma_thickness_nm: f32,
     // Ambient index n₁ (film_lut: baked into the table, this field is ignored).
     ambient_ior: f32,
-    // Spatial variation s = 2g − 1 ∈ [−1, 1] of a stack's lower films (film_stack: film j ≥ 2
-    // is d_j + r_j s; NaN → 0; the other techniques ignore it).
+    // Spatial variation s = 2g − 1 ∈ [−1, 1] of a stack's lower films, from the thickness
+    // map's channel R (or grey), G and B (film_stack: film j ≥ 2 is d_j + r_j s_c for its
+    // channel c; NaN → 0; the other techniques ignore them).
     variation: f32,
-    _pad1: f32,
-    _pad2: f32,
+    variation_g: f32,
+    variation_b: f32,
     // Base index per output channel, real part n (film_fourier; film_lut bakes the base and
     // film_spectral reads it per wavelength from its samples).
     base_ior: vec3<f32>,
@@ -155,7 +157,7 @@ fn unit_power(x: f32) -> f32 {
 //   film_ior            NaN, ±∞ or ≤ 0 → the (sanitised) ambient index; clamped likewise;
 //   base_ior            NaN or ±∞ → BASE_IOR_FALLBACK (1.5); clamped to [IOR_MIN, IOR_MAX];
 //   base_kappa          NaN, ±∞ or < 0 → 0; clamped to [0, IOR_MAX];
-//   variation           NaN → 0; clamped to [−1, 1];
+//   variation(_g, _b)   NaN → 0; clamped to [−1, 1];
 //   _pad*               0.
 // Techniques still evaluate the physics at max(cos_theta_i, COS_THETA_MIN).
 fn sanitize_input(input: FilmInput) -> FilmInput {
@@ -172,8 +174,8 @@ fn sanitize_input(input: FilmInput) -> FilmInput {
     let kappa_ok = vec3_is_finite(input.base_kappa) & (input.base_kappa > vec3<f32>(0.0));
     o.base_kappa = select(vec3<f32>(0.0), min(input.base_kappa, vec3<f32>(IOR_MAX)), kappa_ok);
     o.variation = select(clamp(input.variation, -1.0, 1.0), 0.0, f32_is_nan(input.variation));
-    o._pad1 = 0.0;
-    o._pad2 = 0.0;
+    o.variation_g = select(clamp(input.variation_g, -1.0, 1.0), 0.0, f32_is_nan(input.variation_g));
+    o.variation_b = select(clamp(input.variation_b, -1.0, 1.0), 0.0, f32_is_nan(input.variation_b));
     o._pad3 = 0.0;
     o._pad4 = 0.0;
     return o;

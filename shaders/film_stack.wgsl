@@ -15,7 +15,8 @@
 //   ñ_m(λ_k)        stack_indices[k M + m]        complex index (n, κ) of medium m at node k
 //   d_j             thickness[j]                  film j's thickness at the pixel, nm
 //   d_j⁰, r_j       StackParams.layers[j].xy      film j's thickness and relative thickness, nm
-//   s               FilmInput.variation           spatial variation 2g − 1 ∈ [−1, 1]
+//   c_j             StackParams.layers[j].w       film j's thickness-map channel: 0 R, 1 G, 2 B
+//   s_c             FilmInput.variation(_g, _b)   spatial variation 2g_c − 1 ∈ [−1, 1] of channel c
 //   k_j             StackParams.layers[j].z       2 max_λ |ñ_j|: film j's OPD per nm
 //   h               StackParams.finesse           the stack's finesse factor (few_wavelengths.rs)
 //   λ_k, W_k        StackNode                     node wavelength, per-channel weight
@@ -24,7 +25,8 @@
 //   Γ_m, τ_m        gamma, tau                    composite amplitudes below interface m
 //
 // Films: d_1 = FilmInput.thickness_nm (the pixel's film thickness, as for every technique),
-// d_j = max(0, d_j⁰ + r_j s) for j ≥ 2 (Sussenbach 2013 Eq. 4.3, d = d_avg + d_rel Δ(x)).
+// d_j = max(0, d_j⁰ + r_j s_{c_j}) for j ≥ 2 (Sussenbach 2013 Eq. 4.3, d = d_avg + d_rel Δ(x),
+// with one map for all layers — every c_j = 0 — or one channel per layer).
 //
 // Rule: OPD = h Σ_j k_j d_j; N = ⌈base_count + count_per_opd_nm · OPD⌉ rounded up to the
 // ladder (StackParams.rule_size, increasing); the rule's nodes are stack_nodes[offset …
@@ -42,7 +44,7 @@
 // interfaces do not depend on λ and are computed once per pixel, before the wavelength loop
 // (the thesis's precalculation of wavelength-invariant terms).
 //
-// FilmInput fields used: cos_theta_i, thickness_nm, variation. The ambient index comes from
+// FilmInput fields used: cos_theta_i, thickness_nm, variation, variation_g, variation_b. The ambient index comes from
 // the stack (its real part), so do the base and the films; film_ior, ambient_ior, base_*
 // and sigma_thickness_nm are ignored. Indices are sanitised like a base index.
 
@@ -73,7 +75,7 @@ struct StackNode {
 //       28    4 _pad0: f32
 //       32   64 rule_offset: array<vec4<u32>, 4>   first node of rule i (component i % 4 of i / 4)
 //       96   64 rule_size: array<vec4<u32>, 4>     nodes of rule i
-//      160  128 layers: array<vec4<f32>, 8>        film j: (d_j⁰, r_j, k_j, 0)
+//      160  128 layers: array<vec4<f32>, 8>        film j: (d_j⁰, r_j, k_j, c_j)
 struct StackParams {
     films: u32,
     dispersive: u32,
@@ -128,11 +130,13 @@ fn film_colour(raw: FilmInput) -> FilmOutput {
     // Films' thicknesses at the pixel and the rule's OPD.
     var thickness: array<f32, 8>;
     var opd = 0.0;
+    let variation = vec3<f32>(input.variation, input.variation_g, input.variation_b);
     for (var j = 0u; j < films; j++) {
         let layer = stack_params.layers[j];
         var d = input.thickness_nm;
         if j > 0u {
-            d = clamp(layer.x + layer.y * input.variation, 0.0, THICKNESS_MAX_NM);
+            let s = variation[min(u32(clamp(layer.w, 0.0, 2.0)), 2u)];
+            d = clamp(layer.x + layer.y * s, 0.0, THICKNESS_MAX_NM);
             d = select(0.0, d, f32_is_finite(d));
         }
         thickness[j] = d;

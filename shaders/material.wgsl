@@ -282,16 +282,24 @@ fn material_thickness_sigma(d_thickness_dx: f32, d_thickness_dy: f32, roughness_
     return min(sqrt(g2 * MATERIAL_BOX_VARIANCE + r * r), THICKNESS_MAX_NM);
 }
 
-// The thickness map's (E[g], E[g²]) at `uv` for a footprint given by the uv derivatives
-// (textureSampleGrad: no implicit derivatives, so it may be called in non-uniform control
-// flow). Non-finite uv → the map's centre.
-fn material_sample_thickness_map(uv: vec2<f32>, duv_dx: vec2<f32>, duv_dy: vec2<f32>) -> vec2<f32> {
+// The thickness map's texel (E[g], E[g²], E[g_G], E[g_B]) at `uv` for a footprint given by
+// the uv derivatives (textureSampleGrad: no implicit derivatives, so it may be called in
+// non-uniform control flow). g is channel R (or grey), g_G and g_B the map's other channels
+// for a stack's films (a two-channel texture reads as (0, 1) there). Non-finite uv → the
+// map's centre; a non-finite component → its flat-map value.
+fn material_sample_thickness_texel(uv: vec2<f32>, duv_dx: vec2<f32>, duv_dy: vec2<f32>) -> vec4<f32> {
     let ok = f32_is_finite(uv.x) && f32_is_finite(uv.y);
     let st = select(vec2<f32>(0.5), uv, ok);
     let gx = select(vec2<f32>(0.0), duv_dx, vec3_is_finite(vec3<f32>(duv_dx, 0.0)).xy);
     let gy = select(vec2<f32>(0.0), duv_dy, vec3_is_finite(vec3<f32>(duv_dy, 0.0)).xy);
-    let m = textureSampleGrad(thickness_map, thickness_sampler, st, gx, gy).rg;
-    return select(vec2<f32>(0.5, 0.25), m, vec3_is_finite(vec3<f32>(m, 0.0)).xy);
+    let m = textureSampleGrad(thickness_map, thickness_sampler, st, gx, gy);
+    let finite = vec4<bool>(vec3_is_finite(m.xyz), f32_is_finite(m.w));
+    return select(vec4<f32>(0.5, 0.25, 0.5, 0.5), m, finite);
+}
+
+// The thickness map's (E[g], E[g²]) at `uv` (material_sample_thickness_texel's first two).
+fn material_sample_thickness_map(uv: vec2<f32>, duv_dx: vec2<f32>, duv_dy: vec2<f32>) -> vec2<f32> {
+    return material_sample_thickness_texel(uv, duv_dx, duv_dy).xy;
 }
 
 // The sub-pixel thickness std. dev. (nm) that the map's filtering removed, combined with the
@@ -415,9 +423,10 @@ fn ggx_albedo(n_dot_v: f32, alpha: f32) -> f32 {
 
 // ─── Film ────────────────────────────────────────────────────────────────────────────────
 
-// The technique's input for incidence cos θ, the point's thickness statistics and a base of
-// index n + iκ per channel (`base_ior`, `base_kappa`: one lobe of SurfaceMaterial).
-fn material_film_input(cos_theta: f32, thickness_nm: f32, sigma_thickness_nm: f32, variation: f32, base_ior: vec3<f32>, base_kappa: vec3<f32>) -> FilmInput {
+// The technique's input for incidence cos θ, the point's thickness statistics (and the
+// thickness map's variation per channel, for film_stack) and a base of index n + iκ per
+// channel (`base_ior`, `base_kappa`: one lobe of SurfaceMaterial).
+fn material_film_input(cos_theta: f32, thickness_nm: f32, sigma_thickness_nm: f32, variation: vec3<f32>, base_ior: vec3<f32>, base_kappa: vec3<f32>) -> FilmInput {
     let p = material_params;
     var input: FilmInput;
     input.cos_theta_i = cos_theta;
@@ -425,7 +434,9 @@ fn material_film_input(cos_theta: f32, thickness_nm: f32, sigma_thickness_nm: f3
     input.film_ior = p.film_ior;
     input.sigma_thickness_nm = sigma_thickness_nm;
     input.ambient_ior = p.ambient_ior;
-    input.variation = variation;
+    input.variation = variation.x;
+    input.variation_g = variation.y;
+    input.variation_b = variation.z;
     input.base_ior = base_ior;
     input.base_kappa = base_kappa;
     return input;
@@ -498,9 +509,10 @@ struct SurfacePoint {
     thickness_nm: f32,
     // Std. dev. of d inside the pixel, nm.
     sigma_thickness_nm: f32,
-    // The thickness map's spatial variation s = 2g − 1 ∈ [−1, 1] (film_stack moves its lower
-    // films by it: d_j + r_j s; 0 where no map is sampled).
-    variation: f32,
+    // The thickness map's spatial variation s_c = 2g_c − 1 ∈ [−1, 1] of channels R (or grey),
+    // G, B (film_stack moves its lower films by their channel's: d_j + r_j s_c; 0 where no
+    // map is sampled).
+    variation: vec3<f32>,
 }
 
 // What the surface sends towards the viewer, and what it lets through.

@@ -272,7 +272,8 @@ fn mesh_fs(in: MeshVertexOut, @builtin(front_facing) front: bool) -> @location(0
     surface.view_dir = v;
     surface.thickness_nm = thickness_nm;
     surface.sigma_thickness_nm = sigma_nm;
-    surface.variation = 2.0 * moments.x - 1.0;
+    // The texture's one channel drives every film.
+    surface.variation = vec3<f32>(2.0 * moments.x - 1.0);
     // Lavapipe (Mesa 22.3, LLVM 15) crashes executing this pipeline when any of the
     // SurfaceMaterial fields above varies per fragment (a textured roughness, metallic, film
     // weight, base colour…), and so does the factor-only material of `mesh_factor_material`

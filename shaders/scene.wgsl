@@ -136,9 +136,9 @@ fn scene_intersect(ray: Ray) -> SceneHit {
     return scene_intersect_sphere(ray);
 }
 
-// The thickness map's (E[g], E[g²]) at map coordinate p with normal n, projected
-// triplanarly, for a footprint given by the screen-space derivatives of p.
-fn scene_sample_thickness(p: vec3<f32>, n: vec3<f32>, dp_dx: vec3<f32>, dp_dy: vec3<f32>) -> vec2<f32> {
+// The thickness map's (E[g], E[g²], E[g_G], E[g_B]) at map coordinate p with normal n,
+// projected triplanarly, for a footprint given by the screen-space derivatives of p.
+fn scene_sample_thickness(p: vec3<f32>, n: vec3<f32>, dp_dx: vec3<f32>, dp_dy: vec3<f32>) -> vec4<f32> {
     let s = 0.5 * finite_or(material_params.thickness_map_scale, 1.0);
     let a = abs(safe_normalize(n, vec3<f32>(0.0, 1.0, 0.0)));
     let a2 = a * a;
@@ -148,26 +148,30 @@ fn scene_sample_thickness(p: vec3<f32>, n: vec3<f32>, dp_dx: vec3<f32>, dp_dy: v
     let q = p * s + 0.5;
     var mean = 0.0;
     var variance = 0.0;
+    var others = vec2<f32>(0.0);
     if w.x > 1e-3 {
-        let m = material_sample_thickness_map(q.zy, gx.zy, gy.zy);
+        let m = material_sample_thickness_texel(q.zy, gx.zy, gy.zy);
         mean += w.x * m.x;
         variance += w.x * max(m.y - m.x * m.x, 0.0);
+        others += w.x * m.zw;
     }
     if w.y > 1e-3 {
-        let m = material_sample_thickness_map(q.xz, gx.xz, gy.xz);
+        let m = material_sample_thickness_texel(q.xz, gx.xz, gy.xz);
         mean += w.y * m.x;
         variance += w.y * max(m.y - m.x * m.x, 0.0);
+        others += w.y * m.zw;
     }
     if w.z > 1e-3 {
-        let m = material_sample_thickness_map(q.xy, gx.xy, gy.xy);
+        let m = material_sample_thickness_texel(q.xy, gx.xy, gy.xy);
         mean += w.z * m.x;
         variance += w.z * max(m.y - m.x * m.x, 0.0);
+        others += w.z * m.zw;
     }
     // The skipped weights (< 1e-3 each) renormalised away.
     let total = select(0.0, w.x, w.x > 1e-3) + select(0.0, w.y, w.y > 1e-3) + select(0.0, w.z, w.z > 1e-3);
     let k = select(1.0, 1.0 / total, total > 0.0);
     let g = mean * k;
-    return vec2<f32>(g, g * g + variance * k);
+    return vec4<f32>(g, g * g + variance * k, others * k);
 }
 
 // Display output: the pixel's radiance exposed, tone-mapped and sRGB-encoded (Rgba8Unorm).
@@ -194,7 +198,7 @@ fn scene_radiance(pixel: vec2<f32>) -> vec3<f32> {
     let dp_dy = dpdy(hit.map_position);
     let moments = scene_sample_thickness(hit.map_position, hit.normal, dp_dx, dp_dy);
     let thickness_nm = material_thickness_nm(moments.x, hit.height);
-    let sigma_nm = material_thickness_sigma(dpdx(thickness_nm), dpdy(thickness_nm), material_thickness_roughness_nm(moments));
+    let sigma_nm = material_thickness_sigma(dpdx(thickness_nm), dpdy(thickness_nm), material_thickness_roughness_nm(moments.xy));
 
     // The surfaces along the ray, front to back: none for a miss, the front wall of an opaque
     // object, or both walls of a bubble. Each adds its reflection times the colour that the
@@ -210,7 +214,7 @@ fn scene_radiance(pixel: vec2<f32>) -> vec3<f32> {
         if k == 0u {
             surface.normal = hit.normal;
             surface.thickness_nm = thickness_nm;
-            surface.variation = 2.0 * moments.x - 1.0;
+            surface.variation = 2.0 * vec3<f32>(moments.x, moments.z, moments.w) - 1.0;
         } else {
             // The back wall, seen from inside: its normal faces the centre, its thickness comes
             // from the map at its own point (with the front's footprint).
@@ -219,7 +223,7 @@ fn scene_radiance(pixel: vec2<f32>) -> vec3<f32> {
             let m = scene_sample_thickness(n_back, n_back, dp_dx, dp_dy);
             surface.normal = -n_back;
             surface.thickness_nm = material_thickness_nm(m.x, n_back.y);
-            surface.variation = 2.0 * m.x - 1.0;
+            surface.variation = 2.0 * vec3<f32>(m.x, m.z, m.w) - 1.0;
         }
         let shade = material_shade(surface);
         radiance += throughput * shade.radiance;

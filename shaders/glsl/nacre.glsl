@@ -113,10 +113,11 @@ struct NacreFilmInput {
     float film_ior;
     float sigma_thickness_nm;
     float ambient_ior;
-    // Spatial variation s = 2g − 1 ∈ [−1, 1] of a stack's lower films (film_stack only).
+    // Spatial variation s = 2g − 1 ∈ [−1, 1] of a stack's lower films, from the thickness
+    // map's channels R (or grey), G and B (film_stack only).
     float variation;
-    float _pad1;
-    float _pad2;
+    float variation_g;
+    float variation_b;
     vec3 base_ior;
     float _pad3;
     vec3 base_kappa;
@@ -141,8 +142,8 @@ NacreFilmInput nacre_make_film_input(float cos_theta_i, float thickness_nm, floa
     i.sigma_thickness_nm = sigma_thickness_nm;
     i.ambient_ior = ambient_ior;
     i.variation = 0.0;
-    i._pad1 = 0.0;
-    i._pad2 = 0.0;
+    i.variation_g = 0.0;
+    i.variation_b = 0.0;
     i.base_ior = base_ior;
     i._pad3 = 0.0;
     i.base_kappa = base_kappa;
@@ -192,7 +193,7 @@ float nacre_unit_power(float x) {
 //   film_ior            NaN, ±∞ or ≤ 0 → the (sanitised) ambient index; clamped likewise;
 //   base_ior            NaN or ±∞ → BASE_IOR_FALLBACK (1.5); clamped to [IOR_MIN, IOR_MAX];
 //   base_kappa          NaN, ±∞ or < 0 → 0; clamped to [0, IOR_MAX];
-//   variation           NaN → 0; clamped to [−1, 1];
+//   variation(_g, _b)   NaN → 0; clamped to [−1, 1];
 //   _pad*               0.
 // Techniques still evaluate the physics at max(cos_theta_i, COS_THETA_MIN).
 NacreFilmInput nacre_sanitize_input(NacreFilmInput inp) {
@@ -210,8 +211,8 @@ NacreFilmInput nacre_sanitize_input(NacreFilmInput inp) {
     bvec3 kappa_ok = bvec3(kappa_finite.x && inp.base_kappa.x > 0.0, kappa_finite.y && inp.base_kappa.y > 0.0, kappa_finite.z && inp.base_kappa.z > 0.0);
     o.base_kappa = mix(vec3(0.0), min(inp.base_kappa, vec3(NACRE_IOR_MAX)), kappa_ok);
     o.variation = nacre_f32_is_nan(inp.variation) ? 0.0 : clamp(inp.variation, -1.0, 1.0);
-    o._pad1 = 0.0;
-    o._pad2 = 0.0;
+    o.variation_g = nacre_f32_is_nan(inp.variation_g) ? 0.0 : clamp(inp.variation_g, -1.0, 1.0);
+    o.variation_b = nacre_f32_is_nan(inp.variation_b) ? 0.0 : clamp(inp.variation_b, -1.0, 1.0);
     o._pad3 = 0.0;
     o._pad4 = 0.0;
     return o;

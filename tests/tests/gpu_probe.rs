@@ -209,10 +209,10 @@ fn film_spectral_matches_samples_n() {
 }
 
 /// `film_stack` against its CPU twin (`StackEvaluation`) over random pixels (incidence,
-/// top-film thickness, variation s) for stacks of 1 to 8 films: dielectric, absorbing metal
-/// films (10 nm silver, chromium), dispersive materials, and an ambient denser than its
-/// films (total internal reflection and evanescent films), with the rule ladder and with a
-/// fixed rule: max |GPU − CPU| ≤ 1e-4 per channel.
+/// top-film thickness, variations s_R, s_G, s_B, the films on map channels R, G, B in
+/// turn) for stacks of 1 to 8 films: dielectric, absorbing metal films (10 nm silver,
+/// chromium), dispersive materials, and an ambient denser than its films (total internal
+/// reflection and evanescent films), with the rule ladder and with a fixed rule: max |GPU − CPU| ≤ 1e-4 per channel.
 #[test]
 fn film_stack_matches_its_cpu_twin() {
     use nacre_optics::few_wavelengths::StackEvaluation;
@@ -294,11 +294,17 @@ fn film_stack_matches_its_cpu_twin() {
     for (name, stack, samples) in cases {
         let films = stack.layers().len();
         let relative_nm: Vec<f64> = (0..films).map(|j| 15.0 * j as f64).collect();
-        let eval = StackEvaluation::new(&colorimeter, &stack, &relative_nm, samples).unwrap();
+        // One thickness-map channel per film (R, G, B in turn).
+        let channels: Vec<usize> = (0..films).map(|j| j % 3).collect();
+        let eval = StackEvaluation::new(&colorimeter, &stack, &relative_nm, samples)
+            .unwrap()
+            .with_channels(&channels)
+            .unwrap();
         let options = TechniqueOptions {
             stack: StackSetup {
                 stack,
                 relative_nm,
+                channels,
                 samples,
             },
             ..Default::default()
@@ -306,13 +312,18 @@ fn film_stack_matches_its_cpu_twin() {
         let binding =
             TechniqueBinding::new(ctx, &tables, Technique::Stack, &options, &colorimeter).unwrap();
         let mut rng = Lcg(41);
-        let pixels: Vec<(f64, f64, f64)> = (0..400)
-            .map(|_| (rng.next(), 500.0 * rng.next(), 2.0 * rng.next() - 1.0))
+        let pixels: Vec<(f64, f64, [f64; 3])> = (0..400)
+            .map(|_| {
+                let (c, d) = (rng.next(), 500.0 * rng.next());
+                (c, d, [(); 3].map(|_| 2.0 * rng.next() - 1.0))
+            })
             .collect();
         let inputs: Vec<FilmInput> = pixels
             .iter()
             .map(|&(c, d, s)| FilmInput {
-                variation: s as f32,
+                variation: s[0] as f32,
+                variation_g: s[1] as f32,
+                variation_b: s[2] as f32,
                 ..input(c, d, 1.5, 0.0, 1.0, C64::new(1.5, 0.0))
             })
             .collect();
@@ -324,7 +335,7 @@ fn film_stack_matches_its_cpu_twin() {
                 eval.colour(
                     f64::from(i.cos_theta_i),
                     f64::from(i.thickness_nm),
-                    f64::from(i.variation),
+                    [i.variation, i.variation_g, i.variation_b].map(f64::from),
                 )
             })
             .collect();

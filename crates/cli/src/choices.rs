@@ -21,6 +21,25 @@ impl From<QuantityArg> for Quantity {
     }
 }
 
+/// `nacre render --layer-channel`: the thickness-map channel a stack's film follows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ChannelArg {
+    R,
+    G,
+    B,
+}
+
+impl ChannelArg {
+    /// The channel's index (0 R or grey, 1 G, 2 B).
+    pub fn index(self) -> usize {
+        match self {
+            ChannelArg::R => 0,
+            ChannelArg::G => 1,
+            ChannelArg::B => 2,
+        }
+    }
+}
+
 /// `nacre render --technique`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum TechniqueArg {

@@ -350,7 +350,9 @@ struct RenderArgs {
     /// row 0 = zenith) [default: tables/env/studio.exr].
     #[arg(long, value_name = "FILE")]
     env: Option<PathBuf>,
-    /// Greyscale thickness map (8- or 16-bit PNG) [default: built-in swirls].
+    /// Thickness map, 8- or 16-bit PNG or JPEG: greyscale, or with --technique stack RGB,
+    /// one channel per film (--layer-channel) [default: built-in swirls, channels R, G, B
+    /// three phases of one pattern].
     #[arg(long, value_name = "FILE.png")]
     thickness_map: Option<PathBuf>,
     /// Exposure in EV stops (radiance × 2^EV before tone mapping).
@@ -371,6 +373,11 @@ struct RenderArgs {
     /// [default: 0 for every film].
     #[arg(long = "relative", value_name = "NM")]
     relative: Vec<f64>,
+    /// --technique stack: the thickness-map channel each film follows (repeat once per film,
+    /// top first; the top film's is r): one map for every film, or one channel per film
+    /// (the thesis's SVT per layer) [default: r for every film].
+    #[arg(long = "layer-channel", value_name = "C", value_enum)]
+    layer_channels: Vec<choices::ChannelArg>,
     /// Diffraction scenes: wavelength step of the colour sum, nm, over the table's range (the
     /// table's own step, 5 nm for the default set, is the CPU's grid); layout "terms" only
     /// (an integrated table's sum is fixed at bake time) [default: 10].
@@ -401,7 +408,8 @@ wavelength_nm,n,k .csv file, or a refractiveindex.info page SHELF/BOOK/PAGE
 (`main/Au/Johnson`) with --material-db DIR. Thickness: nanometres, `635` or `635nm` (or `1.2um`).
 
 Examples:
-  # the default: a 400 nm soap film in air, 0:89:1 degrees × 380:780:5 nm, to stdout
+  # the default: a 400 nm soap film (index 1.33) in vacuum (1.0), 0:89:1 degrees ×
+  # 380:780:5 nm, to stdout
   nacre spectrum
   # quarter-wave MgF2 anti-reflection coating on BK7 glass, to a file
   nacre spectrum --layer mgf2@99.75nm --substrate bk7 -o ar-coating.csv
@@ -414,13 +422,15 @@ Examples:
 
 #[derive(Args)]
 struct StackArgs {
-    /// Ambient (incidence) medium; must be non-absorbing [default: air].
+    /// Ambient (incidence) medium; must be non-absorbing [default: 1.0, vacuum, at every
+    /// wavelength; with a lut:/rough-lut: method and no stack flags, the table's own stack].
     #[arg(long, value_name = "M")]
     ambient: Option<String>,
-    /// A film, top first; repeat for more films (default with no stack flags: water@400).
+    /// A film, top first; repeat for more films (default with no stack flags: 1.33@400, a
+    /// soap film).
     #[arg(long = "layer", value_name = "M@THICKNESS")]
     layers: Vec<String>,
-    /// Substrate (any index, absorbing allowed) [default: air].
+    /// Substrate (any index, absorbing allowed) [default: 1.0, vacuum].
     #[arg(long, value_name = "M")]
     substrate: Option<String>,
     /// Read the stack (and optional angles/wavelengths) from a TOML recipe instead.
@@ -494,14 +504,28 @@ fn run_spectrum(args: &SpectrumArgs) -> Result<()> {
 fn run_color(args: &ColorArgs) -> Result<()> {
     use nacre_bake::commands::color::{self, Method, Quantity};
     use nacre_bake::commands::color_request::{self as request, ColorRequest, ColourSettings};
-    let (spec, recipe_angles, _) = load_stack(&args.stack)?;
     let method = Method::parse(&args.method)?;
+    let (mut spec, recipe_angles, _) = load_stack(&args.stack)?;
+    // A table method and no stack flags: the stack the table was baked for.
+    let s = &args.stack;
+    if s.ambient.is_none()
+        && s.layers.is_empty()
+        && s.substrate.is_none()
+        && s.recipe.is_none()
+        && let Method::Lut(path) | Method::RoughLut { path, .. } = &method
+        && let Some(own) = StackSpec::for_table(&Manifest::read(path)?, path)
+    {
+        spec = own;
+    }
     let quantity = Quantity::from(args.quantity);
     let points = match &args.points {
         Some(path) => request::read_points(path)?,
         None => request::angle_points(args.angles.clone().or(recipe_angles))?,
     };
     let stack = spec.build()?;
+    // A material without data (or without a physical index) at a wavelength the method
+    // needs: named by the input that gave it.
+    let named = |e| spec.attribute(&stack, e);
     let prepared = request::prepare(
         &stack,
         method,
@@ -515,8 +539,9 @@ fn run_color(args: &ColorArgs) -> Result<()> {
             },
             fourier_table: args.fourier_table.as_deref(),
         },
-    )?;
-    let out = request::compute(&stack, &points, &prepared, quantity)?;
+    )
+    .map_err(named)?;
+    let out = request::compute(&stack, &points, &prepared, quantity).map_err(named)?;
     if let Some((samples, worst)) = out.monte_carlo {
         eprintln!(
             "rough-mc: {samples} samples per point (seed = point index); largest standard error per channel {worst:.2e}"
@@ -619,6 +644,7 @@ fn run_render(args: &RenderArgs) -> Result<()> {
         options.stack = nacre_runtime::bindings::StackSetup {
             stack,
             relative_nm: relative,
+            channels: args.layer_channels.iter().map(|c| c.index()).collect(),
             samples: args.wavelengths,
         };
     }
@@ -631,7 +657,7 @@ fn run_render(args: &RenderArgs) -> Result<()> {
         nacre_runtime::render::EnvironmentMap::load(path)?;
     }
     if let Some(path) = &options.thickness_map {
-        nacre_runtime::render::ThicknessMap::load_png(path)?;
+        nacre_runtime::render::ThicknessMap::load_for(path, technique)?;
     }
     let gltf = match &args.gltf {
         Some(path) => Some(nacre_runtime::gltf_scene::GltfScene::load(path)?),
@@ -1072,12 +1098,16 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Materials => {
+            // The ranges exactly as the data give them (not rounded: each bound printed is
+            // accepted).
             for b in materials::BUNDLED {
                 let m = materials::load_bundled(b)?;
                 let (lo, hi) = m.range_nm();
                 println!(
-                    "{:<13} {:>7.1}–{:<8.1} nm  {}",
-                    b.name, lo, hi, b.description
+                    "{:<13} {:<26} {}",
+                    b.name,
+                    format!("{lo}–{hi} nm"),
+                    b.description
                 );
             }
             Ok(())
@@ -1085,12 +1115,37 @@ fn run(cli: Cli) -> Result<()> {
     }
 }
 
+/// Mesa's Vulkan device-select layer (`VK_LAYER_MESA_device_select`, an implicit layer that
+/// Mesa installs) asks libwayland for the session's display to rank the GPUs; without a
+/// Wayland session (`XDG_RUNTIME_DIR` unset or not a folder) libwayland prints `error:
+/// XDG_RUNTIME_DIR is invalid or not set in the environment.` to stderr, once per Vulkan
+/// instance, although nothing failed. nacre picks its adapter itself (`WGPU_ADAPTER_NAME`,
+/// else wgpu's choice), so there the layer is switched off with its own switch,
+/// `NODEVICE_SELECT=1` — unless the user set `NODEVICE_SELECT` or asks the layer for a
+/// device (`MESA_VK_DEVICE_SELECT`).
+fn quiet_vulkan_device_select() {
+    let has = |var: &str| std::env::var_os(var).is_some_and(|v| !v.is_empty());
+    let session = std::env::var_os("XDG_RUNTIME_DIR")
+        .map(PathBuf::from)
+        .is_some_and(|dir| dir.is_absolute() && dir.is_dir());
+    if !session && !has("NODEVICE_SELECT") && !has("MESA_VK_DEVICE_SELECT") {
+        // SAFETY: called first thing in `main`, before any other thread exists.
+        unsafe { std::env::set_var("NODEVICE_SELECT", "1") };
+    }
+}
+
 fn main() -> ExitCode {
+    quiet_vulkan_device_select();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => e.exit(), // usage errors exit with status 2, --help/--version with 0
     };
-    match run(cli) {
+    let result = run(cli);
+    // What the material readers repaired or set aside (the materials are usable).
+    for w in materials::take_warnings() {
+        eprintln!("nacre: warning: {w}");
+    }
+    match result {
         Ok(()) => ExitCode::SUCCESS,
         // `nacre spectrum | head`: the reader closed the pipe; end quietly.
         Err(e) if e.is_broken_pipe() => ExitCode::SUCCESS,

@@ -51,6 +51,45 @@ fn default_spectrum_to_stdout() {
     assert!(nacre(&["spectrum", "--help"], dir.path()).status.success());
 }
 
+/// The defaults work at every wavelength (issue 16 §5): vacuum around a 1.33 film, not the
+/// bundled `air` (230–1690 nm) and `water` (182–1129 nm); `--help` says what they are.
+#[test]
+fn defaults_work_at_every_wavelength_and_help_states_them() {
+    let dir = tempfile::tempdir().unwrap();
+    for wavelengths in ["100:200:50", "2000:20000:9000"] {
+        let o = nacre(
+            &["spectrum", "--angles", "0", "--wavelengths", wavelengths],
+            dir.path(),
+        );
+        assert!(o.status.success(), "{wavelengths}: {}", stderr(&o));
+        assert!(o.stderr.is_empty(), "{}", stderr(&o));
+    }
+    let help = String::from_utf8(nacre(&["spectrum", "--help"], dir.path()).stdout).unwrap();
+    let help = help.split_whitespace().collect::<Vec<_>>().join(" ");
+    for needle in ["[default: 1.0, vacuum", "1.33@400", "the table's own stack"] {
+        assert!(help.contains(needle), "`{needle}` not in: {help}");
+    }
+}
+
+/// A table method and no stack flags: the table's own stack (issue 16 §5).
+#[test]
+fn a_table_method_without_stack_flags_uses_the_tables_stack() {
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    for method in ["lut:film-dielectric", "lut:soap-film", "lut:film-gold"] {
+        let o = Command::new(env!("CARGO_BIN_EXE_nacre"))
+            .args(["color", "--method", method, "--angles", "0:80:40"])
+            .current_dir(&repo)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{method}: {}", stderr(&o));
+        assert_eq!(
+            String::from_utf8_lossy(&o.stdout).lines().count(),
+            4,
+            "{method}"
+        );
+    }
+}
+
 #[test]
 fn recipe_and_flags_agree_and_write_a_file() {
     let dir = tempfile::tempdir().unwrap();
@@ -120,8 +159,8 @@ fn bad_input_exits_2_with_a_message_and_keeps_existing_output() {
             "END must not be below START",
         ),
         (
-            &["--wavelengths", "100:200:1"],
-            "--wavelengths: material `air` has no data at 100 nm",
+            &["--substrate", "air", "--wavelengths", "100:200:1"],
+            "--wavelengths: material `air` has no data at 100 nm: its data covers 230–1690 nm",
         ),
         (&["--wavelengths", "-5"], "--wavelengths"),
         (&["--layer", "water@-5"], "--layer `water@-5`"),
@@ -310,6 +349,8 @@ fn color_and_bake_bad_input() {
         (
             &[
                 "color",
+                "--ambient",
+                "air",
                 "--layer",
                 "1.33@400",
                 "--substrate",
@@ -317,7 +358,7 @@ fn color_and_bake_bad_input() {
                 "--method",
                 "lut:soap-film",
             ],
-            "baked for ambient `1.0`",
+            "baked for ambient `1.0`, this stack has `air`",
         ),
         (
             &[
@@ -479,6 +520,22 @@ fn render_writes_a_png() {
     assert!(stderr(&o).contains("adapter: "), "{}", stderr(&o));
     let png = std::fs::read(d.join("sphere.png")).unwrap();
     assert_eq!(png_size(&png), (64, 48));
+    // Without a Wayland session, nothing on stderr says "error" (issue 16 §5: Mesa's Vulkan
+    // device-select layer made libwayland print `error: XDG_RUNTIME_DIR is invalid or not
+    // set in the environment.` twice on success).
+    let o = Command::new(env!("CARGO_BIN_EXE_nacre"))
+        .args(["render", "--width", "8", "--height", "8", "-o", "quiet.png"])
+        .current_dir(d)
+        .env_remove("XDG_RUNTIME_DIR")
+        .env_remove("NODEVICE_SELECT")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        !stderr(&o).to_lowercase().contains("error"),
+        "{}",
+        stderr(&o)
+    );
     for (scene, technique, extra) in [
         ("bubble", "spectral", &["--wavelengths", "12"][..]),
         (

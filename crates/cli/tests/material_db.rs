@@ -188,3 +188,90 @@ fn missing_pages_and_missing_databases_are_clear_errors() {
         "{e}"
     );
 }
+
+/// Imperfect pages (docs/materials.md): repaired with a warning on stderr naming file and
+/// line, the command succeeding; a shelf starting with a digit; a formula's non-physical
+/// stretch refused naming the flag.
+#[test]
+fn imperfect_pages_work_with_warnings_and_name_their_lines() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let write = |rel: &str, text: &str| {
+        let p = d.join("db").join(rel);
+        std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+        std::fs::write(p, text).unwrap();
+    };
+    // Line 13 repeats 0.50 µm (line 12) with other values; line 14 is out of order; line 15
+    // has k < 0.
+    write(
+        "database/data/main/Au/nk/Messy.yml",
+        &GOLD_LIKE.replace(
+            "        1.00 0.20 6.00\n",
+            "        0.50 0.90 2.20\n        0.40 1.10 1.90\n        0.70 0.40 -1.0\n        1.00 0.20 6.00\n",
+        ),
+    );
+    // A formula with a pole at 2 µm: no physical n for √2 < λ < 2 µm.
+    write(
+        "database/data/main/X/nk/Pole.yml",
+        "DATA:\n  - type: formula 2\n    wavelength_range: 0.5 5\n    coefficients: 0 1 4\n",
+    );
+    write(
+        "database/catalog-nk.yml",
+        "- SHELF: 3d\n  content:\n    - BOOK: metals\n      content:\n        - PAGE: gold\n          data: main/Au/nk/Messy.yml\n",
+    );
+    let db = d.join("db");
+    let db = db.to_str().unwrap();
+    let spectrum = |substrate: &str, wavelengths: &str| {
+        nacre(
+            &[
+                "--material-db",
+                db,
+                "spectrum",
+                "--substrate",
+                substrate,
+                "--angles",
+                "0",
+                "--wavelengths",
+                wavelengths,
+            ],
+            d,
+            None,
+        )
+    };
+    for page in ["main/Au/Messy", "3d/metals/gold"] {
+        let o = spectrum(page, "300:1000:100");
+        let e = stderr(&o);
+        assert!(o.status.success(), "{page}: {e}");
+        let file = d.join("db/database/data/main/Au/nk/Messy.yml");
+        let file = file.display();
+        let lines: Vec<&str> = e.lines().collect();
+        assert_eq!(
+            lines,
+            [
+                format!("nacre: warning: {file}:13: wavelength 0.5 µm repeats line 12 with other values: their mean is used").as_str(),
+                &format!("nacre: warning: {file}:14: wavelength 0.4 µm follows 0.5 µm: the rows are sorted by wavelength"),
+                &format!("nacre: warning: {file}:15: k = -1 at 0.7 µm is negative (gain): this k is skipped"),
+            ][..],
+            "{page}"
+        );
+        assert_eq!(String::from_utf8_lossy(&o.stdout).lines().count(), 9);
+    }
+    // The formula: fine outside its gap, refused inside it naming the flag.
+    let o = spectrum("main/X/Pole", "1000");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains(
+            "Pole.yml:3: the formula gives no physical n between 1414.213 and 2000.001 nm"
+        ),
+        "{}",
+        stderr(&o)
+    );
+    let o = spectrum("main/X/Pole", "1700");
+    assert_eq!(o.status.code(), Some(2));
+    let e = stderr(&o);
+    assert!(
+        e.contains("nacre: error: --wavelengths: material `main/X/Pole` has no physical index at 1700 nm: its formula gives none between 1414.213 and 2000.001 nm"),
+        "{e}"
+    );
+    assert!(o.stdout.is_empty());
+}

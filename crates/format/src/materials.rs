@@ -8,9 +8,13 @@
 //!    such as `gold` or `sio2` are accepted);
 //! 3. a path to a refractiveindex.info `.yml`/`.yaml` file or a `wavelength_nm,n,k` `.csv`
 //!    file (relative paths in a recipe are taken relative to the recipe's folder);
-//! 4. a refractiveindex.info page `shelf/book/page` (`main/Au/Johnson`), looked up in a
-//!    local copy of the database ([`MaterialDb`]; the parameter [`Param::MaterialDb`] or
-//!    the environment variable `NACRE_MATERIAL_DB` sets it with [`set_database`]).
+//! 4. a refractiveindex.info page `shelf/book/page` (`main/Au/Johnson`, also on shelves
+//!    whose name starts with a digit, `3d/metals/aluminium`), looked up in a local copy of
+//!    the database ([`MaterialDb`]; the parameter [`Param::MaterialDb`] or the environment
+//!    variable `NACRE_MATERIAL_DB` sets it with [`set_database`]).
+//!
+//! What the readers repaired or set aside in a file or page (docs/materials.md) is kept for
+//! [`take_warnings`], each warning once per process.
 //!
 //! # The refractiveindex.info database layout
 //!
@@ -35,9 +39,10 @@
 use crate::error::{Error, Result};
 use crate::msg;
 use crate::param::{Origin, Param};
-use nacre_optics::Material;
+use nacre_optics::{Material, MaterialWarning};
+use std::collections::HashSet;
 use std::path::{Path, PathBuf};
-use std::sync::RwLock;
+use std::sync::{Mutex, RwLock};
 
 /// A bundled material: its name, what it is, and its data file's text.
 pub struct Bundled {
@@ -138,6 +143,44 @@ pub struct MaterialDb {
     /// Where the setting came from, for messages: the parameter [`Param::MaterialDb`] or an
     /// environment variable.
     pub origin: Origin,
+}
+
+/// Warnings of the materials [`resolve`] has loaded: every one seen (as text), and those
+/// not yet taken.
+struct WarningLog {
+    seen: Option<HashSet<String>>,
+    pending: Vec<MaterialWarning>,
+}
+
+static WARNINGS: Mutex<WarningLog> = Mutex::new(WarningLog {
+    seen: None,
+    pending: Vec::new(),
+});
+
+/// Keeps `m`'s warnings for [`take_warnings`] (each warning once per process) and returns
+/// `m`.
+fn noting_warnings(m: Material) -> Material {
+    if m.warnings().is_empty() {
+        return m;
+    }
+    let mut log = WARNINGS.lock().unwrap_or_else(|e| e.into_inner());
+    let WarningLog { seen, pending } = &mut *log;
+    let seen = seen.get_or_insert_with(HashSet::new);
+    for w in m.warnings() {
+        if seen.insert(w.to_string()) {
+            pending.push(w.clone());
+        }
+    }
+    m
+}
+
+/// The warnings of every material file or database page that [`resolve`] (or
+/// [`MaterialDb::load`]) has read since the last call, in the order they were read, each
+/// once per process: rows the reader repaired or set aside, see
+/// [`nacre_optics::WarningKind`]. The materials are usable; a front end shows these to the
+/// user (the `nacre` binary prints them as `nacre: warning: FILE:LINE: …`).
+pub fn take_warnings() -> Vec<MaterialWarning> {
+    std::mem::take(&mut WARNINGS.lock().unwrap_or_else(|e| e.into_inner()).pending)
 }
 
 /// The process-wide database used by [`resolve`]; None until [`set_database`].
@@ -267,7 +310,9 @@ impl MaterialDb {
             source,
         })?;
         let shown = path.display().to_string();
-        Ok(Material::from_refractiveindex_yaml(spec, &shown, &text)?)
+        Ok(noting_warnings(Material::from_refractiveindex_yaml(
+            spec, &shown, &text,
+        )?))
     }
 }
 
@@ -324,10 +369,13 @@ pub fn resolve_with(
 ) -> Result<Material> {
     let context = context.into();
     let spec = spec.trim();
+    // A number, unless it has the SHELF/BOOK/PAGE form (shelves such as `3d` start with a
+    // digit; no index literal contains `/`).
     let looks_numeric = spec
         .chars()
         .next()
-        .is_some_and(|c| c.is_ascii_digit() || matches!(c, '.' | '-' | '+'));
+        .is_some_and(|c| c.is_ascii_digit() || matches!(c, '.' | '-' | '+'))
+        && database_page(spec).is_none();
     if looks_numeric {
         return Material::parse_index(spec).map_err(|source| Error::OpticsIn { context, source });
     }
@@ -349,7 +397,7 @@ pub fn resolve_with(
             message: format!("cannot read the material file {}: {source}", path.display()).into(),
         })?;
         let shown = path.display().to_string();
-        return Ok(parse_material_text(spec, &shown, &text)?);
+        return Ok(noting_warnings(parse_material_text(spec, &shown, &text)?));
     }
     if database_page(spec).is_some() {
         return match db {

@@ -59,6 +59,21 @@ pub enum Error {
         /// The offending value, as text.
         value: String,
     },
+    /// A wavelength inside a material's range where its dispersion formula gives no physical
+    /// index (a stretch its reader found and reported with a warning).
+    #[error(
+        "material `{material}` has no physical index at {wavelength_nm} nm: its formula gives none between {from_nm} and {to_nm} nm (choose wavelengths outside that interval or another page)"
+    )]
+    NoPhysicalIndex {
+        /// Material name.
+        material: String,
+        /// Vacuum wavelength in nm.
+        wavelength_nm: f64,
+        /// Start of the interval, nm.
+        from_nm: f64,
+        /// End of the interval, nm.
+        to_nm: f64,
+    },
     /// A film thickness is negative or not finite.
     #[error(
         "layer {layer} (`{material}`): thickness {thickness_nm} nm must be finite and non-negative"

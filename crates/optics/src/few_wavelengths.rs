@@ -303,6 +303,7 @@ pub struct StackEvaluation {
     indices: Vec<Vec<crate::C64>>,
     thickness_nm: Vec<f64>,
     relative_nm: Vec<f64>,
+    channels: Vec<usize>,
     opd_factors: Vec<f64>,
     finesse: f64,
     dispersive: bool,
@@ -395,6 +396,7 @@ impl StackEvaluation {
             indices,
             thickness_nm: stack.thicknesses_nm(),
             relative_nm: relative_nm.to_vec(),
+            channels: vec![0; films],
             opd_factors,
             finesse: finesse_factor(&at_550),
             dispersive,
@@ -441,22 +443,58 @@ impl StackEvaluation {
         self.dispersive
     }
 
+    /// The same stack with film j's thickness following channel `channels[j]` of the
+    /// thickness map (0 = R or grey, 1 = G, 2 = B; one per film; the top film's must be 0:
+    /// its thickness is the pixel's, from channel 0): the thesis's SVT with one map channel
+    /// per layer (Sussenbach 2013 §4.2). Without it every film follows channel 0.
+    ///
+    /// # Errors
+    /// [`crate::Error::OutOfRange`] for a count other than one per film, a channel above 2
+    /// or a top film's channel other than 0.
+    pub fn with_channels(mut self, channels: &[usize]) -> crate::Result<Self> {
+        if channels.len() != self.thickness_nm.len() {
+            return Err(crate::Error::OutOfRange {
+                what: "map channels given",
+                value: channels.len() as f64,
+                expected: "one per film",
+            });
+        }
+        if channels.first().is_some_and(|&c| c != 0) {
+            return Err(crate::Error::OutOfRange {
+                what: "top film's map channel",
+                value: channels[0] as f64,
+                expected: "0 (R): the top film's thickness is the pixel's",
+            });
+        }
+        if let Some(&c) = channels.iter().find(|&&c| c > 2) {
+            return Err(crate::Error::OutOfRange {
+                what: "map channel",
+                value: c as f64,
+                expected: "0 (R), 1 (G) or 2 (B)",
+            });
+        }
+        self.channels = channels.to_vec();
+        Ok(self)
+    }
+
+    /// Film j's map channel (0 = R, 1 = G, 2 = B; [`StackEvaluation::with_channels`]).
+    pub fn channels(&self) -> &[usize] {
+        &self.channels
+    }
+
     /// The films' thicknesses at a pixel: the top film `top_thickness_nm`, film j ≥ 2
-    /// max(0, d_j⁰ + r_j s), s = `variation` clamped to [−1, 1] (NaN → 0); thicknesses
-    /// sanitised as the GPU's FilmInput (NaN or ≤ 0 → 0, at most 10⁶ nm).
-    pub fn thicknesses_at(&self, top_thickness_nm: f64, variation: f64) -> Vec<f64> {
+    /// max(0, d_j⁰ + r_j s_c), s_c = `variation[c]` for film j's channel c, clamped to
+    /// [−1, 1] (NaN → 0); thicknesses sanitised as the GPU's FilmInput (NaN or ≤ 0 → 0, at
+    /// most 10⁶ nm).
+    pub fn thicknesses_at(&self, top_thickness_nm: f64, variation: [f64; 3]) -> Vec<f64> {
         let clean = |d: f64| if d > 0.0 { d.min(1e6) } else { 0.0 };
-        let s = if variation.is_nan() {
-            0.0
-        } else {
-            variation.clamp(-1.0, 1.0)
-        };
+        let s = variation.map(|v| if v.is_nan() { 0.0 } else { v.clamp(-1.0, 1.0) });
         (0..self.thickness_nm.len())
             .map(|j| {
                 if j == 0 {
                     clean(top_thickness_nm)
                 } else {
-                    clean(self.thickness_nm[j] + self.relative_nm[j] * s)
+                    clean(self.thickness_nm[j] + self.relative_nm[j] * s[self.channels[j]])
                 }
             })
             .collect()
@@ -489,7 +527,7 @@ impl StackEvaluation {
         &self,
         cos_theta_i: f64,
         top_thickness_nm: f64,
-        variation: f64,
+        variation: [f64; 3],
     ) -> ([f64; 3], [f64; 3]) {
         let c = if cos_theta_i.is_nan() {
             1.0
@@ -578,11 +616,15 @@ mod tests_support {
         )
     }
 
-    fn metal(name: &str) -> Material {
+    /// A bundled material (tables/materials).
+    pub fn metal(name: &str) -> Material {
         let text = match name {
             "au" => include_str!("../../../tables/materials/au.yml"),
             "ag" => include_str!("../../../tables/materials/ag.yml"),
             "cr" => include_str!("../../../tables/materials/cr.yml"),
+            "mgf2" => include_str!("../../../tables/materials/mgf2.yml"),
+            "tio2" => include_str!("../../../tables/materials/tio2.yml"),
+            "bk7" => include_str!("../../../tables/materials/bk7.yml"),
             _ => include_str!("../../../tables/materials/al.yml"),
         };
         Material::from_refractiveindex_yaml(name, name, text).unwrap()
@@ -738,6 +780,41 @@ mod tests {
         }
     }
 
+    /// Every film below the top follows its own map channel (the thesis's SVT with one
+    /// channel per layer); a wrong channel list is refused.
+    #[test]
+    fn films_follow_their_map_channels() {
+        let c = colorimeter();
+        let mut rng = Rng(9);
+        let (stack, _) = loop {
+            let (s, a) = random_stack(&mut rng);
+            if s.layers().len() >= 3 {
+                break (s, a);
+            }
+        };
+        let films = stack.layers().len();
+        let relative: Vec<f64> = (0..films).map(|j| 10.0 * j as f64).collect();
+        let eval = StackEvaluation::new(&c, &stack, &relative, None).unwrap();
+        let channels: Vec<usize> = (0..films).map(|j| j % 3).collect();
+        let eval = eval.with_channels(&channels).unwrap();
+        assert_eq!(eval.channels(), channels.as_slice());
+        let s = [0.25, -0.5, 1.0];
+        let d = eval.thicknesses_at(40.0, s);
+        assert_eq!(d[0], 40.0);
+        for j in 1..films {
+            let want = (stack.layers()[j].thickness_nm + 10.0 * j as f64 * s[j % 3]).max(0.0);
+            assert_eq!(d[j], want, "film {j}");
+        }
+        // One channel per film, each 0 to 2, the top film's 0.
+        assert!(eval.clone().with_channels(&channels[1..]).is_err());
+        let mut top = channels.clone();
+        top[0] = 1;
+        assert!(eval.clone().with_channels(&top).is_err());
+        let mut bad = channels.clone();
+        bad[1] = 3;
+        assert!(eval.with_channels(&bad).is_err());
+    }
+
     /// The evaluation is the stack at the pixel's thicknesses through the ladder's rule;
     /// bad inputs are refused or sanitised.
     #[test]
@@ -758,15 +835,15 @@ mod tests {
             }
             let moved =
                 Stack::new(stack.ambient().clone(), layers, stack.substrate().clone()).unwrap();
-            let d = eval.thicknesses_at(top, 0.5);
+            let d = eval.thicknesses_at(top, [0.5; 3]);
             let rule = &eval.rules()[eval.rule_index(&d)];
             let want = reflectance_colour(&moved, angle, rule.wavelengths_nm(), rule.weights());
-            let (got, t) = eval.colour(cos, top, 0.5);
+            let (got, t) = eval.colour(cos, top, [0.5; 3]);
             for k in 0..3 {
                 assert!((got[k] - want[k]).abs() < 1e-9, "{got:?} {want:?}");
                 assert!(t[k].is_finite());
             }
-            let (nan, _) = eval.colour(f64::NAN, f64::NAN, f64::NAN);
+            let (nan, _) = eval.colour(f64::NAN, f64::NAN, [f64::NAN; 3]);
             assert!(nan.iter().all(|x| x.is_finite()));
         }
         let (stack, _) = random_stack(&mut Rng(9));
@@ -857,6 +934,162 @@ mod tests {
             let rule = FewWavelengthRule::new(&c, n);
             let (fp, fm) = errors(rule.wavelengths_nm(), rule.weights());
             eprintln!("{n:4} {up:11.3} {um:7.3} {fp:12.3} {fm:7.3}");
+        }
+    }
+
+    /// A stack with every film scaled by `scale` (issue 17 §6: d_j(x) = a(x) d_j⁰).
+    fn scaled(stack: &Stack, scale: f64) -> Stack {
+        let layers = stack
+            .layers()
+            .iter()
+            .map(|l| crate::Layer {
+                material: l.material.clone(),
+                thickness_nm: l.thickness_nm * scale,
+            })
+            .collect();
+        Stack::new(stack.ambient().clone(), layers, stack.substrate().clone()).unwrap()
+    }
+
+    /// The exact (spectral) reflectance colour of `stack` at incidence cosine `cos_theta`.
+    fn exact_colour(c: &Colorimeter, stack: &Stack, cos_theta: f64) -> [f64; 3] {
+        let angle = cos_theta.clamp(0.0, 1.0).acos().to_degrees().min(89.9);
+        let rule = SpectralRule::new(c, stack.max_opd_nm(None));
+        reflectance_colour(stack, angle, rule.wavelengths_nm(), rule.weights())
+    }
+
+    /// Issue 17 §6's other candidate: a 2-D table over (cos θ, a) for a stack whose films all
+    /// follow one map, d_j = a d_j⁰ with a ∈ `scale_range`. Texels: x = t, cos θ = t² (the
+    /// film-lut mapping), `cos_count` of them; y = a uniform, `scale_count`; each texel the
+    /// exact colour. (Texels uniform in sin²θ instead, which spreads the films' phase evenly,
+    /// are 5–50× worse: the Fresnel terms change fastest near grazing, where t² puts texels.)
+    /// Returns ΔE2000 (mean, p95, max) of the bilinear lookup against the exact
+    /// colour at `points` random (θ ∈ 0–85°, a) points.
+    fn scale_table_errors(
+        stack: &Stack,
+        scale_range: (f64, f64),
+        cos_count: usize,
+        scale_count: usize,
+        points: usize,
+    ) -> (f64, f64, f64) {
+        let c = colorimeter();
+        let (a_lo, a_hi) = scale_range;
+        let scale_at = |j: usize| a_lo + (a_hi - a_lo) * j as f64 / (scale_count - 1) as f64;
+        let table: Vec<[f64; 3]> = (0..scale_count * cos_count)
+            .into_par_iter()
+            .map(|k| {
+                let (j, i) = (k / cos_count, k % cos_count);
+                let t = i as f64 / (cos_count - 1) as f64;
+                exact_colour(&c, &scaled(stack, scale_at(j)), t * t)
+            })
+            .collect();
+        let mut rng = Rng(17);
+        let samples: Vec<(f64, f64)> = (0..points)
+            .map(|_| {
+                let angle = 85.0 * rng.next();
+                (angle.to_radians().cos(), a_lo + (a_hi - a_lo) * rng.next())
+            })
+            .collect();
+        let mut errors: Vec<f64> = samples
+            .par_iter()
+            .map(|&(cos_theta, a)| {
+                let x = cos_theta.sqrt() * (cos_count - 1) as f64;
+                let y = (a - a_lo) / (a_hi - a_lo) * (scale_count - 1) as f64;
+                let (i, j) = (
+                    (x.floor() as usize).min(cos_count - 2),
+                    (y.floor() as usize).min(scale_count - 2),
+                );
+                let (fx, fy) = (x - i as f64, y - j as f64);
+                let texel = |ii: usize, jj: usize| table[jj * cos_count + ii];
+                let looked: [f64; 3] = std::array::from_fn(|ch| {
+                    let bottom = texel(i, j)[ch] * (1.0 - fx) + texel(i + 1, j)[ch] * fx;
+                    let top = texel(i, j + 1)[ch] * (1.0 - fx) + texel(i + 1, j + 1)[ch] * fx;
+                    bottom * (1.0 - fy) + top * fy
+                });
+                delta_e(&c, looked, exact_colour(&c, &scaled(stack, a), cos_theta))
+            })
+            .collect();
+        let mean = errors.iter().sum::<f64>() / errors.len() as f64;
+        let (p95, max) = p95_max(std::mem::take(&mut errors));
+        (mean, p95, max)
+    }
+
+    fn constant(n: f64) -> crate::Material {
+        crate::Material::constant(format!("{n}"), crate::C64::new(n, 0.0)).unwrap()
+    }
+
+    fn layer(material: crate::Material, thickness_nm: f64) -> crate::Layer {
+        crate::Layer {
+            material,
+            thickness_nm,
+        }
+    }
+
+    /// The three scenes' stacks (README), each with the range of its common scale a.
+    fn scale_scenes() -> Vec<(&'static str, Stack, (f64, f64))> {
+        vec![
+            (
+                "oil slick: 1.4@350 | 1.33@350 | 1.635, a 0–2",
+                Stack::new(
+                    constant(1.0),
+                    vec![layer(constant(1.4), 350.0), layer(constant(1.33), 350.0)],
+                    constant(1.635),
+                )
+                .unwrap(),
+                (0.0, 2.0),
+            ),
+            (
+                "AR lens: mgf2@95 | tio2@105 | mgf2@25 | tio2@12 | bk7, a 0.9–1.1",
+                Stack::new(
+                    constant(1.0),
+                    vec![
+                        layer(metal("mgf2"), 95.0),
+                        layer(metal("tio2"), 105.0),
+                        layer(metal("mgf2"), 25.0),
+                        layer(metal("tio2"), 12.0),
+                    ],
+                    metal("bk7"),
+                )
+                .unwrap(),
+                (0.9, 1.1),
+            ),
+            (
+                "filter: cr@8 | 1.46@190 | al, a 0.4–1.6",
+                Stack::new(
+                    constant(1.0),
+                    vec![layer(metal("cr"), 8.0), layer(constant(1.46), 190.0)],
+                    metal("al"),
+                )
+                .unwrap(),
+                (0.4, 1.6),
+            ),
+        ]
+    }
+
+    /// A (cos θ, a) table of 64 × 256 texels meets the stack targets (ΔE2000 p95 ≤ 0.3,
+    /// max ≤ 1.0) on the oil slick with both layers following one map (a ∈ 0–2: each layer
+    /// 0–700 nm, OPD up to ≈ 3.8 µm).
+    #[test]
+    fn a_scale_table_meets_the_stack_targets_on_the_oil_slick() {
+        let (name, stack, range) = scale_scenes().swap_remove(0);
+        let (mean, p95, max) = scale_table_errors(&stack, range, 64, 256, 200);
+        assert!(
+            p95 <= 0.3 && max <= 1.0,
+            "{name}: mean {mean} p95 {p95} max {max}"
+        );
+    }
+
+    /// The (cos θ, a) table's error against its size, for the three scenes. `cargo test
+    /// --release -p nacre-optics --lib few_wavelengths -- --ignored --nocapture`.
+    #[test]
+    #[ignore = "a sweep that prints the scale table's error against its size"]
+    fn scale_table_error_against_size() {
+        for (name, stack, range) in scale_scenes() {
+            eprintln!("{name}");
+            eprintln!("  cos × a     mean    p95     max");
+            for (nc, na) in [(32, 128), (32, 256), (64, 128), (64, 256), (128, 256)] {
+                let (mean, p95, max) = scale_table_errors(&stack, range, nc, na, 400);
+                eprintln!("  {nc:3} × {na:3} {mean:7.3} {p95:7.3} {max:7.3}");
+            }
         }
     }
 }

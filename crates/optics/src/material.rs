@@ -16,6 +16,18 @@
 //! [`Error::WavelengthOutOfRange`] naming the material and its range: nothing is
 //! extrapolated.
 //!
+//! # Imperfect pages (refractiveindex.info YAML)
+//!
+//! A page is usable wherever its data are sound (docs/materials.md gives the policy and
+//! the whole-database figures). Wavelengths in µm become nm exactly as written
+//! ([`um_to_nm`]). Rows out of order are sorted; rows repeating a wavelength are merged (the
+//! mean of their values); an n ≤ 0 or a κ < 0 is skipped, the row's other value kept. The
+//! material covers n's range; κ is 0 outside κ's own table. A second entry giving n (or κ)
+//! is ignored. A formula's non-physical stretches are cut off its range's ends, or refused
+//! inside it ([`Error::NoPhysicalIndex`], [`Material::gaps_nm`]). Each repair is a
+//! [`MaterialWarning`] naming file and line ([`Material::warnings`]). A page without n, and
+//! text that is not the format, stay errors. `wavelength_nm,n,k` CSV files stay strict.
+//!
 //! # Dispersion formulas (refractiveindex.info numbering; λ in µm, C₁… the coefficients)
 //!
 //! | type | formula |
@@ -43,10 +55,13 @@ use yaml_rust2::scanner::{Marker, TScalarStyle};
 enum Dispersion {
     /// Independent of wavelength.
     Constant(f64),
-    /// Samples at strictly increasing wavelengths (nm), linearly interpolated.
+    /// Samples at strictly increasing wavelengths (nm), linearly interpolated; outside
+    /// them 0 when `zero_outside` (κ beyond its own table), else never asked for (n: the
+    /// material's range is the table's).
     Tabulated {
         wavelength_nm: Vec<f64>,
         value: Vec<f64>,
+        zero_outside: bool,
     },
     /// A refractiveindex.info dispersion formula evaluated with λ in µm; gives n.
     Formula { kind: u8, coefficients: Vec<f64> },
@@ -59,7 +74,14 @@ impl Dispersion {
             Dispersion::Tabulated {
                 wavelength_nm: w,
                 value,
-            } => interpolate(w, value, wavelength_nm),
+                zero_outside,
+            } => {
+                if *zero_outside && !(wavelength_nm >= w[0] && wavelength_nm <= w[w.len() - 1]) {
+                    0.0
+                } else {
+                    interpolate(w, value, wavelength_nm)
+                }
+            }
             Dispersion::Formula { kind, coefficients } => {
                 eval_formula(*kind, coefficients, wavelength_nm * 1e-3)
             }
@@ -134,6 +156,10 @@ pub struct Material {
     k: Dispersion,
     /// Wavelengths covered, in nm (inclusive).
     range_nm: (f64, f64),
+    /// Open intervals (nm) inside the range where a formula gives no physical n.
+    gaps_nm: Vec<(f64, f64)>,
+    /// What the reader repaired or set aside.
+    warnings: Vec<MaterialWarning>,
 }
 
 impl Material {
@@ -148,6 +174,8 @@ impl Material {
             n: Dispersion::Constant(index.re),
             k: Dispersion::Constant(index.im),
             range_nm: (0.0, f64::INFINITY),
+            gaps_nm: Vec::new(),
+            warnings: Vec::new(),
         })
     }
 
@@ -155,20 +183,7 @@ impl Material {
     /// also `0.27+2.9j`, spaces allowed around the sign). The material is named by the text.
     pub fn parse_index(text: &str) -> Result<Self> {
         let index = parse_complex(text)?;
-        let name = text.trim().to_string();
-        if !(index.re > 0.0) || !index.re.is_finite() {
-            return Err(Error::InvalidIndex {
-                text: name,
-                reason: "the real part n must be finite and positive".into(),
-            });
-        }
-        if !(index.im >= 0.0) || !index.im.is_finite() {
-            return Err(Error::InvalidIndex {
-                text: name,
-                reason: "the extinction coefficient κ must be finite and non-negative (κ < 0 would be gain)".into(),
-            });
-        }
-        Material::constant(name, index)
+        Material::constant(text.trim(), index)
     }
 
     /// Reads a plain CSV: `#` comment lines and blank lines anywhere, one header line
@@ -224,8 +239,9 @@ impl Material {
         Material::from_rows(name, source_name, rows)
     }
 
-    /// Reads the refractiveindex.info database YAML format (see module docs).
-    /// `source_name` labels errors (`file:line`).
+    /// Reads the refractiveindex.info database YAML format (see module docs, and the
+    /// policy for imperfect pages there). `source_name` labels errors and warnings
+    /// (`file:line`); what was repaired or set aside is in [`Material::warnings`].
     pub fn from_refractiveindex_yaml(
         name: impl Into<String>,
         source_name: &str,
@@ -236,6 +252,14 @@ impl Material {
             source_name: source_name.to_string(),
             line,
             message,
+        };
+        let mut warnings = Vec::new();
+        let mut warn = |line: usize, kind: WarningKind| {
+            warnings.push(MaterialWarning {
+                source_name: source_name.to_string(),
+                line,
+                kind,
+            });
         };
         let root = parse_yaml_tree(text).map_err(|(line, m)| perr(line, m))?;
         let Node::Map(entries, _) = &root else {
@@ -260,8 +284,9 @@ impl Material {
         if items.is_empty() {
             return Err(perr(*data_line, "`DATA` is empty".into()));
         }
-        let mut n_part: Option<(Dispersion, (f64, f64))> = None;
-        let mut k_part: Option<(Dispersion, (f64, f64))> = None;
+        // (dispersion, range nm, line of its range, line of the entry's `type`)
+        let mut n_part: Option<(Dispersion, (f64, f64), usize, usize)> = None;
+        let mut k_part: Option<(Table, usize)> = None;
         for item in items {
             let Node::Map(fields, item_line) = item else {
                 return Err(perr(
@@ -301,14 +326,20 @@ impl Material {
                 if coefficients.is_empty() {
                     return Err(perr(*item_line, "`coefficients` is empty".into()));
                 }
-                let range_nm = match get("wavelength_range") {
+                let (range_nm, range_line) = match get("wavelength_range") {
                     Some(Node::Scalar(s, _, line)) => {
-                        let v = parse_numbers(s).map_err(|tok| {
-                            perr(
-                                *line,
-                                format!("wavelength_range value `{tok}` is not a finite number"),
-                            )
-                        })?;
+                        let v = s
+                            .split_whitespace()
+                            .map(|t| um_to_nm(t).ok_or_else(|| t.to_string()))
+                            .collect::<std::result::Result<Vec<f64>, String>>()
+                            .map_err(|tok| {
+                                perr(
+                                    *line,
+                                    format!(
+                                        "wavelength_range value `{tok}` is not a finite number"
+                                    ),
+                                )
+                            })?;
                         if v.len() != 2 || !(v[0] > 0.0 && v[1] > v[0]) {
                             return Err(perr(
                                 *line,
@@ -318,7 +349,7 @@ impl Material {
                                 ),
                             ));
                         }
-                        (v[0] * 1e3, v[1] * 1e3)
+                        ((v[0], v[1]), *line)
                     }
                     Some(other) => {
                         return Err(perr(
@@ -326,10 +357,15 @@ impl Material {
                             "`wavelength_range` must be two numbers".into(),
                         ));
                     }
-                    None => (0.0, f64::INFINITY),
+                    None => ((0.0, f64::INFINITY), type_line),
                 };
                 (
-                    Some((Dispersion::Formula { kind, coefficients }, range_nm)),
+                    Some((
+                        Dispersion::Formula { kind, coefficients },
+                        range_nm,
+                        range_line,
+                        type_line,
+                    )),
                     None,
                 )
             } else {
@@ -364,118 +400,233 @@ impl Material {
                         ));
                     }
                 };
-                let mut w = Vec::new();
-                let mut a = Vec::new();
-                let mut b = Vec::new();
+                let mut rows: Vec<TableRow> = Vec::new();
                 for (i, row) in block.lines().enumerate() {
-                    let line_no = first_line + i;
+                    let line = first_line + i;
                     if row.trim().is_empty() {
                         continue;
                     }
+                    let tokens: Vec<&str> = row.split_whitespace().collect();
                     let v = parse_numbers(row)
-                        .map_err(|tok| perr(line_no, format!("`{tok}` is not a finite number")))?;
+                        .map_err(|tok| perr(line, format!("`{tok}` is not a finite number")))?;
                     if v.len() != columns {
                         return Err(perr(
-                            line_no,
+                            line,
                             format!("`{ty}` rows need {columns} numbers, found {}", v.len()),
                         ));
                     }
                     if !(v[0] > 0.0) {
                         return Err(perr(
-                            line_no,
+                            line,
                             format!("wavelength {} µm must be positive", v[0]),
                         ));
                     }
-                    if let Some(&prev) = w.last()
-                        && !(v[0] * 1e3 > prev)
-                    {
-                        return Err(perr(
-                            line_no,
-                            format!(
-                                "wavelengths must strictly increase ({} µm follows {} µm)",
-                                v[0],
-                                prev * 1e-3
-                            ),
-                        ));
-                    }
-                    let (is_n, is_k) = match ty.as_str() {
-                        "tabulated nk" => (Some(v[1]), Some(v[2])),
-                        "tabulated n" => (Some(v[1]), None),
-                        _ => (None, Some(v[1])),
-                    };
-                    if let Some(n) = is_n
-                        && !(n > 0.0)
-                    {
-                        return Err(perr(line_no, format!("n = {n} must be positive")));
-                    }
-                    if let Some(k) = is_k
-                        && !(k >= 0.0)
-                    {
-                        return Err(perr(line_no, format!("k = {k} must be non-negative")));
-                    }
-                    w.push(v[0] * 1e3);
-                    a.push(v[1]);
-                    if columns == 3 {
-                        b.push(v[2]);
-                    }
+                    let wavelength_nm = um_to_nm(tokens[0]).expect("parsed above");
+                    rows.push(TableRow {
+                        line,
+                        wavelength_um: v[0],
+                        wavelength_nm,
+                        values: v[1..].to_vec(),
+                    });
                 }
-                if w.is_empty() {
+                if rows.is_empty() {
                     return Err(perr(first_line, format!("`{ty}` entry has no data rows")));
                 }
-                let range = (w[0], *w.last().unwrap_or(&w[0]));
-                let tab = |value: Vec<f64>| Dispersion::Tabulated {
-                    wavelength_nm: w.clone(),
-                    value,
-                };
-                match ty.as_str() {
-                    "tabulated nk" => (Some((tab(a), range)), Some((tab(b), range))),
-                    "tabulated n" => (Some((tab(a), range)), None),
-                    _ => (None, Some((tab(a), range))),
+                // Rows out of order are sorted (stably: rows at one wavelength keep their
+                // order), each named once.
+                for pair in rows.windows(2) {
+                    if pair[1].wavelength_nm < pair[0].wavelength_nm {
+                        warn(
+                            pair[1].line,
+                            WarningKind::OutOfOrder {
+                                wavelength_um: pair[1].wavelength_um,
+                                previous_um: pair[0].wavelength_um,
+                            },
+                        );
+                    }
                 }
+                rows.sort_by(|a, b| a.wavelength_nm.total_cmp(&b.wavelength_nm));
+                // Rows repeating a wavelength with other values: named once each.
+                for group in rows.chunk_by(|a, b| a.wavelength_nm == b.wavelength_nm) {
+                    for r in &group[1..] {
+                        if r.values != group[0].values {
+                            warn(
+                                r.line,
+                                WarningKind::Repeated {
+                                    wavelength_um: r.wavelength_um,
+                                    first_line: group[0].line,
+                                },
+                            );
+                        }
+                    }
+                }
+                let (n_col, k_col) = match ty.as_str() {
+                    "tabulated nk" => (Some(0), Some(1)),
+                    "tabulated n" => (Some(0), None),
+                    _ => (None, Some(0)),
+                };
+                let n = n_col.map(|c| {
+                    tabulate(
+                        &rows,
+                        c,
+                        |v| v > 0.0,
+                        |row, v| {
+                            warn(
+                                row.line,
+                                WarningKind::NonPositiveN {
+                                    wavelength_um: row.wavelength_um,
+                                    n: v,
+                                },
+                            )
+                        },
+                    )
+                });
+                let k = k_col.map(|c| {
+                    tabulate(
+                        &rows,
+                        c,
+                        |v| v >= 0.0,
+                        |row, v| {
+                            warn(
+                                row.line,
+                                WarningKind::NegativeK {
+                                    wavelength_um: row.wavelength_um,
+                                    k: v,
+                                },
+                            )
+                        },
+                    )
+                });
+                let n = match n {
+                    Some(None) => {
+                        return Err(perr(
+                            first_line,
+                            format!("`{ty}` entry has no row with n > 0"),
+                        ));
+                    }
+                    Some(Some(t)) => {
+                        let range = t.range();
+                        Some((t.into_dispersion(), range, type_line, type_line))
+                    }
+                    None => None,
+                };
+                // A k table whose every value is negative gives no k: k = 0 (each row named).
+                let k = k.flatten().map(|t| (t, type_line));
+                (n, k)
             };
             if let Some(p) = parsed_n {
-                if n_part.is_some() {
-                    return Err(perr(type_line, "more than one `DATA` entry gives n".into()));
+                match &n_part {
+                    Some((_, _, _, first)) => warn(
+                        type_line,
+                        WarningKind::SecondEntry {
+                            quantity: 'n',
+                            first_line: *first,
+                        },
+                    ),
+                    None => n_part = Some(p),
                 }
-                n_part = Some(p);
             }
-            if let Some(p) = parsed_k {
-                if k_part.is_some() {
-                    return Err(perr(type_line, "more than one `DATA` entry gives k".into()));
+            if let Some((table, line)) = parsed_k {
+                match &k_part {
+                    Some((_, first)) => warn(
+                        line,
+                        WarningKind::SecondEntry {
+                            quantity: 'k',
+                            first_line: *first,
+                        },
+                    ),
+                    None => k_part = Some((table, line)),
                 }
-                k_part = Some(p);
             }
         }
-        let (n, n_range) = n_part.ok_or_else(|| {
+        let (n, mut range_nm, n_line, _) = n_part.ok_or_else(|| {
             perr(
                 *data_line,
-                "no `DATA` entry gives the real index n (only `tabulated k`)".into(),
+                "no `DATA` entry gives the real index n (only `tabulated k`): the page cannot be used alone".into(),
             )
         })?;
-        let (k, range_nm) = match k_part {
-            Some((k, k_range)) => {
-                let range = (n_range.0.max(k_range.0), n_range.1.min(k_range.1));
-                if range.0 > range.1 {
+        // A formula non-physical somewhere inside its stated range: its ends are cut off,
+        // a gap inside is refused.
+        let mut gaps_nm = Vec::new();
+        if matches!(n, Dispersion::Formula { .. }) && range_nm.1.is_finite() {
+            let physical = |w: f64| {
+                let v = n.eval(w);
+                v > 0.0 && v.is_finite()
+            };
+            match formula_gaps(&physical, range_nm) {
+                None => {
                     return Err(perr(
-                        *data_line,
+                        n_line,
                         format!(
-                            "the n data ({}–{} nm) and k data ({}–{} nm) do not overlap",
-                            n_range.0, n_range.1, k_range.0, k_range.1
+                            "the formula gives no physical n (n > 0) anywhere in its wavelength_range {}–{} nm",
+                            range_nm.0, range_nm.1
                         ),
                     ));
                 }
-                (k, range)
+                Some((usable, gaps)) => {
+                    if usable != range_nm {
+                        warn(
+                            n_line,
+                            WarningKind::FormulaRangeCut {
+                                stated_nm: range_nm,
+                                usable_nm: usable,
+                            },
+                        );
+                    }
+                    for &(from_nm, to_nm) in &gaps {
+                        warn(n_line, WarningKind::FormulaGap { from_nm, to_nm });
+                    }
+                    range_nm = usable;
+                    gaps_nm = gaps;
+                }
             }
-            None => (Dispersion::Constant(0.0), n_range),
+        }
+        let k = match k_part {
+            Some((k, k_line)) => {
+                // k = 0 outside k's table; named when the table ends inside n's range at a
+                // k that is not negligible.
+                let (w, v) = (&k.wavelength_nm, &k.value);
+                let (first, last) = (0, w.len() - 1);
+                for (i, lower, inside) in [
+                    (first, true, w[first] > range_nm.0),
+                    (last, false, w[last] < range_nm.1),
+                ] {
+                    if inside && v[i] >= K_STEP_WARNING && w[i] >= range_nm.0 && w[i] <= range_nm.1
+                    {
+                        warn(
+                            k.lines[i],
+                            WarningKind::KTableEnds {
+                                wavelength_nm: w[i],
+                                lower,
+                                k: v[i],
+                                n_range_nm: range_nm,
+                            },
+                        );
+                    }
+                }
+                if w[last] < range_nm.0 || w[first] > range_nm.1 {
+                    warn(
+                        k_line,
+                        WarningKind::KOutsideN {
+                            k_range_nm: (w[first], w[last]),
+                            n_range_nm: range_nm,
+                        },
+                    );
+                }
+                k.into_dispersion_zero_outside()
+            }
+            None => Dispersion::Constant(0.0),
         };
+        warnings.sort_by_key(|w| w.line);
         Ok(Material {
             name,
             n,
             k,
             range_nm,
+            gaps_nm,
+            warnings,
         })
     }
-
     fn from_rows(name: String, source_name: &str, rows: Vec<(usize, [f64; 3])>) -> Result<Self> {
         let perr = |line: usize, message: String| Error::Parse {
             source_name: source_name.to_string(),
@@ -513,12 +664,16 @@ impl Material {
             n: Dispersion::Tabulated {
                 wavelength_nm: w.clone(),
                 value: rows.iter().map(|(_, r)| r[1]).collect(),
+                zero_outside: false,
             },
             k: Dispersion::Tabulated {
                 wavelength_nm: w,
                 value: rows.iter().map(|(_, r)| r[2]).collect(),
+                zero_outside: false,
             },
             range_nm,
+            gaps_nm: Vec::new(),
+            warnings: Vec::new(),
         })
     }
 
@@ -536,6 +691,20 @@ impl Material {
     /// The wavelengths covered, in nm, inclusive (`(0, ∞)` for constants).
     pub fn range_nm(&self) -> (f64, f64) {
         self.range_nm
+    }
+
+    /// What the reader repaired or set aside in the material's data (rows merged, sorted or
+    /// skipped, a formula's non-physical stretches, where κ's table ends): the material is
+    /// usable, and a front end should show these to the user. Empty for constants, CSV
+    /// files and sound pages.
+    pub fn warnings(&self) -> &[MaterialWarning] {
+        &self.warnings
+    }
+
+    /// Open intervals (nm) inside [`Material::range_nm`] where the material's formula gives
+    /// no physical n: [`Material::index_at`] refuses them.
+    pub fn gaps_nm(&self) -> &[(f64, f64)] {
+        &self.gaps_nm
     }
 
     /// True when the index does not depend on wavelength.
@@ -562,6 +731,18 @@ impl Material {
                 max_nm: hi,
             });
         }
+        if let Some(&(from_nm, to_nm)) = self
+            .gaps_nm
+            .iter()
+            .find(|(a, b)| wavelength_nm > *a && wavelength_nm < *b)
+        {
+            return Err(Error::NoPhysicalIndex {
+                material: self.name.clone(),
+                wavelength_nm,
+                from_nm,
+                to_nm,
+            });
+        }
         let index = C64::new(self.n.eval(wavelength_nm), self.k.eval(wavelength_nm));
         if !(index.re > 0.0 && index.re.is_finite() && index.im >= 0.0 && index.im.is_finite()) {
             return Err(Error::NonPhysicalIndex {
@@ -574,11 +755,369 @@ impl Material {
     }
 }
 
+/// The real parts n a constant index may have, [10⁻⁶, 10⁶]: every measured material lies
+/// well inside (epsilon-near-zero films reach n ≈ 0.01, metals in the far infrared
+/// n ≈ 100), and beyond it the Fresnel and transfer-matrix terms over- or underflow f64 (a
+/// film of n = 10⁻²⁰ or 10¹⁰⁰ gives NaN where [10⁻⁶, 10⁶] stays finite for every angle,
+/// wavelength 10⁻³–10⁶ nm and thickness 0–10⁹ nm).
+pub const INDEX_RANGE: (f64, f64) = (1e-6, 1e6);
+
+/// The largest extinction coefficient κ a constant index may have (see [`INDEX_RANGE`]).
+pub const MAX_KAPPA: f64 = 1e6;
+
+/// κ at the end of a `tabulated k` table, inside n's range, from which the step to κ = 0
+/// beyond the table is worth a warning.
+pub const K_STEP_WARNING: f64 = 1e-3;
+
+/// Samples a formula's stated range at this many points (logarithmically spaced) to find
+/// where it turns non-physical, then bisects each edge.
+const FORMULA_SCAN_POINTS: usize = 8192;
+
+/// Something in a material file that the reader repaired or set aside; the material is
+/// usable (docs/materials.md, "Pages of the refractiveindex.info database").
+/// `Display` writes `file:line: what was done`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MaterialWarning {
+    /// The file (or other label) the text came from.
+    pub source_name: String,
+    /// The 1-based line concerned.
+    pub line: usize,
+    /// What was found and done.
+    pub kind: WarningKind,
+}
+
+/// What a [`MaterialWarning`] reports.
+#[derive(Clone, Debug, PartialEq)]
+pub enum WarningKind {
+    /// A row whose wavelength is below the previous row's: the table is sorted.
+    OutOfOrder {
+        /// The row's wavelength, µm.
+        wavelength_um: f64,
+        /// The previous row's, µm.
+        previous_um: f64,
+    },
+    /// A row at the wavelength of an earlier row, with other values: the rows are merged
+    /// into their mean (identical repeated rows are merged without a warning).
+    Repeated {
+        /// The wavelength, µm.
+        wavelength_um: f64,
+        /// The first row at that wavelength.
+        first_line: usize,
+    },
+    /// A row's n ≤ 0: that n is skipped (the row's κ is kept).
+    NonPositiveN {
+        /// The row's wavelength, µm.
+        wavelength_um: f64,
+        /// The value found.
+        n: f64,
+    },
+    /// A row's κ < 0 (gain): that κ is skipped (the row's n is kept).
+    NegativeK {
+        /// The row's wavelength, µm.
+        wavelength_um: f64,
+        /// The value found.
+        k: f64,
+    },
+    /// A second `DATA` entry giving n (or κ): the first one's is used, this one's ignored.
+    SecondEntry {
+        /// `'n'` or `'k'`.
+        quantity: char,
+        /// The `type` line of the entry used.
+        first_line: usize,
+    },
+    /// κ's table ends inside n's range at κ ≥ [`K_STEP_WARNING`]: κ = 0 beyond it.
+    KTableEnds {
+        /// The table's end, nm.
+        wavelength_nm: f64,
+        /// Whether it is the table's lower end (κ = 0 below it) or its upper end.
+        lower: bool,
+        /// κ there.
+        k: f64,
+        /// n's range (the material's), nm.
+        n_range_nm: (f64, f64),
+    },
+    /// κ's table lies wholly outside n's range: κ = 0 throughout.
+    KOutsideN {
+        /// κ's table, nm.
+        k_range_nm: (f64, f64),
+        /// n's range, nm.
+        n_range_nm: (f64, f64),
+    },
+    /// A formula that gives no physical n (n ≤ 0 or n² < 0) at an end of its stated
+    /// `wavelength_range`: the range is cut to where it does.
+    FormulaRangeCut {
+        /// The stated range, nm.
+        stated_nm: (f64, f64),
+        /// The range kept, nm.
+        usable_nm: (f64, f64),
+    },
+    /// A formula that gives no physical n over an interval inside its range (e.g. across a
+    /// resonance): wavelengths there are refused ([`Error::NoPhysicalIndex`]).
+    FormulaGap {
+        /// Start of the interval, nm (exclusive).
+        from_nm: f64,
+        /// End of the interval, nm (exclusive).
+        to_nm: f64,
+    },
+}
+
+impl std::fmt::Display for MaterialWarning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}:{}: ", self.source_name, self.line)?;
+        match &self.kind {
+            WarningKind::OutOfOrder {
+                wavelength_um,
+                previous_um,
+            } => write!(
+                f,
+                "wavelength {wavelength_um} µm follows {previous_um} µm: the rows are sorted by wavelength"
+            ),
+            WarningKind::Repeated {
+                wavelength_um,
+                first_line,
+            } => write!(
+                f,
+                "wavelength {wavelength_um} µm repeats line {first_line} with other values: their mean is used"
+            ),
+            WarningKind::NonPositiveN { wavelength_um, n } => write!(
+                f,
+                "n = {n} at {wavelength_um} µm is not positive: this n is skipped"
+            ),
+            WarningKind::NegativeK { wavelength_um, k } => write!(
+                f,
+                "k = {k} at {wavelength_um} µm is negative (gain): this k is skipped"
+            ),
+            WarningKind::SecondEntry {
+                quantity,
+                first_line,
+            } => write!(
+                f,
+                "a second entry giving {quantity}: the entry of line {first_line} gives it, this one's {quantity} is ignored"
+            ),
+            WarningKind::KTableEnds {
+                wavelength_nm,
+                lower,
+                k,
+                n_range_nm,
+            } => write!(
+                f,
+                "k is tabulated only {} {wavelength_nm} nm (k = {k} there) inside n's range {}–{} nm: k = 0 beyond its table",
+                if *lower { "from" } else { "up to" },
+                n_range_nm.0,
+                n_range_nm.1
+            ),
+            WarningKind::KOutsideN {
+                k_range_nm,
+                n_range_nm,
+            } => write!(
+                f,
+                "k is tabulated over {}–{} nm, outside n's range {}–{} nm: k = 0 throughout",
+                k_range_nm.0, k_range_nm.1, n_range_nm.0, n_range_nm.1
+            ),
+            WarningKind::FormulaRangeCut {
+                stated_nm,
+                usable_nm,
+            } => write!(
+                f,
+                "the formula gives no physical n at the ends of its wavelength_range {}–{} nm: only {}–{} nm is used",
+                stated_nm.0, stated_nm.1, usable_nm.0, usable_nm.1
+            ),
+            WarningKind::FormulaGap { from_nm, to_nm } => write!(
+                f,
+                "the formula gives no physical n between {from_nm} and {to_nm} nm, inside its wavelength_range: wavelengths there are refused"
+            ),
+        }
+    }
+}
+
+/// One row of a `tabulated` block.
+struct TableRow {
+    line: usize,
+    wavelength_um: f64,
+    wavelength_nm: f64,
+    values: Vec<f64>,
+}
+
+/// One quantity's samples from a table: wavelengths (nm, strictly increasing), values, and
+/// the line each sample came from (the first row at that wavelength).
+struct Table {
+    wavelength_nm: Vec<f64>,
+    value: Vec<f64>,
+    lines: Vec<usize>,
+}
+
+impl Table {
+    fn range(&self) -> (f64, f64) {
+        (
+            self.wavelength_nm[0],
+            self.wavelength_nm[self.wavelength_nm.len() - 1],
+        )
+    }
+
+    fn into_dispersion(self) -> Dispersion {
+        Dispersion::Tabulated {
+            wavelength_nm: self.wavelength_nm,
+            value: self.value,
+            zero_outside: false,
+        }
+    }
+
+    fn into_dispersion_zero_outside(self) -> Dispersion {
+        Dispersion::Tabulated {
+            wavelength_nm: self.wavelength_nm,
+            value: self.value,
+            zero_outside: true,
+        }
+    }
+}
+
+/// Column `col` of `rows` (sorted by wavelength) as a table: values failing `valid` are
+/// skipped (each reported to `skipped`), values at one wavelength merged into their mean.
+/// None when no value is valid.
+fn tabulate(
+    rows: &[TableRow],
+    col: usize,
+    valid: impl Fn(f64) -> bool,
+    mut skipped: impl FnMut(&TableRow, f64),
+) -> Option<Table> {
+    let mut t = Table {
+        wavelength_nm: Vec::new(),
+        value: Vec::new(),
+        lines: Vec::new(),
+    };
+    for group in rows.chunk_by(|a, b| a.wavelength_nm == b.wavelength_nm) {
+        let mut sum = 0.0;
+        let mut count = 0u32;
+        for r in group {
+            let v = r.values[col];
+            if valid(v) {
+                sum += v;
+                count += 1;
+            } else {
+                skipped(r, v);
+            }
+        }
+        if count > 0 {
+            t.wavelength_nm.push(group[0].wavelength_nm);
+            t.value.push(sum / f64::from(count));
+            t.lines.push(group[0].line);
+        }
+    }
+    (!t.value.is_empty()).then_some(t)
+}
+
+/// A decimal number of micrometres (`0.017586`, `1.5E-2`) in nanometres, correctly rounded:
+/// the decimal point is moved three places in the text before parsing, so a page's own
+/// wavelengths print back as written (`17.586`, not `17.586000000000002`). None unless a
+/// finite number.
+pub fn um_to_nm(token: &str) -> Option<f64> {
+    let t = token.trim();
+    parse_finite(t)?;
+    let (mantissa, exponent) = match t.find(['e', 'E']) {
+        Some(i) => (&t[..i], t[i + 1..].parse::<i64>().ok()?),
+        None => (t, 0),
+    };
+    parse_finite(&format!("{mantissa}e{}", exponent + 3))
+}
+
+/// A wavelength interval, nm: (from, to).
+type Range = (f64, f64);
+
+/// Where a formula is physical over `range` (nm): the usable range (the stated one with any
+/// non-physical ends cut off) and the non-physical open intervals inside it. None when it
+/// is physical nowhere. The range is sampled at [`FORMULA_SCAN_POINTS`] points, each edge
+/// found by bisection and moved to a short decimal on the physical side.
+fn formula_gaps(physical: &dyn Fn(f64) -> bool, range: (f64, f64)) -> Option<(Range, Vec<Range>)> {
+    let (lo, hi) = range;
+    let last = FORMULA_SCAN_POINTS - 1;
+    let at = |i: usize| match i {
+        0 => lo,
+        i if i == last => hi,
+        i => lo * (hi / lo).powf(i as f64 / last as f64),
+    };
+    let ok: Vec<bool> = (0..FORMULA_SCAN_POINTS).map(|i| physical(at(i))).collect();
+    if ok.iter().all(|&b| b) {
+        return Some((range, Vec::new()));
+    }
+    let first_ok = ok.iter().position(|&b| b)?;
+    let last_ok = ok.iter().rposition(|&b| b)?;
+    // The edge between a physical `good` and a non-physical `bad` wavelength, on the
+    // physical side, as a short decimal when one is physical and between them.
+    let edge = |good: f64, bad: f64| {
+        let (mut g, mut b) = (good, bad);
+        for _ in 0..200 {
+            let m = 0.5 * (g + b);
+            if m == g || m == b {
+                break;
+            }
+            if physical(m) {
+                g = m;
+            } else {
+                b = m;
+            }
+        }
+        (7..=15)
+            .map(|digits| round_away(g, b, digits))
+            .find(|&c| physical(c) && (c - good) * (c - b) <= 0.0 && (c - g) * (c - b) >= 0.0)
+            .unwrap_or(g)
+    };
+    let usable = (
+        if first_ok == 0 {
+            lo
+        } else {
+            edge(at(first_ok), at(first_ok - 1))
+        },
+        if last_ok == last {
+            hi
+        } else {
+            edge(at(last_ok), at(last_ok + 1))
+        },
+    );
+    let mut gaps = Vec::new();
+    let mut i = first_ok;
+    while i < last_ok {
+        if ok[i] && !ok[i + 1] {
+            let j = (i + 1..=last_ok)
+                .find(|&j| ok[j])
+                .expect("last_ok is physical");
+            gaps.push((edge(at(i), at(i + 1)), edge(at(j), at(j - 1))));
+            i = j;
+        } else {
+            i += 1;
+        }
+    }
+    Some((usable, gaps))
+}
+
+/// `x` rounded to `digits` significant decimal digits, away from `from` (so that the result
+/// is not nearer to `from` than `x` is).
+fn round_away(x: f64, from: f64, digits: i32) -> f64 {
+    let scale = 10f64.powi(digits - 1 - x.abs().log10().floor() as i32);
+    let r = if x > from {
+        (x * scale).ceil() / scale
+    } else {
+        (x * scale).floor() / scale
+    };
+    // Print-friendly: the shortest decimal of r.
+    format!("{r:.*e}", (digits - 1) as usize)
+        .parse()
+        .unwrap_or(r)
+}
+
 fn check_index(name: &str, index: C64) -> Result<()> {
     if !(index.re > 0.0 && index.re.is_finite()) {
         return Err(Error::InvalidIndex {
             text: name.to_string(),
             reason: "the real part n must be finite and positive".into(),
+        });
+    }
+    if !(INDEX_RANGE.0..=INDEX_RANGE.1).contains(&index.re) {
+        return Err(Error::InvalidIndex {
+            text: name.to_string(),
+            reason: format!(
+                "the real part n must lie in [{:e}, {:e}]",
+                INDEX_RANGE.0, INDEX_RANGE.1
+            ),
         });
     }
     if !(index.im >= 0.0 && index.im.is_finite()) {
@@ -587,6 +1126,12 @@ fn check_index(name: &str, index: C64) -> Result<()> {
             reason:
                 "the extinction coefficient κ must be finite and non-negative (κ < 0 would be gain)"
                     .into(),
+        });
+    }
+    if index.im > MAX_KAPPA {
+        return Err(Error::InvalidIndex {
+            text: name.to_string(),
+            reason: format!("the extinction coefficient κ must be at most {MAX_KAPPA:e}"),
         });
     }
     Ok(())
@@ -784,23 +1329,30 @@ DATA:
         let bad = METAL.replace("0.50 1.0 2.0", "0.50 1.0 x2.0");
         let e = Material::from_refractiveindex_yaml("m", "m.yml", &bad).unwrap_err();
         assert_eq!(e.to_string(), "m.yml:6: `x2.0` is not a finite number");
-        let bad = METAL.replace("0.50 1.0 2.0", "0.30 1.0 2.0");
+        let bad = METAL.replace("0.50 1.0 2.0", "0.50 1.0 2.0 7");
         let e = Material::from_refractiveindex_yaml("m", "m.yml", &bad).unwrap_err();
-        assert!(
-            e.to_string()
-                .starts_with("m.yml:6: wavelengths must strictly increase"),
-            "{e}"
+        assert_eq!(
+            e.to_string(),
+            "m.yml:6: `tabulated nk` rows need 3 numbers, found 4"
+        );
+        let bad = METAL.replace("0.50 1.0 2.0", "-0.50 1.0 2.0");
+        let e = Material::from_refractiveindex_yaml("m", "m.yml", &bad).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "m.yml:6: wavelength -0.5 µm must be positive"
         );
         let bad = METAL.replace("data: |\n", "data: |\n\n");
         let bad = bad.replace("0.50 1.0 2.0", "0.50 1.0 x2.0");
         let e = Material::from_refractiveindex_yaml("m", "m.yml", &bad).unwrap_err();
         assert_eq!(e.to_string(), "m.yml:7: `x2.0` is not a finite number");
-        let bad = METAL.replace("0.60 0.5 3.0", "0.60 0.5 -3.0");
+        let bad = METAL
+            .replace("1.5 1.9", "-1.5 1.9")
+            .replace("1.0 2.0", "0 2.0");
+        let bad = bad.replace("0.5 3.0", "-0.5 3.0");
         let e = Material::from_refractiveindex_yaml("m", "m.yml", &bad).unwrap_err();
-        assert!(
-            e.to_string()
-                .starts_with("m.yml:7: k = -3 must be non-negative"),
-            "{e}"
+        assert_eq!(
+            e.to_string(),
+            "m.yml:5: `tabulated nk` entry has no row with n > 0"
         );
         let e = Material::from_refractiveindex_yaml("m", "m.yml", "DATA: [").unwrap_err();
         assert!(e.to_string().contains("malformed YAML"), "{e}");
@@ -827,10 +1379,192 @@ DATA:
         0.80 0.2
 ";
         let m = Material::from_refractiveindex_yaml("c", "c.yml", text).unwrap();
-        assert_eq!(m.range_nm(), (350.0, 800.0));
+        // n's range; κ = 0 outside κ's table (its ends, 0.1 and 0.2, are named).
+        assert_eq!(m.range_nm(), (300.0, 900.0));
+        assert_eq!(m.index_at(300.0).unwrap().im, 0.0);
+        assert_eq!(m.warnings().len(), 2);
         let n = m.index_at(500.0).unwrap();
         assert!((n.re - (1.5 + 0.01 / 0.25)).abs() < 1e-14);
         assert!((n.im - (0.1 + 0.1 * 150.0 / 450.0)).abs() < 1e-14);
+    }
+
+    fn warnings_of(m: &Material) -> Vec<String> {
+        m.warnings().iter().map(ToString::to_string).collect()
+    }
+
+    #[test]
+    fn repeated_rows_are_merged_and_unordered_rows_sorted() {
+        // Line 5 repeats line 4 exactly (merged silently); line 7 repeats line 6 with other
+        // values (merged into their mean, named); line 9 is out of order (sorted, named).
+        let text = "\
+DATA:
+  - type: tabulated nk
+    data: |
+        0.40 1.5 1.9
+        0.40 1.5 1.9
+        0.50 1.0 2.0
+        0.50 1.2 2.2
+        0.70 0.5 3.0
+        0.60 0.7 2.5
+";
+        let m = Material::from_refractiveindex_yaml("m", "m.yml", text).unwrap();
+        assert_eq!(
+            warnings_of(&m),
+            [
+                "m.yml:7: wavelength 0.5 µm repeats line 6 with other values: their mean is used",
+                "m.yml:9: wavelength 0.6 µm follows 0.7 µm: the rows are sorted by wavelength",
+            ]
+        );
+        assert_eq!(m.range_nm(), (400.0, 700.0));
+        let at = |w: f64| m.index_at(w).unwrap();
+        assert!((at(500.0) - C64::new(1.1, 2.1)).norm() < 1e-15);
+        assert_eq!(at(600.0), C64::new(0.7, 2.5));
+        assert_eq!(at(400.0), C64::new(1.5, 1.9));
+    }
+
+    #[test]
+    fn unphysical_values_are_skipped_with_their_lines() {
+        // k < 0 at line 4 (k skipped, n kept); n ≤ 0 at the last row (n skipped: the range
+        // ends at the row before; k kept but beyond n's range unused).
+        let text = "\
+DATA:
+  - type: tabulated nk
+    data: |
+        0.40 1.5 -0.2
+        0.50 1.0 2.0
+        0.60 0.5 3.0
+        900 -256 1265
+";
+        let m = Material::from_refractiveindex_yaml("m", "m.yml", text).unwrap();
+        assert_eq!(
+            warnings_of(&m),
+            [
+                "m.yml:4: k = -0.2 at 0.4 µm is negative (gain): this k is skipped",
+                "m.yml:5: k is tabulated only from 500 nm (k = 2 there) inside n's range 400–600 nm: k = 0 beyond its table",
+                "m.yml:7: n = -256 at 900 µm is not positive: this n is skipped",
+            ]
+        );
+        assert_eq!(m.range_nm(), (400.0, 600.0));
+        // κ's table now starts at 500 nm (κ = 2, named): κ = 0 below it.
+        assert_eq!(m.index_at(400.0).unwrap(), C64::new(1.5, 0.0));
+        assert_eq!(m.index_at(550.0).unwrap(), C64::new(0.75, 2.5));
+    }
+
+    #[test]
+    fn micrometres_convert_to_the_decimal_nanometres() {
+        assert_eq!(um_to_nm("0.017586"), Some(17.586));
+        assert_eq!(um_to_nm("2.479684"), Some(2479.684));
+        assert_eq!(um_to_nm("1.5E-2"), Some(15.0));
+        assert_eq!(um_to_nm("2.36e-3"), Some(2.36));
+        assert_eq!(um_to_nm("7e5"), Some(7e8));
+        assert_eq!(um_to_nm("x"), None);
+        assert_eq!(um_to_nm("inf"), None);
+        let text = "DATA:\n  - type: tabulated nk\n    data: |\n        0.017586 0.9 0.3\n        2.479684 0.2 14\n";
+        let m = Material::from_refractiveindex_yaml("m", "m.yml", text).unwrap();
+        assert_eq!(m.range_nm(), (17.586, 2479.684));
+        m.index_at(17.586).unwrap();
+        m.index_at(2479.684).unwrap();
+    }
+
+    #[test]
+    fn formula_n_with_a_narrower_k_table_covers_the_formula_range() {
+        // κ tabulated over 0.5–0.8 µm only: κ = 0 outside it (κ = 0.2 at its upper end is
+        // not negligible: named); the formula's whole range is usable.
+        let text = "\
+DATA:
+  - type: formula 5
+    wavelength_range: 0.4 13.9
+    coefficients: 2.4 0.01 -2
+  - type: tabulated k
+    data: |
+        0.50 0.0001
+        0.80 0.2
+";
+        let m = Material::from_refractiveindex_yaml("c", "c.yml", text).unwrap();
+        assert_eq!(m.range_nm(), (400.0, 13900.0));
+        assert_eq!(m.index_at(450.0).unwrap().im, 0.0);
+        assert!((m.index_at(650.0).unwrap().im - 0.10005).abs() < 1e-12);
+        assert_eq!(m.index_at(13900.0).unwrap().im, 0.0);
+        assert_eq!(
+            warnings_of(&m),
+            [
+                "c.yml:8: k is tabulated only up to 800 nm (k = 0.2 there) inside n's range 400–13900 nm: k = 0 beyond its table"
+            ]
+        );
+    }
+
+    #[test]
+    fn a_second_entry_giving_n_is_ignored() {
+        let text = "\
+DATA:
+  - type: formula 5
+    wavelength_range: 0.375 1
+    coefficients: 1.5 0.002 -2
+  - type: tabulated nk
+    data: |
+        0.375 1.9 0.004
+        1.0 1.9 0.001
+";
+        let m = Material::from_refractiveindex_yaml("c", "c.yml", text).unwrap();
+        assert_eq!(
+            warnings_of(&m),
+            [
+                "c.yml:5: a second entry giving n: the entry of line 2 gives it, this one's n is ignored"
+            ]
+        );
+        let n = m.index_at(500.0).unwrap();
+        assert!((n.re - 1.508).abs() < 1e-12 && n.im > 0.001, "{n}");
+    }
+
+    #[test]
+    fn a_formula_non_physical_inside_its_range_is_cut_or_refused_there() {
+        // Formula 2 with a pole at λ² = 4 (2 µm): n² < 0 just above it, down to where
+        // 1 + 1·λ²/(λ² − 4) = 0, i.e. λ² = 2 … 4: n is non-physical for √2 < λ < 2 µm.
+        let text = "\
+DATA:
+  - type: formula 2
+    wavelength_range: 0.5 5
+    coefficients: 0 1 4
+";
+        let m = Material::from_refractiveindex_yaml("p", "p.yml", text).unwrap();
+        assert_eq!(m.range_nm(), (500.0, 5000.0));
+        let &[(a, b)] = m.gaps_nm() else {
+            panic!("{:?}", m.gaps_nm())
+        };
+        assert!(
+            a <= 2f64.sqrt() * 1e3 && a > 1414.2 && (2000.0..2000.01).contains(&b),
+            "{a} {b}"
+        );
+        m.index_at(a).unwrap();
+        m.index_at(b).unwrap();
+        let e = m.index_at(1700.0).unwrap_err();
+        assert!(matches!(e, Error::NoPhysicalIndex { .. }), "{e}");
+        assert_eq!(
+            e.to_string(),
+            format!(
+                "material `p` has no physical index at 1700 nm: its formula gives none between {a} and {b} nm (choose wavelengths outside that interval or another page)"
+            )
+        );
+        assert_eq!(
+            warnings_of(&m),
+            [format!(
+                "p.yml:3: the formula gives no physical n between {a} and {b} nm, inside its wavelength_range: wavelengths there are refused"
+            )]
+        );
+        // Non-physical at an end: the range is cut.
+        let cut = text.replace("0.5 5", "1.5 5");
+        let m = Material::from_refractiveindex_yaml("p", "p.yml", &cut).unwrap();
+        assert_eq!(m.range_nm().0, b);
+        assert!(m.gaps_nm().is_empty());
+        assert!(warnings_of(&m)[0].contains("only"), "{:?}", warnings_of(&m));
+        // Nowhere physical: an error naming the line.
+        let none = text.replace("0.5 5", "1.5 1.9");
+        let e = Material::from_refractiveindex_yaml("p", "p.yml", &none).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("p.yml:3: the formula gives no physical n"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -161,7 +161,7 @@ impl FilmTerm {
         cells: usize,
     ) -> Result<Self> {
         let cells = cells.max(1);
-        let rule = SpectralRule::new(colorimeter, stack.max_opd_nm(None));
+        let rule = SpectralRule::try_new(colorimeter, stack.max_opd_nm(None))?;
         let wavelengths = rule.wavelengths_nm();
         let white = rule.colour(std::iter::repeat_n(1.0, wavelengths.len()));
         let angles_deg: Vec<f64> = (1..=cells)

@@ -52,7 +52,7 @@
 //! ΔE2000 0.0013.
 
 use crate::colour::{Colorimeter, SPECTRAL_MAX_NM, SPECTRAL_MIN_NM};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::stack::{Prepared, Stack, ThicknessSweep, uniform_step};
 use std::f64::consts::PI;
 
@@ -67,6 +67,13 @@ const GL2: f64 = 0.577_350_269_189_625_8;
 
 /// Spacing of the fringe-finesse samples of [`SpectralRule::for_stack`], nm.
 pub const FINESSE_GRID_NM: f64 = 5.0;
+
+/// Most nodes a rule may have (2²², 128 MiB of wavelengths and weights): a finesse-blind
+/// rule reaches it at an optical path difference of about 1.5×10⁸ nm (a 5 cm glass plate),
+/// a rule for sharp fringes sooner. [`SpectralRule::for_stack`] and
+/// [`SpectralRule::try_new`] refuse a larger rule with [`Error::OutOfRange`] instead of
+/// exhausting memory on an absurd thickness.
+pub const MAX_RULE_NODES: usize = 1 << 22;
 
 /// Bound on the aliased part of the reflectance, ε of [`phase_step_rad`].
 const FRINGE_TOLERANCE: f64 = 1e-6;
@@ -110,20 +117,34 @@ impl SpectralRule {
     /// The rule for spectra whose interference terms have optical path differences up to
     /// `max_opd_nm` (0 for smooth spectra) and broad fringes (fringe finesse ρ ≤ 0.37, see
     /// [`SpectralRule::with_finesse`]), for `colorimeter`'s sensitivities.
+    ///
+    /// # Panics
+    /// If the rule would have more than [`MAX_RULE_NODES`] nodes; [`SpectralRule::try_new`]
+    /// returns an error instead (for optical paths that come from user input).
     pub fn new(colorimeter: &Colorimeter, max_opd_nm: f64) -> Self {
-        Self::build(colorimeter, max_opd_nm, |_| Ok(0.0)).expect("infallible finesse")
+        Self::try_new(colorimeter, max_opd_nm).expect("a rule within MAX_RULE_NODES")
+    }
+
+    /// [`SpectralRule::new`], or [`Error::OutOfRange`] when the rule would have more than
+    /// [`MAX_RULE_NODES`] nodes.
+    pub fn try_new(colorimeter: &Colorimeter, max_opd_nm: f64) -> Result<Self> {
+        Self::build(colorimeter, max_opd_nm, |_| Ok(0.0))
     }
 
     /// The rule for films whose fringes have finesse up to `finesse(λ)` (the round-trip
     /// amplitude ρ of [`Stack::fringe_finesse`], in [0, 1]) near wavelength λ: each cell's
     /// phase step is [`phase_step_rad`]`(ρ)`, with ρ the larger of its values at the
     /// cell's two ends. For ρ ≤ 0.37 this is [`SpectralRule::new`]'s rule, node for node.
+    ///
+    /// # Panics
+    /// If the rule would have more than [`MAX_RULE_NODES`] nodes.
     pub fn with_finesse(
         colorimeter: &Colorimeter,
         max_opd_nm: f64,
         mut finesse: impl FnMut(f64) -> f64,
     ) -> Self {
-        Self::build(colorimeter, max_opd_nm, |wl| Ok(finesse(wl))).expect("infallible finesse")
+        Self::build(colorimeter, max_opd_nm, |wl| Ok(finesse(wl)))
+            .expect("a rule within MAX_RULE_NODES")
     }
 
     /// The rule for `stack` seen at every angle of `angles_deg`, with optical path
@@ -181,6 +202,13 @@ impl SpectralRule {
                 if step < MAX_PHASE_STEP_RAD {
                     h = h.min(cell(step));
                 }
+            }
+            if wavelengths_nm.len() >= MAX_RULE_NODES {
+                return Err(Error::OutOfRange {
+                    what: "optical path difference of the spectral rule, nm",
+                    value: max_opd_nm,
+                    expected: "a path the exact integration resolves in at most 2^22 wavelengths (about 1.5e8 nm for broad fringes, less for sharp ones)",
+                });
             }
             let centre = lo + 0.5 * h;
             for x in [centre - 0.5 * h * GL2, centre + 0.5 * h * GL2] {
@@ -468,6 +496,30 @@ mod tests {
         let expected = (top.r_s.norm() * bottom.r_s.norm()).max(top.r_p.norm() * bottom.r_p.norm());
         assert!((rho - expected).abs() < 1e-15, "{rho} vs {expected}");
         assert!(rho > 0.7 && rho < 0.9, "{rho}");
+    }
+
+    #[test]
+    fn absurd_paths_are_refused_not_allocated() {
+        let c = srgb();
+        assert!(SpectralRule::try_new(&c, 1e7).is_ok());
+        for opd in [1e12, 1e300, f64::INFINITY] {
+            let e = SpectralRule::try_new(&c, opd).unwrap_err();
+            assert!(matches!(e, Error::OutOfRange { .. }), "{opd}: {e}");
+        }
+        let film = |d: f64| {
+            Stack::new(
+                Material::constant("1.0", C64::new(1.0, 0.0)).unwrap(),
+                vec![Layer {
+                    material: Material::constant("1.33", C64::new(1.33, 0.0)).unwrap(),
+                    thickness_nm: d,
+                }],
+                Material::constant("1.0", C64::new(1.0, 0.0)).unwrap(),
+            )
+            .unwrap()
+        };
+        let s = film(1e300);
+        let e = SpectralRule::for_stack(&c, &s, &[0.0], s.max_opd_nm(None)).unwrap_err();
+        assert!(e.to_string().contains("out of range"), "{e}");
     }
 
     #[test]

@@ -73,8 +73,13 @@ pub struct Amplitudes {
 }
 
 /// Power reflectance and transmittance of a stack, per polarisation.
+///
+/// `#[repr(C)]`: four `f64` in field order (R_s, R_p, T_s, T_p), so that a slice of powers
+/// is an (n, 4) array of `f64` for bindings (the Python package hands a sweep to numpy
+/// without copying it).
 #[allow(non_snake_case)]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(C)]
 pub struct Power {
     /// Reflectance, s polarisation.
     pub R_s: f64,

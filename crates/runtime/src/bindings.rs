@@ -125,14 +125,18 @@ pub fn spectral_samples(
 }
 
 /// What `film_stack` evaluates: a stack of 1 to 8 films whose top film takes the pixel's
-/// thickness and whose other films vary as d_j + r_j s
-/// ([`nacre_optics::few_wavelengths::StackEvaluation`]).
+/// thickness and whose other films vary as d_j + r_j s_c, s_c from their channel c of the
+/// thickness map ([`nacre_optics::few_wavelengths::StackEvaluation`]).
 #[derive(Clone, Debug)]
 pub struct StackSetup {
     /// Ambient, films (their own thicknesses d_j⁰) and base.
     pub stack: nacre_optics::Stack,
     /// Relative thickness r_j of each film, nm (the top film's is unused).
     pub relative_nm: Vec<f64>,
+    /// Each film's thickness-map channel (0 R or grey, 1 G, 2 B; the top film's is unused:
+    /// it follows the material's thickness mapping of channel R); empty: every film follows
+    /// channel R.
+    pub channels: Vec<usize>,
     /// `None`: the rule ladder (counts from the pixel's OPD); `Some(N)`: N nodes everywhere.
     pub samples: Option<usize>,
 }
@@ -159,6 +163,7 @@ impl Default for StackSetup {
             stack: nacre_optics::Stack::new(constant(1.0), layers, constant(1.5))
                 .expect("finite thicknesses and a clear ambient"),
             relative_nm: vec![0.0, 30.0],
+            channels: Vec::new(),
             samples: None,
         }
     }
@@ -193,6 +198,7 @@ impl StackSetup {
             relative_nm: (0..films)
                 .map(|j| if j == 0 { 0.0 } else { 20.0 })
                 .collect(),
+            channels: Vec::new(),
             samples: None,
         })
     }
@@ -206,7 +212,11 @@ pub fn stack_buffers(
     setup: &StackSetup,
 ) -> Result<(Vec<params::StackNode>, Vec<[f32; 2]>, params::StackParams)> {
     use nacre_optics::few_wavelengths::{BASE_COUNT, COUNT_PER_OPD_NM, StackEvaluation};
-    let eval = StackEvaluation::new(colorimeter, &setup.stack, &setup.relative_nm, setup.samples)?;
+    let mut eval =
+        StackEvaluation::new(colorimeter, &setup.stack, &setup.relative_nm, setup.samples)?;
+    if !setup.channels.is_empty() {
+        eval = eval.with_channels(&setup.channels)?;
+    }
     let mut nodes = Vec::new();
     let mut u = params::StackParams {
         films: eval.thickness_nm().len() as u32,
@@ -229,14 +239,15 @@ pub fn stack_buffers(
             });
         }
     }
-    for (j, ((d, r), k)) in eval
+    for (j, (((d, r), k), c)) in eval
         .thickness_nm()
         .iter()
         .zip(eval.relative_nm())
         .zip(eval.opd_factors())
+        .zip(eval.channels())
         .enumerate()
     {
-        u.layers[j] = [*d as f32, *r as f32, *k as f32, 0.0];
+        u.layers[j] = [*d as f32, *r as f32, *k as f32, *c as f32];
     }
     let indices = eval
         .indices()

@@ -829,6 +829,7 @@ fn thickness_map_of(picture: &image::DynamicImage) -> std::result::Result<Thickn
         width: width as usize,
         height: height as usize,
         values,
+        green_blue: None,
     })
 }
 

@@ -580,6 +580,7 @@ pub fn render_gltf(
         width: 1,
         height: 1,
         values: vec![1.0],
+        green_blue: None,
     };
     let flat_texture = upload_mips(
         ctx,

@@ -17,11 +17,14 @@ pub struct FilmInput {
     pub sigma_thickness_nm: f32,
     /// Ambient index n₁.
     pub ambient_ior: f32,
-    /// Spatial variation s = 2g − 1 ∈ [−1, 1] of a stack's lower films (`film_stack`:
-    /// film j ≥ 2 is d_j + r_j s); the other techniques ignore it.
+    /// Spatial variation s = 2g − 1 ∈ [−1, 1] of a stack's lower films from the thickness
+    /// map's channel R or grey (`film_stack`: film j ≥ 2 is d_j + r_j s_c for its map
+    /// channel c); the other techniques ignore it.
     pub variation: f32,
-    /// Padding.
-    pub _pad1: [f32; 2],
+    /// The same from the map's channel G.
+    pub variation_g: f32,
+    /// The same from the map's channel B.
+    pub variation_b: f32,
     /// Base index per output channel, real part.
     pub base_ior: [f32; 3],
     /// Padding.

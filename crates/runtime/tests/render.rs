@@ -460,10 +460,24 @@ fn bad_files_and_settings_are_errors() {
     grey(&wide_png, 9000, 1, image::ExtendedColorType::L8);
     let err = ThicknessMap::load_png(&wide_png).unwrap_err();
     assert!(err.to_string().contains("8192"), "{err}");
-    // Colour PNGs are not thickness maps; 8- and 16-bit greyscale are.
+    // A colour PNG is a thickness map for the stack technique only (R for the top film, G
+    // and B for the films that follow them); 8- and 16-bit greyscale are for every technique.
     let rgb = dir.path().join("rgb.png");
     grey(&rgb, 4, 4, image::ExtendedColorType::Rgb8);
-    assert!(ThicknessMap::load_png(&rgb).is_err());
+    let err = ThicknessMap::load_for(&rgb, Technique::Lut).unwrap_err();
+    assert!(err.to_string().contains("technique `stack`"), "{err}");
+    let map = ThicknessMap::load_for(&rgb, Technique::Stack).unwrap();
+    let half = 128.0 / 255.0;
+    assert_eq!(map.values, vec![half; 16]);
+    assert_eq!(map.green_blue, Some(vec![[half, half]; 16]));
+    let grey_alpha = dir.path().join("la.png");
+    grey(&grey_alpha, 2, 2, image::ExtendedColorType::La8);
+    assert_eq!(
+        ThicknessMap::load_for(&grey_alpha, Technique::Lut)
+            .unwrap()
+            .green_blue,
+        None
+    );
     for depth in [image::ExtendedColorType::L8, image::ExtendedColorType::L16] {
         let p = dir.path().join("ok.png");
         grey(&p, 5, 3, depth);

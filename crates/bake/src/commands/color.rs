@@ -241,6 +241,58 @@ pub struct Point {
     pub film_ior: Option<f64>,
 }
 
+/// Which value of a [`Point`] is unacceptable, and why ([`Point::check`]); displays as
+/// `COLUMN VALUE REQUIREMENT` (`film_ior -1 must be finite and positive`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PointProblem {
+    /// The column that names the value: `angle_deg`, `thickness_nm` or `film_ior`.
+    pub column: &'static str,
+    /// The value.
+    pub value: f64,
+    /// What it must be.
+    pub requirement: &'static str,
+}
+
+impl std::fmt::Display for PointProblem {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} {} {}", self.column, self.value, self.requirement)
+    }
+}
+
+impl Point {
+    /// Checks the values every method needs: the angle strictly between −90° and 90°, a
+    /// given thickness finite and non-negative, a given film index finite and positive.
+    pub fn check(&self) -> std::result::Result<(), PointProblem> {
+        let a = self.angle_deg;
+        if !(a.abs() < 90.0) {
+            return Err(PointProblem {
+                column: "angle_deg",
+                value: a,
+                requirement: "must lie strictly between -90 and 90",
+            });
+        }
+        if let Some(d) = self.thickness_nm
+            && !(d >= 0.0 && d.is_finite())
+        {
+            return Err(PointProblem {
+                column: "thickness_nm",
+                value: d,
+                requirement: "must be finite and non-negative",
+            });
+        }
+        if let Some(n) = self.film_ior
+            && !(n > 0.0 && n.is_finite())
+        {
+            return Err(PointProblem {
+                column: "film_ior",
+                value: n,
+                requirement: "must be finite and positive",
+            });
+        }
+        Ok(())
+    }
+}
+
 /// Reads `--points` CSV: header `angle_deg,thickness_nm,film_ior`, then rows. `#` comment
 /// lines, blank lines, quoted fields, a UTF-8 BOM, CRLF and spaces around fields are
 /// accepted (see [`nacre_optics::csv_rows`]).
@@ -285,23 +337,15 @@ pub fn parse_points(path: &Path, text: &str) -> Result<Vec<Point>> {
             num(&f[1], "thickness_nm")?,
             num(&f[2], "film_ior")?,
         );
-        if !(a.abs() < 90.0) {
-            return Err(perr(
-                line,
-                format!("angle_deg {a} must lie strictly between -90 and 90"),
-            ));
-        }
-        if d < 0.0 {
-            return Err(perr(line, format!("thickness_nm {d} must be non-negative")));
-        }
-        if !(n > 0.0) {
-            return Err(perr(line, format!("film_ior {n} must be positive")));
-        }
-        out.push(Point {
+        let point = Point {
             angle_deg: a,
             thickness_nm: Some(d),
             film_ior: Some(n),
-        });
+        };
+        point
+            .check()
+            .map_err(|problem| perr(line, problem.to_string()))?;
+        out.push(point);
         if out.len() > MAX_POINTS {
             return Err(nacre_format::Error::TooLarge {
                 what: format!("{}: points", path.display()).into(),
@@ -668,7 +712,7 @@ pub fn evaluate(
                         return Err(nacre_optics::Error::InvalidAngle { angle_deg: angle }.into());
                     }
                     let top = point.thickness_nm.unwrap_or(stack.layers()[0].thickness_nm);
-                    let (r, t) = eval.colour(angle.to_radians().cos(), top, 0.0);
+                    let (r, t) = eval.colour(angle.to_radians().cos(), top, [0.0; 3]);
                     Ok(match quantity {
                         Quantity::Reflectance => r,
                         Quantity::Transmittance => t,
@@ -910,6 +954,14 @@ fn film_on_base(
     ))
 }
 
+/// The XYZ (the CSV's X, Y, Z columns) of a colour `c` in `colorimeter`'s output space.
+pub fn output_to_xyz(colorimeter: &Colorimeter, c: [f64; 3]) -> [f64; 3] {
+    match colorimeter.space() {
+        OutputSpace::Xyz => c,
+        OutputSpace::Rgb(_) => colorimeter.xyz_from_output(c),
+    }
+}
+
 /// Writes the CSV.
 pub fn write_csv(
     w: &mut dyn Write,
@@ -921,10 +973,7 @@ pub fn write_csv(
     let mut csv = crate::csv_text::writer(w);
     csv.write_record(HEADER.split(','))?;
     for (p, c) in points.iter().zip(colours) {
-        let xyz = match colorimeter.space() {
-            OutputSpace::Xyz => *c,
-            OutputSpace::Rgb(_) => colorimeter.xyz_from_output(*c),
-        };
+        let xyz = output_to_xyz(colorimeter, *c);
         let (d, n) = film_columns(stack, p);
         csv.write_record([
             p.angle_deg.to_string(),

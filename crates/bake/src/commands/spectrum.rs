@@ -33,7 +33,56 @@ pub fn fmt_sig(v: f64) -> String {
 
 /// Computes the table (checks the size limit and the angles first).
 pub fn compute(stack: &Stack, angles_deg: &[f64], wavelengths_nm: &[f64]) -> Result<Vec<Power>> {
-    let rows = angles_deg.len() as u64 * wavelengths_nm.len() as u64;
+    check_axes(angles_deg, wavelengths_nm, 1)?;
+    check_phases(stack, None, wavelengths_nm)?;
+    stack
+        .sweep(angles_deg, wavelengths_nm)
+        .map_err(optics_error)
+}
+
+/// The table over a third axis, film `layer`'s thickness (1-based, top film = 1; the other
+/// films keep theirs): [`Stack::sweep_thickness`], element
+/// `(a * wavelengths.len() + w) * thicknesses.len() + d`, after the checks of [`compute`]
+/// (the size limit counts every thickness).
+pub fn compute_thickness(
+    stack: &Stack,
+    layer: usize,
+    angles_deg: &[f64],
+    wavelengths_nm: &[f64],
+    thicknesses_nm: &[f64],
+) -> Result<Vec<Power>> {
+    check_axes(angles_deg, wavelengths_nm, thicknesses_nm.len() as u64)?;
+    for &d in thicknesses_nm {
+        if !(d >= 0.0 && d.is_finite()) {
+            return Err(Error::value(
+                Param::Thicknesses,
+                format!("{d}"),
+                "thickness must be finite and non-negative",
+            ));
+        }
+    }
+    if layer == 0 || layer > stack.layers().len() {
+        return Err(Error::optics_in(
+            Param::Layer,
+            nacre_optics::Error::NoSuchLayer {
+                layer,
+                count: stack.layers().len(),
+            },
+        ));
+    }
+    let thickest = thicknesses_nm.iter().copied().fold(0.0, f64::max);
+    check_phases(stack, Some((layer, thickest)), wavelengths_nm)?;
+    stack
+        .sweep_thickness(layer, angles_deg, wavelengths_nm, thicknesses_nm)
+        .map_err(optics_error)
+}
+
+/// The size limit (`per_row` values per (angle, wavelength)), the angles and the
+/// wavelengths of a table.
+fn check_axes(angles_deg: &[f64], wavelengths_nm: &[f64], per_row: u64) -> Result<()> {
+    let rows = (angles_deg.len() as u64)
+        .saturating_mul(wavelengths_nm.len() as u64)
+        .saturating_mul(per_row);
     if rows > MAX_ROWS {
         return Err(nacre_format::Error::TooLarge {
             what: "rows (angles × wavelengths)".into(),
@@ -61,15 +110,62 @@ pub fn compute(stack: &Stack, angles_deg: &[f64], wavelengths_nm: &[f64]) -> Res
             ));
         }
     }
-    stack
-        .sweep(angles_deg, wavelengths_nm)
-        .map_err(|source| match source {
-            nacre_optics::Error::WavelengthOutOfRange { .. }
-            | nacre_optics::Error::AbsorbingAmbient { .. } => {
-                Error::optics_in(Param::Wavelengths, source)
+    Ok(())
+}
+
+/// Refuses films whose phase overflows: a film of thickness d and index ñ under an ambient
+/// n₀ has the phase 2π ñ cos θ d / λ with |ñ cos θ| ≤ |ñ| + n₀, and a phase beyond f64
+/// (a 10³⁰⁰ nm film at 10⁻³⁰⁰ nm) would make the sweep return NaN. `swept` is the film
+/// (1-based) whose thickness a sweep varies, with its largest thickness.
+fn check_phases(stack: &Stack, swept: Option<(usize, f64)>, wavelengths_nm: &[f64]) -> Result<()> {
+    for &wavelength_nm in wavelengths_nm {
+        let indices = stack.indices_at(wavelength_nm).map_err(optics_error)?;
+        let ambient = indices[0].norm();
+        for (j, layer) in stack.layers().iter().enumerate() {
+            let d = match swept {
+                Some((k, d)) if k == j + 1 => d,
+                _ => layer.thickness_nm,
+            };
+            let phase =
+                2.0 * std::f64::consts::PI * (indices[j + 1].norm() + ambient) * d / wavelength_nm;
+            if !phase.is_finite() {
+                return Err(Error::invalid(
+                    Param::Wavelengths,
+                    format!(
+                        "film {} (`{}`, {} nm) at {} nm: its phase 2π ñ d / λ overflows; the film is too thick for the wavelength",
+                        j + 1,
+                        layer.material.name(),
+                        short(d),
+                        short(wavelength_nm)
+                    ),
+                ));
             }
-            other => other.into(),
-        })
+        }
+    }
+    Ok(())
+}
+
+/// `v` for a message: plain (`400`, `0.5`) in [10⁻⁴, 10¹⁵), else scientific (`1e300`).
+fn short(v: f64) -> String {
+    if v == 0.0 || (1e-4..1e15).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
+/// Errors of a sweep: a wavelength outside a material's data or an absorbing ambient are
+/// said to come from the wavelengths.
+fn optics_error(source: nacre_optics::Error) -> Error {
+    match source {
+        nacre_optics::Error::WavelengthOutOfRange { .. }
+        | nacre_optics::Error::NonPhysicalIndex { .. }
+        | nacre_optics::Error::NoPhysicalIndex { .. }
+        | nacre_optics::Error::AbsorbingAmbient { .. } => {
+            Error::optics_in(Param::Wavelengths, source)
+        }
+        other => other.into(),
+    }
 }
 
 /// Writes the CSV table.

@@ -5,8 +5,8 @@
 //!
 //! ```toml
 //! # A quarter-wave MgF2 anti-reflection coating on BK7.
-//! ambient = "air"            # material spec; default "air"
-//! substrate = "bk7"          # material spec; default "air"
+//! ambient = "air"            # material spec; default "1.0" (vacuum)
+//! substrate = "bk7"          # material spec; default "1.0"
 //! angles = "0:89:1"          # optional, degrees in the ambient (flags override)
 //! wavelengths = "380:780:5"  # optional, vacuum nm (flags override)
 //!
@@ -20,17 +20,20 @@
 use crate::commands::grid::parse_thickness_nm;
 use crate::error::{Error, Origin, Param, Result};
 use crate::recipe::{line_of, toml_error};
-use nacre_format::materials::resolve;
+use nacre_format::materials::{MaterialDb, database, resolve_with};
 use nacre_optics::{Layer, Stack};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
-/// Material used for the ambient and the substrate when none is given.
-pub const DEFAULT_MEDIUM: &str = "air";
+/// Material used for the ambient and the substrate when none is given: vacuum, a constant
+/// index that every wavelength accepts (air differs from it by 3×10⁻⁴; the bundled `air` has
+/// data over 230–1690 nm only).
+pub const DEFAULT_MEDIUM: &str = "1.0";
 
-/// The default example stack: a 400 nm soap (water) film in air.
-pub const DEFAULT_LAYER: (&str, f64) = ("water", 400.0);
+/// The default example stack: a 400 nm soap film of constant index 1.33 in vacuum (usable
+/// at every wavelength, unlike the bundled `water`, 182–1129 nm).
+pub const DEFAULT_LAYER: (&str, f64) = ("1.33", 400.0);
 
 /// A material spec and where it came from (for messages).
 #[derive(Clone, Debug)]
@@ -106,10 +109,76 @@ impl StackSpec {
         })
     }
 
-    /// Loads the materials and builds the stack.
+    /// The stack a baked film table (`film-lut`, `rough-film-lut`) at `path` was made for: its
+    /// ambient, the default film ([`DEFAULT_LAYER`]), its fixed layers and its base, named
+    /// by the manifest in messages. None when the manifest records no ambient or base.
+    pub fn for_table(m: &nacre_format::Manifest, path: &Path) -> Option<Self> {
+        if m.ambient.is_empty() || m.base.is_empty() {
+            return None;
+        }
+        let from = |spec: &str, what: &str| MaterialRef {
+            spec: spec.to_string(),
+            context: format!("{} ({what} of table `{}`)", path.display(), m.name).into(),
+        };
+        let mut layers = vec![(
+            MaterialRef {
+                spec: DEFAULT_LAYER.0.into(),
+                context: "default stack".into(),
+            },
+            DEFAULT_LAYER.1,
+        )];
+        layers.extend(
+            m.under
+                .iter()
+                .map(|(spec, d)| (from(spec, "fixed layer"), *d)),
+        );
+        Some(StackSpec {
+            ambient: from(&m.ambient, "ambient"),
+            layers,
+            substrate: from(&m.base, "base"),
+            base_dir: path.parent().map(Path::to_path_buf),
+        })
+    }
+
+    /// `e` with the input named when it is a material's complaint about a wavelength (no
+    /// data there, no physical index there, an absorbing ambient) about one of `stack`'s
+    /// materials, `stack` built from `self`: the ambient's, a layer's or the substrate's
+    /// origin. Other errors are returned as they are.
+    pub fn attribute(&self, stack: &Stack, e: Error) -> Error {
+        let Error::Optics(source) = e else { return e };
+        let material = match &source {
+            nacre_optics::Error::WavelengthOutOfRange { material, .. }
+            | nacre_optics::Error::NonPhysicalIndex { material, .. }
+            | nacre_optics::Error::NoPhysicalIndex { material, .. }
+            | nacre_optics::Error::AbsorbingAmbient { material, .. } => material,
+            _ => return Error::Optics(source),
+        };
+        let mut named = std::iter::once((stack.ambient(), &self.ambient))
+            .chain(
+                stack
+                    .layers()
+                    .iter()
+                    .map(|l| &l.material)
+                    .zip(self.layers.iter().map(|(m, _)| m)),
+            )
+            .chain(std::iter::once((stack.substrate(), &self.substrate)));
+        match named.find(|(m, _)| m.name() == material) {
+            Some((_, r)) => Error::optics_in(r.context.clone(), source),
+            None => Error::Optics(source),
+        }
+    }
+
+    /// Loads the materials and builds the stack, with the material database set by
+    /// [`nacre_format::materials::set_database`].
     pub fn build(&self) -> Result<Stack> {
+        self.build_with(database().as_ref())
+    }
+
+    /// Loads the materials and builds the stack, reading `shelf/book/page` materials from
+    /// `db` (None: such specs are an error that says how to set a database).
+    pub fn build_with(&self, db: Option<&MaterialDb>) -> Result<Stack> {
         let base = self.base_dir.as_deref();
-        let load = |m: &MaterialRef| resolve(&m.spec, m.context.clone(), base);
+        let load = |m: &MaterialRef| resolve_with(&m.spec, m.context.clone(), base, db);
         let ambient = load(&self.ambient)?;
         let layers = self
             .layers
@@ -221,7 +290,14 @@ mod tests {
     fn flags_and_defaults() {
         let s = StackSpec::from_flags(None, &[], None).unwrap();
         assert_eq!(s.layers.len(), 1);
-        assert_eq!(s.layers[0].0.spec, "water");
+        assert_eq!(s.layers[0].0.spec, "1.33");
+        assert_eq!(s.ambient.spec, "1.0");
+        assert_eq!(s.substrate.spec, "1.0");
+        // The defaults work at every wavelength.
+        let stack = s.build().unwrap();
+        for wl in [100.0, 380.0, 2000.0, 20000.0] {
+            stack.evaluate(0.0, wl).unwrap();
+        }
         let s = StackSpec::from_flags(None, &[], Some("bk7")).unwrap();
         assert!(s.layers.is_empty());
         let s = StackSpec::from_flags(

@@ -19,8 +19,10 @@
 //!   `tables/env/README.md`). Uploaded as `Rgba16Float` with a full mip chain of 2×2 box
 //!   filters built here;
 //! * the thickness map ([`ThicknessMap`], `thickness_map.rs`): an 8- or 16-bit greyscale PNG, or
-//!   [`procedural_thickness_map`]. Uploaded as `Rg16Float` holding (g, g²) with a full mip
-//!   chain, so that the shader can recover the thickness variance that filtering removed.
+//!   [`procedural_thickness_map`]. Uploaded as `Rgba16Float` holding (g, g², g_G, g_B) with a
+//!   full mip chain, so that the shader can recover the thickness variance that filtering
+//!   removed; g_G and g_B (a colour map's, or the built-in map's, channels G and B) move the
+//!   lower films of `film_stack` that follow them.
 //!
 //! ```no_run
 //! use nacre_runtime::render::{SceneKind, SceneOptions, render_scene};
@@ -166,7 +168,7 @@ impl Renderer {
             None => EnvironmentMap::default_map()?,
         };
         let thickness = match &options.thickness_map {
-            Some(path) => ThicknessMap::load_png(path)?,
+            Some(path) => ThicknessMap::load_for(path, self.technique)?,
             None => procedural_thickness_map(DEFAULT_THICKNESS_MAP_SIZE),
         };
         self.render_with(ctx, tables, options, &environment, &thickness)
@@ -289,8 +291,8 @@ impl Renderer {
         let thickness_texture = upload_mips(
             ctx,
             "thickness map",
-            wgpu::TextureFormat::Rg16Float,
-            &thickness.mip_chain(),
+            wgpu::TextureFormat::Rgba16Float,
+            &thickness.stack_mip_chain(),
         )?;
         let device = &ctx.device;
         let (target, submitted) = ctx.checked("rendering the scene", || {
