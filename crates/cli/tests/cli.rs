@@ -850,7 +850,6 @@ fn render_gltf_writes_a_png_and_refuses_bad_files() {
         (&["--gltf", "missing.glb"], "missing.glb"),
         (&["--gltf", "truncated.glb"], "truncated.glb"),
         (&["--gltf", "junk.gltf"], "junk.gltf"),
-        (&["--gltf", "lines.glb"], "triangle"),
         (&["--gltf", sweep, "--width", "0"], "width"),
         (&["--gltf", sweep, "--height", "100000"], "8192"),
     ];
@@ -871,6 +870,28 @@ fn render_gltf_writes_a_png_and_refuses_bad_files() {
         assert!(!err.contains("panicked"), "{extra:?}: {err}");
         assert!(!d.join("out.png").exists(), "{extra:?} wrote an output");
     }
+    // A primitive nacre does not draw (lines) is skipped with a note; the file renders.
+    let o = nacre(
+        &[
+            "render",
+            "--width",
+            "16",
+            "--height",
+            "12",
+            "--gltf",
+            "lines.glb",
+            "-o",
+            "lines.png",
+        ],
+        d,
+    );
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("skipped 1 primitive") && err.contains("Lines"),
+        "{err}"
+    );
+    assert!(d.join("lines.png").exists());
 }
 
 /// `nacre color --method rough-lut:NAME --roughness A` (issue 6) agrees with the Monte Carlo
