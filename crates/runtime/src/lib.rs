@@ -16,6 +16,7 @@ pub mod diffraction;
 pub mod environment;
 pub mod error;
 pub mod gltf_assets;
+pub mod gltf_metal;
 pub mod gltf_scene;
 pub mod gpu;
 pub mod ibl;
