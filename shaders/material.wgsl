@@ -597,7 +597,7 @@ fn material_shade(s: SurfacePoint) -> ShadeResult {
 // point's material `mat` (SurfaceMaterial: one or two lobes).
 //
 // Compile-time care: `film_colour` is called from exactly one place, inside a loop whose trip
-// count (1, or 2 when the light is above the surface, times the lobes) is not a compile-time
+// count (1 or 2, plus the lobe samples, times the lobes) is not a compile-time
 // constant, so that shader compilers that inline every call (Mesa's NIR → LLVM in lavapipe)
 // see one copy of the technique — film_fourier's loops, inlined several times, make LLVM's
 // loop analyses take minutes. scene.wgsl and mesh.wgsl likewise call this from one place.
@@ -633,7 +633,10 @@ fn material_shade_with(s: SurfacePoint, mat: SurfaceMaterial) -> ShadeResult {
     var film_v_m: FilmOutput;
     var film_h_d: FilmOutput;
     var film_h_m: FilmOutput;
-    let light_evaluations = select(0u, 1u, n_dot_l > 0.0 && mode != MATERIAL_FILM_EVAL_NV);
+    // The light's evaluation runs whether or not the light is above the surface (its result
+    // is used only when it is): a trip count that varies per fragment made lavapipe (Mesa
+    // 22.3, LLVM 15) crash compiling the mesh shader once its material varies per fragment.
+    let light_evaluations = select(0u, 1u, mode != MATERIAL_FILM_EVAL_NV);
     let lobe_samples = select(0u, MATERIAL_LOBE_SAMPLES, mode == MATERIAL_FILM_EVAL_EXACT);
     let evaluations = 1u + light_evaluations + lobe_samples;
     // The lobe's frame (n = +z) and the view in it.

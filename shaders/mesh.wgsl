@@ -184,30 +184,6 @@ fn mesh_metal_index(f0: vec3<f32>) -> MetalIndex {
     return MetalIndex(max(n, vec3<f32>(1e-3)), sqrt(max(k2, vec3<f32>(0.0))));
 }
 
-// Whether the fragment shader shades with the textured per-fragment material (see mesh_fs).
-const MESH_PER_FRAGMENT_MATERIAL: bool = false;
-
-// The material of the factors alone (uniform over the draw).
-fn mesh_factor_material(metal: MetalIndex) -> SurfaceMaterial {
-    let q = mesh_params;
-    let ior = select(1.5, q.dielectric_ior, f32_is_finite(q.dielectric_ior) && q.dielectric_ior >= 1.0);
-    let roughness = clamp(finite_or(q.roughness, 1.0), 0.0, 1.0);
-    var mat: SurfaceMaterial;
-    mat.diffuse_colour = clamp(q.base_colour.rgb, vec3<f32>(0.0), vec3<f32>(1.0));
-    mat.metallic = clamp(finite_or(q.metallic, 0.0), 0.0, 1.0);
-    mat.lobes = q.lobes;
-    mat.dielectric_ior = vec3<f32>(ior);
-    mat.dielectric_kappa = vec3<f32>(0.0);
-    mat.metal_ior = metal.n;
-    mat.metal_kappa = metal.kappa;
-    mat.roughness_alpha = roughness * roughness;
-    mat.film_weight = clamp(finite_or(q.iridescence, 0.0), 0.0, 1.0);
-    mat.transmission = clamp(finite_or(q.transmission, 0.0), 0.0, 1.0);
-    mat.occlusion = 1.0;
-    mat.specular_colour = clamp(q.specular * q.specular_colour, vec3<f32>(0.0), vec3<f32>(1.0));
-    return mat;
-}
-
 @fragment
 fn mesh_fs(in: MeshVertexOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
     let q = mesh_params;
@@ -250,8 +226,13 @@ fn mesh_fs(in: MeshVertexOut, @builtin(front_facing) front: bool) -> @location(0
 
     let metallic = clamp(finite_or(q.metallic * mr_tex.b, 0.0), 0.0, 1.0);
     let roughness = clamp(finite_or(q.roughness * mr_tex.g, 1.0), 0.0, 1.0);
-    let metal = mesh_metal_index(base.rgb);
-    let metal_factor = mesh_metal_index(q.base_colour.rgb);
+    // The metal lobe's index: where the colour is the factor's alone (no texture or vertex
+    // colour changes it), the uniform's metal (built per channel where that channel's
+    // sensitivity lies: gltf_metal.rs), else Gulbrandsen's fit to the fragment's colour.
+    let fitted_metal = mesh_metal_index(base.rgb);
+    let from_factor = all(abs(base.rgb - clamp(q.base_colour.rgb, vec3<f32>(0.0), vec3<f32>(1.0))) <= vec3<f32>(1e-6));
+    let uniform_metal = material_params.base_kind != MATERIAL_BASE_DIELECTRIC && from_factor;
+    let metal = MetalIndex(select(fitted_metal.n, material_params.base_ior, uniform_metal), select(fitted_metal.kappa, material_params.base_kappa, uniform_metal));
     let ior = select(1.5, q.dielectric_ior, f32_is_finite(q.dielectric_ior) && q.dielectric_ior >= 1.0);
     var mat: SurfaceMaterial;
     mat.diffuse_colour = base.rgb;
@@ -274,18 +255,7 @@ fn mesh_fs(in: MeshVertexOut, @builtin(front_facing) front: bool) -> @location(0
     surface.sigma_thickness_nm = sigma_nm;
     // The texture's one channel drives every film.
     surface.variation = vec3<f32>(2.0 * moments.x - 1.0);
-    // Lavapipe (Mesa 22.3, LLVM 15) crashes executing this pipeline when any of the
-    // SurfaceMaterial fields above varies per fragment (a textured roughness, metallic, film
-    // weight, base colour…), and so does the factor-only material of `mesh_factor_material`
-    // with both lobes: until that is understood, the shading reads the uniform's material
-    // (`material_surface`: one lobe, as before issue 18), and the textures enter only where
-    // they act after the shading (alpha, emission). MESH_PER_FRAGMENT_MATERIAL switches the
-    // textured material on (untested on hardware drivers; see issue 18).
-    var shaded = material_surface();
-    if MESH_PER_FRAGMENT_MATERIAL {
-        shaded = mat;
-    }
-    let shade = material_shade_with(surface, shaded);
+    let shade = material_shade_with(surface, mat);
     var radiance = shade.radiance + sanitize_radiance(q.emissive * emissive_tex.rgb);
     if any(shade.transmittance > vec3<f32>(0.0)) {
         radiance += shade.transmittance * env_radiance(-v, 0.0);

@@ -34,7 +34,7 @@
 //! | `ior` (`KHR_materials_ior`, default 1.5) | a dielectric base of real index `ior` |
 //! | `metallicFactor` m × texture B | per fragment mix(dielectric lobe, metal lobe, m) (glTF Appendix B), the film on both lobes |
 //! | `metallicFactor` 1, no texture | the uniform's base: a metal from the base colour ([`rgb_metal_for`]) |
-//! | `baseColorFactor` × texture × `COLOR_0` | the dielectric lobe's Lambertian albedo; the metal lobe's F0 ([`metal_index_gulbrandsen2014`], per fragment) |
+//! | `baseColorFactor` × texture × `COLOR_0` | the dielectric lobe's Lambertian albedo; the metal lobe's F0: the uniform's metal ([`rgb_metal_for`], each channel's F0 where its sensitivity lies) where the colour is the factor's alone, else [`metal_index_gulbrandsen2014`] of the fragment's colour |
 //! | `roughnessFactor` r × texture G | GGX α = r² |
 //! | `transmissionFactor` t | the share t of the dielectric lobe that is a thin transparent shell (what is behind is the environment) |
 //! | `specularFactor` × `specularColorFactor` (+ textures) | scale of the dielectric lobe's reflectance |
@@ -348,9 +348,10 @@ impl GltfMaterial {
         m.ambient_ior = 1.0;
         let r = clamp01(self.roughness);
         m.roughness_alpha = r * r;
-        // One base per material while the fragment shader shades with the uniform's material
-        // (shaders/mesh.wgsl, MESH_PER_FRAGMENT_MATERIAL): a metal when the metallic factor is
-        // at least 0.5.
+        // The uniform's base: a metal when the metallic factor is at least 0.5 (the metal
+        // lobe's index wherever no texture or vertex colour changes the base colour:
+        // shaders/mesh.wgsl), else the dielectric; the `lut` table's base and the one the
+        // `spectral` technique integrates over.
         if clamp01(self.metallic) >= 0.5 {
             let bands = MetalBands::new(colorimeter);
             m.base = rgb_metal_for(
