@@ -444,17 +444,16 @@ fn material_film_input(cos_theta: f32, thickness_nm: f32, sigma_thickness_nm: f3
 
 // The bare base's unpolarised Fresnel reflectance per channel at incidence cos θ, seen from
 // the ambient n₁ (fresnel_interface, (|r_s|² + |r_p|²)/2): the film-free part of a partially
-// coated surface (film_weight < 1). The base is the uniform's (MaterialParams.base_ior/kappa),
-// except for the metal lobe of a two-lobe point (`schlick`), whose bare reflectance is
-// glTF's F_schlick(F0, v·h) with F0 the metal index's normal-incidence reflectance (glTF 2.0
-// Appendix B, conductor_fresnel). (Reading the index from the uniform, not from values
-// passed in, avoids a crash of lavapipe's LLVM back end of Mesa 22.)
-fn material_base_reflectance(cos_theta: f32, schlick: bool, metal_ior: vec3<f32>, metal_kappa: vec3<f32>) -> vec3<f32> {
+// coated surface (film_weight < 1). The base is the lobe's (`base_ior`, `base_kappa`: the
+// dielectric's or the metal's), and for the metal lobe of a two-lobe point (`schlick`) the
+// bare reflectance is glTF's F_schlick(F0, v·h) with F0 the metal index's normal-incidence
+// reflectance (glTF 2.0 Appendix B, conductor_fresnel).
+fn material_base_reflectance(cos_theta: f32, schlick: bool, base_ior: vec3<f32>, base_kappa: vec3<f32>) -> vec3<f32> {
     let p = material_params;
     let c = clamp(finite_or(cos_theta, 1.0), 1e-6, 1.0);
     if schlick {
-        let n = max(metal_ior, vec3<f32>(1e-3));
-        let k2 = metal_kappa * metal_kappa;
+        let n = max(base_ior, vec3<f32>(1e-3));
+        let k2 = base_kappa * base_kappa;
         let f0 = ((n - 1.0) * (n - 1.0) + k2) / ((n + 1.0) * (n + 1.0) + k2);
         return clamp(f0 + (1.0 - f0) * pow(1.0 - c, 5.0), vec3<f32>(0.0), vec3<f32>(1.0));
     }
@@ -462,7 +461,7 @@ fn material_base_reflectance(cos_theta: f32, schlick: bool, metal_ior: vec3<f32>
     let q0 = c_real(n1 * c);
     var r = vec3<f32>(0.0);
     for (var j = 0; j < 3; j++) {
-        let nk = sanitize_base_index(p.base_ior[j], p.base_kappa[j]);
+        let nk = sanitize_base_index(base_ior[j], base_kappa[j]);
         let f = fresnel_interface(c_real(n1), q0, nk, normal_component_cos(nk, n1, c));
         r[j] = clamp(0.5 * (c_abs2(f.r_s) + c_abs2(f.r_p)), 0.0, 1.0);
     }

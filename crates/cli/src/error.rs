@@ -55,6 +55,10 @@ pub fn flag(param: Param) -> &'static str {
         Param::DiffractionStep => "--diffraction-step",
         Param::EnvSamples => "--env-samples",
         Param::ReferenceSamples => "--reference-samples",
+        Param::Camera => "--camera",
+        Param::Yaw => "--yaw",
+        Param::OrbitPitch => "--pitch",
+        Param::Distance => "--distance",
     }
 }
 

@@ -294,6 +294,9 @@ Examples:
   nacre render --scene rough-row --reference-samples 1024 -o rough-row.png
   # a glTF 2.0 / GLB scene with KHR_materials_iridescence (meshes rasterised, camera fitted)
   nacre render --gltf tests/golden/gltf/sweep-thickness.glb --width 1000 --height 260 -o sweep.png
+  # the same from above and to the left, or from the file's first camera
+  nacre render --gltf scene.glb --yaw -35 --pitch 30 -o orbit.png
+  nacre render --gltf scene.glb --camera 0 -o camera.png
   # diffraction (technique `diffraction`, tables cd-tracks / snake-ridges): a CD and snake scales
   nacre render --scene cd-disc -o cd.png && nacre render --scene snake-skin -o snake.png
   # the CD from the fast table (layout \"integrated\": the wavelength sum baked in)
@@ -358,6 +361,32 @@ struct RenderArgs {
     /// Exposure in EV stops (radiance × 2^EV before tone mapping).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     exposure: f32,
+    /// With --gltf: render from the file's camera N (0-based, in node order) instead of the
+    /// orbit camera.
+    #[arg(long, value_name = "N", requires = "gltf", conflicts_with_all = ["yaw", "pitch", "distance"])]
+    camera: Option<usize>,
+    /// With --gltf: the orbit camera's rotation about the vertical axis, degrees (0: looking
+    /// along −z; 90: from the +x side) [default: 0].
+    #[arg(
+        long,
+        value_name = "DEG",
+        requires = "gltf",
+        allow_hyphen_values = true
+    )]
+    yaw: Option<f64>,
+    /// With --gltf: the orbit camera's elevation, degrees (−89 to 89) [default: 11.3, the
+    /// direction (0, 0.2, 1)].
+    #[arg(
+        long,
+        value_name = "DEG",
+        requires = "gltf",
+        allow_hyphen_values = true
+    )]
+    pitch: Option<f64>,
+    /// With --gltf: the orbit camera's distance from the scene's centre, in the file's units
+    /// (metres) [default: the nearest that frames the whole scene].
+    #[arg(long, value_name = "D", requires = "gltf")]
+    distance: Option<f64>,
     /// Harmonics M of the fourier technique (0 = automatic) [default: 3].
     #[arg(long, value_name = "M")]
     harmonics: Option<u32>,
@@ -660,7 +689,23 @@ fn run_render(args: &RenderArgs) -> Result<()> {
         nacre_runtime::render::ThicknessMap::load_for(path, technique)?;
     }
     let gltf = match &args.gltf {
-        Some(path) => Some(nacre_runtime::gltf_scene::GltfScene::load(path)?),
+        Some(path) => {
+            let scene = nacre_runtime::gltf_scene::GltfScene::load(path)?;
+            let view = match args.camera {
+                Some(k) => nacre_runtime::mesh::ViewPoint::File(k),
+                None => {
+                    let default = nacre_runtime::mesh::Orbit::default();
+                    nacre_runtime::mesh::ViewPoint::Orbit(nacre_runtime::mesh::Orbit {
+                        yaw_deg: args.yaw.unwrap_or(default.yaw_deg),
+                        pitch_deg: args.pitch.unwrap_or(default.pitch_deg),
+                        distance: args.distance,
+                    })
+                }
+            };
+            let aspect = f64::from(options.width) / f64::from(options.height);
+            nacre_runtime::mesh::view_camera(&scene, view, aspect)?;
+            Some((scene, view))
+        }
         None => None,
     };
     let ctx = GpuContext::new_headless()?;
@@ -669,9 +714,11 @@ fn run_render(args: &RenderArgs) -> Result<()> {
     for name in &names {
         tables.add(&ctx, &set::resolve_table(name))?;
     }
-    if let Some(scene) = &gltf {
+    if let Some((scene, view)) = &gltf {
         let start = std::time::Instant::now();
-        let out = nacre_runtime::mesh::render_gltf(&ctx, &tables, technique, scene, &options)?;
+        let out = nacre_runtime::mesh::render_gltf_from(
+            &ctx, &tables, technique, scene, &options, *view,
+        )?;
         for note in &out.notes {
             eprintln!("note: {}", note.named(&error::Flags));
         }

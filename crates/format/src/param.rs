@@ -133,6 +133,14 @@ params! {
     ReferenceSamples => "reference_samples",
     /// The file an export writes.
     Out => "out",
+    /// The glTF file's camera to render from.
+    Camera => "camera",
+    /// Orbit camera: rotation about the vertical, degrees.
+    Yaw => "yaw",
+    /// Orbit camera: elevation, degrees.
+    OrbitPitch => "orbit_pitch",
+    /// Orbit camera: distance from the scene's centre, world units.
+    Distance => "distance",
 }
 
 impl Param {

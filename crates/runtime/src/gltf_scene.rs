@@ -42,7 +42,8 @@
 //!
 //! Skins, morph targets, sparse accessors, quantised positions (`KHR_mesh_quantization`),
 //! Draco, `KHR_materials_volume`, `KHR_materials_clearcoat`, `_sheen`, `_anisotropy` and
-//! `KHR_lights_punctual` are not read.
+//! `KHR_lights_punctual` are not read. The default scene's cameras (perspective and
+//! orthographic, placed by their nodes) are read: [`GltfScene::cameras`].
 //!
 //! # Metals from a base colour
 //!
@@ -435,6 +436,45 @@ pub struct GltfScene {
     pub textures: Vec<GltfTexture>,
     /// What the loader could not read (textures it skipped), one line each.
     pub notes: Vec<String>,
+    /// The cameras placed by the default scene's nodes, in node index order (a node used
+    /// twice in the tree places its camera twice): `nacre render --camera N`.
+    pub cameras: Vec<GltfCamera>,
+}
+
+/// How a glTF camera projects (glTF 2.0 §3.10).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum GltfProjection {
+    /// `yfov` radians, `znear`, `zfar` (None: infinite); the image's aspect is used.
+    Perspective {
+        /// Vertical field of view, radians.
+        yfov_rad: f32,
+        /// Near plane distance, world units.
+        znear: f32,
+        /// Far plane distance, world units (None: infinite projection).
+        zfar: Option<f32>,
+    },
+    /// Half-width `xmag` and half-height `ymag` of the view volume, `znear`, `zfar`.
+    Orthographic {
+        /// Half the view's width, world units.
+        xmag: f32,
+        /// Half the view's height, world units.
+        ymag: f32,
+        /// Near plane distance, world units.
+        znear: f32,
+        /// Far plane distance, world units.
+        zfar: f32,
+    },
+}
+
+/// A camera placed by a node: it looks down the node's −z axis with +y up (§3.10).
+#[derive(Clone, Debug, PartialEq)]
+pub struct GltfCamera {
+    /// The camera's `name`, or `camera K` (its index in the file).
+    pub name: String,
+    /// The node's world transform (column-major; scale is removed when the camera is used).
+    pub world: [[f32; 4]; 4],
+    /// Its projection.
+    pub projection: GltfProjection,
 }
 
 fn invalid(path: &Path, message: impl Into<String>) -> Error {
@@ -1159,6 +1199,7 @@ impl GltfScene {
         let mut stack: Vec<(gltf::Node, [[f32; 4]; 4], usize)> =
             roots.into_iter().map(|n| (n, identity, 0)).collect();
         let mut primitives = Vec::new();
+        let mut cameras = Vec::new();
         let mut skipped: std::collections::BTreeMap<String, usize> = Default::default();
         let (mut vertices, mut corners) = (0usize, 0usize);
         while let Some((node, parent, depth)) = stack.pop() {
@@ -1175,6 +1216,9 @@ impl GltfScene {
             }
             for child in node.children() {
                 stack.push((child, world, depth + 1));
+            }
+            if let Some(camera) = node.camera() {
+                cameras.push((node.index(), gltf_camera(path, &camera, world)?));
             }
             let Some(mesh) = node.mesh() else { continue };
             for prim in mesh.primitives() {
@@ -1371,6 +1415,10 @@ impl GltfScene {
             thickness_maps,
             textures,
             notes,
+            cameras: {
+                cameras.sort_by_key(|(node, _)| *node);
+                cameras.into_iter().map(|(_, c)| c).collect()
+            },
         })
     }
 
@@ -1386,6 +1434,53 @@ impl GltfScene {
         }
         (lo, hi)
     }
+}
+
+/// A node's camera, checked: finite positive planes and field of view (§3.10.2–3).
+fn gltf_camera(path: &Path, camera: &gltf::Camera, world: [[f32; 4]; 4]) -> Result<GltfCamera> {
+    let name = camera
+        .name()
+        .map_or_else(|| format!("camera {}", camera.index()), str::to_string);
+    let positive = |x: f32| x.is_finite() && x > 0.0;
+    let bad = |what: String| invalid(path, format!("camera `{name}`: {what}"));
+    let projection = match camera.projection() {
+        gltf::camera::Projection::Perspective(p) => {
+            let (yfov_rad, znear, zfar) = (p.yfov(), p.znear(), p.zfar());
+            if !(positive(yfov_rad) && yfov_rad < std::f32::consts::PI) {
+                return Err(bad(format!(
+                    "yfov {yfov_rad} rad (expected between 0 and π)"
+                )));
+            }
+            if !positive(znear) || zfar.is_some_and(|f| !(f.is_finite() && f > znear)) {
+                return Err(bad(format!("znear {znear}, zfar {zfar:?}")));
+            }
+            GltfProjection::Perspective {
+                yfov_rad,
+                znear,
+                zfar,
+            }
+        }
+        gltf::camera::Projection::Orthographic(o) => {
+            let (xmag, ymag, znear, zfar) = (o.xmag(), o.ymag(), o.znear(), o.zfar());
+            if !(xmag.is_finite() && xmag != 0.0 && ymag.is_finite() && ymag != 0.0) {
+                return Err(bad(format!("xmag {xmag}, ymag {ymag}")));
+            }
+            if !(znear.is_finite() && znear >= 0.0 && zfar.is_finite() && zfar > znear) {
+                return Err(bad(format!("znear {znear}, zfar {zfar}")));
+            }
+            GltfProjection::Orthographic {
+                xmag: xmag.abs(),
+                ymag: ymag.abs(),
+                znear,
+                zfar,
+            }
+        }
+    };
+    Ok(GltfCamera {
+        name,
+        world,
+        projection,
+    })
 }
 
 /// Every triangle corner its own vertex (all attributes copied).
