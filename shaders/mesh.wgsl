@@ -36,17 +36,21 @@
 // Texture coordinates: each texture reads TEXCOORD_0 or TEXCOORD_1 through its
 // KHR_texture_transform, uv' = (a u + b v + c, d u + e v + f) (MeshParams.transforms).
 //
-// Transmission (thin shells, KHR_materials_transmission ≥ 0.5 in the runtime's mapping): the
-// fragment adds T_f · L_env(−v), the environment straight behind it (other meshes behind a
-// transparent one are not seen: no refraction of the scene yet).
+// Transmission (KHR_materials_transmission, KHR_materials_volume): as the glTF Sample Viewer
+// does, the runtime first draws every non-transmissive primitive into a linear-radiance
+// picture of the scene (flag MESH_FLAG_LINEAR_OUTPUT), then draws the whole scene; a
+// transmissive fragment adds T_f · baseColor · L_behind, L_behind the picture's radiance
+// where the refracted ray leaves the volume (mesh_behind; the environment where the picture
+// shows nothing). Neither the picture's blur by roughness nor transmissive surfaces behind
+// transmissive ones are modelled.
 //
 // Double-sided: the shading normal faces the viewer (a back face's normal and tangent frame
 // are reversed, as glTF prescribes); single-sided materials are culled by the pipeline.
 //
 // Bind groups: 0 view, 1 technique, 2 material (material.wgsl), 3 the primitive's glTF
-// material (MeshParams, 8 textures and their samplers):
+// material (MeshParams, 8 textures and their samplers, and at binding 17 the scene behind):
 //
-// 432 bytes, uniform (mirrored by `MeshUniform` in crates/runtime/src/mesh.rs):
+// 464 bytes, uniform (mirrored by `MeshUniform` in crates/runtime/src/mesh.rs):
 //
 //   offset size field
 //        0   64 view_proj: mat4x4<f32>     world → clip (x, y ∈ [−1, 1], z ∈ [0, 1] near → far)
@@ -62,11 +66,14 @@
 //      128    4 dielectric_ior: f32        ior (KHR_materials_ior)
 //      132    4 iridescence: f32           iridescenceFactor
 //      136    4 alpha_mode: u32            0 OPAQUE, 1 MASK, 2 BLEND
-//      140    4 flags: u32                 bit 0: a normal texture is bound
-//      144    4 transmission: f32          thin-shell share of the dielectric lobe
+//      140    4 flags: u32                 bit 0: a normal texture is bound; MESH_FLAG_*
+//      144    4 transmission: f32          transmissionFactor: the transmitting share of the
+//                                          dielectric lobe
 //      148    4 lobes: u32                 0 dielectric lobe only, 1 metal only, 2 both
-//      152    8 _pad
-//      160  288 transforms: array<TexTransform, 9>  per slot (MESH_TEX_*): rows (a, b, c, set),
+//      152    4 volume_thickness: f32      thicknessFactor (KHR_materials_volume), world units
+//      156    4 attenuation_distance: f32  attenuationDistance (0: no attenuation)
+//      160   16 attenuation_colour: vec4   attenuationColor (rgb)
+//      176  288 transforms: array<TexTransform, 9>  per slot (MESH_TEX_*): rows (a, b, c, set),
 //                                                     (d, e, f, 0)
 struct TexTransform {
     row0: vec4<f32>,
@@ -90,8 +97,9 @@ struct MeshParams {
     flags: u32,
     transmission: f32,
     lobes: u32,
-    _pad1: f32,
-    _pad2: f32,
+    volume_thickness: f32,
+    attenuation_distance: f32,
+    attenuation_colour: vec4<f32>,
     transforms: array<TexTransform, 9>,
 }
 
@@ -109,6 +117,10 @@ const MESH_TEX_THICKNESS: u32 = 8u;
 const MESH_ALPHA_MASK: u32 = 1u;
 const MESH_ALPHA_BLEND: u32 = 2u;
 const MESH_FLAG_NORMAL_MAP: u32 = 1u;
+// The draw writes linear radiance (the scene behind transmissive surfaces), not display colour.
+const MESH_FLAG_LINEAR_OUTPUT: u32 = 2u;
+// mesh_behind_tex holds the opaque scene's linear radiance (alpha 0 where nothing was drawn).
+const MESH_FLAG_BEHIND: u32 = 4u;
 
 @group(3) @binding(0) var<uniform> mesh_params: MeshParams;
 @group(3) @binding(1) var mesh_base_tex: texture_2d<f32>;
@@ -127,6 +139,8 @@ const MESH_FLAG_NORMAL_MAP: u32 = 1u;
 @group(3) @binding(14) var mesh_specular_smp: sampler;
 @group(3) @binding(15) var mesh_specular_colour_tex: texture_2d<f32>;
 @group(3) @binding(16) var mesh_specular_colour_smp: sampler;
+// The opaque scene's linear radiance, read with textureLoad (no sampler).
+@group(3) @binding(17) var mesh_behind_tex: texture_2d<f32>;
 
 struct MeshVertexOut {
     @builtin(position) clip: vec4<f32>,
@@ -182,6 +196,40 @@ fn mesh_metal_index(f0: vec3<f32>) -> MetalIndex {
     let n = g * (1.0 - r) / (1.0 + r) + (1.0 - g) * (1.0 + sr) / (1.0 - sr);
     let k2 = (r * (n + 1.0) * (n + 1.0) - (n - 1.0) * (n - 1.0)) / (1.0 - r);
     return MetalIndex(max(n, vec3<f32>(1e-3)), sqrt(max(k2, vec3<f32>(0.0))));
+}
+
+// What a transmissive surface at `world` (shading normal n, view direction v, dielectric
+// index `ior`) lets through from behind it, before its own transmittance and colour: the glTF
+// Sample Viewer's screen-space refraction (KHR_materials_transmission with
+// KHR_materials_volume). The refracted ray d = refract(−v, n, 1/ior) leaves the volume at
+// world + d · thickness (thin-walled, thickness 0: straight through, d = −v); the opaque
+// scene's radiance at that point's pixel, or the environment along d where the scene shows
+// nothing, attenuated by Beer–Lambert over the path inside, c^(thickness / distance)
+// (KHR_materials_volume attenuationColor c, attenuationDistance; 0 = none).
+fn mesh_behind(world: vec3<f32>, n: vec3<f32>, v: vec3<f32>, ior: f32) -> vec3<f32> {
+    let q = mesh_params;
+    let thickness = max(finite_or(q.volume_thickness, 0.0), 0.0);
+    let bent = refract(-v, n, 1.0 / max(ior, 1.0));
+    let d = select(-v, safe_normalize(bent, -v), thickness > 0.0 && dot(bent, bent) > 0.0);
+    let exit = world + d * thickness;
+    var behind = env_radiance(d, 0.0);
+    if (q.flags & MESH_FLAG_BEHIND) != 0u {
+        let clip = q.view_proj * vec4<f32>(exit, 1.0);
+        if clip.w > 0.0 && f32_is_finite(clip.x / clip.w) && f32_is_finite(clip.y / clip.w) {
+            let ndc = clip.xy / clip.w;
+            let size = vec2<i32>(textureDimensions(mesh_behind_tex));
+            let uv = vec2<f32>(0.5 + 0.5 * ndc.x, 0.5 - 0.5 * ndc.y);
+            let texel = clamp(vec2<i32>(floor(clamp(uv, vec2<f32>(0.0), vec2<f32>(1.0)) * vec2<f32>(size))), vec2<i32>(0), size - 1);
+            let scene = textureLoad(mesh_behind_tex, texel, 0);
+            behind = mix(behind, sanitize_radiance(scene.rgb), clamp(finite_or(scene.a, 0.0), 0.0, 1.0));
+        }
+    }
+    let distance = finite_or(q.attenuation_distance, 0.0);
+    if distance > 0.0 && thickness > 0.0 {
+        let c = clamp(select(vec3<f32>(1.0), q.attenuation_colour.rgb, vec3_is_finite(q.attenuation_colour.rgb)), vec3<f32>(0.0), vec3<f32>(1.0));
+        behind *= pow(c, vec3<f32>(thickness / distance));
+    }
+    return behind;
 }
 
 @fragment
@@ -258,14 +306,18 @@ fn mesh_fs(in: MeshVertexOut, @builtin(front_facing) front: bool) -> @location(0
     let shade = material_shade_with(surface, mat);
     var radiance = shade.radiance + sanitize_radiance(q.emissive * emissive_tex.rgb);
     if any(shade.transmittance > vec3<f32>(0.0)) {
-        radiance += shade.transmittance * env_radiance(-v, 0.0);
+        // glTF's specular BTDF is tinted by the base colour.
+        radiance += shade.transmittance * base.rgb * mesh_behind(in.world, n, v, ior);
     }
     // MASK: below the cutoff the fragment is discarded (after the shading: lavapipe's
     // LLVM back end of Mesa 22 crashed compiling the shading loop after an early discard).
     if q.alpha_mode == MESH_ALPHA_MASK && !(base.a >= q.alpha_cutoff) {
         discard;
     }
-    let colour = material_display(radiance);
     let alpha = select(1.0, base.a, q.alpha_mode == MESH_ALPHA_BLEND);
+    if (q.flags & MESH_FLAG_LINEAR_OUTPUT) != 0u {
+        return vec4<f32>(sanitize_radiance(radiance), alpha);
+    }
+    let colour = material_display(radiance);
     return vec4<f32>(colour.rgb, alpha);
 }

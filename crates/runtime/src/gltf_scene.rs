@@ -2,8 +2,8 @@
 //! tangents, two texture-coordinate sets, vertex colours, indexed or not, node transforms
 //! applied) and their materials — the core metallic-roughness model with all its textures,
 //! `KHR_materials_iridescence`, `KHR_materials_ior`, `KHR_materials_specular`,
-//! `KHR_materials_emissive_strength`, `KHR_texture_transform` and (as a thin shell)
-//! `KHR_materials_transmission` — mapped onto nacre's [`MaterialOptions`] (the uniform
+//! `KHR_materials_emissive_strength`, `KHR_texture_transform`, `KHR_materials_transmission`
+//! and `KHR_materials_volume` (thickness factor and attenuation) — mapped onto nacre's [`MaterialOptions`] (the uniform
 //! parameters) and [`GltfMaterial`]'s textures (read per fragment by `shaders/mesh.wgsl`).
 //!
 //! # What is read (glTF 2.0 specification §3.7–§3.9)
@@ -36,12 +36,13 @@
 //! | `metallicFactor` 1, no texture | the uniform's base: a metal from the base colour ([`rgb_metal_for`]) |
 //! | `baseColorFactor` × texture × `COLOR_0` | the dielectric lobe's Lambertian albedo; the metal lobe's F0: the uniform's metal ([`rgb_metal_for`], each channel's F0 where its sensitivity lies) where the colour is the factor's alone, else [`metal_index_gulbrandsen2014`] of the fragment's colour |
 //! | `roughnessFactor` r × texture G | GGX α = r² |
-//! | `transmissionFactor` t | the share t of the dielectric lobe that is a thin transparent shell (what is behind is the environment) |
+//! | `transmissionFactor` t | the share t of the dielectric lobe that transmits: the opaque scene behind, refracted in screen space (the environment where it shows nothing), tinted by the base colour |
+//! | `KHR_materials_volume` `thicknessFactor`, `attenuationDistance`, `attenuationColor` | the refracted ray's length inside, and Beer–Lambert attenuation along it |
 //! | `specularFactor` × `specularColorFactor` (+ textures) | scale of the dielectric lobe's reflectance |
 //! | normal, occlusion, emissive (× `emissiveStrength`) | per fragment (`shaders/mesh.wgsl`) |
 //!
 //! Skins, morph targets, sparse accessors, quantised positions (`KHR_mesh_quantization`),
-//! Draco, `KHR_materials_volume`, `KHR_materials_clearcoat`, `_sheen`, `_anisotropy` and
+//! Draco, `transmissionTexture`, `thicknessTexture`, `KHR_materials_clearcoat`, `_sheen`, `_anisotropy` and
 //! `KHR_lights_punctual` are not read. The default scene's cameras (perspective and
 //! orthographic, placed by their nodes) are read: [`GltfScene::cameras`].
 //!
@@ -74,14 +75,15 @@ use nacre_optics::{C64, Material};
 use std::path::{Path, PathBuf};
 
 /// The glTF extensions nacre implements: a file whose `extensionsRequired` lists only these
-/// loads (`KHR_materials_transmission` is drawn as a thin shell: the environment, not the
-/// scene, is seen through it).
-pub const SUPPORTED_EXTENSIONS: [&str; 6] = [
+/// loads (`KHR_materials_transmission` and `_volume` refract the opaque scene in screen
+/// space, as the glTF Sample Viewer does: `shaders/mesh.wgsl`).
+pub const SUPPORTED_EXTENSIONS: [&str; 7] = [
     "KHR_materials_iridescence",
     "KHR_materials_ior",
     "KHR_materials_specular",
     "KHR_materials_emissive_strength",
     "KHR_materials_transmission",
+    "KHR_materials_volume",
     "KHR_texture_transform",
 ];
 
@@ -242,6 +244,19 @@ pub struct MaterialTextures {
     pub specular_colour: Option<TextureRef>,
 }
 
+/// `KHR_materials_volume`: the volume under a transmissive surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Volume {
+    /// `thicknessFactor`: the volume's thickness, in the mesh's (local) units (default 0:
+    /// thin-walled). Its `thicknessTexture` is not read.
+    pub thickness: f32,
+    /// `attenuationDistance`: the distance at which light takes `attenuation_colour`
+    /// (default +∞: none).
+    pub attenuation_distance: f32,
+    /// `attenuationColor`, linear RGB (default 1).
+    pub attenuation_colour: [f32; 3],
+}
+
 /// One glTF material's parameters.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GltfMaterial {
@@ -257,6 +272,8 @@ pub struct GltfMaterial {
     pub ior: f32,
     /// `KHR_materials_transmission` `transmissionFactor` (default 0).
     pub transmission: f32,
+    /// `KHR_materials_volume`, if present.
+    pub volume: Option<Volume>,
     /// `KHR_materials_iridescence`, if present.
     pub iridescence: Option<Iridescence>,
     /// `alphaMode` and `alphaCutoff` (default 0.5).
@@ -287,6 +304,7 @@ impl Default for GltfMaterial {
             roughness: 1.0,
             ior: 1.5,
             transmission: 0.0,
+            volume: None,
             iridescence: None,
             alpha_mode: AlphaMode::Opaque,
             double_sided: false,
@@ -1133,6 +1151,11 @@ impl GltfScene {
                 roughness: pbr.roughness_factor(),
                 ior: m.ior().unwrap_or(1.5),
                 transmission: m.transmission().map_or(0.0, |t| t.transmission_factor()),
+                volume: m.volume().map(|v| Volume {
+                    thickness: v.thickness_factor(),
+                    attenuation_distance: v.attenuation_distance(),
+                    attenuation_colour: v.attenuation_color(),
+                }),
                 iridescence,
                 alpha_mode: match m.alpha_mode() {
                     gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,

@@ -41,7 +41,7 @@ use std::sync::Arc;
 /// Depth buffer format.
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
-/// Mirror of `MeshParams` (`shaders/mesh.wgsl`): 448 bytes, one per drawn material.
+/// Mirror of `MeshParams` (`shaders/mesh.wgsl`): 464 bytes, one per drawn material.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct MeshUniform {
@@ -71,18 +71,33 @@ pub struct MeshUniform {
     pub iridescence: f32,
     /// 0 OPAQUE, 1 MASK, 2 BLEND.
     pub alpha_mode: u32,
-    /// Bit 0: a normal texture is bound.
+    /// Bit 0: a normal texture is bound; [`FLAG_LINEAR_OUTPUT`], [`FLAG_BEHIND`].
     pub flags: u32,
     /// `transmissionFactor`.
     pub transmission: f32,
     /// The lobes every fragment evaluates: 0 dielectric, 1 metal, 2 both.
     pub lobes: u32,
-    /// Padding.
-    pub _pad: [f32; 2],
+    /// `KHR_materials_volume` `thicknessFactor` (0: thin-walled).
+    pub volume_thickness: f32,
+    /// `attenuationDistance` (0: no attenuation).
+    pub attenuation_distance: f32,
+    /// `attenuationColor` (rgb; w unused).
+    pub attenuation_colour: [f32; 4],
     /// Per texture slot ([`TEXTURE_SLOTS`] and the thickness texture): rows (a, b, c, set),
     /// (d, e, f, 0) of its `KHR_texture_transform`.
     pub transforms: [[[f32; 4]; 2]; 9],
 }
+
+/// [`MeshUniform::flags`]: the draw writes linear radiance (the scene behind transmissive
+/// surfaces) instead of display colour (`shaders/mesh.wgsl` MESH_FLAG_LINEAR_OUTPUT).
+pub const FLAG_LINEAR_OUTPUT: u32 = 2;
+
+/// [`MeshUniform::flags`]: binding 17 holds the opaque scene's linear radiance
+/// (`shaders/mesh.wgsl` MESH_FLAG_BEHIND).
+pub const FLAG_BEHIND: u32 = 4;
+
+/// Format of the picture of the opaque scene that transmissive surfaces refract.
+pub const BEHIND_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 /// The texture slots of group 3 (`shaders/mesh.wgsl` MESH_TEX_*), in binding order.
 pub const TEXTURE_SLOTS: [&str; 8] = [
@@ -149,7 +164,18 @@ impl MeshUniform {
                 (lo, _) if lo >= 1.0 => 1,
                 _ => 2,
             },
-            _pad: [0.0; 2],
+            volume_thickness: m.volume.map_or(0.0, |v| v.thickness),
+            attenuation_distance: m.volume.map_or(0.0, |v| {
+                if v.attenuation_distance.is_finite() {
+                    v.attenuation_distance
+                } else {
+                    0.0
+                }
+            }),
+            attenuation_colour: m.volume.map_or([1.0; 4], |v| {
+                let [r, g, b] = v.attenuation_colour;
+                [r, g, b, 1.0]
+            }),
             transforms,
         }
     }
@@ -478,6 +504,9 @@ struct PipelineState {
     cull_back: bool,
     /// `alphaMode` BLEND: src-alpha blending, no depth writes.
     blend: bool,
+    /// The picture of the opaque scene (linear radiance, [`BEHIND_FORMAT`]) rather than the
+    /// display image.
+    linear: bool,
 }
 
 fn mesh_pipeline(
@@ -538,7 +567,11 @@ fn mesh_pipeline(
                 entry_point: Some("mesh_fs"),
                 compilation_options: Default::default(),
                 targets: &[Some(wgpu::ColorTargetState {
-                    format: TARGET_FORMAT,
+                    format: if state.linear {
+                        BEHIND_FORMAT
+                    } else {
+                        TARGET_FORMAT
+                    },
                     blend: state.blend.then_some(wgpu::BlendState::ALPHA_BLENDING),
                     write_mask: wgpu::ColorWrites::ALL,
                 })],
@@ -759,7 +792,15 @@ pub fn render_gltf_from(
     let state_of = |i: usize| PipelineState {
         cull_back: !scene.materials[i].double_sided,
         blend: scene.materials[i].alpha_mode == AlphaMode::Blend,
+        linear: false,
     };
+    // Transmissive materials see the opaque scene: a first pass draws everything else into a
+    // picture of linear radiance (KHR_materials_transmission, as the glTF Sample Viewer does).
+    let transmissive = |i: usize| {
+        let t = scene.materials[i].transmission;
+        t > 0.0 && t.is_finite()
+    };
+    let behind_needed = used.iter().any(|&i| transmissive(i));
     let mut pass_keys: Vec<(Technique, String)> = used.iter().map(|&i| key_of(i)).collect();
     pass_keys.sort_by(|a, b| (a.0.name(), &a.1).cmp(&(b.0.name(), &b.1)));
     pass_keys.dedup();
@@ -777,11 +818,16 @@ pub fn render_gltf_from(
             technique_options.spectral.base = drawn[i].0.base.clone();
         }
         let binding = TechniqueBinding::new(ctx, tables, t, &technique_options, &colorimeter)?;
-        let mut states: Vec<PipelineState> = used
-            .iter()
-            .filter(|&&i| key_of(i) == *key)
-            .map(|&i| state_of(i))
-            .collect();
+        let mut states: Vec<PipelineState> = Vec::new();
+        for &i in used.iter().filter(|&&i| key_of(i) == *key) {
+            states.push(state_of(i));
+            if behind_needed && !transmissive(i) {
+                states.push(PipelineState {
+                    linear: true,
+                    ..state_of(i)
+                });
+            }
+        }
         states.sort_unstable();
         states.dedup();
         for state in states {
@@ -911,68 +957,74 @@ pub fn render_gltf_from(
                 )
             })
             .collect();
-        // Group 3 per used material: its MeshUniform, textures and samplers.
+        // Group 3 per used material: its MeshUniform (with `extra_flags`), textures and
+        // samplers, and the picture of the scene behind.
         let mut samplers: std::collections::BTreeMap<SamplerKey, wgpu::Sampler> =
             Default::default();
-        let mut mesh_groups: Vec<Option<wgpu::BindGroup>> = Vec::new();
         for (i, gm) in scene.materials.iter().enumerate() {
-            if !used.contains(&i) {
-                mesh_groups.push(None);
-                continue;
+            if used.contains(&i) {
+                for slot in slots_of(gm) {
+                    let spec = slot
+                        .and_then(|r| Some((gpu_textures.get(r.texture)?.as_ref()?, r.texture)))
+                        .map_or(SamplerSpec::default(), |(_, k)| scene.textures[k].sampler);
+                    samplers
+                        .entry(SamplerKey::of(spec))
+                        .or_insert_with(|| create_sampler(device, spec));
+                }
             }
-            let uniform = MeshUniform::new(camera.view_proj, gm);
-            let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("mesh material (glTF)"),
-                contents: bytemuck::bytes_of(&uniform),
-                usage: wgpu::BufferUsages::UNIFORM,
-            });
-            let t = &gm.textures;
-            let slots = [
-                t.base_colour,
-                t.metallic_roughness,
-                t.normal,
-                t.occlusion,
-                t.emissive,
-                t.iridescence,
-                t.specular,
-                t.specular_colour,
-            ];
-            let mut views = Vec::with_capacity(slots.len());
-            let mut keys = Vec::with_capacity(slots.len());
-            for slot in slots {
-                let (texture, spec) = match slot
-                    .and_then(|r| Some((gpu_textures.get(r.texture)?.as_ref()?, r.texture)))
-                {
-                    Some((texture, k)) => (texture, scene.textures[k].sampler),
-                    None => (&white, SamplerSpec::default()),
-                };
-                views.push(texture.create_view(&Default::default()));
-                let key = SamplerKey::of(spec);
-                samplers
-                    .entry(key)
-                    .or_insert_with(|| create_sampler(device, spec));
-                keys.push(key);
-            }
-            let mut entries = vec![wgpu::BindGroupEntry {
-                binding: 0,
-                resource: buffer.as_entire_binding(),
-            }];
-            for (k, (view, key)) in views.iter().zip(&keys).enumerate() {
-                entries.push(wgpu::BindGroupEntry {
-                    binding: 1 + 2 * k as u32,
-                    resource: wgpu::BindingResource::TextureView(view),
-                });
-                entries.push(wgpu::BindGroupEntry {
-                    binding: 2 + 2 * k as u32,
-                    resource: wgpu::BindingResource::Sampler(&samplers[key]),
-                });
-            }
-            mesh_groups.push(Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("mesh material (glTF)"),
-                layout: &mesh_layout,
-                entries: &entries,
-            })));
         }
+        let mesh_groups_with = |extra_flags: u32, behind: &wgpu::TextureView| {
+            let mut mesh_groups: Vec<Option<wgpu::BindGroup>> = Vec::new();
+            for (i, gm) in scene.materials.iter().enumerate() {
+                if !used.contains(&i) {
+                    mesh_groups.push(None);
+                    continue;
+                }
+                let mut uniform = MeshUniform::new(camera.view_proj, gm);
+                uniform.flags |= extra_flags;
+                let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("mesh material (glTF)"),
+                    contents: bytemuck::bytes_of(&uniform),
+                    usage: wgpu::BufferUsages::UNIFORM,
+                });
+                let mut views = Vec::with_capacity(TEXTURE_SLOTS.len());
+                let mut keys = Vec::with_capacity(TEXTURE_SLOTS.len());
+                for slot in slots_of(gm) {
+                    let (texture, spec) = match slot
+                        .and_then(|r| Some((gpu_textures.get(r.texture)?.as_ref()?, r.texture)))
+                    {
+                        Some((texture, k)) => (texture, scene.textures[k].sampler),
+                        None => (&white, SamplerSpec::default()),
+                    };
+                    views.push(texture.create_view(&Default::default()));
+                    keys.push(SamplerKey::of(spec));
+                }
+                let mut entries = vec![wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: buffer.as_entire_binding(),
+                }];
+                for (k, (view, key)) in views.iter().zip(&keys).enumerate() {
+                    entries.push(wgpu::BindGroupEntry {
+                        binding: 1 + 2 * k as u32,
+                        resource: wgpu::BindingResource::TextureView(view),
+                    });
+                    entries.push(wgpu::BindGroupEntry {
+                        binding: 2 + 2 * k as u32,
+                        resource: wgpu::BindingResource::Sampler(&samplers[key]),
+                    });
+                }
+                entries.push(wgpu::BindGroupEntry {
+                    binding: BEHIND_BINDING,
+                    resource: wgpu::BindingResource::TextureView(behind),
+                });
+                mesh_groups.push(Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("mesh material (glTF)"),
+                    layout: &mesh_layout,
+                    entries: &entries,
+                })));
+            }
+            mesh_groups
+        };
         let geometry: Vec<(wgpu::Buffer, wgpu::Buffer, u32, usize, f64)> = scene
             .primitives
             .iter()
@@ -1021,21 +1073,66 @@ pub fn render_gltf_from(
         let depth = crate::gpu::render_target(device, "mesh depth", extent, DEPTH_FORMAT, false);
         let target_view = target.create_view(&Default::default());
         let depth_view = depth.create_view(&Default::default());
-        // The background: the environment seen by the fitted camera is not drawn (a clear
-        // colour keeps the spheres' silhouettes readable).
+        // The picture of the opaque scene (cleared to alpha 0: nothing drawn there), or a
+        // 1 × 1 stand-in when no material transmits.
+        let behind = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("mesh scene behind"),
+            size: if behind_needed {
+                size
+            } else {
+                wgpu::Extent3d {
+                    width: 1,
+                    height: 1,
+                    depth_or_array_layers: 1,
+                }
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: BEHIND_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let behind_view = behind.create_view(&Default::default());
+        let no_behind = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("mesh no scene behind"),
+            size: wgpu::Extent3d {
+                width: 1,
+                height: 1,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: BEHIND_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let no_behind_view = no_behind.create_view(&Default::default());
         let mut encoder = device.create_command_encoder(&Default::default());
-        {
+        // The stand-in is cleared once (alpha 0) so that it reads as "nothing behind".
+        drop(encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("mesh no scene behind"),
+            color_attachments: &[crate::gpu::cleared_attachment(
+                &no_behind_view,
+                wgpu::Color::TRANSPARENT,
+            )],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        }));
+        // Draws `order`'s primitives into `colour` (cleared to `clear`; depth cleared), with
+        // group-3 bind groups `groups`; `linear`: the picture of the opaque scene (transmissive
+        // primitives skipped).
+        let draw = |encoder: &mut wgpu::CommandEncoder,
+                    colour: &wgpu::TextureView,
+                    clear: wgpu::Color,
+                    groups: &[Option<wgpu::BindGroup>],
+                    linear: bool| {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("mesh"),
-                color_attachments: &[crate::gpu::cleared_attachment(
-                    &target_view,
-                    wgpu::Color {
-                        r: 0.18,
-                        g: 0.18,
-                        b: 0.2,
-                        a: 1.0,
-                    },
-                )],
+                color_attachments: &[crate::gpu::cleared_attachment(colour, clear)],
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                     view: &depth_view,
                     depth_ops: Some(wgpu::Operations {
@@ -1052,10 +1149,19 @@ pub fn render_gltf_from(
             let mut current: Option<(usize, PipelineState)> = None;
             for &g in &order {
                 let (vb, ib, count, material, _) = &geometry[g];
-                let (Some(mesh_group), k) = (&mesh_groups[*material], pass_of(*material)) else {
+                if linear && transmissive(*material) {
+                    continue;
+                }
+                let (Some(mesh_group), k) = (&groups[*material], pass_of(*material)) else {
                     continue;
                 };
-                let key = (k, state_of(*material));
+                let key = (
+                    k,
+                    PipelineState {
+                        linear,
+                        ..state_of(*material)
+                    },
+                );
                 let Some(pipeline) = pipelines.get(&key) else {
                     continue;
                 };
@@ -1070,7 +1176,36 @@ pub fn render_gltf_from(
                 pass.set_index_buffer(ib.slice(..), wgpu::IndexFormat::Uint32);
                 pass.draw_indexed(0..*count, 0, 0..1);
             }
+        };
+        if behind_needed {
+            let groups = mesh_groups_with(FLAG_LINEAR_OUTPUT, &no_behind_view);
+            draw(
+                &mut encoder,
+                &behind_view,
+                wgpu::Color::TRANSPARENT,
+                &groups,
+                true,
+            );
         }
+        // The background: the environment seen by the camera is not drawn (a clear colour
+        // keeps the spheres' silhouettes readable).
+        let groups = if behind_needed {
+            mesh_groups_with(FLAG_BEHIND, &behind_view)
+        } else {
+            mesh_groups_with(0, &no_behind_view)
+        };
+        draw(
+            &mut encoder,
+            &target_view,
+            wgpu::Color {
+                r: 0.18,
+                g: 0.18,
+                b: 0.2,
+                a: 1.0,
+            },
+            &groups,
+            false,
+        );
         let _ = device.poll(wgpu::PollType::wait_indefinitely());
         let submitted = std::time::Instant::now();
         ctx.queue.submit([encoder.finish()]);
@@ -1147,10 +1282,39 @@ fn mesh_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
         entries.push(crate::gpu::texture_entry(1 + 2 * k));
         entries.push(crate::gpu::sampler_entry(2 + 2 * k));
     }
+    // The scene behind (textureLoad: a float texture that need not be filterable).
+    entries.push(wgpu::BindGroupLayoutEntry {
+        binding: BEHIND_BINDING,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    });
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("mesh material (glTF)"),
         entries: &entries,
     })
+}
+
+/// Group 3's binding of the scene behind transmissive surfaces.
+const BEHIND_BINDING: u32 = 1 + 2 * TEXTURE_SLOTS.len() as u32;
+
+/// A material's textures in group 3's slot order ([`TEXTURE_SLOTS`]).
+fn slots_of(gm: &GltfMaterial) -> [Option<TextureRef>; 8] {
+    let t = &gm.textures;
+    [
+        t.base_colour,
+        t.metallic_roughness,
+        t.normal,
+        t.occlusion,
+        t.emissive,
+        t.iridescence,
+        t.specular,
+        t.specular_colour,
+    ]
 }
 
 /// A sampler's identity (wrap modes and filters).
