@@ -42,9 +42,10 @@
 //! | normal, occlusion, emissive (× `emissiveStrength`) | per fragment (`shaders/mesh.wgsl`) |
 //!
 //! Skins, morph targets, sparse accessors, quantised positions (`KHR_mesh_quantization`),
-//! Draco, `transmissionTexture`, `thicknessTexture`, `KHR_materials_clearcoat`, `_sheen`, `_anisotropy` and
-//! `KHR_lights_punctual` are not read. The default scene's cameras (perspective and
-//! orthographic, placed by their nodes) are read: [`GltfScene::cameras`].
+//! Draco, `transmissionTexture`, `thicknessTexture`, `KHR_materials_clearcoat`, `_sheen` and
+//! `_anisotropy` are not read. The default scene's cameras (perspective and orthographic, placed by their
+//! nodes: [`GltfScene::cameras`]) and `KHR_lights_punctual` lights ([`GltfScene::lights`])
+//! are read; see `mesh.rs` for how the renderer lights the scene with them.
 //!
 //! # Metals from a base colour
 //!
@@ -77,7 +78,8 @@ use std::path::{Path, PathBuf};
 /// The glTF extensions nacre implements: a file whose `extensionsRequired` lists only these
 /// loads (`KHR_materials_transmission` and `_volume` refract the opaque scene in screen
 /// space, as the glTF Sample Viewer does: `shaders/mesh.wgsl`).
-pub const SUPPORTED_EXTENSIONS: [&str; 7] = [
+pub const SUPPORTED_EXTENSIONS: [&str; 8] = [
+    "KHR_lights_punctual",
     "KHR_materials_iridescence",
     "KHR_materials_ior",
     "KHR_materials_specular",
@@ -454,9 +456,45 @@ pub struct GltfScene {
     pub textures: Vec<GltfTexture>,
     /// What the loader could not read (textures it skipped), one line each.
     pub notes: Vec<String>,
+    /// The `KHR_lights_punctual` lights placed by the default scene's nodes, in node index
+    /// order.
+    pub lights: Vec<GltfLight>,
     /// The cameras placed by the default scene's nodes, in node index order (a node used
     /// twice in the tree places its camera twice): `nacre render --camera N`.
     pub cameras: Vec<GltfCamera>,
+}
+
+/// The kind of a `KHR_lights_punctual` light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightKind {
+    /// Infinitely far, shining along the node's −z; intensity in lux.
+    Directional,
+    /// At the node's position, in every direction; intensity in candela.
+    Point,
+    /// At the node's position, a cone about the node's −z; intensity in candela.
+    Spot {
+        /// Inner cone angle, radians.
+        inner_cone_rad: f32,
+        /// Outer cone angle, radians.
+        outer_cone_rad: f32,
+    },
+}
+
+/// A `KHR_lights_punctual` light placed by a node.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GltfLight {
+    /// The light's `name`, or `light K`.
+    pub name: String,
+    /// Directional, point or spot.
+    pub kind: LightKind,
+    /// `color`, linear RGB (default 1).
+    pub colour: [f32; 3],
+    /// `intensity` (default 1): lux for a directional light, candela otherwise.
+    pub intensity: f32,
+    /// The node's world position (unused by a directional light).
+    pub position: [f32; 3],
+    /// Unit direction the light shines along (the node's world −z).
+    pub direction: [f32; 3],
 }
 
 /// How a glTF camera projects (glTF 2.0 §3.10).
@@ -1223,6 +1261,7 @@ impl GltfScene {
             roots.into_iter().map(|n| (n, identity, 0)).collect();
         let mut primitives = Vec::new();
         let mut cameras = Vec::new();
+        let mut lights = Vec::new();
         let mut skipped: std::collections::BTreeMap<String, usize> = Default::default();
         let (mut vertices, mut corners) = (0usize, 0usize);
         while let Some((node, parent, depth)) = stack.pop() {
@@ -1242,6 +1281,9 @@ impl GltfScene {
             }
             if let Some(camera) = node.camera() {
                 cameras.push((node.index(), gltf_camera(path, &camera, world)?));
+            }
+            if let Some(light) = node_light(path, &node, world)? {
+                lights.push((node.index(), light));
             }
             let Some(mesh) = node.mesh() else { continue };
             for prim in mesh.primitives() {
@@ -1442,6 +1484,10 @@ impl GltfScene {
                 cameras.sort_by_key(|(node, _)| *node);
                 cameras.into_iter().map(|(_, c)| c).collect()
             },
+            lights: {
+                lights.sort_by_key(|(node, _)| *node);
+                lights.into_iter().map(|(_, l)| l).collect()
+            },
         })
     }
 
@@ -1457,6 +1503,64 @@ impl GltfScene {
         }
         (lo, hi)
     }
+}
+
+/// The `KHR_lights_punctual` light a node places, checked (finite, non-negative colour and
+/// intensity; cone angles 0 ≤ inner < outer ≤ π/2).
+fn node_light(path: &Path, node: &gltf::Node, world: [[f32; 4]; 4]) -> Result<Option<GltfLight>> {
+    // The document was validated (gltf::Document::from_json): the light index exists.
+    let Some(light) = node.light() else {
+        return Ok(None);
+    };
+    let index = light.index();
+    let bad = |what: String| invalid(path, format!("node {}: {what}", node.index()));
+    let name = light
+        .name()
+        .map_or_else(|| format!("light {index}"), str::to_string);
+    let (colour, intensity) = (light.color(), light.intensity());
+    if !colour
+        .iter()
+        .chain([&intensity])
+        .all(|x| x.is_finite() && *x >= 0.0)
+    {
+        return Err(bad(format!(
+            "light `{name}`: colour {colour:?}, intensity {intensity} (expected finite, ≥ 0)"
+        )));
+    }
+    let kind = match light.kind() {
+        gltf::khr_lights_punctual::Kind::Directional => LightKind::Directional,
+        gltf::khr_lights_punctual::Kind::Point => LightKind::Point,
+        gltf::khr_lights_punctual::Kind::Spot {
+            inner_cone_angle,
+            outer_cone_angle,
+        } => {
+            let ok = inner_cone_angle >= 0.0
+                && inner_cone_angle < outer_cone_angle
+                && outer_cone_angle <= std::f32::consts::FRAC_PI_2;
+            if !ok {
+                return Err(bad(format!(
+                    "light `{name}`: cone angles {inner_cone_angle}, {outer_cone_angle} rad"
+                )));
+            }
+            LightKind::Spot {
+                inner_cone_rad: inner_cone_angle,
+                outer_cone_rad: outer_cone_angle,
+            }
+        }
+    };
+    let z = [world[2][0], world[2][1], world[2][2]];
+    let len = (z[0] * z[0] + z[1] * z[1] + z[2] * z[2]).sqrt();
+    if !(len > 1e-12 && len.is_finite()) {
+        return Err(bad(format!("light `{name}`: its node's z axis is zero")));
+    }
+    Ok(Some(GltfLight {
+        name,
+        kind,
+        colour,
+        intensity,
+        position: [world[3][0], world[3][1], world[3][2]],
+        direction: z.map(|c| -c / len),
+    }))
 }
 
 /// A node's camera, checked: finite positive planes and field of view (§3.10.2–3).

@@ -20,14 +20,14 @@ use crate::context::GpuContext;
 use crate::environment::EnvironmentMap;
 use crate::error::{Error, Result};
 use crate::gltf_scene::{
-    AlphaMode, GltfCamera, GltfMaterial, GltfProjection, GltfScene, GltfTexture,
-    IDENTITY_TRANSFORM, SamplerSpec, TextureRef, Wrap, is_gold_like,
+    AlphaMode, GltfCamera, GltfLight, GltfMaterial, GltfProjection, GltfScene, GltfTexture,
+    IDENTITY_TRANSFORM, LightKind, SamplerSpec, TextureRef, Wrap, is_gold_like,
 };
 use crate::gpu::read_texture;
 use crate::gpu::{group_layout, uniform_texture_group, upload_mips};
 use crate::image_io::RenderedImage;
 use crate::render::{
-    BaseKind, MaterialOptions, MaterialUniform, SceneOptions, TARGET_FORMAT, ViewUniform,
+    BaseKind, Light, MaterialOptions, MaterialUniform, SceneOptions, TARGET_FORMAT, ViewUniform,
     check_film_lut,
 };
 use crate::shaders::{self, Technique};
@@ -644,6 +644,83 @@ pub fn render_gltf(
     render_gltf_from(ctx, tables, technique, scene, options, ViewPoint::default())
 }
 
+/// The light the mesh renderer draws `scene` with, and a note when it is not all of the
+/// file's lighting. As the glTF Sample Viewer does by default, a file without
+/// `KHR_lights_punctual` lights is lit by the environment alone (the light's intensity is 0).
+/// With lights, the renderer's one light is the file's brightest at the centre of the scene's
+/// bounds: a directional light as it is (intensity in lux as irradiance), a point or spot
+/// light as a directional light from its position towards the centre with the irradiance it
+/// gives there (candela / distance², the spot's smooth cone falloff of the
+/// KHR_lights_punctual specification applied).
+pub fn scene_light(scene: &GltfScene) -> (Light, Option<String>) {
+    let (lo, hi) = scene.bounds();
+    let centre: [f32; 3] = std::array::from_fn(|k| 0.5 * (lo[k] + hi[k]));
+    let mut best: Option<(f32, Light, &GltfLight)> = None;
+    for light in &scene.lights {
+        let (towards, irradiance) = match light.kind {
+            LightKind::Directional => (light.direction.map(|c| -c), light.intensity),
+            LightKind::Point | LightKind::Spot { .. } => {
+                let d: [f32; 3] = std::array::from_fn(|k| light.position[k] - centre[k]);
+                let r2 = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).max(1e-12);
+                let r = r2.sqrt();
+                let towards = d.map(|c| c / r);
+                let cone = match light.kind {
+                    LightKind::Spot {
+                        inner_cone_rad,
+                        outer_cone_rad,
+                    } => {
+                        let cos_angle =
+                            -(0..3).map(|k| towards[k] * light.direction[k]).sum::<f32>();
+                        let (cos_outer, cos_inner) = (outer_cone_rad.cos(), inner_cone_rad.cos());
+                        let t = ((cos_angle - cos_outer) / (cos_inner - cos_outer).max(1e-6))
+                            .clamp(0.0, 1.0);
+                        t * t * (3.0 - 2.0 * t)
+                    }
+                    _ => 1.0,
+                };
+                (towards, light.intensity * cone / r2)
+            }
+        };
+        let brightness = irradiance * light.colour.iter().sum::<f32>();
+        if best.as_ref().is_none_or(|(b, _, _)| brightness > *b) && brightness.is_finite() {
+            best = Some((
+                brightness,
+                Light {
+                    direction: towards,
+                    colour: light.colour,
+                    intensity: irradiance,
+                },
+                light,
+            ));
+        }
+    }
+    let off = Light {
+        intensity: 0.0,
+        ..Light::default()
+    };
+    match best {
+        None => (off, None),
+        Some((_, light, source)) => {
+            let many = scene.lights.len() > 1;
+            let positional = source.kind != LightKind::Directional;
+            let note = (many || positional).then(|| {
+                let mut n = format!("KHR_lights_punctual: drawn with one directional light, `{}`", source.name);
+                if many {
+                    n += &format!(
+                        " (the brightest at the scene's centre of {} lights; the others are not drawn)",
+                        scene.lights.len()
+                    );
+                }
+                if positional {
+                    n += ", from its position towards the scene's centre with the irradiance it gives there";
+                }
+                n
+            });
+            (light, note)
+        }
+    }
+}
+
 /// The camera of `view` for `scene` and an image of aspect `aspect` (width / height): checks
 /// the orbit's angles and distance, or that the file has the camera asked for.
 pub fn view_camera(scene: &GltfScene, view: ViewPoint, aspect: f64) -> Result<FittedCamera> {
@@ -697,6 +774,8 @@ pub fn render_gltf_from(
     view_options.camera.target = camera.target;
     view_options.camera.up = camera.up;
     view_options.camera.fov_y_deg = camera.fov_y_deg;
+    let (light, light_note) = scene_light(scene);
+    view_options.light = light;
 
     // Materials: nacre's options and the technique that draws each.
     let colorimeter = tables.colorimeter()?;
@@ -765,6 +844,9 @@ pub fn render_gltf_from(
                 .map_or(1.0, |l| l.axes.ambient_index as f32);
         }
         drawn.push((m, t));
+    }
+    if let Some(note) = light_note {
+        notes.push(Msg::from(note));
     }
     if let Some((name, why)) = fallbacks.first() {
         notes.push(msg![

@@ -419,3 +419,96 @@ fn bad_gltf_files_are_errors() {
     o.width = 100_000;
     assert!(render_gltf(ctx(), &tables(), Technique::Fourier, &scene, &o).is_err());
 }
+
+/// The file's cameras and KHR_lights_punctual lights are read with their nodes' transforms;
+/// `--camera N` past the last is refused naming the count; the renderer's one light is the
+/// brightest at the scene's centre, and a file without lights is lit by the environment alone.
+#[test]
+fn cameras_and_lights_come_from_the_file() {
+    use nacre_runtime::gltf_scene::{GltfProjection, LightKind};
+    use nacre_runtime::mesh::{ViewPoint, scene_light, view_camera};
+    let dir = tempfile::tempdir().unwrap();
+    let good = sweep_glb(&SWEEPS[0]);
+    let json_len = u32::from_le_bytes(good[12..16].try_into().unwrap()) as usize;
+    let mut doc: serde_json::Value = serde_json::from_slice(&good[20..20 + json_len]).unwrap();
+    let bin = good[20 + json_len + 8..].to_vec();
+    let plain = GltfScene::from_bytes(&good, &dir.path().join("plain.glb")).unwrap();
+    assert!(plain.cameras.is_empty() && plain.lights.is_empty());
+    let (light, note) = scene_light(&plain);
+    assert_eq!(
+        light.intensity, 0.0,
+        "no lights in the file: environment only"
+    );
+    assert!(note.is_none());
+    let e = view_camera(&plain, ViewPoint::File(0), 1.0).unwrap_err();
+    assert!(
+        e.to_string().contains("camera = 0") || e.to_string().contains("0 camera"),
+        "{e}"
+    );
+
+    doc["cameras"] = serde_json::json!([
+        { "type": "perspective", "perspective": { "yfov": 0.5, "znear": 0.05 } },
+        { "type": "orthographic", "orthographic": { "xmag": 2.0, "ymag": 1.0, "znear": 0.0, "zfar": 100.0 } }
+    ]);
+    doc["extensionsUsed"] = serde_json::json!(["KHR_lights_punctual"]);
+    doc["extensions"] = serde_json::json!({ "KHR_lights_punctual": { "lights": [
+        { "type": "directional", "color": [1.0, 0.9, 0.8], "intensity": 2.0, "name": "sun" },
+        { "type": "point", "intensity": 5000.0, "name": "bulb" }
+    ]}});
+    let nodes = doc["nodes"].as_array_mut().unwrap();
+    let first = nodes.len();
+    // A camera 4 units along +z looking at the origin; a sun shining straight down (its −z
+    // turned to −y); a bright bulb 10 units above.
+    nodes.push(serde_json::json!({ "camera": 0, "translation": [0.0, 0.0, 4.0] }));
+    nodes.push(serde_json::json!({ "camera": 1, "translation": [0.0, 0.0, 9.0] }));
+    nodes.push(serde_json::json!({
+        "rotation": [-0.70710678, 0.0, 0.0, 0.70710678],
+        "extensions": { "KHR_lights_punctual": { "light": 0 } }
+    }));
+    nodes.push(serde_json::json!({
+        "translation": [0.0, 10.0, 0.0],
+        "extensions": { "KHR_lights_punctual": { "light": 1 } }
+    }));
+    let scene_nodes = doc["scenes"][0]["nodes"].as_array_mut().unwrap();
+    for k in first..first + 4 {
+        scene_nodes.push(k.into());
+    }
+    let bytes = nacre_runtime::gltf_assets::glb(&doc, &bin);
+    let scene = GltfScene::from_bytes(&bytes, &dir.path().join("lit.glb")).unwrap();
+    assert_eq!(scene.cameras.len(), 2);
+    assert!(matches!(
+        scene.cameras[0].projection,
+        GltfProjection::Perspective { zfar: None, .. }
+    ));
+    assert!(matches!(
+        scene.cameras[1].projection,
+        GltfProjection::Orthographic { .. }
+    ));
+    let cam = view_camera(&scene, ViewPoint::File(0), 2.0).unwrap();
+    assert_eq!(cam.eye, [0.0, 0.0, 4.0]);
+    assert!((cam.fov_y_deg - 0.5f32.to_degrees()).abs() < 1e-3);
+    assert!(view_camera(&scene, ViewPoint::File(1), 2.0).is_ok());
+    let e = view_camera(&scene, ViewPoint::File(2), 2.0).unwrap_err();
+    assert!(e.to_string().contains("2 camera(s)"), "{e}");
+
+    assert_eq!(scene.lights.len(), 2);
+    let sun = &scene.lights[0];
+    assert_eq!(sun.kind, LightKind::Directional);
+    assert!((sun.direction[1] + 1.0).abs() < 1e-6, "{:?}", sun.direction);
+    // The bulb gives 5000 cd / (10 − centre)² ≈ 50 at the centre: brighter than the sun.
+    let (light, note) = scene_light(&scene);
+    assert!(light.intensity > 30.0, "{light:?}");
+    assert!(
+        light.direction[1] > 0.99,
+        "towards the bulb above: {light:?}"
+    );
+    let note = note.expect("two lights, one drawn");
+    assert!(
+        note.contains("`bulb`") && note.contains("2 lights"),
+        "{note}"
+    );
+    // A dangling light index is an error, not a panic.
+    doc["nodes"][first + 3]["extensions"]["KHR_lights_punctual"]["light"] = 7.into();
+    let bytes = nacre_runtime::gltf_assets::glb(&doc, &bin);
+    assert!(GltfScene::from_bytes(&bytes, &dir.path().join("dangling.glb")).is_err());
+}

@@ -147,11 +147,13 @@ fn suzanne_glb_requires_iridescence_and_renders_like_the_gltf() {
 fn the_films_colour_their_regions_of_the_artist_made_assets() {
     let Some(dir) = samples() else { return };
     let tables = tables();
-    for (name, min_chroma) in [
-        // Measured on lavapipe: 33.3 / 13.4 / 25.7 with the film, 13.9 / 5.9 / 20.9 without.
-        ("IridescenceLamp", 20.0),
-        ("IridescentDishWithOlives", 9.0),
-        ("IridescenceAbalone", 18.0),
+    // (asset, least chroma with the film, least gain over the same without it). Measured on
+    // lavapipe, lit by the default environment alone: 33.0 / 13.0 / 12.0 with the film,
+    // 13.8 / 5.6 / 9.4 without (the Abalone's textures are coloured already).
+    for (name, min_chroma, min_gain) in [
+        ("IridescenceLamp", 20.0, 10.0),
+        ("IridescentDishWithOlives", 9.0, 4.0),
+        ("IridescenceAbalone", 10.5, 1.5),
     ] {
         let path = dir.join(name).join("glTF").join(format!("{name}.gltf"));
         let mut scene = GltfScene::load(&path).unwrap();
@@ -178,7 +180,7 @@ fn the_films_colour_their_regions_of_the_artist_made_assets() {
         let (a, b) = (colourfulness(&with.image), colourfulness(&without.image));
         eprintln!("{name}: film region chroma {a:.1} with the film, {b:.1} without");
         assert!(
-            a >= min_chroma && a >= b + 3.0,
+            a >= min_chroma && a >= b + min_gain,
             "{name}: the film region's chroma is {a:.1} (without the film {b:.1})"
         );
     }
