@@ -155,9 +155,11 @@ The recipe format is documented in the README (\"Table recipes\").";
 const COLOR_EXAMPLES: &str = "\
 Methods: spectral (exact reference), lut:NAME|PATH (a baked film-lut, default-set name or
 manifest path), rgb3 (650/510/475 nm), samples:N (N wavelengths over 400-700 nm),
-fourier:M | fourier:auto [:SIGMA_NM] (Belcour & Barla 2017 Eq. 10 with exact Fresnel, the
-baked fourier table sampled as a GPU would, optional prefiltering for a thickness standard
-deviation), fourier-exact:… (the same with exact transforms), gaussian (the glTF
+fourier | fourier:M | fourier:auto [:SIGMA_NM] (Belcour & Barla 2017 Eq. 10 with exact
+Fresnel, the baked fourier table sampled as a GPU would, optional prefiltering for a
+thickness standard deviation; fourier alone is fourier:auto, the GPU's default: per point
+as many harmonics as ΔE2000 p95 <= 0.1 needs), fourier-exact… (the same with exact
+transforms), gaussian (the glTF
 KHR_materials_iridescence Gaussian-fit approximation), rough-lut:NAME|PATH with --roughness
 ALPHA (the directional albedo of the rough GGX film lobe from a baked rough-film-lut table),
 rough-mc[:N] with --roughness ALPHA (its Monte Carlo reference, N samples per point,
@@ -358,7 +360,8 @@ struct RenderArgs {
     /// Exposure in EV stops (radiance × 2^EV before tone mapping).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     exposure: f32,
-    /// Harmonics M of the fourier technique (0 = automatic) [default: 3].
+    /// Harmonics M of the fourier technique (0 = automatic: per pixel, as many as the
+    /// series needs, as `nacre color --method fourier`) [default: 0].
     #[arg(long, value_name = "M")]
     harmonics: Option<u32>,
     /// Wavelengths N of the spectral technique (1 to 4096) [default: 30]; with --technique
