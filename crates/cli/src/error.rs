@@ -55,6 +55,8 @@ pub fn flag(param: Param) -> &'static str {
         Param::DiffractionStep => "--diffraction-step",
         Param::EnvSamples => "--env-samples",
         Param::ReferenceSamples => "--reference-samples",
+        Param::BenchFilmIor => "--film-ior",
+        Param::BenchBaseIor => "--base-ior",
     }
 }
 
