@@ -333,8 +333,8 @@ fn film_colour(raw: FilmInput) -> FilmOutput {
         rho_p.re[j] = rp.rho.x;
         rho_p.im[j] = rp.rho.y;
     }
-    let auto = p.harmonics == 0u;
-    let m_max = select(min(p.harmonics, FOURIER_MAX_HARMONICS), FOURIER_MAX_HARMONICS, auto);
+    let automatic = p.harmonics == 0u;
+    let m_max = select(min(p.harmonics, FOURIER_MAX_HARMONICS), FOURIER_MAX_HARMONICS, automatic);
     let tolerance_r = airy_auto_tolerance(c0_r);
     let tolerance_t = airy_auto_tolerance(c0_t);
 
@@ -363,7 +363,7 @@ fn film_colour(raw: FilmInput) -> FilmOutput {
         if !done_t {
             sum_t += crgb_re_mul_conj(cm_ts, s_hat) + crgb_re_mul_conj(cm_tp, s_hat);
         }
-        if auto {
+        if automatic {
             let s_abs = sqrt(s_hat.re * s_hat.re + s_hat.im * s_hat.im);
             let s_max = max(s_abs.x, max(s_abs.y, s_abs.z));
             done_r = done_r || (airy_tail_converged(cm_rs, rho_s, s_max, tolerance_r)
