@@ -295,8 +295,8 @@ Examples:
   nacre render -o sphere.png
   # a soap bubble, brute-force spectral with 40 wavelengths
   nacre render --scene bubble --technique spectral --wavelengths 40 -o bubble.png
-  # the oil slick, Fourier with automatic harmonics, half a stop darker
-  nacre render --scene plane --technique fourier --harmonics 0 --exposure -0.5 -o plane.png
+  # the oil slick, Fourier with a fixed 3 harmonics (the default: automatic), half a stop darker
+  nacre render --scene plane --technique fourier --harmonics 3 --exposure -0.5 -o plane.png
   # a film on gold, your own environment and thickness map
   nacre render --tables film-gold --tables fourier-srgb --env sky.exr --thickness-map swirl.png -o gold.png
   # a rough film lit the engines' way (film at n·v) and exactly (film per light, rough-film-lut)
