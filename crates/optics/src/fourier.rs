@@ -299,7 +299,8 @@ pub struct FilmOnBase {
 pub struct FourierColour {
     /// Output-space colour.
     pub colour: [f64; 3],
-    /// Harmonics summed (largest over channels and polarisations).
+    /// Harmonics summed (for [`Harmonics::Auto`], until every channel and polarisation met
+    /// the stopping rule).
     pub harmonics: usize,
 }
 
@@ -365,7 +366,8 @@ impl FilmOnBase {
     /// the film vanishes, n₂' = n₁ + (n₂ − n₁) smoothstep(0, 30 nm, d) (Belcour & Barla §4:
     /// "we force η₂ → 1 when d → 0"): a truncated series cannot reproduce the bare base at
     /// d = 0, while with n₂' = n₁ the film term vanishes and the result is exact there.
-    /// [`Harmonics::Auto`] converges and needs no blend.
+    /// [`Harmonics::Auto`] sums until the remaining terms are below its tolerance (at d = 0
+    /// too) and needs no blend.
     /// Returns None for an evanescent film (use the spectral reference there).
     pub fn fourier_colour(
         &self,
