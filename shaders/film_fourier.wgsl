@@ -25,7 +25,7 @@
 //   ν̄_j                  carrier_nu_per_nm    channel centroid frequency, 1/nm
 //   ‖s_j‖                white                colour of a perfect reflector
 //   σ_d                  sigma_thickness_nm   std. dev. of d in the pixel, nm
-//   M                    harmonics            number of harmonics (0 = auto)
+//   M                    harmonics            number of harmonics (0 = auto, the default)
 //
 // Eq. 10 in closed form (fourier.rs module docs), per polarisation, then averaged:
 //
@@ -47,10 +47,11 @@
 // Details that follow the CPU exactly:
 //   * fixed M: the film index is blended to the ambient's as the film vanishes,
 //     n₂' = n₁ + (n₂ − n₁) smoothstep(0, 30 nm, d) (Belcour & Barla §4); auto M: no blend;
-//   * auto M: per series the smallest m with 2|K|/(1 − |ρ|) |ρ|^m ≤ 1e-5 (closed form of
-//     `AirySeries::auto_harmonics`), the largest over channels and polarisations, at least 1,
-//     at most FOURIER_MAX_HARMONICS (the CPU allows 512); reflectance and transmittance
-//     count their harmonics separately, as the CPU's two calls do;
+//   * auto M (harmonics = 0, the default): after each harmonic m, stop once for every channel
+//     j and polarisation 2|c_{m+1}|/(1 − |ρ|) · max_j |Ŝ_j(m D)| ≤ ε max(c̄₀,j, 0.01)^(2/3),
+//     ε = 1e-3 and c̄₀,j the s/p average of c₀ (fourier.rs module docs, "How many
+//     harmonics"), at most FOURIER_MAX_HARMONICS (the CPU's MAX_AUTO_HARMONICS);
+//     reflectance and transmittance stop separately, as the CPU's two calls do;
 //   * prefiltering (§5): harmonic m sees σ_μ = m τ σ_d;
 //   * total internal reflection at the base and conductor bases need nothing special: the
 //     complex normal components carry them.
@@ -70,8 +71,10 @@
 
 // Largest number of harmonics summed, auto or fixed.
 const FOURIER_MAX_HARMONICS: u32 = 128u;
-// Tail bound at which auto harmonics stop (reflectance units; fourier.rs AUTO_TAIL_TOLERANCE).
-const FOURIER_AUTO_TAIL_TOLERANCE: f32 = 1e-5;
+// Tolerance ε of the auto stopping rule at a mean level of 1 (fourier.rs AUTO_TOLERANCE).
+const FOURIER_AUTO_TOLERANCE: f32 = 1e-3;
+// Lowest mean level the auto tolerance is scaled to (fourier.rs AUTO_LEVEL_FLOOR).
+const FOURIER_AUTO_LEVEL_FLOOR: f32 = 0.01;
 // Thickness over which fixed-harmonic evaluation blends the film index, nm
 // (fourier.rs THIN_FILM_BLEND_NM).
 const FOURIER_THIN_FILM_BLEND_NM: f32 = 30.0;
@@ -153,24 +156,20 @@ fn airy_series_transmittance(t12: vec2<f32>, t23: vec2<f32>, factor: f32, rho: v
     return AirySeries(a, a * rho, rho);
 }
 
-// Harmonics for a tail bound 2|K|/(1 − |ρ|) |ρ|^m ≤ FOURIER_AUTO_TAIL_TOLERANCE.
-fn airy_auto_harmonics(s: AirySeries) -> u32 {
-    let r = c_abs(s.rho);
-    if r < 1e-30 {
-        return 1u;
-    }
-    let tail = 2.0 * c_abs(s.k) / max(1.0 - r, 1e-12);
-    if !(tail > FOURIER_AUTO_TAIL_TOLERANCE) {
-        return 1u;
-    }
-    if r >= 1.0 {
-        return FOURIER_MAX_HARMONICS;
-    }
-    let m = ceil(log(FOURIER_AUTO_TAIL_TOLERANCE / tail) / log(r));
-    if !f32_is_finite(m) {
-        return FOURIER_MAX_HARMONICS;
-    }
-    return clamp(u32(clamp(m, 1.0, f32(FOURIER_MAX_HARMONICS))), 1u, FOURIER_MAX_HARMONICS);
+// The auto tolerance of a channel whose mean level is `level`: ε max(level, floor)^(2/3)
+// (fourier.rs `auto_tolerance`).
+fn airy_auto_tolerance(level: vec3<f32>) -> vec3<f32> {
+    return FOURIER_AUTO_TOLERANCE * pow(max(level, vec3<f32>(FOURIER_AUTO_LEVEL_FLOOR)), vec3<f32>(2.0 / 3.0));
+}
+
+// Whether the terms after harmonic m are negligible for one polarisation: per channel
+// 2|c_{m+1}|/(1 − |ρ|) · s_max ≤ tolerance, with c_m the m-th coefficient, s_max = max_j |Ŝ_j(m D)|
+// (fourier.rs `AirySeries::tail_after`).
+fn airy_tail_converged(cm: ComplexRgb, rho: ComplexRgb, s_max: f32, tolerance: vec3<f32>) -> bool {
+    let r = sqrt(rho.re * rho.re + rho.im * rho.im);
+    let cm_abs = sqrt(cm.re * cm.re + cm.im * cm.im);
+    let tail = 2.0 * cm_abs * r / max(1.0 - r, vec3<f32>(1e-12)) * s_max;
+    return all(tail <= tolerance);
 }
 
 // The fractional mip level for a prefilter width σ_μ, nm (`FourierAxes::lod`).
@@ -298,8 +297,6 @@ fn film_colour(raw: FilmInput) -> FilmOutput {
     var k_tp = k_rs;
     var rho_s = k_rs;
     var rho_p = k_rs;
-    var m_r = 1u;
-    var m_t = 1u;
     // A base whose index is the same in every channel (any non-dispersive base) needs its
     // Fresnel terms once, not three times.
     var rs: AirySeries;
@@ -335,24 +332,21 @@ fn film_colour(raw: FilmInput) -> FilmOutput {
         rho_s.im[j] = rs.rho.y;
         rho_p.re[j] = rp.rho.x;
         rho_p.im[j] = rp.rho.y;
-        if p.harmonics == 0u {
-            m_r = max(m_r, max(airy_auto_harmonics(rs), airy_auto_harmonics(rp)));
-            m_t = max(m_t, max(airy_auto_harmonics(ts), airy_auto_harmonics(tp)));
-        }
     }
-    if p.harmonics != 0u {
-        m_r = min(p.harmonics, FOURIER_MAX_HARMONICS);
-        m_t = m_r;
-    }
+    let automatic = p.harmonics == 0u;
+    let m_max = select(min(p.harmonics, FOURIER_MAX_HARMONICS), FOURIER_MAX_HARMONICS, automatic);
+    let tolerance_r = airy_auto_tolerance(c0_r);
+    let tolerance_t = airy_auto_tolerance(c0_t);
 
-    // Eq. 10: c_m = ρ^{m−1} K, summed against Ŝ_j(m D, m τ σ_d).
-    let m_max = max(m_r, m_t);
+    // Eq. 10: c_m = ρ^{m−1} K, summed against Ŝ_j(m D, m τ σ_d); auto stops R and T apart.
     var cm_rs = k_rs;
     var cm_rp = k_rp;
     var cm_ts = k_ts;
     var cm_tp = k_tp;
     var sum_r = vec3<f32>(0.0);
     var sum_t = vec3<f32>(0.0);
+    var done_r = false;
+    var done_t = false;
     for (var m = 1u; m <= m_max; m++) {
         if m > 1u {
             cm_rs = crgb_mul(cm_rs, rho_s);
@@ -363,11 +357,22 @@ fn film_colour(raw: FilmInput) -> FilmOutput {
         let mf = f32(m);
         let s_hat = fourier_sample(mf * opd, mf * tau * sigma_d);
         // 2 Re(…) averaged over the two polarisations.
-        if m <= m_r {
+        if !done_r {
             sum_r += crgb_re_mul_conj(cm_rs, s_hat) + crgb_re_mul_conj(cm_rp, s_hat);
         }
-        if m <= m_t {
+        if !done_t {
             sum_t += crgb_re_mul_conj(cm_ts, s_hat) + crgb_re_mul_conj(cm_tp, s_hat);
+        }
+        if automatic {
+            let s_abs = sqrt(s_hat.re * s_hat.re + s_hat.im * s_hat.im);
+            let s_max = max(s_abs.x, max(s_abs.y, s_abs.z));
+            done_r = done_r || (airy_tail_converged(cm_rs, rho_s, s_max, tolerance_r)
+                && airy_tail_converged(cm_rp, rho_p, s_max, tolerance_r));
+            done_t = done_t || (airy_tail_converged(cm_ts, rho_s, s_max, tolerance_t)
+                && airy_tail_converged(cm_tp, rho_p, s_max, tolerance_t));
+            if done_r && done_t {
+                break;
+            }
         }
     }
     var out: FilmOutput;

@@ -81,6 +81,7 @@ COLOR_CASES: Dict[str, Tuple[Dict[str, Any], str, Dict[str, Any], bool]] = {
     "color-stack": (_stack("air", [("tio2", 60.0), ("au", 10.0), ("mgf2", 99.75)], "bk7"), "stack", {}, False),
     "color-stack-n": (GLTF_BASE, "stack:24", {}, True),
     "color-fourier": (GLTF_BASE, "fourier:3", {}, True),
+    "color-fourier-default": (GLTF_BASE, "fourier", {}, True),
     "color-fourier-auto-sigma": (GLTF_BASE, "fourier:auto:20", {}, True),
     "color-fourier-exact": (_stack(1.0, [(1.5, 300.0)], "au"), "fourier-exact:auto", {}, True),
     "color-gaussian": (GLTF_BASE, "gaussian", {}, True),

@@ -597,7 +597,7 @@ NacreFilmOutput nacre_film_lut_colour(NACRE_TEXTURE_3D(reflectance), NACRE_TEXTU
 //   ν̄_j                  carrier_nu_per_nm    channel centroid frequency, 1/nm
 //   ‖s_j‖                white                colour of a perfect reflector
 //   σ_d                  sigma_thickness_nm   std. dev. of d in the pixel, nm
-//   M                    harmonics            number of harmonics (0 = auto)
+//   M                    harmonics            number of harmonics (0 = auto, the default)
 //
 // Eq. 10 in closed form (fourier.rs module docs), per polarisation, then averaged:
 //
@@ -619,10 +619,11 @@ NacreFilmOutput nacre_film_lut_colour(NACRE_TEXTURE_3D(reflectance), NACRE_TEXTU
 // Details that follow the CPU exactly:
 //   * fixed M: the film index is blended to the ambient's as the film vanishes,
 //     n₂' = n₁ + (n₂ − n₁) smoothstep(0, 30 nm, d) (Belcour & Barla §4); auto M: no blend;
-//   * auto M: per series the smallest m with 2|K|/(1 − |ρ|) |ρ|^m ≤ 1e-5 (closed form of
-//     `AirySeries::auto_harmonics`), the largest over channels and polarisations, at least 1,
-//     at most FOURIER_MAX_HARMONICS (the CPU allows 512); reflectance and transmittance
-//     count their harmonics separately, as the CPU's two calls do;
+//   * auto M (harmonics = 0, the default): after each harmonic m, stop once for every channel
+//     j and polarisation 2|c_{m+1}|/(1 − |ρ|) · max_j |Ŝ_j(m D)| ≤ ε max(c̄₀,j, 0.01)^(2/3),
+//     ε = 1e-3 and c̄₀,j the s/p average of c₀ (fourier.rs module docs, "How many
+//     harmonics"), at most FOURIER_MAX_HARMONICS (the CPU's MAX_AUTO_HARMONICS);
+//     reflectance and transmittance stop separately, as the CPU's two calls do;
 //   * prefiltering (§5): harmonic m sees σ_μ = m τ σ_d;
 //   * total internal reflection at the base and conductor bases need nothing special: the
 //     complex normal components carry them.
@@ -642,8 +643,10 @@ NacreFilmOutput nacre_film_lut_colour(NACRE_TEXTURE_3D(reflectance), NACRE_TEXTU
 
 // Largest number of harmonics summed, auto or fixed.
 const uint NACRE_FOURIER_MAX_HARMONICS = 128u;
-// Tail bound at which auto harmonics stop (reflectance units; fourier.rs AUTO_TAIL_TOLERANCE).
-const float NACRE_FOURIER_AUTO_TAIL_TOLERANCE = 1e-5;
+// Tolerance ε of the auto stopping rule at a mean level of 1 (fourier.rs AUTO_TOLERANCE).
+const float NACRE_FOURIER_AUTO_TOLERANCE = 1e-3;
+// Lowest mean level the auto tolerance is scaled to (fourier.rs AUTO_LEVEL_FLOOR).
+const float NACRE_FOURIER_AUTO_LEVEL_FLOOR = 0.01;
 // Thickness over which fixed-harmonic evaluation blends the film index, nm
 // (fourier.rs THIN_FILM_BLEND_NM).
 const float NACRE_FOURIER_THIN_FILM_BLEND_NM = 30.0;
@@ -651,9 +654,9 @@ const float NACRE_FOURIER_THIN_FILM_BLEND_NM = 30.0;
 const float NACRE_FOURIER_MIN_ONE_MINUS_RHO2 = 1e-6;
 // Variance of a unit-width box footprint (fourier_sigma_from_derivatives).
 const float NACRE_FOURIER_BOX_VARIANCE = 0.0833333333333333;
-// The runtime's default number of harmonics (`TechniqueOptions::harmonics` = 3, as
-// `nacre color --method fourier:3`); 0 selects the automatic count.
-const uint NACRE_FOURIER_DEFAULT_HARMONICS = 3u;
+// The runtime's default number of harmonics (`TechniqueOptions::harmonics` = 0, as
+// `nacre color --method fourier`): 0 selects the automatic count, per pixel.
+const uint NACRE_FOURIER_DEFAULT_HARMONICS = 0u;
 
 // Mirror of `FourierAxes` and the harmonic count (48 bytes in an std140 block).
 struct NacreFourierParams {
@@ -737,24 +740,20 @@ NacreAirySeries nacre_airy_series_transmittance(vec2 t12, vec2 t23, float factor
     return s;
 }
 
-// Harmonics for a tail bound 2|K|/(1 − |ρ|) |ρ|^m ≤ FOURIER_AUTO_TAIL_TOLERANCE.
-uint nacre_airy_auto_harmonics(NacreAirySeries s) {
-    float r = nacre_c_abs(s.rho);
-    if (r < 1e-30) {
-        return 1u;
-    }
-    float tail = 2.0 * nacre_c_abs(s.k) / max(1.0 - r, 1e-12);
-    if (!(tail > NACRE_FOURIER_AUTO_TAIL_TOLERANCE)) {
-        return 1u;
-    }
-    if (r >= 1.0) {
-        return NACRE_FOURIER_MAX_HARMONICS;
-    }
-    float m = ceil(log(NACRE_FOURIER_AUTO_TAIL_TOLERANCE / tail) / log(r));
-    if (!nacre_f32_is_finite(m)) {
-        return NACRE_FOURIER_MAX_HARMONICS;
-    }
-    return clamp(uint(clamp(m, 1.0, float(NACRE_FOURIER_MAX_HARMONICS))), 1u, NACRE_FOURIER_MAX_HARMONICS);
+// The auto tolerance of a channel whose mean level is `level`: ε max(level, floor)^(2/3)
+// (fourier.rs `auto_tolerance`).
+vec3 nacre_airy_auto_tolerance(vec3 level) {
+    return NACRE_FOURIER_AUTO_TOLERANCE * pow(max(level, vec3(NACRE_FOURIER_AUTO_LEVEL_FLOOR, NACRE_FOURIER_AUTO_LEVEL_FLOOR, NACRE_FOURIER_AUTO_LEVEL_FLOOR)), vec3(2.0 / 3.0, 2.0 / 3.0, 2.0 / 3.0));
+}
+
+// Whether the terms after harmonic m are negligible for one polarisation: per channel
+// 2|c_{m+1}|/(1 − |ρ|) · s_max ≤ tolerance, with c_m the m-th coefficient, s_max = max_j |Ŝ_j(m D)|
+// (fourier.rs `AirySeries::tail_after`).
+bool nacre_airy_tail_converged(NacreComplexRgb cm, NacreComplexRgb rho, float s_max, vec3 tolerance) {
+    vec3 r = sqrt(rho.re * rho.re + rho.im * rho.im);
+    vec3 cm_abs = sqrt(cm.re * cm.re + cm.im * cm.im);
+    vec3 tail = 2.0 * cm_abs * r / max(1.0 - r, vec3(1e-12, 1e-12, 1e-12)) * s_max;
+    return all(lessThanEqual(tail, tolerance));
 }
 
 // The fractional mip level for a prefilter width σ_μ, nm (`FourierAxes::lod`).
@@ -886,8 +885,6 @@ NacreFilmOutput nacre_film_fourier_colour(NACRE_TEXTURE_2D_ARRAY(table), NacreFo
     NacreComplexRgb k_tp = k_rs;
     NacreComplexRgb rho_s = k_rs;
     NacreComplexRgb rho_p = k_rs;
-    uint m_r = 1u;
-    uint m_t = 1u;
     NacreAirySeries rs;
     NacreAirySeries rp;
     NacreAirySeries ts;
@@ -921,23 +918,20 @@ NacreFilmOutput nacre_film_fourier_colour(NACRE_TEXTURE_2D_ARRAY(table), NacreFo
         rho_s.im[j] = rs.rho.y;
         rho_p.re[j] = rp.rho.x;
         rho_p.im[j] = rp.rho.y;
-        if (p.harmonics == 0u) {
-            m_r = max(m_r, max(nacre_airy_auto_harmonics(rs), nacre_airy_auto_harmonics(rp)));
-            m_t = max(m_t, max(nacre_airy_auto_harmonics(ts), nacre_airy_auto_harmonics(tp)));
-        }
     }
-    if (p.harmonics != 0u) {
-        m_r = min(p.harmonics, NACRE_FOURIER_MAX_HARMONICS);
-        m_t = m_r;
-    }
+    bool automatic = p.harmonics == 0u;
+    uint m_max = automatic ? NACRE_FOURIER_MAX_HARMONICS : min(p.harmonics, NACRE_FOURIER_MAX_HARMONICS);
+    vec3 tolerance_r = nacre_airy_auto_tolerance(c0_r);
+    vec3 tolerance_t = nacre_airy_auto_tolerance(c0_t);
 
-    uint m_max = max(m_r, m_t);
     NacreComplexRgb cm_rs = k_rs;
     NacreComplexRgb cm_rp = k_rp;
     NacreComplexRgb cm_ts = k_ts;
     NacreComplexRgb cm_tp = k_tp;
-    vec3 sum_r = vec3(0.0);
-    vec3 sum_t = vec3(0.0);
+    vec3 sum_r = vec3(0.0, 0.0, 0.0);
+    vec3 sum_t = vec3(0.0, 0.0, 0.0);
+    bool done_r = false;
+    bool done_t = false;
     for (uint m = 1u; m <= m_max; m++) {
         if (m > 1u) {
             cm_rs = nacre_crgb_mul(cm_rs, rho_s);
@@ -947,11 +941,22 @@ NacreFilmOutput nacre_film_fourier_colour(NACRE_TEXTURE_2D_ARRAY(table), NacreFo
         }
         float mf = float(m);
         NacreComplexRgb s_hat = nacre_fourier_sample(table, p, mf * opd, mf * tau * sigma_d);
-        if (m <= m_r) {
+        if (!done_r) {
             sum_r += nacre_crgb_re_mul_conj(cm_rs, s_hat) + nacre_crgb_re_mul_conj(cm_rp, s_hat);
         }
-        if (m <= m_t) {
+        if (!done_t) {
             sum_t += nacre_crgb_re_mul_conj(cm_ts, s_hat) + nacre_crgb_re_mul_conj(cm_tp, s_hat);
+        }
+        if (automatic) {
+            vec3 s_abs = sqrt(s_hat.re * s_hat.re + s_hat.im * s_hat.im);
+            float s_max = max(s_abs.x, max(s_abs.y, s_abs.z));
+            done_r = done_r || (nacre_airy_tail_converged(cm_rs, rho_s, s_max, tolerance_r)
+                && nacre_airy_tail_converged(cm_rp, rho_p, s_max, tolerance_r));
+            done_t = done_t || (nacre_airy_tail_converged(cm_ts, rho_s, s_max, tolerance_t)
+                && nacre_airy_tail_converged(cm_tp, rho_p, s_max, tolerance_t));
+            if (done_r && done_t) {
+                break;
+            }
         }
     }
     NacreFilmOutput o;

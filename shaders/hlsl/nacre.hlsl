@@ -594,7 +594,7 @@ NacreFilmOutput nacre_film_lut_colour(Texture3D<float4> reflectance, SamplerStat
 //   ν̄_j                  carrier_nu_per_nm    channel centroid frequency, 1/nm
 //   ‖s_j‖                white                colour of a perfect reflector
 //   σ_d                  sigma_thickness_nm   std. dev. of d in the pixel, nm
-//   M                    harmonics            number of harmonics (0 = auto)
+//   M                    harmonics            number of harmonics (0 = auto, the default)
 //
 // Eq. 10 in closed form (fourier.rs module docs), per polarisation, then averaged:
 //
@@ -616,10 +616,11 @@ NacreFilmOutput nacre_film_lut_colour(Texture3D<float4> reflectance, SamplerStat
 // Details that follow the CPU exactly:
 //   * fixed M: the film index is blended to the ambient's as the film vanishes,
 //     n₂' = n₁ + (n₂ − n₁) smoothstep(0, 30 nm, d) (Belcour & Barla §4); auto M: no blend;
-//   * auto M: per series the smallest m with 2|K|/(1 − |ρ|) |ρ|^m ≤ 1e-5 (closed form of
-//     `AirySeries::auto_harmonics`), the largest over channels and polarisations, at least 1,
-//     at most FOURIER_MAX_HARMONICS (the CPU allows 512); reflectance and transmittance
-//     count their harmonics separately, as the CPU's two calls do;
+//   * auto M (harmonics = 0, the default): after each harmonic m, stop once for every channel
+//     j and polarisation 2|c_{m+1}|/(1 − |ρ|) · max_j |Ŝ_j(m D)| ≤ ε max(c̄₀,j, 0.01)^(2/3),
+//     ε = 1e-3 and c̄₀,j the s/p average of c₀ (fourier.rs module docs, "How many
+//     harmonics"), at most FOURIER_MAX_HARMONICS (the CPU's MAX_AUTO_HARMONICS);
+//     reflectance and transmittance stop separately, as the CPU's two calls do;
 //   * prefiltering (§5): harmonic m sees σ_μ = m τ σ_d;
 //   * total internal reflection at the base and conductor bases need nothing special: the
 //     complex normal components carry them.
@@ -639,8 +640,10 @@ NacreFilmOutput nacre_film_lut_colour(Texture3D<float4> reflectance, SamplerStat
 
 // Largest number of harmonics summed, auto or fixed.
 static const uint NACRE_FOURIER_MAX_HARMONICS = 128u;
-// Tail bound at which auto harmonics stop (reflectance units; fourier.rs AUTO_TAIL_TOLERANCE).
-static const float NACRE_FOURIER_AUTO_TAIL_TOLERANCE = 1e-5;
+// Tolerance ε of the auto stopping rule at a mean level of 1 (fourier.rs AUTO_TOLERANCE).
+static const float NACRE_FOURIER_AUTO_TOLERANCE = 1e-3;
+// Lowest mean level the auto tolerance is scaled to (fourier.rs AUTO_LEVEL_FLOOR).
+static const float NACRE_FOURIER_AUTO_LEVEL_FLOOR = 0.01;
 // Thickness over which fixed-harmonic evaluation blends the film index, nm
 // (fourier.rs THIN_FILM_BLEND_NM).
 static const float NACRE_FOURIER_THIN_FILM_BLEND_NM = 30.0;
@@ -648,9 +651,9 @@ static const float NACRE_FOURIER_THIN_FILM_BLEND_NM = 30.0;
 static const float NACRE_FOURIER_MIN_ONE_MINUS_RHO2 = 1e-6;
 // Variance of a unit-width box footprint (fourier_sigma_from_derivatives).
 static const float NACRE_FOURIER_BOX_VARIANCE = 0.0833333333333333;
-// The runtime's default number of harmonics (`TechniqueOptions::harmonics` = 3, as
-// `nacre color --method fourier:3`); 0 selects the automatic count.
-static const uint NACRE_FOURIER_DEFAULT_HARMONICS = 3u;
+// The runtime's default number of harmonics (`TechniqueOptions::harmonics` = 0, as
+// `nacre color --method fourier`): 0 selects the automatic count, per pixel.
+static const uint NACRE_FOURIER_DEFAULT_HARMONICS = 0u;
 
 // Mirror of `FourierAxes` and the harmonic count (48 bytes in a cbuffer).
 struct NacreFourierParams {
@@ -734,24 +737,20 @@ NacreAirySeries nacre_airy_series_transmittance(float2 t12, float2 t23, float fa
     return s;
 }
 
-// Harmonics for a tail bound 2|K|/(1 − |ρ|) |ρ|^m ≤ FOURIER_AUTO_TAIL_TOLERANCE.
-uint nacre_airy_auto_harmonics(NacreAirySeries s) {
-    float r = nacre_c_abs(s.rho);
-    if (r < 1e-30) {
-        return 1u;
-    }
-    float tail = 2.0 * nacre_c_abs(s.k) / max(1.0 - r, 1e-12);
-    if (!(tail > NACRE_FOURIER_AUTO_TAIL_TOLERANCE)) {
-        return 1u;
-    }
-    if (r >= 1.0) {
-        return NACRE_FOURIER_MAX_HARMONICS;
-    }
-    float m = ceil(log(NACRE_FOURIER_AUTO_TAIL_TOLERANCE / tail) / log(r));
-    if (!nacre_f32_is_finite(m)) {
-        return NACRE_FOURIER_MAX_HARMONICS;
-    }
-    return clamp(uint(clamp(m, 1.0, float(NACRE_FOURIER_MAX_HARMONICS))), 1u, NACRE_FOURIER_MAX_HARMONICS);
+// The auto tolerance of a channel whose mean level is `level`: ε max(level, floor)^(2/3)
+// (fourier.rs `auto_tolerance`).
+float3 nacre_airy_auto_tolerance(float3 level) {
+    return NACRE_FOURIER_AUTO_TOLERANCE * pow(max(level, float3(NACRE_FOURIER_AUTO_LEVEL_FLOOR, NACRE_FOURIER_AUTO_LEVEL_FLOOR, NACRE_FOURIER_AUTO_LEVEL_FLOOR)), float3(2.0 / 3.0, 2.0 / 3.0, 2.0 / 3.0));
+}
+
+// Whether the terms after harmonic m are negligible for one polarisation: per channel
+// 2|c_{m+1}|/(1 − |ρ|) · s_max ≤ tolerance, with c_m the m-th coefficient, s_max = max_j |Ŝ_j(m D)|
+// (fourier.rs `AirySeries::tail_after`).
+bool nacre_airy_tail_converged(NacreComplexRgb cm, NacreComplexRgb rho, float s_max, float3 tolerance) {
+    float3 r = sqrt(rho.re * rho.re + rho.im * rho.im);
+    float3 cm_abs = sqrt(cm.re * cm.re + cm.im * cm.im);
+    float3 tail = 2.0 * cm_abs * r / max(1.0 - r, float3(1e-12, 1e-12, 1e-12)) * s_max;
+    return all(tail <= tolerance);
 }
 
 // The fractional mip level for a prefilter width σ_μ, nm (`FourierAxes::lod`).
@@ -883,8 +882,6 @@ NacreFilmOutput nacre_film_fourier_colour(Texture2DArray<float4> table, NacreFou
     NacreComplexRgb k_tp = k_rs;
     NacreComplexRgb rho_s = k_rs;
     NacreComplexRgb rho_p = k_rs;
-    uint m_r = 1u;
-    uint m_t = 1u;
     NacreAirySeries rs;
     NacreAirySeries rp;
     NacreAirySeries ts;
@@ -918,23 +915,20 @@ NacreFilmOutput nacre_film_fourier_colour(Texture2DArray<float4> table, NacreFou
         rho_s.im[j] = rs.rho.y;
         rho_p.re[j] = rp.rho.x;
         rho_p.im[j] = rp.rho.y;
-        if (p.harmonics == 0u) {
-            m_r = max(m_r, max(nacre_airy_auto_harmonics(rs), nacre_airy_auto_harmonics(rp)));
-            m_t = max(m_t, max(nacre_airy_auto_harmonics(ts), nacre_airy_auto_harmonics(tp)));
-        }
     }
-    if (p.harmonics != 0u) {
-        m_r = min(p.harmonics, NACRE_FOURIER_MAX_HARMONICS);
-        m_t = m_r;
-    }
+    bool automatic = p.harmonics == 0u;
+    uint m_max = automatic ? NACRE_FOURIER_MAX_HARMONICS : min(p.harmonics, NACRE_FOURIER_MAX_HARMONICS);
+    float3 tolerance_r = nacre_airy_auto_tolerance(c0_r);
+    float3 tolerance_t = nacre_airy_auto_tolerance(c0_t);
 
-    uint m_max = max(m_r, m_t);
     NacreComplexRgb cm_rs = k_rs;
     NacreComplexRgb cm_rp = k_rp;
     NacreComplexRgb cm_ts = k_ts;
     NacreComplexRgb cm_tp = k_tp;
-    float3 sum_r = (float3)0.0;
-    float3 sum_t = (float3)0.0;
+    float3 sum_r = float3(0.0, 0.0, 0.0);
+    float3 sum_t = float3(0.0, 0.0, 0.0);
+    bool done_r = false;
+    bool done_t = false;
     for (uint m = 1u; m <= m_max; m++) {
         if (m > 1u) {
             cm_rs = nacre_crgb_mul(cm_rs, rho_s);
@@ -944,11 +938,22 @@ NacreFilmOutput nacre_film_fourier_colour(Texture2DArray<float4> table, NacreFou
         }
         float mf = float(m);
         NacreComplexRgb s_hat = nacre_fourier_sample(table, p, mf * opd, mf * tau * sigma_d);
-        if (m <= m_r) {
+        if (!done_r) {
             sum_r += nacre_crgb_re_mul_conj(cm_rs, s_hat) + nacre_crgb_re_mul_conj(cm_rp, s_hat);
         }
-        if (m <= m_t) {
+        if (!done_t) {
             sum_t += nacre_crgb_re_mul_conj(cm_ts, s_hat) + nacre_crgb_re_mul_conj(cm_tp, s_hat);
+        }
+        if (automatic) {
+            float3 s_abs = sqrt(s_hat.re * s_hat.re + s_hat.im * s_hat.im);
+            float s_max = max(s_abs.x, max(s_abs.y, s_abs.z));
+            done_r = done_r || (nacre_airy_tail_converged(cm_rs, rho_s, s_max, tolerance_r)
+                && nacre_airy_tail_converged(cm_rp, rho_p, s_max, tolerance_r));
+            done_t = done_t || (nacre_airy_tail_converged(cm_ts, rho_s, s_max, tolerance_t)
+                && nacre_airy_tail_converged(cm_tp, rho_p, s_max, tolerance_t));
+            if (done_r && done_t) {
+                break;
+            }
         }
     }
     NacreFilmOutput o;

@@ -370,16 +370,26 @@ fn fourier_libraries_match_the_cpu_series() {
     let tables = TableSet::load(ctx, &path).unwrap();
     let colorimeter = tables.colorimeter().unwrap();
     let table = Arc::new(Manifest::read(&path).unwrap().load_fourier(&path).unwrap());
+    // A free film (base 1.0) has the largest |ρ| of the dielectric bases: the most harmonics.
     let bases = [
         C64::new(1.5, 0.0),
         C64::new(2.2, 0.0),
+        C64::new(1.0, 0.0),
         C64::new(0.27, 2.9),
         C64::new(1.2, 1.5),
     ];
-    // M = 3 is the runtime's default (`TechniqueOptions::default().harmonics`).
-    assert_eq!(TechniqueOptions::default().harmonics, 3);
+    // Automatic harmonics (0) are the runtime's default (`TechniqueOptions::default()`).
+    assert_eq!(TechniqueOptions::default().harmonics, 0);
     let hostile = hostile_inputs();
-    for (harmonics, sigma) in [(1u32, 0.0), (2, 0.0), (3, 0.0), (3, 40.0), (0, 0.0)] {
+    // 0: automatic harmonics, the runtime's default (`TechniqueOptions::default().harmonics`).
+    for (harmonics, sigma) in [
+        (1u32, 0.0),
+        (2, 0.0),
+        (3, 0.0),
+        (3, 40.0),
+        (0, 0.0),
+        (0, 40.0),
+    ] {
         let options = TechniqueOptions {
             harmonics,
             ..Default::default()

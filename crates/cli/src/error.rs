@@ -59,6 +59,8 @@ pub fn flag(param: Param) -> &'static str {
         Param::Yaw => "--yaw",
         Param::OrbitPitch => "--pitch",
         Param::Distance => "--distance",
+        Param::BenchFilmIor => "--film-ior",
+        Param::BenchBaseIor => "--base-ior",
     }
 }
 

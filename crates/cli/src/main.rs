@@ -100,7 +100,7 @@ enum Command {
 const BENCH_GPU_EXAMPLES: &str = "\
 Every pass shades each pixel of a WIDTHxHEIGHT target with the same GGX microfacet material
 (shaders/bench.wgsl); only the Fresnel term differs: Schlick (plain), film_lut, film_fourier
-(M harmonics) or film_spectral (N wavelengths). A last pass times the diffraction technique
+(--harmonics M, by default automatic, then M = 3) or film_spectral (N wavelengths). A last pass times the diffraction technique
 at the same resolution (one directional light per pixel, the --diffraction table: layout
 \"terms\" sums over the --diffraction-step grid, layout \"integrated\" reads the sum baked into
 the table). Times are GPU timestamps of the render pass where the adapter supports them,
@@ -111,6 +111,8 @@ Examples:
   nacre bench-gpu
   # a quick look on a software rasteriser
   nacre bench-gpu --width 640 --height 360 --frames 5
+  # film_fourier's hardest case: a free film of index 2.26 (automatic harmonics vs M = 3)
+  nacre bench-gpu --width 640 --height 360 --frames 5 --film-ior 2.26 --base-ior 1.0
   # the diffraction pass on the fast (integrated) table of the same CD surface
   nacre bench-gpu --width 320 --height 180 --frames 5 --diffraction cd-tracks-fast";
 
@@ -125,9 +127,16 @@ struct BenchGpuArgs {
     /// Frames measured per pass (after 3 discarded warm-up frames).
     #[arg(long, default_value_t = 30)]
     frames: u32,
-    /// Harmonics M of film_fourier (0 = automatic).
-    #[arg(long, default_value_t = 3)]
+    /// Harmonics M of film_fourier (0 = automatic, the runtime's default); a pass with
+    /// M = 3 follows it.
+    #[arg(long, default_value_t = 0)]
     harmonics: u32,
+    /// Film index of every pixel.
+    #[arg(long, value_name = "N", default_value_t = 1.45)]
+    film_ior: f32,
+    /// Base index of every pixel (real; 1.0 for a free film).
+    #[arg(long, value_name = "N", default_value_t = 1.5)]
+    base_ior: f32,
     /// Wavelengths N of film_spectral.
     #[arg(long, default_value_t = 30)]
     wavelengths: usize,
@@ -155,9 +164,11 @@ The recipe format is documented in the README (\"Table recipes\").";
 const COLOR_EXAMPLES: &str = "\
 Methods: spectral (exact reference), lut:NAME|PATH (a baked film-lut, default-set name or
 manifest path), rgb3 (650/510/475 nm), samples:N (N wavelengths over 400-700 nm),
-fourier:M | fourier:auto [:SIGMA_NM] (Belcour & Barla 2017 Eq. 10 with exact Fresnel, the
-baked fourier table sampled as a GPU would, optional prefiltering for a thickness standard
-deviation), fourier-exact:… (the same with exact transforms), gaussian (the glTF
+fourier | fourier:M | fourier:auto [:SIGMA_NM] (Belcour & Barla 2017 Eq. 10 with exact
+Fresnel, the baked fourier table sampled as a GPU would, optional prefiltering for a
+thickness standard deviation; fourier alone is fourier:auto, the GPU's default: per point
+as many harmonics as ΔE2000 p95 <= 0.1 needs), fourier-exact… (the same with exact
+transforms), gaussian (the glTF
 KHR_materials_iridescence Gaussian-fit approximation), rough-lut:NAME|PATH with --roughness
 ALPHA (the directional albedo of the rough GGX film lobe from a baked rough-film-lut table),
 rough-mc[:N] with --roughness ALPHA (its Monte Carlo reference, N samples per point,
@@ -284,8 +295,8 @@ Examples:
   nacre render -o sphere.png
   # a soap bubble, brute-force spectral with 40 wavelengths
   nacre render --scene bubble --technique spectral --wavelengths 40 -o bubble.png
-  # the oil slick, Fourier with automatic harmonics, half a stop darker
-  nacre render --scene plane --technique fourier --harmonics 0 --exposure -0.5 -o plane.png
+  # the oil slick, Fourier with a fixed 3 harmonics (the default: automatic), half a stop darker
+  nacre render --scene plane --technique fourier --harmonics 3 --exposure -0.5 -o plane.png
   # a film on gold, your own environment and thickness map
   nacre render --tables film-gold --tables fourier-srgb --env sky.exr --thickness-map swirl.png -o gold.png
   # a rough film lit the engines' way (film at n·v) and exactly (film per light, rough-film-lut)
@@ -387,7 +398,8 @@ struct RenderArgs {
     /// (metres) [default: the nearest that frames the whole scene].
     #[arg(long, value_name = "D", requires = "gltf")]
     distance: Option<f64>,
-    /// Harmonics M of the fourier technique (0 = automatic) [default: 3].
+    /// Harmonics M of the fourier technique (0 = automatic: per pixel, as many as the
+    /// series needs, as `nacre color --method fourier`) [default: 0].
     #[arg(long, value_name = "M")]
     harmonics: Option<u32>,
     /// Wavelengths N of the spectral technique (1 to 4096) [default: 30]; with --technique
@@ -969,6 +981,18 @@ fn run_bench_gpu(args: &BenchGpuArgs) -> Result<()> {
             format!("at a {step_nm} nm step")
         }
     };
+    for (flag, value) in [
+        (Param::BenchFilmIor, args.film_ior),
+        (Param::BenchBaseIor, args.base_ior),
+    ] {
+        if !(value.is_finite() && (1.0..=4.0).contains(&value)) {
+            return Err(nacre_bake::error::Error::invalid(
+                flag,
+                format!("{value} (expected an index from 1 to 4)"),
+            )
+            .into());
+        }
+    }
     let mut technique = TechniqueOptions {
         harmonics: args.harmonics,
         ..Default::default()
@@ -980,6 +1004,8 @@ fn run_bench_gpu(args: &BenchGpuArgs) -> Result<()> {
         frames: args.frames,
         warmup: 3,
         technique,
+        film_ior: args.film_ior,
+        base_ior: args.base_ior,
     };
     let ctx = GpuContext::new_headless()?;
     eprintln!("adapter: {}", ctx.describe());
@@ -993,6 +1019,7 @@ fn run_bench_gpu(args: &BenchGpuArgs) -> Result<()> {
         BenchPass::Plain,
         BenchPass::Film(Technique::Lut),
         BenchPass::Film(Technique::Fourier),
+        BenchPass::FourierFixed(3),
         BenchPass::Film(Technique::Spectral),
         BenchPass::Stack(2),
         BenchPass::Stack(4),
@@ -1009,7 +1036,7 @@ fn run_bench_gpu(args: &BenchGpuArgs) -> Result<()> {
     let plain = results[0].median_ms;
     let lut = results[1].median_ms;
     println!(
-        "{}x{}, {} frames per pass, {} (fourier M = {}, spectral N = {}, diffraction {} {})",
+        "{}x{}, {} frames per pass, {} (film {} on base {}, fourier M = {} (0: automatic), spectral N = {}, diffraction {} {})",
         args.width,
         args.height,
         args.frames,
@@ -1018,6 +1045,8 @@ fn run_bench_gpu(args: &BenchGpuArgs) -> Result<()> {
         } else {
             "wall clock (no timestamp queries)"
         },
+        args.film_ior,
+        args.base_ior,
         args.harmonics,
         args.wavelengths,
         diffraction.name(),

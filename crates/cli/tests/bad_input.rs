@@ -1222,6 +1222,16 @@ fn fixtures(d: &Path) -> Vec<Case> {
             &["exposure"],
         ),
         case(
+            "flag: bench-gpu film index not a number",
+            &["bench-gpu", "--film-ior", "nan", "--frames", "1"],
+            &["--film-ior", "NaN", "1 to 4"],
+        ),
+        case(
+            "flag: bench-gpu base index below 1",
+            &["bench-gpu", "--base-ior", "0.5", "--frames", "1"],
+            &["--base-ior", "0.5", "1 to 4"],
+        ),
+        case(
             "flag: bench-gpu zero width",
             &["bench-gpu", "--width", "0", "--frames", "1"],
             &["0×1080", "1 to"],

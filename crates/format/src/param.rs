@@ -131,6 +131,10 @@ params! {
     EnvSamples => "env_samples",
     /// Monte Carlo samples of a reference.
     ReferenceSamples => "reference_samples",
+    /// Film index of the GPU benchmark's pixels.
+    BenchFilmIor => "bench_film_ior",
+    /// Base index of the GPU benchmark's pixels.
+    BenchBaseIor => "bench_base_ior",
     /// The file an export writes.
     Out => "out",
     /// The glTF file's camera to render from.

@@ -36,8 +36,30 @@
 //! `C_j = ‖s_j‖ [c₀ + 2 Σ_{m=1}^{M} Re(c_m conj Ŝ_j(m D))]`, averaged over s and p.
 //! Reflection phases are carried by the complex c_m: Fresnel amplitudes are exact for
 //! dielectric and conductor bases (not Schlick), and total internal reflection at the base
-//! (|Γ| = 1) needs nothing special. The series converges like |ρ|^M; [`Harmonics::Auto`]
-//! picks the smallest M whose tail bound 2|K||ρ|^M / (1 − |ρ|) is below 10⁻⁵.
+//! (|Γ| = 1) needs nothing special.
+//!
+//! # How many harmonics: [`Harmonics::Auto`], the default
+//!
+//! The terms decay like |ρ|^m (the Airy series) times |Ŝ_j(m D)| (the sensitivities'
+//! transforms fall from 1 at μ = 0 to ≈ 10⁻² at 10 µm and ≈ 10⁻⁴ at 100 µm: thick films need
+//! few harmonics even where |ρ| is large). Auto sums harmonics m = 1, 2, … and stops after
+//! the first m at which, for every channel j and polarisation,
+//!
+//! ```text
+//! 2 |K| |ρ|^m / (1 − |ρ|) · max_j |Ŝ_j(m D)|  ≤  ε · max(c̄₀,j, Y_floor)^(2/3)
+//! ```
+//!
+//! (at most [`MAX_AUTO_HARMONICS`]): the tail bound of the remaining terms with |Ŝ| at the
+//! last harmonic standing in for its decay, against a tolerance ε = [`AUTO_TOLERANCE`] scaled
+//! to the channel's mean level c̄₀,j (the s/p average of c₀; floor Y_floor =
+//! [`AUTO_LEVEL_FLOOR`]). The 2/3 power holds ΔE roughly constant: L* ∝ Y^(1/3), so
+//! dL* = (116/3) Y^(−2/3) dY, and the same ΔE allows an error ∝ Y^(2/3) — dark films (a
+//! free low-index film reflects a few per cent) get a tighter bound than bright metals.
+//! ε was tuned to the ΔE2000 targets (p95 ≤ 0.1, max ≤ 0.5 on dielectric bases including
+//! free films, p95 ≤ 0.3, max ≤ 1.0 on conductors; `BENCHMARKS.md`, test
+//! `fourier_default` of nacre-tests): a fixed M = 3 reaches ΔE2000 0.7 on a free film of
+//! index 2.26 near Brewster's angle (|ρ| = r₁₂² ≈ 0.45 for s) and several units on free
+//! films at grazing angles, while Auto uses 1–3 harmonics for most films.
 //!
 //! # Prefiltering (Belcour & Barla §5)
 //!
@@ -60,19 +82,33 @@ pub const SUBCELLS: usize = 8;
 /// ambient's (Belcour & Barla 2017 §4), nm.
 pub const THIN_FILM_BLEND_NM: f64 = 30.0;
 
-/// Largest number of harmonics [`Harmonics::Auto`] will use.
-pub const MAX_AUTO_HARMONICS: usize = 512;
+/// Largest number of harmonics [`Harmonics::Auto`] will use (the GPU's
+/// `FOURIER_MAX_HARMONICS`).
+pub const MAX_AUTO_HARMONICS: usize = 128;
 
-/// Tail bound below which [`Harmonics::Auto`] stops (reflectance units).
-pub const AUTO_TAIL_TOLERANCE: f64 = 1e-5;
+/// Tolerance ε of [`Harmonics::Auto`]'s stopping rule, in reflectance (or transmittance)
+/// units at a mean level of 1; scaled by the level to the power 2/3 (module docs).
+pub const AUTO_TOLERANCE: f64 = 1e-3;
+
+/// Lowest mean level the tolerance of [`Harmonics::Auto`] is scaled to (Y = 0.01, L* ≈ 9).
+pub const AUTO_LEVEL_FLOOR: f64 = 0.01;
 
 /// How many harmonics of the Airy series to sum.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Harmonics {
     /// m = 1 … M.
     Fixed(usize),
-    /// As many as the tail bound requires (at most [`MAX_AUTO_HARMONICS`]).
+    /// As many as the stopping rule of the module docs requires (at most
+    /// [`MAX_AUTO_HARMONICS`]): the default of `nacre color --method fourier` and of the GPU
+    /// technique.
+    #[default]
     Auto,
+}
+
+/// The tolerance of [`Harmonics::Auto`] for a channel whose mean level (s/p average of c₀)
+/// is `level`: ε · max(level, floor)^(2/3).
+pub fn auto_tolerance(level: f64) -> f64 {
+    AUTO_TOLERANCE * level.max(AUTO_LEVEL_FLOOR).powf(2.0 / 3.0)
 }
 
 /// The sensitivities of a colorimeter in the frequency domain ν = 1/λ, ready for Fourier
@@ -237,19 +273,11 @@ impl AirySeries {
         }
     }
 
-    /// Harmonics needed for a tail bound below [`AUTO_TAIL_TOLERANCE`].
-    fn auto_harmonics(&self) -> usize {
+    /// The bound 2|c_{m+1}| / (1 − |ρ|) of the terms after harmonic m, from |c_m| (the
+    /// module docs' stopping rule, before the |Ŝ| factor).
+    fn tail_after(&self, cm_norm: f64) -> f64 {
         let r = self.rho.norm();
-        if r < 1e-300 {
-            return 1;
-        }
-        let mut tail = 2.0 * self.k.norm() / (1.0 - r).max(1e-12);
-        let mut m = 0;
-        while tail > AUTO_TAIL_TOLERANCE && m < MAX_AUTO_HARMONICS {
-            tail *= r;
-            m += 1;
-        }
-        m.max(1)
+        2.0 * cm_norm * r / (1.0 - r).max(1e-12)
     }
 }
 
@@ -271,7 +299,8 @@ pub struct FilmOnBase {
 pub struct FourierColour {
     /// Output-space colour.
     pub colour: [f64; 3],
-    /// Harmonics summed (largest over channels and polarisations).
+    /// Harmonics summed (for [`Harmonics::Auto`], until every channel and polarisation met
+    /// the stopping rule).
     pub harmonics: usize,
 }
 
@@ -337,7 +366,8 @@ impl FilmOnBase {
     /// the film vanishes, n₂' = n₁ + (n₂ − n₁) smoothstep(0, 30 nm, d) (Belcour & Barla §4:
     /// "we force η₂ → 1 when d → 0"): a truncated series cannot reproduce the bare base at
     /// d = 0, while with n₂' = n₁ the film term vanishes and the result is exact there.
-    /// [`Harmonics::Auto`] converges and needs no blend.
+    /// [`Harmonics::Auto`] sums until the remaining terms are below its tolerance (at d = 0
+    /// too) and needs no blend.
     /// Returns None for an evanescent film (use the spectral reference there).
     pub fn fourier_colour(
         &self,
@@ -395,18 +425,16 @@ impl FilmOnBase {
             std::array::from_fn(|j| self.series(n_film, cos_theta, j, transmittance));
         let m_max = match harmonics {
             Harmonics::Fixed(m) => m,
-            Harmonics::Auto => series
-                .iter()
-                .flatten()
-                .map(AirySeries::auto_harmonics)
-                .max()
-                .unwrap_or(1),
+            Harmonics::Auto => MAX_AUTO_HARMONICS,
         };
         let mut colour = [0.0; 3];
         for (j, c) in colour.iter_mut().enumerate() {
             *c = 0.5 * (series[j][0].c0 + series[j][1].c0);
         }
+        // Auto's tolerance per channel, from its mean level.
+        let tolerance: [f64; 3] = std::array::from_fn(|j| auto_tolerance(colour[j]));
         let mut cm = [[C64::new(0.0, 0.0); 2]; 3];
+        let mut summed = 0;
         for m in 1..=m_max {
             let s_hat = transform(m as f64 * opd, m as f64 * tau * sigma_d_nm);
             for j in 0..3 {
@@ -418,10 +446,22 @@ impl FilmOnBase {
                 }
                 colour[j] += sum; // 2 Re(…) averaged over two polarisations
             }
+            summed = m;
+            if harmonics == Harmonics::Auto {
+                let s_max = s_hat.iter().map(|v| v.norm()).fold(0.0, f64::max);
+                let converged = (0..3).all(|j| {
+                    (0..2).all(|pol| {
+                        series[j][pol].tail_after(cm[j][pol].norm()) * s_max <= tolerance[j]
+                    })
+                });
+                if converged {
+                    break;
+                }
+            }
         }
         Some(FourierColour {
             colour: std::array::from_fn(|j| colour[j] * white[j]),
-            harmonics: m_max,
+            harmonics: summed,
         })
     }
 }

@@ -30,6 +30,9 @@ pub enum BenchPass {
     Plain,
     /// GGX with the technique's film term in place of Fresnel.
     Film(Technique),
+    /// `film_fourier` with a fixed number of harmonics M (whatever
+    /// [`BenchOptions::technique`] says), to time the default (automatic) against M.
+    FourierFixed(u32),
     /// The `diffraction` technique (the table's layout, "terms" or "integrated") for one
     /// directional light per pixel.
     Diffraction,
@@ -45,6 +48,8 @@ impl BenchPass {
             BenchPass::Plain => "plain GGX + Schlick",
             BenchPass::Film(Technique::Lut) => "film_lut",
             BenchPass::Film(Technique::Fourier) => "film_fourier",
+            BenchPass::FourierFixed(3) => "film_fourier, M = 3",
+            BenchPass::FourierFixed(_) => "film_fourier, fixed M",
             BenchPass::Film(Technique::Spectral) => "film_spectral",
             BenchPass::Film(Technique::Stack) => "film_stack",
             BenchPass::Diffraction => "diffraction",
@@ -69,6 +74,10 @@ pub struct BenchOptions {
     pub warmup: u32,
     /// Technique settings (harmonics, spectral wavelengths and base).
     pub technique: TechniqueOptions,
+    /// Film index of every pixel (default 1.45).
+    pub film_ior: f32,
+    /// Base index of every pixel, real (default 1.5; 1.0 for a free film).
+    pub base_ior: f32,
 }
 
 impl Default for BenchOptions {
@@ -79,6 +88,8 @@ impl Default for BenchOptions {
             frames: 30,
             warmup: 3,
             technique: TechniqueOptions::default(),
+            film_ior: 1.45,
+            base_ior: 1.5,
         }
     }
 }
@@ -162,8 +173,8 @@ pub fn run_bench_with_diffraction(
     let params = BenchParams {
         resolution: [options.width as f32, options.height as f32],
         roughness: 0.3,
-        film_ior: 1.45,
-        base_ior: [1.5; 3],
+        film_ior: options.film_ior,
+        base_ior: [options.base_ior; 3],
         ambient_ior: 1.0,
         base_kappa: [0.0; 3],
         pad: 0.0,
@@ -237,6 +248,19 @@ pub fn run_bench_with_diffraction(
                 &options.technique,
                 &colorimeter,
             )?),
+            BenchPass::FourierFixed(harmonics) => {
+                let technique = TechniqueOptions {
+                    harmonics,
+                    ..options.technique.clone()
+                };
+                Some(TechniqueBinding::new(
+                    ctx,
+                    tables,
+                    Technique::Fourier,
+                    &technique,
+                    &colorimeter,
+                )?)
+            }
             BenchPass::Stack(films) => {
                 let technique = TechniqueOptions {
                     stack: StackSetup::alternating(films)?,
@@ -254,6 +278,11 @@ pub fn run_bench_with_diffraction(
         let (source, table_layout, table_group) = match (&binding, pass) {
             (Some(b), BenchPass::Film(t)) => (
                 shaders::film_pipeline(t.module(), &["bench"])?,
+                &b.layout,
+                &b.bind_group,
+            ),
+            (Some(b), BenchPass::FourierFixed(_)) => (
+                shaders::film_pipeline(Technique::Fourier.module(), &["bench"])?,
                 &b.layout,
                 &b.bind_group,
             ),

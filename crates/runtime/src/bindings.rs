@@ -261,7 +261,10 @@ pub fn stack_buffers(
 /// Options of a technique's group-1 bind group.
 #[derive(Clone, Debug)]
 pub struct TechniqueOptions {
-    /// Harmonics M of `film_fourier` (0 = automatic, as `fourier:auto`).
+    /// Harmonics M of `film_fourier`: 0 (the default) = automatic, as `nacre color --method
+    /// fourier` (`fourier:auto`): per pixel, as many as the series' decay and the
+    /// sensitivities' need for ΔE2000 p95 ≤ 0.1 (`nacre_optics::fourier` module docs, "How
+    /// many harmonics"); a fixed M otherwise.
     pub harmonics: u32,
     /// Setup of `film_spectral`.
     pub spectral: SpectralSetup,
@@ -272,7 +275,7 @@ pub struct TechniqueOptions {
 impl Default for TechniqueOptions {
     fn default() -> Self {
         TechniqueOptions {
-            harmonics: 3,
+            harmonics: 0,
             spectral: SpectralSetup {
                 samples: 30,
                 base: Material::constant("1.5", nacre_optics::C64::new(1.5, 0.0))

@@ -15,11 +15,14 @@
 //! * `samples:N` — N wavelengths spread uniformly over 400–700 nm (inclusive), weighted by
 //!   the output-space sensitivities there and normalised so that R ≡ 1 is white: the
 //!   shortcut of the real-time thesis (Sussenbach 2013, §4.3);
-//! * `fourier:M`, `fourier:auto`, `fourier:M:SIGMA_NM`, `fourier:auto:SIGMA_NM` — Belcour &
-//!   Barla 2017 Eq. 10 with exact Fresnel amplitudes and phases per polarisation and the
-//!   sensitivities' Fourier transforms evaluated exactly ([`nacre_optics::fourier`]), with M
-//!   harmonics or as many as a 10⁻⁴ tail bound needs, optionally prefiltered for a Gaussian
-//!   thickness distribution of standard deviation SIGMA_NM (one film on a base; reflectance);
+//! * `fourier` (= `fourier:auto`, the default), `fourier:M`, `fourier:M:SIGMA_NM`,
+//!   `fourier:auto:SIGMA_NM` — Belcour & Barla 2017 Eq. 10 with exact Fresnel amplitudes and
+//!   phases per polarisation and the sensitivities' Fourier transforms sampled from the baked
+//!   `fourier` table as a GPU would (`fourier-exact…`: evaluated exactly,
+//!   [`nacre_optics::fourier`]), with M harmonics or, by default, as many as each point needs
+//!   ([`Harmonics::Auto`]: the series' decay |ρ|^m times the transforms' |Ŝ(mD)| against a
+//!   tolerance tuned to ΔE2000 p95 ≤ 0.1), optionally prefiltered for a Gaussian thickness
+//!   distribution of standard deviation SIGMA_NM (one film on a base);
 //! * `rough-lut:NAME|PATH` (with a roughness α) — the directional albedo of the rough
 //!   (GGX) iridescent lobe from a baked `rough-film-lut` table, looked up as the shader does
 //!   ([`nacre_format::rough_film_lut::RoughFilmLut::lookup`]); `rough-mc[:N]` — the Monte Carlo reference
@@ -184,13 +187,16 @@ impl Method {
                         Ok(n @ 1..=10_000) => Ok(Method::Samples(n)),
                         _ => Err(err("samples:N needs a whole number N from 1 to 10000")),
                     }
+                } else if t == "fourier" || t == "fourier-exact" {
+                    // The default: as many harmonics as each point needs.
+                    Ok(Method::Fourier(Harmonics::Auto, 0.0, None))
                 } else if let Some(rest) = t
                     .strip_prefix("fourier:")
                     .or_else(|| t.strip_prefix("fourier-exact:"))
                 {
                     let bad = || {
                         err(
-                            "expected fourier:M, fourier:auto, fourier:M:SIGMA_NM or fourier:auto:SIGMA_NM (M from 1 to 512, SIGMA_NM ≥ 0), or fourier-exact: with the same forms",
+                            "expected fourier, fourier:M, fourier:auto, fourier:M:SIGMA_NM or fourier:auto:SIGMA_NM (M from 1 to 512, SIGMA_NM ≥ 0), or fourier-exact with the same forms",
                         )
                     };
                     let (m, sigma) = match rest.split_once(':') {
@@ -213,7 +219,7 @@ impl Method {
                     Ok(Method::Fourier(harmonics, sigma, None))
                 } else {
                     Err(err(
-                        "expected spectral, lut:NAME|PATH, rgb3, samples:N, fourier:M[:SIGMA_NM], fourier:auto[:SIGMA_NM], fourier-exact:…, gaussian, rough-lut:NAME|PATH, rough-mc[:N], stack or stack:N",
+                        "expected spectral, lut:NAME|PATH, rgb3, samples:N, fourier, fourier:M[:SIGMA_NM], fourier:auto[:SIGMA_NM], fourier-exact…, gaussian, rough-lut:NAME|PATH, rough-mc[:N], stack or stack:N",
                     ))
                 }
             }

@@ -17,10 +17,11 @@ use std::sync::Arc;
 /// Default incidence angles of `nacre color`, degrees.
 pub const DEFAULT_ANGLES: &str = "0:89:1";
 
-/// True when `text` (a `--method`) asks for the baked `fourier` table (`fourier:…`; not
-/// `fourier-exact:…`).
+/// True when `text` (a `--method`) asks for the baked `fourier` table (`fourier`,
+/// `fourier:…`; not `fourier-exact…`).
 pub fn wants_baked_fourier(text: &str) -> bool {
-    text.trim().starts_with("fourier:")
+    let t = text.trim();
+    t == "fourier" || t.starts_with("fourier:")
 }
 
 /// The colour settings as given (`--observer`, `--illuminant`, `--space`); `None` takes the

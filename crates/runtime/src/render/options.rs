@@ -564,7 +564,7 @@ pub struct SceneOptions {
     pub light: Light,
     /// Exposure, EV stops: radiance is scaled by 2^EV before tone mapping (default 0).
     pub exposure_ev: f32,
-    /// Harmonics M of `film_fourier` (0 = automatic; default 3).
+    /// Harmonics M of `film_fourier` (0 = automatic, the default).
     pub harmonics: u32,
     /// Wavelengths N of `film_spectral` (default 30).
     pub spectral_samples: usize,
