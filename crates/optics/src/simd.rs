@@ -214,6 +214,29 @@ pub(crate) fn exp_neg<S: Simd>(s: S, a: S::f64s) -> S::f64s {
     s.select_f64s(beyond, s.splat_f64s(0.0), s.mul_f64s(y, scale))
 }
 
+/// `sin[k]`, `cos[k]` = sin, cos of `x[k]` ([`sin_cos`]) on the CPU's widest vectors, the
+/// remainder one lane at a time (the same bits).
+pub(crate) fn sin_cos_slice(x: &[f64], sin: &mut [f64], cos: &mut [f64]) {
+    struct Op<'a>(&'a [f64], &'a mut [f64], &'a mut [f64]);
+    impl WithSimd for Op<'_> {
+        type Output = ();
+        #[inline(always)]
+        fn with_simd<S: Simd>(self, s: S) {
+            let (xv, xt) = S::as_simd_f64s(self.0);
+            let (sv, st) = S::as_mut_simd_f64s(self.1);
+            let (cv, ct) = S::as_mut_simd_f64s(self.2);
+            for (i, &x) in xv.iter().enumerate() {
+                (sv[i], cv[i]) = sin_cos(s, x);
+            }
+            let scalar = pulp::Scalar::new();
+            for (i, &x) in xt.iter().enumerate() {
+                (st[i], ct[i]) = sin_cos(scalar, x);
+            }
+        }
+    }
+    ARCH.dispatch(Op(x, sin, cos))
+}
+
 /// The constants of one (angle, wavelength) row of the top-film Airy sweep (see
 /// `stack::ThicknessSweep`): per polarisation (s, p) r₀₁, Γ₁, r₀₁Γ₁ as (re, im) and
 /// |t₀₁τ₁|² × power factor; and z = 2 k₀ q₁, so that e^{2iδ₁} = e^{i z d}.
@@ -225,6 +248,13 @@ pub(crate) struct AiryRow {
     pub t_norm: [f64; 2],
     pub z_re: f64,
     pub z_im: f64,
+}
+
+impl AiryRow {
+    /// Whether r₀₁ and Γ₁ (both polarisations) are real.
+    fn is_real(&self) -> bool {
+        self.r01.iter().chain(&self.gamma).all(|c| c[1] == 0.0)
+    }
 }
 
 /// [`AiryRow`] splatted into lanes.
@@ -275,8 +305,17 @@ impl<S: Simd> Lanes<S> {
     /// (Belcour & Barla 2017, Eq. 2; the recurrence of `stack` without complex division).
     /// One division serves both polarisations: 1/D_s = D_p / (D_s D_p), 1/D_p = D_s / (D_s D_p)
     /// (D ≥ (1 − |r₀₁Γ₁|)², far from under- or overflow).
+    ///
+    /// The variants drop operations whose result they know: `REAL` when r₀₁, Γ₁ (hence
+    /// r₀₁Γ₁) are real (products with a zero imaginary part are ±0, and adding ±0 changes no
+    /// bit of a square), `ABSORBING = false` when |e^{2iδ}| = 1 exactly; each variant gives
+    /// the same bits as the general formula.
     #[inline(always)]
-    fn airy(&self, s: S, [e_re, e_im, e_norm]: [S::f64s; 3]) -> [S::f64s; 4] {
+    fn airy<const ABSORBING: bool, const REAL: bool>(
+        &self,
+        s: S,
+        [e_re, e_im, e_norm]: [S::f64s; 3],
+    ) -> [S::f64s; 4] {
         let one = s.splat_f64s(1.0);
         let mut num2 = [one; 2];
         let mut den2 = [one; 2];
@@ -284,29 +323,48 @@ impl<S: Simd> Lanes<S> {
             let [g_re, g_im] = self.gamma[pol];
             let [r_re, r_im] = self.r01[pol];
             let [rg_re, rg_im] = self.r01_gamma[pol];
-            let num_re = s.add_f64s(
-                r_re,
-                s.sub_f64s(s.mul_f64s(g_re, e_re), s.mul_f64s(g_im, e_im)),
-            );
-            let num_im = s.add_f64s(
-                r_im,
-                s.add_f64s(s.mul_f64s(g_re, e_im), s.mul_f64s(g_im, e_re)),
-            );
-            let den_re = s.add_f64s(
-                one,
-                s.sub_f64s(s.mul_f64s(rg_re, e_re), s.mul_f64s(rg_im, e_im)),
-            );
-            let den_im = s.add_f64s(s.mul_f64s(rg_re, e_im), s.mul_f64s(rg_im, e_re));
+            let (num_re, num_im, den_re, den_im) = if REAL {
+                (
+                    s.add_f64s(r_re, s.mul_f64s(g_re, e_re)),
+                    s.mul_f64s(g_re, e_im),
+                    s.add_f64s(one, s.mul_f64s(rg_re, e_re)),
+                    s.mul_f64s(rg_re, e_im),
+                )
+            } else {
+                (
+                    s.add_f64s(
+                        r_re,
+                        s.sub_f64s(s.mul_f64s(g_re, e_re), s.mul_f64s(g_im, e_im)),
+                    ),
+                    s.add_f64s(
+                        r_im,
+                        s.add_f64s(s.mul_f64s(g_re, e_im), s.mul_f64s(g_im, e_re)),
+                    ),
+                    s.add_f64s(
+                        one,
+                        s.sub_f64s(s.mul_f64s(rg_re, e_re), s.mul_f64s(rg_im, e_im)),
+                    ),
+                    s.add_f64s(s.mul_f64s(rg_re, e_im), s.mul_f64s(rg_im, e_re)),
+                )
+            };
             num2[pol] = s.add_f64s(s.mul_f64s(num_re, num_re), s.mul_f64s(num_im, num_im));
             den2[pol] = s.add_f64s(s.mul_f64s(den_re, den_re), s.mul_f64s(den_im, den_im));
         }
         let inv_both = s.div_f64s(one, s.mul_f64s(den2[0], den2[1]));
         let inv = [s.mul_f64s(den2[1], inv_both), s.mul_f64s(den2[0], inv_both)];
+        let t = if ABSORBING {
+            [
+                s.mul_f64s(self.t_norm[0], e_norm),
+                s.mul_f64s(self.t_norm[1], e_norm),
+            ]
+        } else {
+            self.t_norm
+        };
         [
             s.mul_f64s(num2[0], inv[0]),
             s.mul_f64s(num2[1], inv[1]),
-            s.mul_f64s(s.mul_f64s(self.t_norm[0], e_norm), inv[0]),
-            s.mul_f64s(s.mul_f64s(self.t_norm[1], e_norm), inv[1]),
+            s.mul_f64s(t[0], inv[0]),
+            s.mul_f64s(t[1], inv[1]),
         ]
     }
 }
@@ -517,17 +575,18 @@ impl<T: PowerSlot> WithSimd for PowersOp<'_, T> {
 
     #[inline(always)]
     fn with_simd<S: Simd>(self, s: S) {
-        if self.row.z_im == 0.0 {
-            self.run::<S, false>(s)
-        } else {
-            self.run::<S, true>(s)
+        match (self.row.z_im == 0.0, self.row.is_real()) {
+            (true, true) => self.run::<S, false, true>(s),
+            (true, false) => self.run::<S, false, false>(s),
+            (false, true) => self.run::<S, true, true>(s),
+            (false, false) => self.run::<S, true, false>(s),
         }
     }
 }
 
 impl<T: PowerSlot> PowersOp<'_, T> {
     #[inline(always)]
-    fn run<S: Simd, const ABSORBING: bool>(self, s: S) {
+    fn run<S: Simd, const ABSORBING: bool, const REAL: bool>(self, s: S) {
         let lanes = Lanes::<S>::new(s, self.row);
         let scalar = pulp::Scalar::new();
         let one = Lanes::<pulp::Scalar>::new(scalar, self.row);
@@ -550,7 +609,7 @@ impl<T: PowerSlot> PowersOp<'_, T> {
             let head = re.len() * S::F64_LANES;
             let (out_v, out_t) = out.split_at_mut(head);
             for (i, chunk) in out_v.chunks_exact_mut(S::F64_LANES).enumerate() {
-                let p = lanes.airy(s, [re[i], im[i], norm[i]]);
+                let p = lanes.airy::<ABSORBING, REAL>(s, [re[i], im[i], norm[i]]);
                 let p: [&[f64]; 4] = [
                     bytemuck::cast_slice(std::slice::from_ref(&p[0])),
                     bytemuck::cast_slice(std::slice::from_ref(&p[1])),
@@ -567,7 +626,8 @@ impl<T: PowerSlot> PowersOp<'_, T> {
                 }
             }
             for (i, slot) in out_t.iter_mut().enumerate() {
-                let [rs, rp, ts, tp] = one.airy(scalar, [re_t[i], im_t[i], norm_t[i]]);
+                let [rs, rp, ts, tp] =
+                    one.airy::<ABSORBING, REAL>(scalar, [re_t[i], im_t[i], norm_t[i]]);
                 slot.put(Power {
                     R_s: rs,
                     R_p: rp,
@@ -635,17 +695,18 @@ impl WithSimd for AccumulateOp<'_> {
 
     #[inline(always)]
     fn with_simd<S: Simd>(self, s: S) {
-        if self.row.z_im == 0.0 {
-            self.run::<S, false>(s)
-        } else {
-            self.run::<S, true>(s)
+        match (self.row.z_im == 0.0, self.row.is_real()) {
+            (true, true) => self.run::<S, false, true>(s),
+            (true, false) => self.run::<S, false, false>(s),
+            (false, true) => self.run::<S, true, true>(s),
+            (false, false) => self.run::<S, true, false>(s),
         }
     }
 }
 
 /// One element's (or lane's) contribution: R w and T w added to the six sums.
 #[inline(always)]
-fn accumulate_one<S: Simd>(
+fn accumulate_one<S: Simd, const ABSORBING: bool, const REAL: bool>(
     s: S,
     lanes: &Lanes<S>,
     w: &[S::f64s; 3],
@@ -653,7 +714,7 @@ fn accumulate_one<S: Simd>(
     r: [&mut S::f64s; 3],
     t: [&mut S::f64s; 3],
 ) {
-    let [rs, rp, ts, tp] = lanes.airy(s, e);
+    let [rs, rp, ts, tp] = lanes.airy::<ABSORBING, REAL>(s, e);
     let half = s.splat_f64s(0.5);
     let rv = s.mul_f64s(half, s.add_f64s(rs, rp));
     let tv = s.mul_f64s(half, s.add_f64s(ts, tp));
@@ -665,7 +726,7 @@ fn accumulate_one<S: Simd>(
 
 impl AccumulateOp<'_> {
     #[inline(always)]
-    fn run<S: Simd, const ABSORBING: bool>(self, s: S) {
+    fn run<S: Simd, const ABSORBING: bool, const REAL: bool>(self, s: S) {
         let lanes = Lanes::<S>::new(s, self.row);
         let w = [
             s.splat_f64s(self.weights[0]),
@@ -705,7 +766,7 @@ impl AccumulateOp<'_> {
             let (t1v, t1t) = S::as_mut_simd_f64s(t1);
             let (t2v, t2t) = S::as_mut_simd_f64s(t2);
             for i in 0..re.len() {
-                accumulate_one::<S>(
+                accumulate_one::<S, ABSORBING, REAL>(
                     s,
                     &lanes,
                     &w,
@@ -715,7 +776,7 @@ impl AccumulateOp<'_> {
                 );
             }
             for i in 0..re_t.len() {
-                accumulate_one::<pulp::Scalar>(
+                accumulate_one::<pulp::Scalar, ABSORBING, REAL>(
                     scalar,
                     &one,
                     &self.weights,
@@ -856,7 +917,59 @@ mod tests {
             z_re: 0.04 * n,
             z_im,
         };
-        vec![row(1.33, 0.0), row(2.4, 0.0), row(1.5, 3e-3), row(2.0, 0.2)]
+        let mut real = row(1.33, 0.0);
+        for c in real
+            .r01
+            .iter_mut()
+            .chain(&mut real.gamma)
+            .chain(&mut real.r01_gamma)
+        {
+            c[1] = 0.0;
+        }
+        vec![
+            row(1.33, 0.0),
+            row(2.4, 0.0),
+            row(1.5, 3e-3),
+            row(2.0, 0.2),
+            real,
+        ]
+    }
+
+    /// The real and lossless variants of the kernel give the bits of the general formula.
+    #[test]
+    fn special_variants_match_the_general_formula() {
+        let row = AiryRow {
+            r01: [[-0.2, 0.0], [0.17, 0.0]],
+            gamma: [[0.3, 0.0], [-0.6, 0.0]],
+            r01_gamma: [[-0.06, 0.0], [-0.102, 0.0]],
+            t_norm: [0.8, 0.9],
+            z_re: 0.05,
+            z_im: 0.0,
+        };
+        assert!(row.is_real());
+        for d in [
+            (0..67).map(|k| 3.0 * k as f64).collect::<Vec<_>>(),
+            (0..67).map(|k| (k * k) as f64).collect(),
+        ] {
+            let h = uniform_step(&d);
+            let mut special = vec![Power::default(); d.len()];
+            airy_powers(&row, &d, h, &mut special, true);
+            let mut general = vec![Power::default(); d.len()];
+            PowersOp {
+                row: &row,
+                thickness_nm: &d,
+                uniform_step_nm: h,
+                out: &mut general,
+            }
+            .run::<pulp::Scalar, true, false>(pulp::Scalar::new());
+            let bits = |p: &[Power]| -> Vec<u64> {
+                p.iter()
+                    .flat_map(|p| [p.R_s, p.R_p, p.T_s, p.T_p])
+                    .map(f64::to_bits)
+                    .collect()
+            };
+            assert_eq!(bits(&special), bits(&general));
+        }
     }
 
     #[test]
