@@ -41,7 +41,9 @@
 //! wavelength, compute interface coefficients once per (angle, distinct set of indices) —
 //! so for non-dispersive stacks once per angle, shared by every wavelength and thickness —
 //! and run angles in parallel with rayon. Every value is computed by the same code whatever
-//! the thread count, so results are bit-identical across thread counts.
+//! the thread count, so results are bit-identical across thread counts. A sweep over the top
+//! film's thickness runs the Airy closed form through the vectorised kernel of
+//! [`crate::simd`] (IEEE basic operations only, so the same bits on every CPU and vector width).
 
 use crate::error::{Error, Result};
 use crate::fresnel::{Interface, normal_component, power_factor_p, power_factor_s};
