@@ -624,8 +624,24 @@ impl TaylorTerms {
 
     #[inline]
     fn sum_at(&self, (sy, sx): (usize, usize), c: &[f64]) -> C64 {
-        let t = self.data.slice(s![sy, sx, ..]);
-        t.iter().zip(c).map(|(t, c)| t * c).sum()
+        self.bin_terms(sy, sx)
+            .iter()
+            .zip(c)
+            .map(|(t, c)| t * c)
+            .sum()
+    }
+
+    /// T₀ … T_N of bin (sy, sx): a plain slice of the standard-layout array (an ndarray
+    /// `slice` per bin costs more than the sums over it in the hot loops).
+    #[inline]
+    fn bin_terms(&self, sy: usize, sx: usize) -> &[C64] {
+        let n = self.order + 1;
+        let start = (sy * self.nx + sx) * n;
+        let data = self
+            .data
+            .as_slice()
+            .expect("built by Array3::from_shape_fn: standard layout");
+        &data[start..start + n]
     }
 }
 
@@ -782,7 +798,7 @@ impl DiffractionSurface {
         for &(jy, wy) in &ys {
             for &(jx, wx) in &xs {
                 if let Some((sy, sx)) = self.terms.index(jx, jy) {
-                    let t = self.terms.data.slice(s![sy, sx, ..]);
+                    let t = self.terms.bin_terms(sy, sx);
                     for (o, t) in out.iter_mut().zip(t) {
                         *o += t * (wx * wy);
                     }

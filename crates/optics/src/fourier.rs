@@ -183,28 +183,40 @@ impl SensitivitySpectrum {
                 1.0
             }
         };
+        let cells = self.nu.len() - 1;
+        // The phases e^{−iωνᵢ} and the cells' e^{−iωhᵢ}, by the vectorised deterministic
+        // sin/cos of `crate::simd` (the same bits on every CPU).
+        let mut arg = Vec::with_capacity(2 * cells);
+        arg.extend(self.nu[..cells].iter().map(|&a| -omega * a));
+        arg.extend(self.nu.windows(2).map(|p| -(omega * (p[1] - p[0]))));
+        let (mut sin, mut cos) = (vec![0.0; 2 * cells], vec![0.0; 2 * cells]);
+        crate::simd::sin_cos_slice(&arg, &mut sin, &mut cos);
         let mut sum = [C64::new(0.0, 0.0); 3];
-        for i in 0..self.nu.len() - 1 {
+        let mut da = damp(self.nu[0]);
+        for i in 0..cells {
             let (a, b) = (self.nu[i], self.nu[i + 1]);
             let h = b - a;
-            let (da, db) = (damp(a), damp(b));
+            let db = damp(b);
             let (fa, fb) = (
                 self.values[i].map(|v| v * da),
                 self.values[i + 1].map(|v| v * db),
             );
-            let (wa, wb) = filon_weights(omega, h);
-            let phase = C64::from_polar(1.0, -omega * a);
+            let e = C64::new(cos[cells + i], sin[cells + i]);
+            let (wa, wb) = filon_weights(omega, h, e);
+            let phase = C64::new(cos[i], sin[i]);
             for j in 0..3 {
                 // ∫ (f_a + (f_b − f_a) t / h) e^{−iω(a + t)} dt = e^{−iωa} (f_a A + (f_b − f_a) B / h)
                 sum[j] += phase * (wa * fa[j] + wb * ((fb[j] - fa[j]) / h));
             }
+            da = db;
         }
         std::array::from_fn(|j| sum[j] / self.norm[j])
     }
 }
 
-/// A = ∫₀ʰ e^{−iωt} dt and B = ∫₀ʰ t e^{−iωt} dt, with Taylor series for small ωh.
-fn filon_weights(omega: f64, h: f64) -> (C64, C64) {
+/// A = ∫₀ʰ e^{−iωt} dt and B = ∫₀ʰ t e^{−iωt} dt, with Taylor series for small ωh;
+/// `e` = e^{−iωh}.
+fn filon_weights(omega: f64, h: f64, e: C64) -> (C64, C64) {
     let theta = omega * h;
     let i = C64::new(0.0, 1.0);
     if theta.abs() < 1e-2 {
@@ -214,7 +226,6 @@ fn filon_weights(omega: f64, h: f64) -> (C64, C64) {
         let b = h * h * (0.5 + t / 3.0 + t * t / 8.0 + t * t * t / 30.0 + t * t * t * t / 144.0);
         (a, b)
     } else {
-        let e = C64::from_polar(1.0, -theta);
         let a = (1.0 - e) / (i * omega);
         let b = i * h * e / omega - (1.0 - e) / (omega * omega);
         (a, b)

@@ -31,6 +31,7 @@ pub mod fresnel;
 pub mod material;
 pub mod microfacet;
 pub mod quadrature;
+pub(crate) mod simd;
 pub mod spectral;
 pub mod stack;
 

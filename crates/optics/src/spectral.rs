@@ -53,6 +53,7 @@
 
 use crate::colour::{Colorimeter, SPECTRAL_MAX_NM, SPECTRAL_MIN_NM};
 use crate::error::{Error, Result};
+use crate::simd::{ColourSums, airy_accumulate};
 use crate::stack::{Prepared, Stack, ThicknessSweep, uniform_step};
 use std::f64::consts::PI;
 
@@ -356,13 +357,15 @@ impl Stack {
         self.check_layer(layer, thicknesses_nm)?;
         let sin_theta = sines[0];
         let thickness = self.thicknesses_nm();
-        let step = uniform_step(thicknesses_nm);
         let n = thicknesses_nm.len();
+        let step = uniform_step(thicknesses_nm);
+        let mut row = vec![crate::Power::default(); n];
+        // Top film: the vectorised Airy kernel adds R w and T w straight into per-channel sums.
+        let mut sums = ColourSums::new(if layer == 1 { n } else { 0 });
         let mut out = FilmColours {
             reflectance: vec![[0.0; 3]; n],
             transmittance: vec![[0.0; 3]; n],
         };
-        let mut row = vec![crate::Power::default(); n];
         let mut cache: Option<Prepared> = None;
         for ((&wl, idx), w) in rule
             .wavelengths_nm()
@@ -374,11 +377,12 @@ impl Stack {
                 cache = Some(Prepared::new(idx, idx[0].re * sin_theta));
             }
             let prepared = cache.as_ref().expect("just filled");
-            ThicknessSweep::new(prepared, wl, &thickness, layer).fill(
-                thicknesses_nm,
-                step,
-                &mut row,
-            );
+            let sweep = ThicknessSweep::new(prepared, wl, &thickness, layer);
+            if let Some(airy) = sweep.airy_row() {
+                airy_accumulate(airy, thicknesses_nm, step, *w, &mut sums, true);
+                continue;
+            }
+            sweep.fill(thicknesses_nm, step, &mut row);
             for ((p, r), t) in row
                 .iter()
                 .zip(&mut out.reflectance)
@@ -388,6 +392,14 @@ impl Stack {
                 for c in 0..3 {
                     r[c] += rv * w[c];
                     t[c] += tv * w[c];
+                }
+            }
+        }
+        if layer == 1 {
+            for k in 0..n {
+                for c in 0..3 {
+                    out.reflectance[k][c] = sums.reflectance[c][k];
+                    out.transmittance[k][c] = sums.transmittance[c][k];
                 }
             }
         }

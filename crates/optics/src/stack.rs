@@ -41,11 +41,15 @@
 //! wavelength, compute interface coefficients once per (angle, distinct set of indices) —
 //! so for non-dispersive stacks once per angle, shared by every wavelength and thickness —
 //! and run angles in parallel with rayon. Every value is computed by the same code whatever
-//! the thread count, so results are bit-identical across thread counts.
+//! the thread count, so results are bit-identical across thread counts. A sweep over the top
+//! film's thickness runs the Airy closed form through the vectorised kernel of
+//! [`crate::simd`] (IEEE basic operations only, so the same bits on every CPU and vector width).
 
 use crate::error::{Error, Result};
 use crate::fresnel::{Interface, normal_component, power_factor_p, power_factor_s};
 use crate::material::Material;
+pub(crate) use crate::simd::uniform_step;
+use crate::simd::{AiryRow, PowerSlot, airy_powers};
 use num_complex::Complex64 as C64;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -235,7 +239,9 @@ impl Prepared {
 
 /// A thickness sweep of one film at fixed angle and wavelength: the part of the stack
 /// below the varying film is folded into (Γ, τ) once; each thickness then costs one
-/// complex exponential and the recurrence through the films above it.
+/// complex exponential and the recurrence through the films above it. For the top film
+/// that is the Airy closed form, evaluated by the vectorised kernel of [`crate::simd`]
+/// (the same bits on every CPU and vector width).
 pub(crate) struct ThicknessSweep<'a> {
     prepared: &'a Prepared,
     k0: f64,
@@ -246,10 +252,8 @@ pub(crate) struct ThicknessSweep<'a> {
     tau: [C64; 2],
     /// e^{iδ_j} of the fixed films above the varying one (index j − 1).
     above: Vec<C64>,
-    /// Top-film fast path constants per polarisation: r₀₁, r₀₁Γ₁, |t₀₁τ₁|² × power factor.
-    r01: [C64; 2],
-    r01_gamma: [C64; 2],
-    t_norm: [f64; 2],
+    /// Top-film constants: r₀₁, Γ₁, r₀₁Γ₁, |t₀₁τ₁|² × power factor and z = 2k₀q₁.
+    airy: AiryRow,
 }
 
 impl<'a> ThicknessSweep<'a> {
@@ -274,6 +278,8 @@ impl<'a> ThicknessSweep<'a> {
         let top = &prepared.interfaces[0];
         let r01 = [top.r_s, top.r_p];
         let factor = [prepared.factor_s, prepared.factor_p];
+        let pair = |c: C64| [c.re, c.im];
+        let z = prepared.q[1] * (2.0 * k0);
         ThicknessSweep {
             prepared,
             k0,
@@ -281,81 +287,45 @@ impl<'a> ThicknessSweep<'a> {
             gamma,
             tau,
             above,
-            r01,
-            r01_gamma: [r01[0] * gamma[0], r01[1] * gamma[1]],
-            t_norm: [
-                (top.t_s * tau[0]).norm_sqr() * factor[0],
-                (top.t_p * tau[1]).norm_sqr() * factor[1],
-            ],
+            airy: AiryRow {
+                r01: r01.map(pair),
+                gamma: gamma.map(pair),
+                r01_gamma: [pair(r01[0] * gamma[0]), pair(r01[1] * gamma[1])],
+                t_norm: [
+                    (top.t_s * tau[0]).norm_sqr() * factor[0],
+                    (top.t_p * tau[1]).norm_sqr() * factor[1],
+                ],
+                z_re: z.re,
+                z_im: z.im,
+            },
         }
     }
 
-    /// Fills `row[k]` with the powers at thickness `thickness_nm[k]`. When the thicknesses
-    /// are uniformly spaced by `uniform_step_nm`, the top-film path advances the phasor
-    /// e^{2iδ} by one complex multiplication per step instead of a `sin_cos`, re-anchoring
-    /// on the exact value every [`RESYNC`] steps (R and T stay within 1e-12 of the pointwise values, tested).
-    pub(crate) fn fill(
+    /// The top-film constants, when the varying film is the top one.
+    pub(crate) fn airy_row(&self) -> Option<&AiryRow> {
+        (self.film == 1).then_some(&self.airy)
+    }
+
+    /// Writes into `row[k]` the powers at thickness `thickness_nm[k]`; `uniform_step_nm`
+    /// is [`uniform_step`] of `thickness_nm`.
+    pub(crate) fn fill<T: PowerSlot>(
         &self,
         thickness_nm: &[f64],
         uniform_step_nm: Option<f64>,
-        row: &mut [Power],
+        row: &mut [T],
     ) {
-        if self.film != 1 {
+        if self.film == 1 {
+            airy_powers(&self.airy, thickness_nm, uniform_step_nm, row, true);
+        } else {
             for (slot, &d) in row.iter_mut().zip(thickness_nm) {
-                *slot = self.power(d);
-            }
-            return;
-        }
-        let z = self.prepared.q[1] * (2.0 * self.k0);
-        match uniform_step_nm {
-            Some(step) => {
-                let rotation = exp_i(z * step);
-                let mut e2 = C64::new(1.0, 0.0);
-                for (k, (slot, &d)) in row.iter_mut().zip(thickness_nm).enumerate() {
-                    e2 = if k % RESYNC == 0 {
-                        exp_i(z * d)
-                    } else {
-                        e2 * rotation
-                    };
-                    *slot = self.airy(e2);
-                }
-            }
-            None => {
-                for (slot, &d) in row.iter_mut().zip(thickness_nm) {
-                    *slot = self.airy(exp_i(z * d));
-                }
+                slot.put(self.power(d));
             }
         }
     }
 
-    /// Airy closed form for the top film (Belcour & Barla 2017, Eq. 2) from e^{2iδ₁}:
-    ///   R = |r₀₁ + Γ₁ e^{2iδ}|² / |1 + r₀₁ Γ₁ e^{2iδ}|²,
-    ///   T = |t₀₁ τ₁|² |e^{iδ}|² / |1 + r₀₁ Γ₁ e^{2iδ}|² × power factor,
-    /// the recurrence of `Prepared::step` without complex division (|e^{iδ}|² = |e^{2iδ}|).
-    #[inline]
-    fn airy(&self, e2: C64) -> Power {
-        let e_norm = e2.norm();
-        let mut out = [0.0; 4];
-        for pol in 0..2 {
-            let num = self.r01[pol] + self.gamma[pol] * e2;
-            let den = (1.0 + self.r01_gamma[pol] * e2).norm_sqr().recip();
-            out[pol] = num.norm_sqr() * den;
-            out[2 + pol] = self.t_norm[pol] * e_norm * den;
-        }
-        Power {
-            R_s: out[0],
-            R_p: out[1],
-            T_s: out[2],
-            T_p: out[3],
-        }
-    }
-
-    /// Powers at thickness `d_nm` of the varying film.
+    /// Powers at thickness `d_nm` of a varying film below the top one.
     fn power(&self, d_nm: f64) -> Power {
         let p = self.prepared;
-        if self.film == 1 {
-            return self.airy(exp_i(p.q[1] * (2.0 * self.k0 * d_nm)));
-        }
         let e = p.phase(self.film, self.k0, d_nm);
         let (mut gamma, mut tau) = p.step(self.film - 1, e, self.gamma, self.tau);
         for j in (0..self.film - 1).rev() {
@@ -479,13 +449,17 @@ impl Stack {
         self.check_layer(layer, thicknesses_nm)?;
         let thickness = self.thicknesses_nm();
         let (sines, indices) = self.resolve(angles_deg, wavelengths_nm)?;
-        let uniform_step = uniform_step(thicknesses_nm);
         let per_angle = wavelengths_nm.len() * thicknesses_nm.len();
-        let mut out = vec![Power::default(); sines.len() * per_angle];
+        let step = uniform_step(thicknesses_nm);
+        let total = sines.len() * per_angle;
+        let mut out: Vec<Power> = Vec::with_capacity(total);
         if per_angle == 0 {
+            out.resize(total, Power::default());
             return Ok(out);
         }
-        out.par_chunks_mut(per_angle)
+        // Every slot is written once, straight into the fresh allocation (no zeroing pass).
+        out.spare_capacity_mut()[..total]
+            .par_chunks_mut(per_angle)
             .zip(&sines)
             .for_each(|(block, &sin_theta)| {
                 let mut cache: Option<Prepared> = None;
@@ -493,9 +467,14 @@ impl Stack {
                 for ((row, &wl), idx) in rows.zip(wavelengths_nm).zip(&indices) {
                     let prepared = reuse(&mut cache, idx, sin_theta);
                     let sweep = ThicknessSweep::new(prepared, wl, &thickness, layer);
-                    sweep.fill(thicknesses_nm, uniform_step, row);
+                    sweep.fill(thicknesses_nm, step, row);
                 }
             });
+        // SAFETY: the blocks partition `spare_capacity_mut()[..total]` (per_angle > 0), their
+        // rows partition each block (one row per wavelength, `thicknesses_nm.len()` each),
+        // and `fill` writes every slot of its row, so the first `total` elements are
+        // initialised.
+        unsafe { out.set_len(total) };
         Ok(out)
     }
 
@@ -590,28 +569,6 @@ pub(crate) fn fringe_finesse_of(indices: &[C64], beta: f64) -> f64 {
     } else {
         rho.clamp(0.0, 1.0)
     }
-}
-
-/// Steps between re-anchoring the phasor on an exact exponential in uniform thickness
-/// sweeps.
-const RESYNC: usize = 8;
-
-/// The common spacing of `values` when every value lies within a few ulps of
-/// `values[0] + k · step` (so that stepping a phasor is as exact as evaluating it).
-pub(crate) fn uniform_step(values: &[f64]) -> Option<f64> {
-    let n = values.len();
-    if n < 3 {
-        return None;
-    }
-    let step = (values[n - 1] - values[0]) / (n - 1) as f64;
-    let scale = values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let tolerance = 8.0 * f64::EPSILON * scale;
-    let uniform = step > 0.0
-        && values
-            .iter()
-            .enumerate()
-            .all(|(k, &v)| (v - (values[0] + k as f64 * step)).abs() <= tolerance);
-    uniform.then_some(step)
 }
 
 /// Returns a `Prepared` for `indices`, reusing the cached one when the indices have not

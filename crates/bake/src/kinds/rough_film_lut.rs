@@ -206,6 +206,16 @@ impl RoughLutJob {
                     Ok(stack.colours_over_thickness(1, c.acos().to_degrees(), &rule, &d_grid)?)
                 })
                 .collect::<Result<_>>()?;
+            // F by thickness then cosine, (F_R, F_T) side by side, so that the sums over j
+            // below read consecutive memory: film[m · n_c + j] = (F_R, F_T)(c_j, d_m).
+            let film: Vec<[f64; 6]> = (0..d_nodes)
+                .flat_map(|m| {
+                    colours.iter().map(move |f| {
+                        let (r, t) = (f.reflectance[m], f.transmittance[m]);
+                        [r[0], r[1], r[2], t[0], t[1], t[2]]
+                    })
+                })
+                .collect();
             // The product, one column x at a time: texel (x, y, k, a) =
             // Σ_m w_m Σ_j K[x, a, j] F(c_j, d_m), w the cubic weights of its thickness.
             let columns: Vec<Vec<[f64; 6]>> = (0..a.cos_theta_count)
@@ -221,15 +231,15 @@ impl RoughLutJob {
                             let mut e = [0.0; 6];
                             for (s, ws) in w.iter().enumerate() {
                                 let mut v = [0.0; 6];
+                                let row = (m0 + s) * n_c;
                                 let rows = kern.reflection[lo..hi]
                                     .iter()
                                     .zip(&kern.transmission[lo..hi])
-                                    .zip(&colours[lo..hi]);
+                                    .zip(&film[row + lo..row + hi]);
                                 for ((&kr, &kt), f) in rows {
-                                    let (r, t) = (f.reflectance[m0 + s], f.transmittance[m0 + s]);
                                     for c in 0..3 {
-                                        v[c] += kr * r[c];
-                                        v[3 + c] += kt * t[c];
+                                        v[c] += kr * f[c];
+                                        v[3 + c] += kt * f[3 + c];
                                     }
                                 }
                                 for c in 0..6 {
