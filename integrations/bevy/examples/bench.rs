@@ -72,7 +72,11 @@ fn time_scene(kind: Kind, frames: usize) -> f64 {
                 let mesh = meshes.add(Sphere::new(0.45).mesh().uv(64, 32));
                 for i in 0..GRID * GRID {
                     let (x, y) = ((i % GRID) as f32, (i / GRID) as f32);
-                    let at = Transform::from_xyz(x - (GRID - 1) as f32 / 2.0, y - (GRID - 1) as f32 / 2.0, 0.0);
+                    let at = Transform::from_xyz(
+                        x - (GRID - 1) as f32 / 2.0,
+                        y - (GRID - 1) as f32 / 2.0,
+                        0.0,
+                    );
                     let d = 1100.0 * i as f32 / (GRID * GRID) as f32;
                     let mut entity = commands.spawn((Mesh3d(mesh.clone()), at));
                     match kind {
@@ -85,7 +89,10 @@ fn time_scene(kind: Kind, frames: usize) -> f64 {
                                 extension: NacreFilm {
                                     technique,
                                     film_ior: 1.8,
-                                    thickness: FilmThickness::Gltf { min_nm: d, max_nm: d },
+                                    thickness: FilmThickness::Gltf {
+                                        min_nm: d,
+                                        max_nm: d,
+                                    },
                                     weight: 1.0,
                                     ..default()
                                 },
@@ -147,7 +154,9 @@ fn main() {
         .and_then(|a| a.parse().ok())
         .unwrap_or(30);
     let standard = time_scene(Kind::Standard, frames);
-    println!("StandardMaterial: {standard:.2} ms/frame ({GRID}×{GRID} spheres, {WIDTH}×{HEIGHT}, median of {frames})");
+    println!(
+        "StandardMaterial: {standard:.2} ms/frame ({GRID}×{GRID} spheres, {WIDTH}×{HEIGHT}, median of {frames})"
+    );
     for technique in [FilmTechnique::Lut, FilmTechnique::Fourier] {
         let film = time_scene(Kind::Film(technique), frames);
         println!(

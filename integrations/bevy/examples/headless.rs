@@ -13,11 +13,11 @@ use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::ecs::system::RunSystemOnce;
 use bevy::gltf::GltfAssetLabel;
 use bevy::prelude::*;
-use bevy::world_serialization::{WorldAsset, WorldAssetRoot};
 use bevy::render::pipelined_rendering::PipelinedRenderingPlugin;
 use bevy::render::render_resource::TextureFormat;
 use bevy::render::view::screenshot::{Screenshot, save_to_disk};
 use bevy::window::ExitCondition;
+use bevy::world_serialization::{WorldAsset, WorldAssetRoot};
 use bevy_nacre::{NacreMaterial, NacrePlugin};
 use std::path::PathBuf;
 
@@ -31,7 +31,11 @@ fn main() {
         std::process::exit(2);
     };
     let asset = args.next().map(PathBuf::from);
-    let (width, height) = if asset.is_some() { (800, 400) } else { (700, 100) };
+    let (width, height) = if asset.is_some() {
+        (800, 400)
+    } else {
+        (700, 100)
+    };
     // Assets are read relative to the glTF's folder (the row needs no files).
     let root = asset
         .as_ref()
@@ -62,29 +66,40 @@ fn main() {
     app.cleanup();
 
     let world = app.world_mut();
-    let image = world.resource_mut::<Assets<Image>>().add(Image::new_target_texture(
-        width,
-        height,
-        TextureFormat::Rgba8UnormSrgb,
-        None,
-    ));
+    let image = world
+        .resource_mut::<Assets<Image>>()
+        .add(Image::new_target_texture(
+            width,
+            height,
+            TextureFormat::Rgba8UnormSrgb,
+            None,
+        ));
     let mut scene_handle = None;
     let row_y = if asset.is_some() { -1.6 } else { 0.0 };
-    world.run_system_once(
-        move |mut commands: Commands,
-              mut meshes: ResMut<Assets<Mesh>>,
-              mut materials: ResMut<Assets<NacreMaterial>>| {
-            scene::spawn_lights(&mut commands);
-            scene::spawn_sphere_row(&mut commands, &mut meshes, &mut materials, Vec3::Y * row_y);
-        },
-    )
-    .expect("setting up the scene");
+    world
+        .run_system_once(
+            move |mut commands: Commands,
+                  mut meshes: ResMut<Assets<Mesh>>,
+                  mut materials: ResMut<Assets<NacreMaterial>>| {
+                scene::spawn_lights(&mut commands);
+                scene::spawn_sphere_row(
+                    &mut commands,
+                    &mut meshes,
+                    &mut materials,
+                    Vec3::Y * row_y,
+                );
+            },
+        )
+        .expect("setting up the scene");
     if let Some(asset) = &asset {
         let file = asset.file_name().unwrap().to_string_lossy().into_owned();
         let handle: Handle<WorldAsset> = world
             .resource::<AssetServer>()
             .load(GltfAssetLabel::Scene(0).from_asset(file));
-        world.spawn((WorldAssetRoot(handle.clone()), Transform::from_xyz(0.0, 0.6, 0.0)));
+        world.spawn((
+            WorldAssetRoot(handle.clone()),
+            Transform::from_xyz(0.0, 0.6, 0.0),
+        ));
         scene_handle = Some(handle);
     }
     let (projection, eye) = if asset.is_some() {

@@ -50,8 +50,16 @@ pub struct NacreGltfHandler {
 /// tint `g` (Gulbrandsen 2014, "Artist Friendly Metallic Fresnel", JCGT 3(4), Eq. 1–2; f0
 /// clamped to [0, 0.99]), as nacre's runtime maps a glTF metal (`gltf_metal.rs`).
 pub fn metal_index_gulbrandsen2014(f0: f32, g: f32) -> (f32, f32) {
-    let r = if f0.is_finite() { f0.clamp(0.0, 0.99) } else { 0.5 };
-    let g = if g.is_finite() { g.clamp(0.0, 1.0) } else { 0.5 };
+    let r = if f0.is_finite() {
+        f0.clamp(0.0, 0.99)
+    } else {
+        0.5
+    };
+    let g = if g.is_finite() {
+        g.clamp(0.0, 1.0)
+    } else {
+        0.5
+    };
     let sr = r.sqrt();
     let n = g * (1.0 - r) / (1.0 + r) + (1.0 - g) * (1.0 + sr) / (1.0 - sr);
     let k2 = (r * (n + 1.0).powi(2) - (n - 1.0).powi(2)) / (1.0 - r);
@@ -86,15 +94,25 @@ pub fn film_from_gltf(
     let max_nm = number(ext, "iridescenceThicknessMaximum", 400.0);
     let thickness_texture = texture_index(ext, "iridescenceThicknessTexture").and_then(&texture);
     // Without a thickness texture the film is d_max thick (glTF), so d_min does not matter.
-    let thickness_top = if thickness_texture.is_some() { min_nm.max(max_nm) } else { max_nm };
-    let thickness_bottom = if thickness_texture.is_some() { min_nm.min(max_nm) } else { max_nm };
+    let thickness_top = if thickness_texture.is_some() {
+        min_nm.max(max_nm)
+    } else {
+        max_nm
+    };
+    let thickness_bottom = if thickness_texture.is_some() {
+        min_nm.min(max_nm)
+    } else {
+        max_nm
+    };
     let lut_covers = metallic == 0.0
         && (ior - LUT_BASE_IOR).abs() < 1e-6
         && (LUT_IOR_RANGE.0..=LUT_IOR_RANGE.1).contains(&film_ior)
         && thickness_bottom >= 0.0
         && thickness_top <= LUT_THICKNESS_MAX_NM;
     let (base_ior, base_kappa) = if metallic > 0.0 {
-        let nk = base_colour.to_array().map(|f| metal_index_gulbrandsen2014(f, f));
+        let nk = base_colour
+            .to_array()
+            .map(|f| metal_index_gulbrandsen2014(f, f));
         (
             Vec3::new(nk[0].0, nk[1].0, nk[2].0),
             Vec3::new(nk[0].1, nk[1].1, nk[2].1),
@@ -226,13 +244,31 @@ mod tests {
         let film = film_from_gltf(&json!({}), 1.5, 0.0, Vec3::ONE, |_| None);
         assert_eq!(film.weight, 0.0);
         assert_eq!(film.film_ior, 1.3);
-        assert_eq!(film.thickness, FilmThickness::Gltf { min_nm: 100.0, max_nm: 400.0 });
+        assert_eq!(
+            film.thickness,
+            FilmThickness::Gltf {
+                min_nm: 100.0,
+                max_nm: 400.0
+            }
+        );
         assert_eq!(film.technique, FilmTechnique::Lut);
         // A base of another index, a film outside the table, a metal: fourier.
-        let other_base = film_from_gltf(&json!({"iridescenceFactor": 1.0}), 1.6, 0.0, Vec3::ONE, |_| None);
+        let other_base = film_from_gltf(
+            &json!({"iridescenceFactor": 1.0}),
+            1.6,
+            0.0,
+            Vec3::ONE,
+            |_| None,
+        );
         assert_eq!(other_base.technique, FilmTechnique::Fourier);
         assert_eq!(other_base.base_ior, Vec3::splat(1.6));
-        let thick = film_from_gltf(&json!({"iridescenceThicknessMaximum": 1500.0}), 1.5, 0.0, Vec3::ONE, |_| None);
+        let thick = film_from_gltf(
+            &json!({"iridescenceThicknessMaximum": 1500.0}),
+            1.5,
+            0.0,
+            Vec3::ONE,
+            |_| None,
+        );
         assert_eq!(thick.technique, FilmTechnique::Fourier);
         let metal = film_from_gltf(&json!({}), 1.5, 1.0, Vec3::new(1.0, 0.78, 0.34), |_| None);
         assert_eq!(metal.technique, FilmTechnique::Fourier);
@@ -249,12 +285,23 @@ mod tests {
             "iridescenceThicknessMaximum": 800.0,
             "iridescenceIor": 1.8
         });
-        let film = film_from_gltf(&ext, 1.5, 0.0, Vec3::ONE, |i| (i == 7).then(Handle::default));
+        let film = film_from_gltf(&ext, 1.5, 0.0, Vec3::ONE, |i| {
+            (i == 7).then(Handle::default)
+        });
         assert_eq!(film.weight, 0.5);
         assert_eq!(film.film_ior, 1.8);
         assert!(film.thickness_texture.is_some());
-        assert!(film.weight_texture.is_none(), "texture 2 is not in the file");
-        assert_eq!(film.thickness, FilmThickness::Gltf { min_nm: 200.0, max_nm: 800.0 });
+        assert!(
+            film.weight_texture.is_none(),
+            "texture 2 is not in the file"
+        );
+        assert_eq!(
+            film.thickness,
+            FilmThickness::Gltf {
+                min_nm: 200.0,
+                max_nm: 800.0
+            }
+        );
     }
 
     #[test]

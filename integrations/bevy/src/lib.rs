@@ -85,8 +85,18 @@ fn add_default_tables(app: &mut App) {
     {
         let mut images = world.resource_mut::<Assets<Image>>();
         for (handle, name, text, files) in [
-            (DEFAULT_FILM_LUT, "film-dielectric.json", FILM_LUT_MANIFEST, &FILM_LUT_FILES[..]),
-            (DEFAULT_FOURIER, "fourier-srgb.json", FOURIER_MANIFEST, &FOURIER_FILES[..]),
+            (
+                DEFAULT_FILM_LUT,
+                "film-dielectric.json",
+                FILM_LUT_MANIFEST,
+                &FILM_LUT_FILES[..],
+            ),
+            (
+                DEFAULT_FOURIER,
+                "fourier-srgb.json",
+                FOURIER_MANIFEST,
+                &FOURIER_FILES[..],
+            ),
         ] {
             let table = tables::table_from_memory(name, text, files, |image| images.add(image))
                 .unwrap_or_else(|e| panic!("bevy_nacre: the built-in table {name}: {e}"));

@@ -76,7 +76,9 @@ pub enum ShaderError {
         import: String,
     },
     /// A binding outside group 1, or a group-1 binding in a module without a binding base.
-    #[error("shaders/{module}.wgsl line {line}: binding `{text}` has no place in the material bind group")]
+    #[error(
+        "shaders/{module}.wgsl line {line}: binding `{text}` has no place in the material bind group"
+    )]
     UnexpectedBinding {
         /// The module.
         module: String,
@@ -92,7 +94,12 @@ pub fn header_imports(source: &str) -> Vec<String> {
     source
         .lines()
         .take_while(|l| l.trim_start().starts_with("//"))
-        .filter_map(|l| l.trim_start().trim_start_matches('/').trim().strip_prefix("import:"))
+        .filter_map(|l| {
+            l.trim_start()
+                .trim_start_matches('/')
+                .trim()
+                .strip_prefix("import:")
+        })
         .flat_map(|list| list.split(','))
         .map(str::trim)
         .filter(|n| !n.is_empty() && *n != "(none)")
@@ -282,7 +289,9 @@ mod tests {
         let lut = naga_oil_source("film_lut").unwrap();
         for k in 100..=103 {
             assert!(
-                lut.contains(&format!("@group(#{{MATERIAL_BIND_GROUP}}) @binding({k}) var")),
+                lut.contains(&format!(
+                    "@group(#{{MATERIAL_BIND_GROUP}}) @binding({k}) var"
+                )),
                 "binding {k}"
             );
         }
@@ -293,7 +302,10 @@ mod tests {
 
     #[test]
     fn members_naga_would_rename_get_a_suffix_in_code_only() {
-        assert_eq!(renamed_members(), ["_pad0", "_pad1", "_pad2", "_pad3", "_pad4", "c0"]);
+        assert_eq!(
+            renamed_members(),
+            ["_pad0", "_pad1", "_pad2", "_pad3", "_pad4", "c0"]
+        );
         let common = naga_oil_source("common").unwrap();
         assert!(common.contains("    _pad3_x: f32,"));
         assert!(common.contains("o._pad3_x = 0.0;"));
@@ -306,11 +318,13 @@ mod tests {
 
     #[test]
     fn header_and_item_parsing() {
-        assert_eq!(header_imports("// x\n// import: a, b\n// import: c\nfn f() {}"), [
-            "a", "b", "c"
-        ]);
-        assert_eq!(top_level_items("fn a_b(x: f32) {}\nstruct S {}\n  fn inner() {}\nconst K: f32 = 1.0;"), [
-            "a_b", "S", "K"
-        ]);
+        assert_eq!(
+            header_imports("// x\n// import: a, b\n// import: c\nfn f() {}"),
+            ["a", "b", "c"]
+        );
+        assert_eq!(
+            top_level_items("fn a_b(x: f32) {}\nstruct S {}\n  fn inner() {}\nconst K: f32 = 1.0;"),
+            ["a_b", "S", "K"]
+        );
     }
 }

@@ -13,7 +13,9 @@
 //! plugin and available without files under [`DEFAULT_FILM_LUT`] and [`DEFAULT_FOURIER`].
 
 use bevy::asset::io::Reader;
-use bevy::asset::{Asset, AssetLoader, AssetPath, Handle, LoadContext, RenderAssetUsages, uuid_handle};
+use bevy::asset::{
+    Asset, AssetLoader, AssetPath, Handle, LoadContext, RenderAssetUsages, uuid_handle,
+};
 use bevy::image::{CompressedImageFormats, Image, ImageSampler, ImageType};
 use bevy::math::Vec3;
 use bevy::reflect::TypePath;
@@ -249,8 +251,16 @@ fn ktx2_files<'m>(
 
 /// Decodes one KTX2 file of `manifest` after checking its checksum, and checks its size and
 /// format against the axes.
-fn decode_ktx2(manifest: &Manifest, f: &FileRecord, path: &str, bytes: &[u8]) -> Result<Image, TableError> {
-    let actual: String = Sha256::digest(bytes).iter().map(|b| format!("{b:02x}")).collect();
+fn decode_ktx2(
+    manifest: &Manifest,
+    f: &FileRecord,
+    path: &str,
+    bytes: &[u8],
+) -> Result<Image, TableError> {
+    let actual: String = Sha256::digest(bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
     if actual != f.sha256 {
         return Err(TableError::Checksum {
             path: path.to_owned(),
@@ -273,8 +283,7 @@ fn decode_ktx2(manifest: &Manifest, f: &FileRecord, path: &str, bytes: &[u8]) ->
     // Bevy 0.19's KTX2 reader makes a texture of height 1 one-dimensional even when it has
     // array layers (and then views it as a 2-D array, which wgpu refuses); a fourier table
     // is a 2-D array of height 1, so it is declared two-dimensional (same texel layout).
-    if manifest.fourier().is_some() && image.texture_descriptor.dimension == TextureDimension::D1
-    {
+    if manifest.fourier().is_some() && image.texture_descriptor.dimension == TextureDimension::D1 {
         image.texture_descriptor.dimension = TextureDimension::D2;
     }
     let d = &image.texture_descriptor;
@@ -290,9 +299,16 @@ fn decode_ktx2(manifest: &Manifest, f: &FileRecord, path: &str, bytes: &[u8]) ->
     let ok = match (manifest.film_lut(), manifest.fourier()) {
         (Some(a), _) => {
             d.dimension == TextureDimension::D3
-                && matches!(d.format, TextureFormat::Rgba16Float | TextureFormat::Rgba32Float)
+                && matches!(
+                    d.format,
+                    TextureFormat::Rgba16Float | TextureFormat::Rgba32Float
+                )
                 && (d.size.width, d.size.height, d.size.depth_or_array_layers)
-                    == (a.cos_theta_count as u32, a.opd_count as u32, a.ior_count as u32)
+                    == (
+                        a.cos_theta_count as u32,
+                        a.opd_count as u32,
+                        a.ior_count as u32,
+                    )
         }
         (None, Some(a)) => {
             d.dimension == TextureDimension::D2
@@ -469,7 +485,10 @@ mod tests {
             panic!("film-dielectric is a film-lut table")
         };
         assert_eq!((a.cos_theta_count, a.opd_count, a.ior_count), (24, 384, 32));
-        assert_eq!((a.ior_min, a.ior_max, a.thickness_max_nm), (1.0, 2.5, 1200.0));
+        assert_eq!(
+            (a.ior_min, a.ior_max, a.thickness_max_nm),
+            (1.0, 2.5, 1200.0)
+        );
         assert_eq!(a.has_transmittance, 1);
         let fourier = load(
             "fourier-srgb.json",

@@ -136,7 +136,9 @@ fn run_probe(
     encoder.copy_buffer_to_buffer(&output, 0, &readback, 0, size);
     queue.submit([encoder.finish()]);
     let slice = readback.slice(..);
-    slice.map_async(MapMode::Read, |r| r.expect("mapping the probe's readback buffer"));
+    slice.map_async(MapMode::Read, |r| {
+        r.expect("mapping the probe's readback buffer")
+    });
     device
         .poll(PollType::Wait {
             submission_index: None,
@@ -170,7 +172,10 @@ fn gpu_probe(inputs: Vec<f32>) -> Vec<[[f32; 3]; 4]> {
     let shader = app
         .world_mut()
         .resource_mut::<Assets<Shader>>()
-        .add(Shader::from_wgsl(include_str!("probe.wgsl"), "bevy_nacre/tests/probe.wgsl"));
+        .add(Shader::from_wgsl(
+            include_str!("probe.wgsl"),
+            "bevy_nacre/tests/probe.wgsl",
+        ));
     let result: Slot = Arc::default();
     let layout = BindGroupLayoutDescriptor::new(
         "nacre probe",
@@ -179,11 +184,20 @@ fn gpu_probe(inputs: Vec<f32>) -> Vec<[[f32; 3]; 4]> {
             (
                 (0, storage_buffer_read_only_sized(false, None)),
                 (1, storage_buffer_sized(false, None)),
-                (100, texture_3d(TextureSampleType::Float { filterable: true })),
-                (101, texture_3d(TextureSampleType::Float { filterable: true })),
+                (
+                    100,
+                    texture_3d(TextureSampleType::Float { filterable: true }),
+                ),
+                (
+                    101,
+                    texture_3d(TextureSampleType::Float { filterable: true }),
+                ),
                 (102, sampler(SamplerBindingType::Filtering)),
                 (103, uniform_buffer_sized(false, None)),
-                (104, texture_2d_array(TextureSampleType::Float { filterable: false })),
+                (
+                    104,
+                    texture_2d_array(TextureSampleType::Float { filterable: false }),
+                ),
                 (105, uniform_buffer_sized(false, None)),
             ),
         ),
@@ -207,7 +221,9 @@ fn gpu_probe(inputs: Vec<f32>) -> Vec<[[f32; 3]; 4]> {
         pipeline,
         images: [
             lut.texture.clone(),
-            lut.transmittance.clone().expect("film-dielectric has a transmittance"),
+            lut.transmittance
+                .clone()
+                .expect("film-dielectric has a transmittance"),
             fourier.texture.clone(),
         ],
         lut_axes,
@@ -278,8 +294,14 @@ fn the_plugins_shader_functions_match_nacre_color() {
     let lut_path = baked.join("film-dielectric.json");
     let lut_manifest = Manifest::read(&lut_path).unwrap();
     let axes = lut_manifest.film_lut().cloned().unwrap();
-    let refl = lut_manifest.load_table(&lut_path, "reflectance").unwrap().unwrap();
-    let trans = lut_manifest.load_table(&lut_path, "transmittance").unwrap().unwrap();
+    let refl = lut_manifest
+        .load_table(&lut_path, "reflectance")
+        .unwrap()
+        .unwrap();
+    let trans = lut_manifest
+        .load_table(&lut_path, "transmittance")
+        .unwrap()
+        .unwrap();
     let fourier_path = baked.join("fourier-srgb.json");
     let fourier_manifest = Manifest::read(&fourier_path).unwrap();
     let fourier = fourier_manifest.load_fourier(&fourier_path).unwrap();
@@ -372,7 +394,10 @@ fn the_plugins_shader_functions_match_nacre_color() {
             g.push(o[k]);
         }
         let (worst, _) = max_diff(&cpu, &g);
-        eprintln!("film_fourier {name}: {} points, max |GPU − CPU| = {worst:.2e}", cpu.len());
+        eprintln!(
+            "film_fourier {name}: {} points, max |GPU − CPU| = {worst:.2e}",
+            cpu.len()
+        );
         assert!(worst <= 2e-3, "film_fourier {name}: {worst:e}");
     }
 }

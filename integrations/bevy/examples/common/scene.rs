@@ -8,9 +8,9 @@ use bevy_nacre::{FilmThickness, NacreFilm, NacreMaterial};
 /// Spheres in the row.
 pub const ROW: usize = 7;
 /// Thickness of the last sphere's film, nm (the first has none).
-pub const THICKNESS_MAX_NM: f32 = 1100.0;
+pub const THICKNESS_MAX_NM: f32 = 700.0;
 
-/// Spawns the sphere row (film index 1.8 on a black glazed dielectric, 0 … 1100 nm left to
+/// Spawns the sphere row (film index 1.8 on a black glazed dielectric, 0 … 700 nm left to
 /// right) centred at `centre`.
 pub fn spawn_sphere_row(
     commands: &mut Commands,
@@ -49,12 +49,12 @@ pub fn spawn_sphere_row(
 pub fn spawn_lights(commands: &mut Commands) {
     commands.insert_resource(GlobalAmbientLight {
         color: Color::WHITE,
-        brightness: 6000.0,
+        brightness: 2500.0,
         ..default()
     });
     commands.spawn((
         DirectionalLight {
-            illuminance: 3000.0,
+            illuminance: 2000.0,
             ..default()
         },
         Transform::from_xyz(2.0, 4.0, 6.0).looking_at(Vec3::ZERO, Vec3::Y),
