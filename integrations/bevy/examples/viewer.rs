@@ -9,7 +9,7 @@
 use bevy::gltf::GltfAssetLabel;
 use bevy::input::mouse::{AccumulatedMouseMotion, AccumulatedMouseScroll};
 use bevy::prelude::*;
-use bevy::world_serialization::{WorldAsset, WorldAssetRoot};
+use bevy::world_serialization::WorldAssetRoot;
 use bevy_nacre::{NacreMaterial, NacrePlugin};
 use std::path::PathBuf;
 
