@@ -238,7 +238,10 @@ fn sphere_grids_load_with_their_films() {
     );
     let (count, sectors) = colourfulness(&metallic);
     eprintln!("IridescenceMetallicSpheres: {count} saturated pixels over {sectors} hue sectors");
-    assert!(count >= 500 && sectors >= 6, "{count} pixels, {sectors} sectors");
+    assert!(
+        count >= 500 && sectors >= 6,
+        "{count} pixels, {sectors} sectors"
+    );
     // The dielectric grid's white diffuse bases outshine their films under this light: the
     // films are checked by the hook's count only.
     render_gltf(
