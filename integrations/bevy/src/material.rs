@@ -1,0 +1,275 @@
+//! The film material: an extension of Bevy's `StandardMaterial` whose fragment shader puts
+//! nacre's film colour in place of the specular lobe's Fresnel term (`film_material.wgsl`
+//! has the equations).
+
+use crate::shaders::FILM_MATERIAL_HANDLE;
+use crate::tables::{
+    DEFAULT_FILM_LUT, DEFAULT_FOURIER, FilmLutUniform, FourierUniform, NacreTable, NacreTableAxes,
+};
+use bevy::asset::{AssetEvent, Assets, Handle};
+use bevy::ecs::message::MessageReader;
+use bevy::image::Image;
+use bevy::math::Vec3;
+use bevy::pbr::{ExtendedMaterial, MaterialExtension, StandardMaterial};
+use bevy::prelude::{Asset, ResMut};
+use bevy::reflect::Reflect;
+use bevy::render::render_asset::RenderAssets;
+use bevy::render::render_resource::{AsBindGroup, AsBindGroupShaderType, ShaderType};
+use bevy::render::texture::GpuImage;
+use bevy::shader::ShaderRef;
+
+/// `StandardMaterial` with a nacre thin film on top.
+pub type NacreMaterial = ExtendedMaterial<StandardMaterial, NacreFilm>;
+
+/// Which of nacre's techniques colours the film.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Reflect)]
+pub enum FilmTechnique {
+    /// One trilinear lookup in a baked `film-lut` table (`film_lut.wgsl`): the table's ambient
+    /// and base are baked in ([`NacreFilm::base_ior`] and `base_kappa` are ignored).
+    #[default]
+    Lut,
+    /// The Fourier-series method (`film_fourier.wgsl`): any film index on any base, metals
+    /// included, from [`NacreFilm::base_ior`] and [`NacreFilm::base_kappa`].
+    Fourier,
+}
+
+/// How the thickness texture's green channel g maps to the film thickness d.
+#[derive(Clone, Copy, Debug, PartialEq, Reflect)]
+pub enum FilmThickness {
+    /// glTF `KHR_materials_iridescence`: d = mix(min_nm, max_nm, g); d = max_nm without a
+    /// texture.
+    Gltf {
+        /// `iridescenceThicknessMinimum`, nm.
+        min_nm: f32,
+        /// `iridescenceThicknessMaximum`, nm.
+        max_nm: f32,
+    },
+    /// nacre's SVT form: d = average_nm + relative_nm (2g − 1); d = average_nm + relative_nm
+    /// without a texture (g = 1).
+    Svt {
+        /// d_avg, nm.
+        average_nm: f32,
+        /// d_rel, nm.
+        relative_nm: f32,
+    },
+}
+
+impl Default for FilmThickness {
+    /// glTF's defaults: 100–400 nm.
+    fn default() -> Self {
+        FilmThickness::Gltf {
+            min_nm: 100.0,
+            max_nm: 400.0,
+        }
+    }
+}
+
+/// Mirror of `NacreFilmUniform` (`film_material.wgsl`, 64 bytes).
+#[derive(Clone, Copy, Debug, Default, PartialEq, ShaderType)]
+pub struct NacreFilmUniform {
+    /// 0 film_lut, 1 film_fourier.
+    pub technique: u32,
+    /// 0 glTF, 1 SVT.
+    pub thickness_mode: u32,
+    /// Bit 0: thickness texture bound; bit 1: weight texture bound.
+    pub flags: u32,
+    /// Padding.
+    pub _pad0: u32,
+    /// Film index n₂.
+    pub film_ior: f32,
+    /// glTF d_min or SVT d_avg, nm.
+    pub thickness_a_nm: f32,
+    /// glTF d_max or SVT d_rel, nm.
+    pub thickness_b_nm: f32,
+    /// Film weight w.
+    pub weight: f32,
+    /// Base index, real part, per channel (fourier).
+    pub base_ior: Vec3,
+    /// Ambient index n₁ (fourier).
+    pub ambient_ior: f32,
+    /// Base index, imaginary part, per channel (fourier).
+    pub base_kappa: Vec3,
+    /// Padding.
+    pub _pad1: f32,
+}
+
+/// The film on top of a `StandardMaterial` (use as [`NacreMaterial`]'s extension).
+///
+/// The table fields are filled from [`NacreFilm::lut_table`] and [`NacreFilm::fourier_table`]
+/// by the plugin whenever those tables load or change (hot reload); they are the default
+/// set unless set otherwise.
+#[derive(Asset, AsBindGroup, Reflect, Debug, Clone)]
+#[uniform(106, NacreFilmUniform)]
+pub struct NacreFilm {
+    /// The film-lut table whose textures are bound (see the struct docs).
+    pub lut_table: Handle<NacreTable>,
+    /// The fourier table whose texture is bound.
+    pub fourier_table: Handle<NacreTable>,
+    /// Technique.
+    pub technique: FilmTechnique,
+    /// Film index n₂ (glTF `iridescenceIor`, default 1.3).
+    pub film_ior: f32,
+    /// Thickness range and form.
+    pub thickness: FilmThickness,
+    /// Thickness texture (its green channel is g).
+    #[texture(107)]
+    #[sampler(108)]
+    pub thickness_texture: Option<Handle<Image>>,
+    /// Film weight w ∈ [0, 1] (glTF `iridescenceFactor`).
+    pub weight: f32,
+    /// Weight texture (its red channel multiplies [`NacreFilm::weight`]).
+    #[texture(109)]
+    #[sampler(110)]
+    pub weight_texture: Option<Handle<Image>>,
+    /// Base index n per channel (fourier; glTF `KHR_materials_ior`, 1.5 by default).
+    pub base_ior: Vec3,
+    /// Base index κ per channel (fourier; 0 for dielectrics).
+    pub base_kappa: Vec3,
+    /// Ambient index n₁ (fourier; 1 = air).
+    pub ambient_ior: f32,
+    /// film-lut reflectance (from [`NacreFilm::lut_table`]).
+    #[texture(100, dimension = "3d")]
+    #[sampler(102)]
+    pub lut_reflectance: Option<Handle<Image>>,
+    /// film-lut transmittance (from [`NacreFilm::lut_table`]).
+    #[texture(101, dimension = "3d")]
+    pub lut_transmittance: Option<Handle<Image>>,
+    /// film-lut axes (from [`NacreFilm::lut_table`]).
+    #[uniform(103)]
+    pub lut_axes: FilmLutUniform,
+    /// fourier coefficients (from [`NacreFilm::fourier_table`]).
+    #[texture(104, dimension = "2d_array", sample_type = "float", filterable = false)]
+    pub fourier_coefficients: Option<Handle<Image>>,
+    /// fourier axes (from [`NacreFilm::fourier_table`]).
+    #[uniform(105)]
+    pub fourier_axes: FourierUniform,
+}
+
+impl Default for NacreFilm {
+    /// glTF `KHR_materials_iridescence`'s defaults (index 1.3, 100–400 nm, weight 1) on the
+    /// default table set, film-lut technique.
+    fn default() -> Self {
+        NacreFilm {
+            lut_table: DEFAULT_FILM_LUT,
+            fourier_table: DEFAULT_FOURIER,
+            technique: FilmTechnique::Lut,
+            film_ior: 1.3,
+            thickness: FilmThickness::default(),
+            thickness_texture: None,
+            weight: 1.0,
+            weight_texture: None,
+            base_ior: Vec3::splat(1.5),
+            base_kappa: Vec3::ZERO,
+            ambient_ior: 1.0,
+            lut_reflectance: None,
+            lut_transmittance: None,
+            lut_axes: FilmLutUniform::default(),
+            fourier_coefficients: None,
+            fourier_axes: FourierUniform::default(),
+        }
+    }
+}
+
+impl NacreFilm {
+    /// Copies the textures and axes of the loaded tables into the bound fields; true when
+    /// something changed.
+    pub fn bind_tables(&mut self, tables: &Assets<NacreTable>) -> bool {
+        let mut changed = false;
+        if let Some(t) = tables.get(&self.lut_table)
+            && let NacreTableAxes::FilmLut(axes) = t.axes
+        {
+            let r = Some(t.texture.clone());
+            if self.lut_reflectance != r
+                || self.lut_transmittance != t.transmittance
+                || self.lut_axes != axes
+            {
+                self.lut_reflectance = r;
+                self.lut_transmittance = t.transmittance.clone();
+                self.lut_axes = axes;
+                changed = true;
+            }
+        }
+        if let Some(t) = tables.get(&self.fourier_table)
+            && let NacreTableAxes::Fourier(axes) = t.axes
+        {
+            let c = Some(t.texture.clone());
+            if self.fourier_coefficients != c || self.fourier_axes != axes {
+                self.fourier_coefficients = c;
+                self.fourier_axes = axes;
+                changed = true;
+            }
+        }
+        changed
+    }
+}
+
+impl AsBindGroupShaderType<NacreFilmUniform> for NacreFilm {
+    fn as_bind_group_shader_type(&self, _images: &RenderAssets<GpuImage>) -> NacreFilmUniform {
+        let (thickness_mode, a, b) = match self.thickness {
+            FilmThickness::Gltf { min_nm, max_nm } => (0, min_nm, max_nm),
+            FilmThickness::Svt {
+                average_nm,
+                relative_nm,
+            } => (1, average_nm, relative_nm),
+        };
+        NacreFilmUniform {
+            technique: match self.technique {
+                FilmTechnique::Lut => 0,
+                FilmTechnique::Fourier => 1,
+            },
+            thickness_mode,
+            flags: u32::from(self.thickness_texture.is_some())
+                | (u32::from(self.weight_texture.is_some()) << 1),
+            _pad0: 0,
+            film_ior: self.film_ior,
+            thickness_a_nm: a,
+            thickness_b_nm: b,
+            weight: self.weight,
+            base_ior: self.base_ior,
+            ambient_ior: self.ambient_ior,
+            base_kappa: self.base_kappa,
+            _pad1: 0.0,
+        }
+    }
+}
+
+impl MaterialExtension for NacreFilm {
+    fn fragment_shader() -> ShaderRef {
+        ShaderRef::Handle(FILM_MATERIAL_HANDLE)
+    }
+}
+
+/// Binds each material's tables when the material or one of the tables is added or changes.
+pub(crate) fn bind_tables(
+    mut table_events: MessageReader<AssetEvent<NacreTable>>,
+    mut material_events: MessageReader<AssetEvent<NacreMaterial>>,
+    tables: bevy::prelude::Res<Assets<NacreTable>>,
+    mut materials: ResMut<Assets<NacreMaterial>>,
+) {
+    let tables_changed = table_events.read().any(|e| {
+        matches!(
+            e,
+            AssetEvent::Added { .. }
+                | AssetEvent::Modified { .. }
+                | AssetEvent::LoadedWithDependencies { .. }
+        )
+    });
+    let mut ids: Vec<_> = material_events
+        .read()
+        .filter_map(|e| match e {
+            AssetEvent::Added { id } | AssetEvent::Modified { id } => Some(*id),
+            _ => None,
+        })
+        .collect();
+    if tables_changed {
+        ids = materials.ids().collect();
+    }
+    for id in ids {
+        let needs = materials
+            .get(id)
+            .is_some_and(|m| m.extension.clone().bind_tables(&tables));
+        if needs && let Some(mut m) = materials.get_mut(id) {
+            m.extension.bind_tables(&tables);
+        }
+    }
+}
