@@ -283,7 +283,7 @@ pub fn orbit_camera(
             "a finite angle in degrees",
         ));
     }
-    if !(orbit.pitch_deg.abs() < 89.0) {
+    if orbit.pitch_deg.is_nan() || orbit.pitch_deg.abs() >= 89.0 {
         return Err(refused(
             Param::OrbitPitch,
             orbit.pitch_deg.to_string(),

@@ -462,7 +462,7 @@ fn cameras_and_lights_come_from_the_file() {
     nodes.push(serde_json::json!({ "camera": 0, "translation": [0.0, 0.0, 4.0] }));
     nodes.push(serde_json::json!({ "camera": 1, "translation": [0.0, 0.0, 9.0] }));
     nodes.push(serde_json::json!({
-        "rotation": [-0.70710678, 0.0, 0.0, 0.70710678],
+        "rotation": [-std::f64::consts::FRAC_1_SQRT_2, 0.0, 0.0, std::f64::consts::FRAC_1_SQRT_2],
         "extensions": { "KHR_lights_punctual": { "light": 0 } }
     }));
     nodes.push(serde_json::json!({
