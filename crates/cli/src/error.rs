@@ -57,7 +57,6 @@ pub fn flag(param: Param) -> &'static str {
         Param::ReferenceSamples => "--reference-samples",
         Param::Camera => "--camera",
         Param::Yaw => "--yaw",
-        Param::OrbitPitch => "--pitch",
         Param::Distance => "--distance",
         Param::BenchFilmIor => "--film-ior",
         Param::BenchBaseIor => "--base-ior",

@@ -103,7 +103,8 @@ params! {
     Layout => "layout",
     /// Texels along v of an in-memory integrated table.
     IntegratedSamples => "integrated_samples",
-    /// Sample pitch of a height field, µm.
+    /// Sample pitch of a height field, µm; or the orbit camera's elevation, degrees (no
+    /// command takes both).
     Pitch => "pitch",
     /// Samples per axis of a synthetic height field.
     Samples => "samples",
@@ -141,8 +142,6 @@ params! {
     Camera => "camera",
     /// Orbit camera: rotation about the vertical, degrees.
     Yaw => "yaw",
-    /// Orbit camera: elevation, degrees.
-    OrbitPitch => "orbit_pitch",
     /// Orbit camera: distance from the scene's centre, world units.
     Distance => "distance",
 }

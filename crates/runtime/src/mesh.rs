@@ -285,7 +285,7 @@ pub fn orbit_camera(
     }
     if orbit.pitch_deg.is_nan() || orbit.pitch_deg.abs() >= 89.0 {
         return Err(refused(
-            Param::OrbitPitch,
+            Param::Pitch,
             orbit.pitch_deg.to_string(),
             "degrees between −89 and 89",
         ));
@@ -1646,7 +1646,7 @@ mod tests {
                     pitch_deg: 90.0,
                     ..Orbit::default()
                 },
-                Param::OrbitPitch,
+                Param::Pitch,
             ),
             (
                 Orbit {
