@@ -70,9 +70,16 @@ const P5: f64 = 4.138_136_797_057_238_460_39e-08;
 /// Largest decay exponent evaluated; beyond it e^{−a} is flushed to 0.
 const MAX_DECAY: f64 = 708.0;
 
+/// Largest |x| that [`sin_cos`] reduces (2⁴⁰ rad); larger arguments count as 0.
+const HUGE_PHASE: f64 = 1_099_511_627_776.0;
+
 /// (sin x, cos x) lane by lane; see the module docs for the method and its error.
 #[inline(always)]
 pub(crate) fn sin_cos<S: Simd>(s: S, x: S::f64s) -> (S::f64s, S::f64s) {
+    // Phases beyond HUGE_PHASE rad (fringes no spectrum resolves; past 2⁵² π/2 the reduction
+    // below would overflow) are taken as 0, so that the result stays finite; NaN stays NaN.
+    let big = s.greater_than_f64s(s.abs_f64s(x), s.splat_f64s(HUGE_PHASE));
+    let x = s.select_f64s(big, s.splat_f64s(0.0), x);
     let shifter = s.splat_f64s(SHIFTER);
     // m = round(x · 2/π); y = x − m π/2 in three parts.
     let m = s.sub_f64s(
