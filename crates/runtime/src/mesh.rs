@@ -1157,39 +1157,27 @@ pub fn render_gltf_from(
         let depth_view = depth.create_view(&Default::default());
         // The picture of the opaque scene (cleared to alpha 0: nothing drawn there), or a
         // 1 × 1 stand-in when no material transmits.
-        let behind = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("mesh scene behind"),
-            size: if behind_needed {
-                size
-            } else {
-                wgpu::Extent3d {
-                    width: 1,
-                    height: 1,
-                    depth_or_array_layers: 1,
-                }
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: BEHIND_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        });
+        let linear_texture = |label: &str, size: wgpu::Extent3d| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size,
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: BEHIND_FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            })
+        };
+        let one = wgpu::Extent3d {
+            width: 1,
+            height: 1,
+            depth_or_array_layers: 1,
+        };
+        let behind = linear_texture("mesh scene behind", if behind_needed { size } else { one });
         let behind_view = behind.create_view(&Default::default());
-        let no_behind = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("mesh no scene behind"),
-            size: wgpu::Extent3d {
-                width: 1,
-                height: 1,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: BEHIND_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        });
+        let no_behind = linear_texture("mesh no scene behind", one);
         let no_behind_view = no_behind.create_view(&Default::default());
         let mut encoder = device.create_command_encoder(&Default::default());
         // The stand-in is cleared once (alpha 0) so that it reads as "nothing behind".
