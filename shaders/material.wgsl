@@ -500,6 +500,8 @@ fn material_rough_film_albedo(n_dot_v: f32, alpha: f32, thickness_nm: f32, weigh
 
 // One shading point, as scene.wgsl finds it.
 struct SurfacePoint {
+    // World position (where the punctual lights are seen from).
+    position: vec3<f32>,
     // Unit normal on the viewer's side.
     normal: vec3<f32>,
     // Unit vector from the point towards the viewer.
@@ -587,6 +589,40 @@ fn material_surface() -> SurfaceMaterial {
     return m;
 }
 
+// A light as one shading point sees it.
+struct MaterialLightSample {
+    // Unit vector from the point towards the light.
+    towards: vec3<f32>,
+    // Irradiance at normal incidence, linear RGB.
+    irradiance: vec3<f32>,
+}
+
+// Light slot `slot` seen from `position`: slot 0 is the directional light of the uniform's
+// light_* fields, slot k ≥ 1 is lights[k − 1] (KHR_lights_punctual, "Range Property" and
+// "Inner and Outer Cone Angles": E = radiant · clamp(1 − (r/range)⁴, 0, 1)² / r² · t² for a
+// point or spot light at distance r, E = radiant for a directional one).
+fn material_light_sample(slot: u32, position: vec3<f32>) -> MaterialLightSample {
+    var out: MaterialLightSample;
+    if slot == 0u {
+        out.towards = safe_normalize(view.light_direction, vec3<f32>(0.0, 1.0, 0.0));
+        out.irradiance = sanitize_radiance(view.light_colour * finite_or(view.light_intensity, 0.0));
+        return out;
+    }
+    let light = view.lights[min(slot - 1u, VIEW_MAX_LIGHTS - 1u)];
+    if light.kind == VIEW_LIGHT_DIRECTIONAL {
+        out.towards = safe_normalize(-light.direction, vec3<f32>(0.0, 1.0, 0.0));
+        out.irradiance = sanitize_radiance(light.radiant);
+        return out;
+    }
+    let d = light.position - position;
+    let r2 = max(dot(d, d), 1e-12);
+    out.towards = d * inverseSqrt(r2);
+    let window = clamp(1.0 - r2 * r2 * light.inv_range4, 0.0, 1.0);
+    let t = clamp(dot(light.direction, -out.towards) * light.cone_scale + light.cone_offset, 0.0, 1.0);
+    out.irradiance = sanitize_radiance(light.radiant * (window * window * t * t / r2));
+    return out;
+}
+
 // Shades one point of the film-coated surface with the uniform's material.
 fn material_shade(s: SurfacePoint) -> ShadeResult {
     return material_shade_with(s, material_surface());
@@ -612,30 +648,27 @@ fn material_shade_with(s: SurfacePoint, mat: SurfaceMaterial) -> ShadeResult {
     // The dielectric lobe's diffuse weight (1 − m)(1 − t); 0 for a metal or a thin shell.
     let diffuse_weight = (1.0 - metallic) * (1.0 - transmission);
     let albedo = select(vec3<f32>(0.0), clamp(mat.diffuse_colour, vec3<f32>(0.0), vec3<f32>(1.0)), diffuse_weight > 0.0 && all(vec3_is_finite(mat.diffuse_colour))) * diffuse_weight;
-    let l = safe_normalize(view.light_direction, vec3<f32>(0.0, 1.0, 0.0));
-    let n_dot_l = dot(n, l);
-    let h = safe_normalize(v + l, n);
-    let v_dot_h = clamp(dot(v, h), 0.0, 1.0);
     let mode = select(MATERIAL_FILM_EVAL_CLASSIC, material_params.film_eval, material_params.film_eval <= MATERIAL_FILM_EVAL_EXACT);
     // Lobes: 0 the dielectric, 1 the metal; both when 0 < m < 1.
     let lobe_count = select(1u, 2u, mat.lobes == 2u);
     let first_lobe = select(0u, 1u, mat.lobes == 1u);
 
     // Per lobe: the film at n·v (environment, transmission, and every light for the
-    // shortcut), when the light is above the surface and the path evaluates the film per
-    // light at v·h, and for the exact path at each of the lobe's MATERIAL_LOBE_SAMPLES visible
+    // shortcut), the film of each light at its own v·h when the path evaluates the film per
+    // light (light slot 0, the directional light, then the view's punctual lights), and for
+    // the exact path at each of the lobe's MATERIAL_LOBE_SAMPLES visible
     // normals (see the header: the environment's distribution over the lobe, weighted by the
     // film). Each lobe's reflectance enters weighted by its share (1 − m or m).
     // (Separate variables, not arrays indexed by the lobe: lavapipe's LLVM back end of Mesa
     // 22 crashed on the divergent indexing.)
     var film_v_d: FilmOutput;
     var film_v_m: FilmOutput;
-    var film_h_d: FilmOutput;
-    var film_h_m: FilmOutput;
-    // The light's evaluation runs whether or not the light is above the surface (its result
-    // is used only when it is): a trip count that varies per fragment made lavapipe (Mesa
-    // 22.3, LLVM 15) crash compiling the mesh shader once its material varies per fragment.
-    let light_evaluations = select(0u, 1u, mode != MATERIAL_FILM_EVAL_NV);
+    // Each light's evaluation runs whether or not the light is above the surface (its
+    // result is used only when it is): a trip count that varies per fragment made lavapipe
+    // (Mesa 22.3, LLVM 15) crash compiling the mesh shader once its material varies per
+    // fragment. The count of lights is the view's, the same for every fragment.
+    let light_slots = 1u + min(view.light_count, VIEW_MAX_LIGHTS);
+    let light_evaluations = select(0u, light_slots, mode != MATERIAL_FILM_EVAL_NV);
     let lobe_samples = select(0u, MATERIAL_LOBE_SAMPLES, mode == MATERIAL_FILM_EVAL_EXACT);
     let evaluations = 1u + light_evaluations + lobe_samples;
     // The lobe's frame (n = +z) and the view in it.
@@ -646,6 +679,8 @@ fn material_shade_with(s: SurfacePoint, mat: SurfaceMaterial) -> ShadeResult {
     let lambda_o = ggx_lambda(wo.z, alpha);
     var lobe_film_env = vec3<f32>(0.0);
     var lobe_film = vec3<f32>(0.0);
+    // Σ over the lights of (specular + diffuse) · E · n·l, accumulated lobe by lobe.
+    var light_radiance = vec3<f32>(0.0);
     for (var kk = 0u; kk < evaluations * lobe_count; kk++) {
         let lobe = first_lobe + kk / evaluations;
         let k = kk % evaluations;
@@ -653,7 +688,13 @@ fn material_shade_with(s: SurfacePoint, mat: SurfaceMaterial) -> ShadeResult {
         let base_kappa = select(mat.dielectric_kappa, mat.metal_kappa, lobe == 1u);
         let share = select(1.0, select(1.0 - metallic, metallic, lobe == 1u), lobe_count == 2u);
         let scale = select(specular_scale, vec3<f32>(1.0), lobe == 1u) * share;
-        var cos_theta = select(n_dot_v, v_dot_h, k == 1u && light_evaluations == 1u);
+        // A light's slot, its direction and half vector (slot 0 for the other evaluations:
+        // their values are not used).
+        let is_light = k >= 1u && k <= light_evaluations;
+        let light = material_light_sample(select(0u, k - 1u, is_light), s.position);
+        let h = safe_normalize(v + light.towards, n);
+        let n_dot_l = dot(n, light.towards);
+        var cos_theta = select(n_dot_v, clamp(dot(v, h), 0.0, 1.0), is_light);
         var lobe_weight = 0.0;
         var lobe_dir = n;
         var lobe_alpha = alpha;
@@ -677,21 +718,19 @@ fn material_shade_with(s: SurfacePoint, mat: SurfaceMaterial) -> ShadeResult {
             } else {
                 film_v_m = film;
             }
-        } else if k <= light_evaluations {
+        } else if is_light {
+            // The lobe's share of this light: its specular term with the film at v·h, and
+            // for the dielectric lobe the diffuse base under what the film does not reflect.
+            var f = ggx_distribution(dot(n, h), alpha) * ggx_visibility(n_dot_v, max(n_dot_l, 0.0), alpha) * film.reflectance * scale;
             if lobe == 0u {
-                film_h_d = film;
-            } else {
-                film_h_m = film;
+                f += albedo / PI * max(vec3<f32>(1.0) - film.reflectance * specular_scale, vec3<f32>(0.0));
             }
+            light_radiance += select(vec3<f32>(0.0), f * light.irradiance * n_dot_l, n_dot_l > 0.0);
         } else {
             let f = lobe_weight * film.reflectance * scale;
             lobe_film += f;
             lobe_film_env += f * env_prefiltered_radiance(lobe_dir, lobe_alpha);
         }
-    }
-    if mode == MATERIAL_FILM_EVAL_NV {
-        film_h_d = film_v_d;
-        film_h_m = film_v_m;
     }
     // The lobes' reflectances weighted by their shares (one lobe: itself, unscaled but for
     // the dielectric's specular colour).
@@ -700,10 +739,8 @@ fn material_shade_with(s: SurfacePoint, mat: SurfaceMaterial) -> ShadeResult {
     let w_m = select(1.0, metallic, lobe_count == 2u) * f32(first_lobe == 1u || lobe_count == 2u);
     let spec_d = specular_scale * w_d;
     let reflectance_v = film_v_d.reflectance * spec_d + film_v_m.reflectance * w_m;
-    let reflectance_h = film_h_d.reflectance * spec_d + film_h_m.reflectance * w_m;
     // What the dielectric lobe's film does not reflect reaches its diffuse base.
     let diffuse_v = max(one - film_v_d.reflectance * specular_scale, vec3<f32>(0.0));
-    let diffuse_h = max(one - film_h_d.reflectance * specular_scale, vec3<f32>(0.0));
 
     // Environment.
     let r = reflect(-v, n);
@@ -734,13 +771,18 @@ fn material_shade_with(s: SurfacePoint, mat: SurfaceMaterial) -> ShadeResult {
     }
     radiance *= occlusion;
 
-    // The directional light.
-    if n_dot_l > 0.0 {
-        let e_l = sanitize_radiance(view.light_colour * finite_or(view.light_intensity, 0.0));
-        let specular = ggx_distribution(dot(n, h), alpha) * ggx_visibility(n_dot_v, n_dot_l, alpha) * reflectance_h;
-        let diffuse = albedo / PI * diffuse_h;
-        radiance += (specular + diffuse) * e_l * n_dot_l;
+    // The lights: evaluated in the loop above, or here with the film at n·v (the shortcut).
+    if mode == MATERIAL_FILM_EVAL_NV {
+        for (var j = 0u; j < light_slots; j++) {
+            let light = material_light_sample(j, s.position);
+            let n_dot_l = dot(n, light.towards);
+            let h = safe_normalize(v + light.towards, n);
+            let specular = ggx_distribution(dot(n, h), alpha) * ggx_visibility(n_dot_v, max(n_dot_l, 0.0), alpha) * reflectance_v;
+            let diffuse = albedo / PI * diffuse_v;
+            light_radiance += select(vec3<f32>(0.0), (specular + diffuse) * light.irradiance * n_dot_l, n_dot_l > 0.0);
+        }
     }
+    radiance += light_radiance;
 
     var out: ShadeResult;
     out.radiance = sanitize_radiance(radiance);

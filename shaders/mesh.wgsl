@@ -297,6 +297,7 @@ fn mesh_fs(in: MeshVertexOut, @builtin(front_facing) front: bool) -> @location(0
     mat.specular_colour = clamp(q.specular * specular_tex.a * q.specular_colour * specular_colour_tex.rgb, vec3<f32>(0.0), vec3<f32>(1.0));
 
     var surface: SurfacePoint;
+    surface.position = in.world;
     surface.normal = n;
     surface.view_dir = v;
     surface.thickness_nm = thickness_nm;

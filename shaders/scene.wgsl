@@ -212,6 +212,7 @@ fn scene_radiance(pixel: vec2<f32>) -> vec3<f32> {
         surface.view_dir = -ray.dir;
         surface.sigma_thickness_nm = sigma_nm;
         if k == 0u {
+            surface.position = ray.origin + hit.t * ray.dir;
             surface.normal = hit.normal;
             surface.thickness_nm = thickness_nm;
             surface.variation = 2.0 * vec3<f32>(moments.x, moments.z, moments.w) - 1.0;
@@ -221,6 +222,7 @@ fn scene_radiance(pixel: vec2<f32>) -> vec3<f32> {
             let p_back = ray.origin + hit.t_exit * ray.dir;
             let n_back = safe_normalize(p_back - SCENE_SPHERE_CENTRE, ray.dir);
             let m = scene_sample_thickness(n_back, n_back, dp_dx, dp_dy);
+            surface.position = p_back;
             surface.normal = -n_back;
             surface.thickness_nm = material_thickness_nm(m.x, n_back.y);
             surface.variation = 2.0 * vec3<f32>(m.x, m.z, m.w) - 1.0;

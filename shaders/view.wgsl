@@ -11,7 +11,7 @@
 //
 // ─── Group 0: the view (changes per frame) ───────────────────────────────────────────────
 //
-// 128 bytes, uniform (mirrored by `ViewUniform` in crates/runtime/src/render/view.rs):
+// 656 bytes, uniform (mirrored by `ViewUniform` in crates/runtime/src/render/view.rs):
 //
 //   offset size field
 //        0   64 inv_view_proj: mat4x4<f32>    clip (x, y ∈ [−1, 1], z ∈ [0, 1]) → world
@@ -27,6 +27,34 @@
 //                                             diffraction_scene.wgsl: 0 cd-disc, 1 snake-skin,
 //                                             2 the bench pass
 //      124    4 env_lod_max: f32              last mip level of env_map (GLSL ES cannot query it)
+//      128    4 light_count: u32              how many of `lights` are drawn (≤ VIEW_MAX_LIGHTS)
+//      144  512 lights: array<ViewLight, 8>   KHR_lights_punctual lights besides the
+//                                             directional one (`LightUniform`, 64 bytes each)
+
+// The most punctual lights a view draws (`MAX_PUNCTUAL_LIGHTS`).
+const VIEW_MAX_LIGHTS: u32 = 8u;
+const VIEW_LIGHT_DIRECTIONAL: u32 = 0u;
+const VIEW_LIGHT_POINT: u32 = 1u;
+const VIEW_LIGHT_SPOT: u32 = 2u;
+
+// One KHR_lights_punctual light (`LightUniform`, 64 bytes).
+struct ViewLight {
+    // World position (point and spot).
+    position: vec3<f32>,
+    // VIEW_LIGHT_DIRECTIONAL, _POINT or _SPOT.
+    kind: u32,
+    // Unit direction the light shines along.
+    direction: vec3<f32>,
+    // 1 / range⁴, 0 for an unlimited range.
+    inv_range4: f32,
+    // Colour × intensity (lux for a directional light, candela otherwise).
+    radiant: vec3<f32>,
+    // The spot's angular factor t = clamp(cos θ · cone_scale + cone_offset, 0, 1), drawn as
+    // t²; scale 0 and offset 1 for the other kinds.
+    cone_scale: f32,
+    cone_offset: f32,
+}
+
 struct ViewParams {
     inv_view_proj: mat4x4<f32>,
     eye_position: vec3<f32>,
@@ -38,6 +66,8 @@ struct ViewParams {
     resolution: vec2<f32>,
     scene: u32,
     env_lod_max: f32,
+    light_count: u32,
+    lights: array<ViewLight, 8>,
 }
 
 @group(0) @binding(0) var<uniform> view: ViewParams;

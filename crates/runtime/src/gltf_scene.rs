@@ -495,6 +495,9 @@ pub struct GltfLight {
     pub position: [f32; 3],
     /// Unit direction the light shines along (the node's world −z).
     pub direction: [f32; 3],
+    /// `range`: the distance beyond which a point or spot light gives nothing (`None`:
+    /// unlimited).
+    pub range: Option<f32>,
 }
 
 /// How a glTF camera projects (glTF 2.0 §3.10).
@@ -1527,6 +1530,13 @@ fn node_light(path: &Path, node: &gltf::Node, world: [[f32; 4]; 4]) -> Result<Op
             "light `{name}`: colour {colour:?}, intensity {intensity} (expected finite, ≥ 0)"
         )));
     }
+    let range = light.range();
+    if range.is_some_and(|r| !(r > 0.0 && r.is_finite())) {
+        return Err(bad(format!(
+            "light `{name}`: range {} (expected a positive number)",
+            range.unwrap_or_default()
+        )));
+    }
     let kind = match light.kind() {
         gltf::khr_lights_punctual::Kind::Directional => LightKind::Directional,
         gltf::khr_lights_punctual::Kind::Point => LightKind::Point,
@@ -1560,6 +1570,7 @@ fn node_light(path: &Path, node: &gltf::Node, world: [[f32; 4]; 4]) -> Result<Op
         intensity,
         position: [world[3][0], world[3][1], world[3][2]],
         direction: z.map(|c| -c / len),
+        range,
     }))
 }
 

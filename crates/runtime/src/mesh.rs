@@ -20,15 +20,15 @@ use crate::context::GpuContext;
 use crate::environment::EnvironmentMap;
 use crate::error::{Error, Result};
 use crate::gltf_scene::{
-    AlphaMode, GltfCamera, GltfLight, GltfMaterial, GltfProjection, GltfScene, GltfTexture,
+    AlphaMode, GltfCamera, GltfMaterial, GltfProjection, GltfScene, GltfTexture,
     IDENTITY_TRANSFORM, LightKind, SamplerSpec, TextureRef, Wrap, is_gold_like,
 };
 use crate::gpu::read_texture;
 use crate::gpu::{group_layout, uniform_texture_group, upload_mips};
 use crate::image_io::RenderedImage;
 use crate::render::{
-    BaseKind, Light, MaterialOptions, MaterialUniform, SceneOptions, TARGET_FORMAT, ViewUniform,
-    check_film_lut,
+    BaseKind, Light, MAX_PUNCTUAL_LIGHTS, MaterialOptions, MaterialUniform, PunctualKind,
+    PunctualLight, SceneOptions, TARGET_FORMAT, ViewUniform, check_film_lut,
 };
 use crate::shaders::{self, Technique};
 use crate::tables::TableSet;
@@ -644,81 +644,89 @@ pub fn render_gltf(
     render_gltf_from(ctx, tables, technique, scene, options, ViewPoint::default())
 }
 
-/// The light the mesh renderer draws `scene` with, and a note when it is not all of the
+/// The lights the mesh renderer draws `scene` with, and a note when they are not all of the
 /// file's lighting. As the glTF Sample Viewer does by default, a file without
-/// `KHR_lights_punctual` lights is lit by the environment alone (the light's intensity is 0).
-/// With lights, the renderer's one light is the file's brightest at the centre of the scene's
-/// bounds: a directional light as it is (intensity in lux as irradiance), a point or spot
-/// light as a directional light from its position towards the centre with the irradiance it
-/// gives there (candela / distance², the spot's smooth cone falloff of the
-/// KHR_lights_punctual specification applied).
-pub fn scene_light(scene: &GltfScene) -> (Light, Option<String>) {
-    let (lo, hi) = scene.bounds();
-    let centre: [f32; 3] = std::array::from_fn(|k| 0.5 * (lo[k] + hi[k]));
-    let mut best: Option<(f32, Light, &GltfLight)> = None;
-    for light in &scene.lights {
-        let (towards, irradiance) = match light.kind {
-            LightKind::Directional => (light.direction.map(|c| -c), light.intensity),
-            LightKind::Point | LightKind::Spot { .. } => {
-                let d: [f32; 3] = std::array::from_fn(|k| light.position[k] - centre[k]);
-                let r2 = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).max(1e-12);
-                let r = r2.sqrt();
-                let towards = d.map(|c| c / r);
-                let cone = match light.kind {
-                    LightKind::Spot {
-                        inner_cone_rad,
-                        outer_cone_rad,
-                    } => {
-                        let cos_angle =
-                            -(0..3).map(|k| towards[k] * light.direction[k]).sum::<f32>();
-                        let (cos_outer, cos_inner) = (outer_cone_rad.cos(), inner_cone_rad.cos());
-                        let t = ((cos_angle - cos_outer) / (cos_inner - cos_outer).max(1e-6))
-                            .clamp(0.0, 1.0);
-                        t * t * (3.0 - 2.0 * t)
-                    }
-                    _ => 1.0,
-                };
-                (towards, light.intensity * cone / r2)
-            }
-        };
-        let brightness = irradiance * light.colour.iter().sum::<f32>();
-        if best.as_ref().is_none_or(|(b, _, _)| brightness > *b) && brightness.is_finite() {
-            best = Some((
-                brightness,
-                Light {
-                    direction: towards,
-                    colour: light.colour,
-                    intensity: irradiance,
-                },
-                light,
-            ));
-        }
-    }
+/// `KHR_lights_punctual` lights is lit by the environment alone (the directional light's
+/// intensity is 0). A file's lights are drawn as they are, at every shading point
+/// ([`PunctualLight`]: position, cone, range and r² falloff of the specification), up to
+/// [`MAX_PUNCTUAL_LIGHTS`]: beyond that, the brightest at the centre of the scene's bounds
+/// (colour × intensity × falloff there), with a note naming how many are left out.
+pub fn scene_lights(scene: &GltfScene) -> (Light, Vec<PunctualLight>, Option<String>) {
     let off = Light {
         intensity: 0.0,
         ..Light::default()
     };
-    match best {
-        None => (off, None),
-        Some((_, light, source)) => {
-            let many = scene.lights.len() > 1;
-            let positional = source.kind != LightKind::Directional;
-            let note = (many || positional).then(|| {
-                let mut n = format!("KHR_lights_punctual: drawn with one directional light, `{}`", source.name);
-                if many {
-                    n += &format!(
-                        " (the brightest at the scene's centre of {} lights; the others are not drawn)",
-                        scene.lights.len()
-                    );
-                }
-                if positional {
-                    n += ", from its position towards the scene's centre with the irradiance it gives there";
-                }
-                n
-            });
-            (light, note)
-        }
+    let (lo, hi) = scene.bounds();
+    let centre: [f32; 3] = std::array::from_fn(|k| 0.5 * (lo[k] + hi[k]));
+    let mut lights: Vec<(f32, PunctualLight)> = scene
+        .lights
+        .iter()
+        .map(|light| {
+            let punctual = PunctualLight {
+                kind: match light.kind {
+                    LightKind::Directional => PunctualKind::Directional,
+                    LightKind::Point => PunctualKind::Point,
+                    LightKind::Spot {
+                        inner_cone_rad,
+                        outer_cone_rad,
+                    } => PunctualKind::Spot {
+                        inner_cone_rad,
+                        outer_cone_rad,
+                    },
+                },
+                position: light.position,
+                direction: light.direction,
+                colour: light.colour,
+                intensity: light.intensity,
+                range: light.range,
+            };
+            (brightness_at(&punctual, centre), punctual)
+        })
+        .collect();
+    let note = (lights.len() > MAX_PUNCTUAL_LIGHTS).then(|| {
+        format!(
+            "KHR_lights_punctual: {} lights; the {MAX_PUNCTUAL_LIGHTS} brightest at the scene's centre are drawn",
+            lights.len()
+        )
+    });
+    if lights.len() > MAX_PUNCTUAL_LIGHTS {
+        // Brightest first; a stable sort keeps the file's order among equals.
+        lights.sort_by(|a, b| b.0.total_cmp(&a.0));
+        lights.truncate(MAX_PUNCTUAL_LIGHTS);
     }
+    (off, lights.into_iter().map(|(_, l)| l).collect(), note)
+}
+
+/// The irradiance (summed over colour channels) `light` gives at `point` facing it: its
+/// ranking when a file has more lights than are drawn.
+fn brightness_at(light: &PunctualLight, point: [f32; 3]) -> f32 {
+    let colour = light.colour.iter().sum::<f32>() * light.intensity;
+    let value = match light.kind {
+        PunctualKind::Directional => colour,
+        PunctualKind::Point | PunctualKind::Spot { .. } => {
+            let d: [f32; 3] = std::array::from_fn(|k| point[k] - light.position[k]);
+            let r2 = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).max(1e-12);
+            let window = light.range.map_or(1.0, |range| {
+                (1.0 - (r2 / (range * range)).powi(2)).clamp(0.0, 1.0)
+            });
+            let cone = match light.kind {
+                PunctualKind::Spot {
+                    inner_cone_rad,
+                    outer_cone_rad,
+                } => {
+                    let r = r2.sqrt();
+                    let cos_angle = (0..3).map(|k| d[k] / r * light.direction[k]).sum::<f32>();
+                    let (cos_inner, cos_outer) = (inner_cone_rad.cos(), outer_cone_rad.cos());
+                    let t = ((cos_angle - cos_outer) / (cos_inner - cos_outer).max(1e-3))
+                        .clamp(0.0, 1.0);
+                    t * t
+                }
+                _ => 1.0,
+            };
+            colour * window * window * cone / r2
+        }
+    };
+    if value.is_finite() { value } else { 0.0 }
 }
 
 /// The camera of `view` for `scene` and an image of aspect `aspect` (width / height): checks
@@ -774,8 +782,9 @@ pub fn render_gltf_from(
     view_options.camera.target = camera.target;
     view_options.camera.up = camera.up;
     view_options.camera.fov_y_deg = camera.fov_y_deg;
-    let (light, light_note) = scene_light(scene);
+    let (light, punctual_lights, light_note) = scene_lights(scene);
     view_options.light = light;
+    view_options.punctual_lights = punctual_lights;
 
     // Materials: nacre's options and the technique that draws each.
     let colorimeter = tables.colorimeter()?;

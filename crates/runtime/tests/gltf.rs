@@ -421,12 +421,14 @@ fn bad_gltf_files_are_errors() {
 }
 
 /// The file's cameras and KHR_lights_punctual lights are read with their nodes' transforms;
-/// `--camera N` past the last is refused naming the count; the renderer's one light is the
-/// brightest at the scene's centre, and a file without lights is lit by the environment alone.
+/// `--camera N` past the last is refused naming the count; every light is drawn (up to
+/// `MAX_PUNCTUAL_LIGHTS`, then the brightest at the scene's centre, with a note), and a file
+/// without lights is lit by the environment alone.
 #[test]
 fn cameras_and_lights_come_from_the_file() {
     use nacre_runtime::gltf_scene::{GltfProjection, LightKind};
-    use nacre_runtime::mesh::{ViewPoint, scene_light, view_camera};
+    use nacre_runtime::mesh::{ViewPoint, scene_lights, view_camera};
+    use nacre_runtime::render::{MAX_PUNCTUAL_LIGHTS, PunctualKind};
     let dir = tempfile::tempdir().unwrap();
     let good = sweep_glb(&SWEEPS[0]);
     let json_len = u32::from_le_bytes(good[12..16].try_into().unwrap()) as usize;
@@ -434,12 +436,12 @@ fn cameras_and_lights_come_from_the_file() {
     let bin = good[20 + json_len + 8..].to_vec();
     let plain = GltfScene::from_bytes(&good, &dir.path().join("plain.glb")).unwrap();
     assert!(plain.cameras.is_empty() && plain.lights.is_empty());
-    let (light, note) = scene_light(&plain);
+    let (light, punctual, note) = scene_lights(&plain);
     assert_eq!(
         light.intensity, 0.0,
         "no lights in the file: environment only"
     );
-    assert!(note.is_none());
+    assert!(punctual.is_empty() && note.is_none());
     let e = view_camera(&plain, ViewPoint::File(0), 1.0).unwrap_err();
     assert!(
         e.to_string().contains("camera = 0") || e.to_string().contains("0 camera"),
@@ -453,7 +455,7 @@ fn cameras_and_lights_come_from_the_file() {
     doc["extensionsUsed"] = serde_json::json!(["KHR_lights_punctual"]);
     doc["extensions"] = serde_json::json!({ "KHR_lights_punctual": { "lights": [
         { "type": "directional", "color": [1.0, 0.9, 0.8], "intensity": 2.0, "name": "sun" },
-        { "type": "point", "intensity": 5000.0, "name": "bulb" }
+        { "type": "point", "intensity": 5000.0, "name": "bulb", "range": 40.0 }
     ]}});
     let nodes = doc["nodes"].as_array_mut().unwrap();
     let first = nodes.len();
@@ -495,20 +497,143 @@ fn cameras_and_lights_come_from_the_file() {
     let sun = &scene.lights[0];
     assert_eq!(sun.kind, LightKind::Directional);
     assert!((sun.direction[1] + 1.0).abs() < 1e-6, "{:?}", sun.direction);
-    // The bulb gives 5000 cd / (10 − centre)² ≈ 50 at the centre: brighter than the sun.
-    let (light, note) = scene_light(&scene);
-    assert!(light.intensity > 30.0, "{light:?}");
-    assert!(
-        light.direction[1] > 0.99,
-        "towards the bulb above: {light:?}"
+    assert_eq!(scene.lights[1].range, Some(40.0));
+    assert_eq!(scene.lights[1].position, [0.0, 10.0, 0.0]);
+    // Both drawn as they are, in the file's order; the directional light of the analytic
+    // scenes is off.
+    let (light, punctual, note) = scene_lights(&scene);
+    assert_eq!(light.intensity, 0.0);
+    assert!(note.is_none(), "{note:?}");
+    assert_eq!(punctual.len(), 2);
+    assert_eq!(punctual[0].kind, PunctualKind::Directional);
+    assert_eq!(punctual[0].intensity, 2.0);
+    assert_eq!(punctual[1].kind, PunctualKind::Point);
+    assert_eq!(
+        (punctual[1].position, punctual[1].range),
+        ([0.0, 10.0, 0.0], Some(40.0))
     );
-    let note = note.expect("two lights, one drawn");
+
+    // More lights than are drawn: the brightest at the centre, with a note. Ten bulbs along
+    // +y at heights 10, 20, …, 100 and the sun: the sun (2 lx) outshines every bulb above
+    // 50 (5000 cd / r² < 2 lx); the bulbs at 10–70 (≥ 1.0 lx) are kept, 80–100 are not.
+    let lights: Vec<_> = (0..10)
+        .map(|_| serde_json::json!({ "type": "point", "intensity": 5000.0 }))
+        .chain([serde_json::json!({ "type": "directional", "intensity": 2.0 })])
+        .collect();
+    let mut many = doc.clone();
+    many["extensions"]["KHR_lights_punctual"]["lights"] = lights.into();
+    let nodes = many["nodes"].as_array_mut().unwrap();
+    let first_light = nodes.len();
+    for k in 0..11 {
+        nodes.push(serde_json::json!({
+            "translation": [0.0, 10.0 * (k + 1) as f64, 0.0],
+            "extensions": { "KHR_lights_punctual": { "light": k } }
+        }));
+    }
+    for k in first_light..first_light + 11 {
+        many["scenes"][0]["nodes"]
+            .as_array_mut()
+            .unwrap()
+            .push(k.into());
+    }
+    let bytes = nacre_runtime::gltf_assets::glb(&many, &bin);
+    let crowded = GltfScene::from_bytes(&bytes, &dir.path().join("many.glb")).unwrap();
+    assert_eq!(crowded.lights.len(), 13);
+    let (_, punctual, note) = scene_lights(&crowded);
+    assert_eq!(punctual.len(), MAX_PUNCTUAL_LIGHTS);
+    let note = note.expect("13 lights, 8 drawn");
     assert!(
-        note.contains("`bulb`") && note.contains("2 lights"),
+        note.contains("13 lights") && note.contains("8 brightest"),
         "{note}"
+    );
+    let heights: Vec<f32> = punctual
+        .iter()
+        .filter(|l| l.kind == PunctualKind::Point)
+        .map(|l| l.position[1])
+        .collect();
+    assert!(heights.iter().all(|&h| h <= 50.0), "{heights:?}");
+
+    // A range that is not a positive number is refused, naming the light.
+    let mut bad = doc.clone();
+    bad["extensions"]["KHR_lights_punctual"]["lights"][1]["range"] = (-1.0).into();
+    let bytes = nacre_runtime::gltf_assets::glb(&bad, &bin);
+    let e = GltfScene::from_bytes(&bytes, &dir.path().join("range.glb")).unwrap_err();
+    assert!(
+        e.to_string().contains("bulb") && e.to_string().contains("range"),
+        "{e}"
     );
     // A dangling light index is an error, not a panic.
     doc["nodes"][first + 3]["extensions"]["KHR_lights_punctual"]["light"] = 7.into();
     let bytes = nacre_runtime::gltf_assets::glb(&doc, &bin);
     assert!(GltfScene::from_bytes(&bytes, &dir.path().join("dangling.glb")).is_err());
+}
+
+/// Every punctual light lights the scene, with the specification's falloff: a point light in
+/// front of the leftmost sphere lights it and barely the rightmost, one in front of the
+/// rightmost the reverse, both together both; a spot aimed away, or a range that ends before
+/// the spheres, gives nothing; the same spot aimed at the sphere lights it.
+#[test]
+fn every_punctual_light_is_drawn() {
+    use nacre_runtime::gltf_scene::{GltfLight, LightKind};
+    let plain = GltfScene::load(&asset_dir().join(SWEEPS[0].file)).unwrap();
+    let point = |k: f32| GltfLight {
+        name: format!("bulb {k}"),
+        kind: LightKind::Point,
+        position: [(k - 2.0) * SPHERE_SPACING, 0.6, 2.0],
+        direction: [0.0, 0.0, -1.0],
+        colour: [1.0, 1.0, 1.0],
+        intensity: 6.0,
+        range: None,
+    };
+    let render = |lights: Vec<GltfLight>| {
+        let mut o = options();
+        o.env_intensity = 0.0;
+        let mut scene = plain.clone();
+        scene.lights = lights;
+        let out = render_gltf(ctx(), &tables(), Technique::Fourier, &scene, &o).unwrap();
+        let grey = |k| sphere_colour(&scene, &out.image, k).iter().sum::<f64>() / 3.0;
+        (grey(0), grey(4))
+    };
+    let dark = render(Vec::new());
+    assert!(dark.0 < 2.0 && dark.1 < 2.0, "no light: {dark:?}");
+    let left = render(vec![point(0.0)]);
+    let right = render(vec![point(4.0)]);
+    let both = render(vec![point(0.0), point(4.0)]);
+    eprintln!("left {left:?}, right {right:?}, both {both:?}");
+    assert!(
+        left.0 > 40.0 && left.0 > 3.0 * left.1,
+        "left light: {left:?}"
+    );
+    assert!(
+        right.1 > 40.0 && right.1 > 3.0 * right.0,
+        "right light: {right:?}"
+    );
+    assert!(
+        both.0 > left.0 - 1.0 && both.1 > right.1 - 1.0 && both.0 > 40.0 && both.1 > 40.0,
+        "both: {both:?} (left {left:?}, right {right:?})"
+    );
+    // A spot pointing away from the spheres, and a point light whose range ends before them.
+    let away = GltfLight {
+        kind: LightKind::Spot {
+            inner_cone_rad: 0.2,
+            outer_cone_rad: 0.4,
+        },
+        direction: [0.0, 0.0, 1.0],
+        ..point(0.0)
+    };
+    let short = GltfLight {
+        range: Some(0.5),
+        ..point(0.0)
+    };
+    for (name, light) in [("spot aimed away", away.clone()), ("short range", short)] {
+        let lit = render(vec![light]);
+        assert!(lit.0 < 2.0 && lit.1 < 2.0, "{name}: {lit:?}");
+    }
+    let norm = (0.09f32 + 1.0).sqrt();
+    let toward = GltfLight {
+        direction: [0.0, -0.3 / norm, -1.0 / norm],
+        ..away
+    };
+    let lit = render(vec![toward]);
+    assert!(lit.0 > 40.0, "spot aimed at the sphere: {lit:?}");
 }

@@ -100,7 +100,7 @@ fn scene_pipelines_validate_for_every_technique() {
         for (struct_name, span, members) in [
             (
                 "ViewParams",
-                128u32,
+                656u32,
                 &[
                     ("inv_view_proj", 0u32),
                     ("eye_position", 64),
@@ -112,6 +112,21 @@ fn scene_pipelines_validate_for_every_technique() {
                     ("resolution", 112),
                     ("scene", 120),
                     ("env_lod_max", 124),
+                    ("light_count", 128),
+                    ("lights", 144),
+                ][..],
+            ),
+            (
+                "ViewLight",
+                64,
+                &[
+                    ("position", 0),
+                    ("kind", 12),
+                    ("direction", 16),
+                    ("inv_range4", 28),
+                    ("radiant", 32),
+                    ("cone_scale", 44),
+                    ("cone_offset", 48),
                 ][..],
             ),
             (
@@ -161,7 +176,11 @@ fn scene_pipelines_validate_for_every_technique() {
     }
     assert_eq!(
         std::mem::size_of::<nacre_runtime::render::ViewUniform>(),
-        128
+        656
+    );
+    assert_eq!(
+        std::mem::size_of::<nacre_runtime::render::LightUniform>(),
+        64
     );
     assert_eq!(
         std::mem::size_of::<nacre_runtime::render::MaterialUniform>(),

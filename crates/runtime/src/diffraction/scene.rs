@@ -582,6 +582,7 @@ pub fn render_diffraction_scene(
         resolution: [width as f32, height as f32],
         scene: options.scene.id(),
         env_lod_max: env.mip_chain().len().saturating_sub(1) as f32,
+        ..ViewUniform::zeroed()
     };
     let samples = environment_samples(&env, options.env_samples);
     let mut lights = DiffractionLightsUniform {

@@ -67,12 +67,12 @@ pub use crate::thickness_map::{
     DEFAULT_THICKNESS_MAP_SIZE, ThicknessMap, procedural_thickness_map,
 };
 pub use options::{
-    BaseKind, Camera, FilmEval, Light, MaterialOptions, MaterialUniform, SceneKind, SceneOptions,
-    ThicknessMapping,
+    BaseKind, Camera, FilmEval, Light, MAX_PUNCTUAL_LIGHTS, MaterialOptions, MaterialUniform,
+    PunctualKind, PunctualLight, SceneKind, SceneOptions, ThicknessMapping,
 };
 pub(crate) use view::EnvironmentTextures;
 pub use view::{
-    LINEAR_TARGET_FORMAT, RenderOutput, RoughLutUniform, TARGET_FORMAT, ViewUniform,
+    LINEAR_TARGET_FORMAT, LightUniform, RenderOutput, RoughLutUniform, TARGET_FORMAT, ViewUniform,
     view_group_layout,
 };
 

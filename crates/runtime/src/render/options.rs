@@ -10,6 +10,7 @@ use crate::image_io::MAX_DIMENSION;
 use crate::tables::TableSet;
 use bytemuck::{Pod, Zeroable};
 use nacre_optics::{C64, Material};
+use std::f32::consts::FRAC_PI_2;
 use std::path::PathBuf;
 use std::str::FromStr;
 
@@ -251,6 +252,49 @@ impl Default for Light {
             intensity: 3.0,
         }
     }
+}
+
+/// The most [`PunctualLight`]s one render draws ([`SceneOptions::punctual_lights`];
+/// `VIEW_MAX_LIGHTS` in `shaders/view.wgsl`).
+pub const MAX_PUNCTUAL_LIGHTS: usize = 8;
+
+/// Where a [`PunctualLight`] is and how its light falls off (KHR_lights_punctual).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PunctualKind {
+    /// Infinitely far: the same direction and irradiance everywhere.
+    Directional,
+    /// At `position`, in every direction.
+    Point,
+    /// At `position`, a cone about `direction` with the specification's angular falloff
+    /// t² (t = clamp((cos θ − cos θ_outer) / (cos θ_inner − cos θ_outer), 0, 1)).
+    Spot {
+        /// Inner cone angle, radians.
+        inner_cone_rad: f32,
+        /// Outer cone angle, radians.
+        outer_cone_rad: f32,
+    },
+}
+
+/// A `KHR_lights_punctual` light evaluated at every shading point, besides the scene's one
+/// directional [`Light`]. For a point or spot light at distance r the irradiance at normal
+/// incidence is colour × intensity × w(r) / r², with the specification's range window
+/// w(r) = clamp(1 − (r / range)⁴, 0, 1)² (w = 1 without a range); a directional light's is
+/// colour × intensity (KHR_lights_punctual, "Range Property" and "Inner and Outer Cone
+/// Angles").
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PunctualLight {
+    /// Directional, point or spot.
+    pub kind: PunctualKind,
+    /// World position (unused by a directional light).
+    pub position: [f32; 3],
+    /// Direction the light shines along (need not be unit; unused by a point light).
+    pub direction: [f32; 3],
+    /// Linear RGB colour.
+    pub colour: [f32; 3],
+    /// Lux for a directional light, candela otherwise.
+    pub intensity: f32,
+    /// Distance beyond which a point or spot light gives nothing; `None`: unlimited.
+    pub range: Option<f32>,
 }
 
 /// How the greyscale thickness map value g ∈ [0, 1] becomes the film thickness d.
@@ -562,6 +606,10 @@ pub struct SceneOptions {
     pub material: MaterialOptions,
     /// The directional light (default: [`Light::default`]).
     pub light: Light,
+    /// Point, spot and directional lights drawn besides `light`, at most
+    /// [`MAX_PUNCTUAL_LIGHTS`] (default none; the glTF renderer fills it from the file's
+    /// `KHR_lights_punctual` lights).
+    pub punctual_lights: Vec<PunctualLight>,
     /// Exposure, EV stops: radiance is scaled by 2^EV before tone mapping (default 0).
     pub exposure_ev: f32,
     /// Harmonics M of `film_fourier` (0 = automatic, the default).
@@ -589,6 +637,7 @@ impl SceneOptions {
             thickness_map: None,
             material: MaterialOptions::for_scene(scene),
             light: Light::default(),
+            punctual_lights: Vec::new(),
             exposure_ev: 0.0,
             harmonics: technique.harmonics,
             spectral_samples: technique.spectral.samples,
@@ -679,6 +728,47 @@ impl SceneOptions {
                     self.light
                 ),
             });
+        }
+        if self.punctual_lights.len() > MAX_PUNCTUAL_LIGHTS {
+            return Err(Error::Invalid {
+                context: "punctual lights".into(),
+                message: format!(
+                    "{} lights (at most {MAX_PUNCTUAL_LIGHTS} are drawn)",
+                    self.punctual_lights.len()
+                ),
+            });
+        }
+        for (k, light) in self.punctual_lights.iter().enumerate() {
+            let finite = light
+                .position
+                .iter()
+                .chain(&light.direction)
+                .chain(&light.colour)
+                .chain([&light.intensity])
+                .all(|x| x.is_finite());
+            let cone_ok = match light.kind {
+                PunctualKind::Spot {
+                    inner_cone_rad,
+                    outer_cone_rad,
+                } => (0.0..outer_cone_rad).contains(&inner_cone_rad) && outer_cone_rad <= FRAC_PI_2,
+                _ => true,
+            };
+            let aimed = light.kind == PunctualKind::Point
+                || normalize(light.direction.map(f64::from)).is_some();
+            if !finite
+                || light.colour.iter().any(|&c| c < 0.0)
+                || light.intensity < 0.0
+                || light.range.is_some_and(|r| !(r > 0.0 && r.is_finite()))
+                || !cone_ok
+                || !aimed
+            {
+                return Err(Error::Invalid {
+                    context: format!("punctual light {k}"),
+                    message: format!(
+                        "{light:?} (expected finite values, a non-negative colour and intensity, a positive range, a direction, 0 ≤ inner < outer ≤ π/2)"
+                    ),
+                });
+            }
         }
         self.material.validate()
     }

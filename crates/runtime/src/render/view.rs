@@ -3,7 +3,9 @@
 //! box mip chain, the GGX-prefiltered levels and E₁ table of [`crate::ibl`], the
 //! `rough-film-lut` of [`FilmEval::Exact`]) and the render targets' formats.
 
-use super::options::{FilmEval, SceneOptions, normalize};
+use super::options::{
+    FilmEval, MAX_PUNCTUAL_LIGHTS, PunctualKind, PunctualLight, SceneOptions, normalize,
+};
 use crate::context::{BufferInitExt, GpuContext};
 use crate::environment::EnvironmentMap;
 use crate::error::{Error, Result};
@@ -31,7 +33,61 @@ pub enum RenderOutput {
 /// The render target format of [`RenderOutput::Linear`].
 pub const LINEAR_TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
-/// Mirror of `ViewParams` (`shaders/material.wgsl`): 128 bytes.
+/// Mirror of `ViewLight` (`shaders/view.wgsl`): one [`PunctualLight`], 64 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct LightUniform {
+    /// World position (point and spot lights).
+    pub position: [f32; 3],
+    /// 0 directional, 1 point, 2 spot (`VIEW_LIGHT_*`).
+    pub kind: u32,
+    /// Unit direction the light shines along.
+    pub direction: [f32; 3],
+    /// 1 / range⁴ (0: unlimited), for the window clamp(1 − r⁴ / range⁴, 0, 1)².
+    pub inv_range4: f32,
+    /// Colour × intensity, linear RGB.
+    pub radiant: [f32; 3],
+    /// The spot's t = clamp(cos θ · scale + offset, 0, 1): scale = 1 / (cos θ_inner −
+    /// cos θ_outer) (0 for other kinds).
+    pub cone_scale: f32,
+    /// offset = −cos θ_outer · scale (1 for other kinds: t = 1).
+    pub cone_offset: f32,
+    /// Padding to 64 bytes.
+    pub _pad: [f32; 3],
+}
+
+impl LightUniform {
+    /// The uniform of `light` (checked by [`SceneOptions::validate`]).
+    pub fn new(light: &PunctualLight) -> LightUniform {
+        let direction = normalize(light.direction.map(f64::from))
+            .map_or([0.0, -1.0, 0.0], |d| d.map(|x| x as f32));
+        let (kind, cone_scale, cone_offset) = match light.kind {
+            PunctualKind::Directional => (0, 0.0, 1.0),
+            PunctualKind::Point => (1, 0.0, 1.0),
+            PunctualKind::Spot {
+                inner_cone_rad,
+                outer_cone_rad,
+            } => {
+                // KHR_lights_punctual's reference: scale = 1 / max(0.001, cos θ_i − cos θ_o).
+                let (cos_inner, cos_outer) = (inner_cone_rad.cos(), outer_cone_rad.cos());
+                let scale = 1.0 / (cos_inner - cos_outer).max(1e-3);
+                (2, scale, -cos_outer * scale)
+            }
+        };
+        LightUniform {
+            position: light.position,
+            kind,
+            direction,
+            inv_range4: light.range.map_or(0.0, |r| r.powi(-4)),
+            radiant: light.colour.map(|c| c * light.intensity),
+            cone_scale,
+            cone_offset,
+            _pad: [0.0; 3],
+        }
+    }
+}
+
+/// Mirror of `ViewParams` (`shaders/view.wgsl`): 656 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct ViewUniform {
@@ -55,6 +111,12 @@ pub struct ViewUniform {
     pub scene: u32,
     /// Last mip level of the environment texture.
     pub env_lod_max: f32,
+    /// How many of `lights` are drawn (≤ [`MAX_PUNCTUAL_LIGHTS`]).
+    pub light_count: u32,
+    /// Padding to the array's 16-byte alignment.
+    pub _pad: [u32; 3],
+    /// The punctual lights drawn besides the directional one.
+    pub lights: [LightUniform; MAX_PUNCTUAL_LIGHTS],
 }
 
 impl ViewUniform {
@@ -77,6 +139,14 @@ impl ViewUniform {
             resolution: [options.width as f32, options.height as f32],
             scene: options.scene.id(),
             env_lod_max: env_levels.saturating_sub(1) as f32,
+            light_count: options.punctual_lights.len().min(MAX_PUNCTUAL_LIGHTS) as u32,
+            _pad: [0; 3],
+            lights: std::array::from_fn(|k| {
+                options
+                    .punctual_lights
+                    .get(k)
+                    .map_or_else(LightUniform::default, LightUniform::new)
+            }),
         })
     }
 }
