@@ -198,6 +198,34 @@ fn mesh_metal_index(f0: vec3<f32>) -> MetalIndex {
     return MetalIndex(max(n, vec3<f32>(1e-3)), sqrt(max(k2, vec3<f32>(0.0))));
 }
 
+// The picture of the opaque scene at uv ∈ [0, 1]² and mip level `lod` (fractional): bilinear
+// within the two nearest levels of its box-filtered chain (mip_down.wgsl), linear between
+// them, by textureLoad (the binding is a non-filterable float texture; no sampler).
+fn mesh_behind_sample(uv: vec2<f32>, lod: f32) -> vec4<f32> {
+    // The full chain's last level, ⌊log₂ max(w, h)⌋ (textureNumLevels has no GLSL ES 3.1
+    // counterpart).
+    let size = textureDimensions(mesh_behind_tex);
+    let last_level = f32(firstLeadingBit(max(max(size.x, size.y), 1u)));
+    let level = clamp(finite_or(lod, 0.0), 0.0, last_level);
+    let l0 = u32(floor(level));
+    let l1 = min(l0 + 1u, u32(last_level));
+    return mix(mesh_behind_bilinear(uv, l0), mesh_behind_bilinear(uv, l1), level - floor(level));
+}
+
+// Level `level` of the picture at uv, bilinear between its four nearest texels (clamped to
+// the edge).
+fn mesh_behind_bilinear(uv: vec2<f32>, level: u32) -> vec4<f32> {
+    let size = vec2<i32>(textureDimensions(mesh_behind_tex, level));
+    let p = clamp(uv, vec2<f32>(0.0), vec2<f32>(1.0)) * vec2<f32>(size) - 0.5;
+    let f = p - floor(p);
+    let lo = clamp(vec2<i32>(floor(p)), vec2<i32>(0), size - 1);
+    let hi = clamp(vec2<i32>(floor(p)) + 1, vec2<i32>(0), size - 1);
+    let l = i32(level);
+    let top = mix(textureLoad(mesh_behind_tex, lo, l), textureLoad(mesh_behind_tex, vec2<i32>(hi.x, lo.y), l), f.x);
+    let bottom = mix(textureLoad(mesh_behind_tex, vec2<i32>(lo.x, hi.y), l), textureLoad(mesh_behind_tex, hi, l), f.x);
+    return mix(top, bottom, f.y);
+}
+
 // What a transmissive surface at `world` (shading normal n, view direction v, dielectric
 // index `ior`) lets through from behind it, before its own transmittance and colour: the glTF
 // Sample Viewer's screen-space refraction (KHR_materials_transmission with
@@ -206,7 +234,9 @@ fn mesh_metal_index(f0: vec3<f32>) -> MetalIndex {
 // scene's radiance at that point's pixel, or the environment along d where the scene shows
 // nothing, attenuated by Beer–Lambert over the path inside, c^(thickness / distance)
 // (KHR_materials_volume attenuationColor c, attenuationDistance; 0 = none).
-fn mesh_behind(world: vec3<f32>, n: vec3<f32>, v: vec3<f32>, ior: f32) -> vec3<f32> {
+// Rough surfaces see it blurred, as the glTF Sample Viewer draws them: at mip
+// level log₂(width) · r · clamp(2 ior − 2, 0, 1) of the picture (r the perceptual roughness).
+fn mesh_behind(world: vec3<f32>, n: vec3<f32>, v: vec3<f32>, ior: f32, roughness: f32) -> vec3<f32> {
     let q = mesh_params;
     let thickness = max(finite_or(q.volume_thickness, 0.0), 0.0);
     let bent = refract(-v, n, 1.0 / max(ior, 1.0));
@@ -217,11 +247,13 @@ fn mesh_behind(world: vec3<f32>, n: vec3<f32>, v: vec3<f32>, ior: f32) -> vec3<f
         let clip = q.view_proj * vec4<f32>(exit, 1.0);
         if clip.w > 0.0 && f32_is_finite(clip.x / clip.w) && f32_is_finite(clip.y / clip.w) {
             let ndc = clip.xy / clip.w;
-            let size = vec2<i32>(textureDimensions(mesh_behind_tex));
+            let width = f32(textureDimensions(mesh_behind_tex).x);
+            let lod = log2(width) * clamp(roughness, 0.0, 1.0) * clamp(2.0 * ior - 2.0, 0.0, 1.0);
             let uv = vec2<f32>(0.5 + 0.5 * ndc.x, 0.5 - 0.5 * ndc.y);
-            let texel = clamp(vec2<i32>(floor(clamp(uv, vec2<f32>(0.0), vec2<f32>(1.0)) * vec2<f32>(size))), vec2<i32>(0), size - 1);
-            let scene = textureLoad(mesh_behind_tex, texel, 0);
-            behind = mix(behind, sanitize_radiance(scene.rgb), clamp(finite_or(scene.a, 0.0), 0.0, 1.0));
+            let scene = mesh_behind_sample(uv, lod);
+            // Premultiplied: the scene's radiance where it covers, the environment elsewhere.
+            let coverage = clamp(finite_or(scene.a, 0.0), 0.0, 1.0);
+            behind = behind * (1.0 - coverage) + sanitize_radiance(scene.rgb);
         }
     }
     let distance = finite_or(q.attenuation_distance, 0.0);
@@ -308,7 +340,7 @@ fn mesh_fs(in: MeshVertexOut, @builtin(front_facing) front: bool) -> @location(0
     var radiance = shade.radiance + sanitize_radiance(q.emissive * emissive_tex.rgb);
     if any(shade.transmittance > vec3<f32>(0.0)) {
         // glTF's specular BTDF is tinted by the base colour.
-        radiance += shade.transmittance * base.rgb * mesh_behind(in.world, n, v, ior);
+        radiance += shade.transmittance * base.rgb * mesh_behind(in.world, n, v, ior, roughness);
     }
     // MASK: below the cutoff the fragment is discarded (after the shading: lavapipe's
     // LLVM back end of Mesa 22 crashed compiling the shading loop after an early discard).

@@ -1021,6 +1021,11 @@ pub fn render_gltf_from(
         },
     )?;
 
+    let mip_down = if behind_needed {
+        Some(MipDown::new(ctx)?)
+    } else {
+        None
+    };
     let (target, submitted) = ctx.checked("rendering the glTF scene", || {
         let group = |layout: &wgpu::BindGroupLayout,
                      label: &str,
@@ -1170,7 +1175,8 @@ pub fn render_gltf_from(
             device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
                 size,
-                mip_level_count: 1,
+                // The full chain (mip_down.wgsl): rough surfaces refract a blurred picture.
+                mip_level_count: size.max_mips(wgpu::TextureDimension::D2),
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
                 format: BEHIND_FORMAT,
@@ -1186,6 +1192,14 @@ pub fn render_gltf_from(
         };
         let behind = linear_texture("mesh scene behind", if behind_needed { size } else { one });
         let behind_view = behind.create_view(&Default::default());
+        // Level k of the picture, alone: a render attachment holds one level.
+        let behind_level = |k: u32| {
+            behind.create_view(&wgpu::TextureViewDescriptor {
+                base_mip_level: k,
+                mip_level_count: Some(1),
+                ..Default::default()
+            })
+        };
         let no_behind = linear_texture("mesh no scene behind", one);
         let no_behind_view = no_behind.create_view(&Default::default());
         let mut encoder = device.create_command_encoder(&Default::default());
@@ -1260,11 +1274,19 @@ pub fn render_gltf_from(
             let groups = mesh_groups_with(FLAG_LINEAR_OUTPUT, &no_behind_view);
             draw(
                 &mut encoder,
-                &behind_view,
+                &behind_level(0),
                 wgpu::Color::TRANSPARENT,
                 &groups,
                 true,
             );
+            if let Some(mip_down) = &mip_down {
+                mip_down.fill(
+                    device,
+                    &mut encoder,
+                    &behind_level,
+                    behind.mip_level_count(),
+                );
+            }
         }
         // The background: the environment seen by the camera is not drawn (a clear colour
         // keeps the spheres' silhouettes readable).
@@ -1376,6 +1398,84 @@ fn mesh_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
         label: Some("mesh material (glTF)"),
         entries: &entries,
     })
+}
+
+/// The box-filter pass of `shaders/mip_down.wgsl` and its one binding (level k, read).
+struct MipDown {
+    layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::RenderPipeline,
+}
+
+impl MipDown {
+    fn new(ctx: &GpuContext) -> Result<MipDown> {
+        let device = &ctx.device;
+        let source = shaders::flatten("mip_down")?;
+        let module = shaders::create_module(ctx, "mip_down", &source)?;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("mip_down"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+                count: None,
+            }],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("mip_down"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = crate::gpu::fullscreen_pipeline(
+            device,
+            "mip_down",
+            &module,
+            &pipeline_layout,
+            ("mip_down_vs", "mip_down_fs"),
+            &[BEHIND_FORMAT],
+        );
+        Ok(MipDown { layout, pipeline })
+    }
+
+    /// Fills levels 1 … `levels` − 1 of a [`BEHIND_FORMAT`] picture, each the 2 × 2 box mean
+    /// of the level above; `level(k)` is level k's one-level view.
+    fn fill(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        level: &dyn Fn(u32) -> wgpu::TextureView,
+        levels: u32,
+    ) {
+        for k in 1..levels {
+            let above = level(k - 1);
+            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("mip_down"),
+                layout: &self.layout,
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(&above),
+                }],
+            });
+            let target = level(k);
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("mip_down"),
+                color_attachments: &[crate::gpu::cleared_attachment(
+                    &target,
+                    wgpu::Color::TRANSPARENT,
+                )],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &group, &[]);
+            pass.draw(0..3, 0..1);
+        }
+    }
 }
 
 /// Group 3's binding of the scene behind transmissive surfaces.

@@ -68,6 +68,8 @@ pub const SCENE: &str = include_str!("../../../shaders/scene.wgsl");
 /// Consumer: rasterised triangle meshes (glTF scenes of `nacre render --gltf`; group 3 holds
 /// the view-projection). Compose it after [`MATERIAL`].
 pub const MESH: &str = include_str!("../../../shaders/mesh.wgsl");
+/// The box-filter mip-level pass of the picture behind transmissive glTF surfaces.
+pub const MIP_DOWN: &str = include_str!("../../../shaders/mip_down.wgsl");
 
 /// The placeholder of an import header for the technique module chosen by the host.
 pub const TECHNIQUE_SLOT: &str = "<technique>";
@@ -115,6 +117,7 @@ pub const MODULES: &[Module] = modules![
     "material",
     "scene",
     "mesh",
+    "mip_down",
     "probe",
     "bench",
     "diffraction_common",
