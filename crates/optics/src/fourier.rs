@@ -273,7 +273,9 @@ pub struct AirySeries {
 }
 
 impl AirySeries {
-    fn new(r12: C64, gamma: C64) -> Self {
+    /// The series of the reflectance of a film with top amplitude `r12` and base reflection
+    /// `gamma` seen from inside the film (module docs).
+    pub fn new(r12: C64, gamma: C64) -> Self {
         let beta = (1.0 - r12 * r12) * gamma;
         let rho = -r12 * gamma;
         let inv = 1.0 / (1.0 - rho.norm_sqr());
