@@ -188,9 +188,9 @@ impl RuleTransform {
     #[inline]
     pub fn at(&self, mu_nm: f64) -> [C64; 3] {
         let x = mu_nm / self.step_nm;
-        let p = x.floor();
-        let t = x - p;
-        let p = p as usize;
+        // x ≥ 0: truncation is the floor.
+        let p = x as usize;
+        let t = x - p as f64;
         // (t − l) for the nodes l = −3 … 4 relative to p, numbered 0 … 7.
         let d: [f64; 8] = std::array::from_fn(|i| t - (i as f64 - 3.0));
         let mut left = [1.0; 8];

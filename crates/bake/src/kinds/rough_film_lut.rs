@@ -275,36 +275,50 @@ impl RoughLutJob {
                 })
                 .collect();
             // The product, one column x at a time: texel (x, y, k, a) =
-            // Σ_m w_m Σ_j K[x, a, j] F(c_j, d_m), w the cubic weights of its thickness.
+            // Σ_s w_s G(m₀ + s), w the cubic weights of its thickness and
+            // G(m) = Σ_j K[x, a, j] F(c_j, d_m) the kernel-weighted film colour at fine node
+            // m, computed once per node that some texel of the column reads.
             let columns: Vec<Vec<[f64; 6]>> = (0..a.cos_theta_count)
                 .into_par_iter()
                 .map(|x| {
-                    let mut out = Vec::with_capacity(a.opd_count * a.alpha_count);
-                    for y in 0..a.opd_count {
-                        for al in 0..a.alpha_count {
-                            let kern = &kernels[x * a.alpha_count + al];
-                            let (lo, hi) = supports[x * a.alpha_count + al];
-                            let d = a.texel_thickness_nm(x, y, k, al);
-                            let (m0, w) = cubic_stencil(d / d_step, d_nodes);
+                    let mut out = vec![[0.0; 6]; a.opd_count * a.alpha_count];
+                    let mut g: Vec<[f64; 6]> = Vec::new();
+                    for al in 0..a.alpha_count {
+                        let kern = &kernels[x * a.alpha_count + al];
+                        let (lo, hi) = supports[x * a.alpha_count + al];
+                        let stencils: Vec<(usize, [f64; 4])> = (0..a.opd_count)
+                            .map(|y| {
+                                let d = a.texel_thickness_nm(x, y, k, al);
+                                cubic_stencil(d / d_step, d_nodes)
+                            })
+                            .collect();
+                        let first = stencils.iter().map(|s| s.0).min().unwrap_or(0);
+                        let last = stencils.iter().map(|s| s.0 + 4).max().unwrap_or(0);
+                        g.clear();
+                        g.extend((first..last).map(|m| {
+                            let mut v = [0.0; 6];
+                            let row = m * n_c;
+                            let rows = kern.reflection[lo..hi]
+                                .iter()
+                                .zip(&kern.transmission[lo..hi])
+                                .zip(&film[row + lo..row + hi]);
+                            for ((&kr, &kt), f) in rows {
+                                for c in 0..3 {
+                                    v[c] += kr * f[c];
+                                    v[3 + c] += kt * f[3 + c];
+                                }
+                            }
+                            v
+                        }));
+                        for (y, (m0, w)) in stencils.iter().enumerate() {
                             let mut e = [0.0; 6];
                             for (s, ws) in w.iter().enumerate() {
-                                let mut v = [0.0; 6];
-                                let row = (m0 + s) * n_c;
-                                let rows = kern.reflection[lo..hi]
-                                    .iter()
-                                    .zip(&kern.transmission[lo..hi])
-                                    .zip(&film[row + lo..row + hi]);
-                                for ((&kr, &kt), f) in rows {
-                                    for c in 0..3 {
-                                        v[c] += kr * f[c];
-                                        v[3 + c] += kt * f[3 + c];
-                                    }
-                                }
+                                let v = &g[m0 + s - first];
                                 for c in 0..6 {
                                     e[c] += ws * v[c];
                                 }
                             }
-                            out.push(e);
+                            out[y * a.alpha_count + al] = e;
                         }
                     }
                     out
