@@ -643,9 +643,11 @@ fn run_bake(args: &BakeArgs) -> Result<()> {
             scope.spawn_fifo(move |_| {
                 let bar = bars.add(
                     ProgressBar::new(recipe.work()).with_style(
-                        ProgressStyle::with_template("{prefix:>22} [{bar:30}] {pos}/{len} {elapsed}")
-                            .expect("valid template")
-                            .progress_chars("=> "),
+                        ProgressStyle::with_template(
+                            "{prefix:>22} [{bar:30}] {pos}/{len} {elapsed}",
+                        )
+                        .expect("valid template")
+                        .progress_chars("=> "),
                     ),
                 );
                 bar.set_prefix(recipe.name().to_string());

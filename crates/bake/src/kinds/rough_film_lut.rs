@@ -102,7 +102,9 @@ use nacre_format::rough_film_lut::{RoughFilmLut, RoughLutAxes, validate_axes};
 use nacre_format::stage::StagedTable;
 use nacre_format::table_io::{Precision, Table3};
 use nacre_optics::colour::Colorimeter;
-use nacre_optics::film_series::{RuleTransform, SingleFilm};
+use nacre_optics::film_series::{
+    RuleTransform, SingleFilm, non_dispersive_surround, series_extent,
+};
 use nacre_optics::microfacet::REFRACTION_WAVELENGTH_NM;
 use nacre_optics::microfacet::kernel::{
     KERNEL_AZIMUTH_NODES, KERNEL_COS_NODES, KERNEL_RADIAL_NODES, Kernel, kernel_cos, kernels,
@@ -171,18 +173,6 @@ impl RoughLutJob {
         (nodes, top / (nodes - 1) as f64)
     }
 
-    /// The ambient's (real) and the base's index when the film colours are a Fourier series
-    /// (module docs, step 2): no fixed layers under the film, and neither the ambient nor the
-    /// base dispersive.
-    fn non_dispersive(&self) -> Option<(f64, C64)> {
-        if !self.under.is_empty() || !self.ambient.is_constant() || !self.base.is_constant() {
-            return None;
-        }
-        let ambient = self.ambient.index_at(560.0).ok()?;
-        let base = self.base.index_at(560.0).ok()?;
-        (ambient.im == 0.0).then_some((ambient.re, base))
-    }
-
     /// Bakes the table (module docs); `progress` is called once per film index.
     pub fn bake(&self, progress: &(dyn Fn() + Sync)) -> Result<RoughFilmLut> {
         let a = &self.axes;
@@ -209,38 +199,55 @@ impl RoughLutJob {
         let mut transmittance = self
             .transmittance
             .then(|| Table3::new(a.cos_theta_count, a.opd_count, depth));
-        // Non-dispersive stacks: every film colour from the Airy series (module docs, step 2).
-        let films: Option<Vec<Vec<Option<(SingleFilm, usize)>>>> =
-            self.non_dispersive().map(|(n_ambient, base)| {
-                (0..a.ior_count)
-                    .map(|k| {
-                        (0..n_c)
-                            .map(|j| {
-                                let c = kernel_cos(j, n_c).max(MIN_COS_THETA);
-                                let film = SingleFilm::new(
-                                    n_ambient,
-                                    a.texel_ior(k),
-                                    base,
-                                    c,
-                                    self.transmittance,
-                                )?;
-                                Some((film, film.harmonics()?))
-                            })
-                            .collect()
-                    })
-                    .collect()
-            });
-        let transform = films
-            .as_ref()
-            .map(|films| {
-                let top = films
-                    .iter()
-                    .flatten()
-                    .flatten()
-                    .map(|(f, m)| *m as f64 * f.opd_nm(d_grid[d_nodes - 1]))
-                    .fold(0.0, f64::max);
-                RuleTransform::new(&rule, top)
-            })
+        // Non-dispersive stacks: the film colours from the Airy series (module docs, step 2),
+        // where its transform's extent pays off (film_series::series_extent).
+        let plans: Option<Vec<Vec<Option<(SingleFilm, usize, f64)>>>> =
+            non_dispersive_surround(&self.ambient, &self.under, &self.base).map(
+                |(n_ambient, base)| {
+                    (0..a.ior_count)
+                        .map(|k| {
+                            (0..n_c)
+                                .map(|j| {
+                                    let c = kernel_cos(j, n_c).max(MIN_COS_THETA);
+                                    let film = SingleFilm::new(
+                                        n_ambient,
+                                        a.texel_ior(k),
+                                        base,
+                                        c,
+                                        self.transmittance,
+                                    )?;
+                                    let (m, mu) = film.plan(d_grid[d_nodes - 1])?;
+                                    Some((film, m, mu))
+                                })
+                                .collect()
+                        })
+                        .collect()
+                },
+            );
+        let extent = plans.as_ref().map(|plans| {
+            let needs: Vec<(f64, usize)> = plans
+                .iter()
+                .flatten()
+                .flatten()
+                .map(|&(_, _, mu)| (mu, d_nodes))
+                .collect();
+            series_extent(&needs)
+        });
+        let films: Option<Vec<Vec<Option<(SingleFilm, usize)>>>> = plans.map(|plans| {
+            plans
+                .into_iter()
+                .map(|row| {
+                    row.into_iter()
+                        .map(|p| {
+                            p.filter(|&(_, _, mu)| Some(mu) <= extent)
+                                .map(|(f, m, _)| (f, m))
+                        })
+                        .collect()
+                })
+                .collect()
+        });
+        let transform = extent
+            .map(|extent| RuleTransform::new(&rule, extent))
             .transpose()?;
         for k in 0..a.ior_count {
             let n = a.texel_ior(k);

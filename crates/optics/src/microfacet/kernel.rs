@@ -32,8 +32,8 @@
 //! fixed order, so the kernels are the same bits on every run and thread count.
 
 use super::{VndfFrame, refract, smith_lambda};
-use std::f64::consts::PI;
 use crate::quadrature::{cubic_stencil, gauss_legendre_01};
+use std::f64::consts::PI;
 
 /// Nodes of the uniform grid of microfacet cosines c = ω_o·h on which the kernels are
 /// tabulated (and a baker evaluates the film colours).
