@@ -60,7 +60,9 @@
 //!
 //! Measured against [`crate::Stack::colours_over_thickness`] with the same rule: ≤ 1.2·10⁻¹¹
 //! over film indices 1.0–2.5 (1.0 and the base's 1.5 included), 0–1800 nm, cos θ 10⁻³–1
-//! (test `series_matches_the_wavelength_sum`).
+//! (test `series_matches_the_wavelength_sum`); the largest differences are at grazing
+//! incidence, where the series takes q₀ = n₀ cos θ exactly and the wavelength sum takes it
+//! through the angle in degrees (q₀² = 1 − sin²θ loses ≈ 10⁻⁴ of itself at cos θ = 10⁻⁶).
 
 use crate::error::{Error, Result};
 use crate::fourier::AirySeries;
@@ -471,7 +473,7 @@ mod tests {
         let base = C64::new(1.5, 0.0);
         let mut films = Vec::new();
         for &n in &[1.0, 1.0026, 1.2, 1.5, 1.9, 2.5] {
-            for &c in &[1e-3, 0.02, 0.3, 0.7071, 1.0] {
+            for &c in &[1e-3, 0.02, 0.3, 0.6, 1.0] {
                 let film = SingleFilm::new(1.0, n, base, c, true).unwrap();
                 films.push((n, c, film, film.harmonics().unwrap()));
             }
@@ -500,15 +502,14 @@ mod tests {
             let want = stack
                 .colours_over_thickness(1, c.acos().to_degrees(), &rule, &thicknesses)
                 .unwrap();
-            for i in 0..thicknesses.len() {
+            for (i, d) in thicknesses.iter().enumerate() {
                 for j in 0..3 {
                     let e = (got.reflectance[i][j] - want.reflectance[i][j]).abs();
                     let f = (got.transmittance[i][j] - want.transmittance[i][j]).abs();
                     worst = worst.max(e.max(f));
                     assert!(
                         e.max(f) <= 1e-9,
-                        "n {n} cos {c} d {} channel {j}: R {} vs {}, T {} vs {}",
-                        thicknesses[i],
+                        "n {n} cos {c} d {d} channel {j}: R {} vs {}, T {} vs {}",
                         got.reflectance[i][j],
                         want.reflectance[i][j],
                         got.transmittance[i][j],

@@ -148,6 +148,12 @@ pub fn rounded_to_half(lut: &RoughFilmLut) -> (Table3, Option<Table3>) {
     (r_out, Some(t_out))
 }
 
+/// A film on the Airy-series path: its series, harmonics M and the extent M D it reaches.
+type Planned = (SingleFilm, usize, f64);
+
+/// A film the series computes: its series and harmonics M.
+type Series = (SingleFilm, usize);
+
 /// Everything needed to bake one rough-film LUT.
 pub struct RoughLutJob {
     /// Axes.
@@ -201,7 +207,7 @@ impl RoughLutJob {
             .then(|| Table3::new(a.cos_theta_count, a.opd_count, depth));
         // Non-dispersive stacks: the film colours from the Airy series (module docs, step 2),
         // where its transform's extent pays off (film_series::series_extent).
-        let plans: Option<Vec<Vec<Option<(SingleFilm, usize, f64)>>>> =
+        let plans: Option<Vec<Vec<Option<Planned>>>> =
             non_dispersive_surround(&self.ambient, &self.under, &self.base).map(
                 |(n_ambient, base)| {
                     (0..a.ior_count)
@@ -233,7 +239,7 @@ impl RoughLutJob {
                 .collect();
             series_extent(&needs)
         });
-        let films: Option<Vec<Vec<Option<(SingleFilm, usize)>>>> = plans.map(|plans| {
+        let films: Option<Vec<Vec<Option<Series>>>> = plans.map(|plans| {
             plans
                 .into_iter()
                 .map(|row| {
