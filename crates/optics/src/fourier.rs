@@ -175,7 +175,13 @@ impl SensitivitySpectrum {
     /// Ŝ_j(μ), prefiltered by a Gaussian of standard deviation `sigma_mu_nm` in μ
     /// (multiplying S_j(ν) by exp(−(2π σ_μ ν)²/2); 0 for none).
     pub fn transform(&self, mu_nm: f64, sigma_mu_nm: f64) -> [C64; 3] {
-        let omega = 2.0 * PI * mu_nm;
+        self.transform_damped(mu_nm, &self.damped(sigma_mu_nm))
+    }
+
+    /// The node values S_j(νᵢ) exp(−(2π σ_μ νᵢ)²/2) of the prefilter `sigma_mu_nm` (0 for
+    /// none), for [`SensitivitySpectrum::transform_damped`]: many μ at one σ_μ (a mip level
+    /// of the `fourier` table) share them.
+    pub fn damped(&self, sigma_mu_nm: f64) -> Vec<[f64; 3]> {
         let damp = |nu: f64| {
             if sigma_mu_nm > 0.0 {
                 (-0.5 * (2.0 * PI * sigma_mu_nm * nu).powi(2)).exp()
@@ -183,6 +189,20 @@ impl SensitivitySpectrum {
                 1.0
             }
         };
+        self.nu
+            .iter()
+            .zip(&self.values)
+            .map(|(&nu, v)| {
+                let d = damp(nu);
+                v.map(|v| v * d)
+            })
+            .collect()
+    }
+
+    /// Ŝ_j(μ) with the node values `damped` of [`SensitivitySpectrum::damped`] (the same
+    /// bits as [`SensitivitySpectrum::transform`] at that σ_μ).
+    pub fn transform_damped(&self, mu_nm: f64, damped: &[[f64; 3]]) -> [C64; 3] {
+        let omega = 2.0 * PI * mu_nm;
         let cells = self.nu.len() - 1;
         // The phases e^{−iωνᵢ} and the cells' e^{−iωhᵢ}, by the vectorised deterministic
         // sin/cos of `crate::simd` (the same bits on every CPU).
@@ -192,15 +212,10 @@ impl SensitivitySpectrum {
         let (mut sin, mut cos) = (vec![0.0; 2 * cells], vec![0.0; 2 * cells]);
         crate::simd::sin_cos_slice(&arg, &mut sin, &mut cos);
         let mut sum = [C64::new(0.0, 0.0); 3];
-        let mut da = damp(self.nu[0]);
         for i in 0..cells {
             let (a, b) = (self.nu[i], self.nu[i + 1]);
             let h = b - a;
-            let db = damp(b);
-            let (fa, fb) = (
-                self.values[i].map(|v| v * da),
-                self.values[i + 1].map(|v| v * db),
-            );
+            let (fa, fb) = (damped[i], damped[i + 1]);
             let e = C64::new(cos[cells + i], sin[cells + i]);
             let (wa, wb) = filon_weights(omega, h, e);
             let phase = C64::new(cos[i], sin[i]);
@@ -208,7 +223,6 @@ impl SensitivitySpectrum {
                 // ∫ (f_a + (f_b − f_a) t / h) e^{−iω(a + t)} dt = e^{−iωa} (f_a A + (f_b − f_a) B / h)
                 sum[j] += phase * (wa * fa[j] + wb * ((fb[j] - fa[j]) / h));
             }
-            da = db;
         }
         std::array::from_fn(|j| sum[j] / self.norm[j])
     }
@@ -273,7 +287,9 @@ pub struct AirySeries {
 }
 
 impl AirySeries {
-    fn new(r12: C64, gamma: C64) -> Self {
+    /// The series of the reflectance of a film with top amplitude `r12` and base reflection
+    /// `gamma` seen from inside the film (module docs).
+    pub fn new(r12: C64, gamma: C64) -> Self {
         let beta = (1.0 - r12 * r12) * gamma;
         let rho = -r12 * gamma;
         let inv = 1.0 / (1.0 - rho.norm_sqr());

@@ -26,6 +26,7 @@ pub mod csv_rows;
 pub mod diffraction;
 pub mod error;
 pub mod few_wavelengths;
+pub mod film_series;
 pub mod fourier;
 pub mod fresnel;
 pub mod material;

@@ -375,24 +375,57 @@ pub fn radiance_directional(
 /// h = normalize(α N_hx, α N_hy, max(0, N_hz))              (unstretch)
 /// ```
 pub fn sample_ggx_vndf(wo: [f64; 3], alpha: f64, u1: f64, u2: f64) -> [f64; 3] {
-    let vh = normalize([alpha * wo[0], alpha * wo[1], wo[2]]);
-    let lensq = vh[0] * vh[0] + vh[1] * vh[1];
-    let t1v = if lensq > 0.0 {
-        let inv = 1.0 / lensq.sqrt();
-        [-vh[1] * inv, vh[0] * inv, 0.0]
-    } else {
-        [1.0, 0.0, 0.0]
-    };
-    let t2v = cross(vh, t1v);
-    let r = u1.sqrt();
     let (sin_phi, cos_phi) = (2.0 * PI * u2).sin_cos();
-    let t1 = r * cos_phi;
-    let mut t2 = r * sin_phi;
-    let s = 0.5 * (1.0 + vh[2]);
-    t2 = (1.0 - s) * (1.0 - t1 * t1).max(0.0).sqrt() + s * t2;
-    let tz = (1.0 - t1 * t1 - t2 * t2).max(0.0).sqrt();
-    let nh: [f64; 3] = std::array::from_fn(|c| t1 * t1v[c] + t2 * t2v[c] + tz * vh[c]);
-    normalize([alpha * nh[0], alpha * nh[1], nh[2].max(0.0)])
+    VndfFrame::new(wo, alpha).sample(u1.sqrt(), sin_phi, cos_phi)
+}
+
+/// The part of [`sample_ggx_vndf`] that depends on the view and α only (V_h, T₁, T₂, s), so
+/// that a quadrature over many (r, φ) computes it once; [`VndfFrame::sample`] is the rest,
+/// the same operations in the same order (the same bits as [`sample_ggx_vndf`]).
+#[derive(Clone, Copy, Debug)]
+pub struct VndfFrame {
+    alpha: f64,
+    vh: [f64; 3],
+    t1v: [f64; 3],
+    t2v: [f64; 3],
+    s: f64,
+}
+
+impl VndfFrame {
+    /// The frame of view `wo` and roughness `alpha`.
+    pub fn new(wo: [f64; 3], alpha: f64) -> Self {
+        let vh = normalize([alpha * wo[0], alpha * wo[1], wo[2]]);
+        let lensq = vh[0] * vh[0] + vh[1] * vh[1];
+        let t1v = if lensq > 0.0 {
+            let inv = 1.0 / lensq.sqrt();
+            [-vh[1] * inv, vh[0] * inv, 0.0]
+        } else {
+            [1.0, 0.0, 0.0]
+        };
+        let t2v = cross(vh, t1v);
+        let s = 0.5 * (1.0 + vh[2]);
+        VndfFrame {
+            alpha,
+            vh,
+            t1v,
+            t2v,
+            s,
+        }
+    }
+
+    /// The half vector at disk radius `r` = √u₁ and azimuth φ = 2π u₂ given as
+    /// (`sin_phi`, `cos_phi`).
+    #[inline]
+    pub fn sample(&self, r: f64, sin_phi: f64, cos_phi: f64) -> [f64; 3] {
+        let (alpha, s) = (self.alpha, self.s);
+        let t1 = r * cos_phi;
+        let mut t2 = r * sin_phi;
+        t2 = (1.0 - s) * (1.0 - t1 * t1).max(0.0).sqrt() + s * t2;
+        let tz = (1.0 - t1 * t1 - t2 * t2).max(0.0).sqrt();
+        let nh: [f64; 3] =
+            std::array::from_fn(|c| t1 * self.t1v[c] + t2 * self.t2v[c] + tz * self.vh[c]);
+        normalize([alpha * nh[0], alpha * nh[1], nh[2].max(0.0)])
+    }
 }
 
 // ---------------------------------------------------------------------------------------

@@ -38,6 +38,11 @@
 //! and beside each EXR the same table as a KTX 2.0 texture, `NAME.QUANTITY.ktx2` (3-D
 //! `RGBA16F`; a `fourier` table gives one `NAME.ktx2`, a 2-D array `RGBA32F` texture with
 //! every mip level: see [`nacre_format::ktx2`]). Every file is written atomically; the manifest last.
+//!
+//! Each row of constant (cos θ, n) is one thickness sweep of the exact spectral rule
+//! ([`Stack::colours_over_thickness`]); where the ambient and the base are non-dispersive
+//! and no layers lie under the film (`film-dielectric`, `soap-film`) the same sums come from
+//! the film's Airy Fourier series ([`nacre_optics::film_series`], equal to ≈ 10⁻¹¹).
 
 use crate::error::Result;
 use crate::kinds::{KindEntry, TableRecipe};
@@ -50,6 +55,9 @@ use nacre_format::ktx2::{Ktx2Format, film_lut_image_as};
 use nacre_format::manifest::{AxisRecord, KindRecord, MAX_TEXELS, Manifest, TableKind};
 use nacre_format::table_io::{Precision, Table3};
 use nacre_optics::colour::Colorimeter;
+use nacre_optics::film_series::{
+    RuleTransform, SingleFilm, non_dispersive_surround, series_extent,
+};
 use nacre_optics::{C64, Layer, Material, SpectralRule, Stack};
 use rayon::prelude::*;
 use serde::Deserialize;
@@ -320,13 +328,61 @@ impl FilmLutJob {
         let rows: Vec<(usize, usize)> = (0..a.ior_count)
             .flat_map(|z| (0..a.cos_theta_count).map(move |x| (x, z)))
             .collect();
+        let thicknesses = |x: usize, z: usize| -> Vec<f64> {
+            (0..a.opd_count)
+                .map(|y| a.texel_parameters(x, y, z).1)
+                .collect()
+        };
+        // A non-dispersive film between non-dispersive media: the same wavelength sums from
+        // the film's Airy Fourier series (nacre_optics::film_series; rough_film_lut's
+        // module docs, step 2).
+        let plans: Option<Vec<Option<(SingleFilm, usize, f64)>>> =
+            non_dispersive_surround(&self.ambient, &self.under, &self.base).map(
+                |(n_ambient, base)| {
+                    rows.iter()
+                        .map(|&(x, z)| {
+                            let (cos_theta, _, n) = a.texel_parameters(x, 0, z);
+                            let film =
+                                SingleFilm::new(n_ambient, n, base, cos_theta, self.transmittance)?;
+                            let d = thicknesses(x, z).into_iter().fold(0.0, f64::max);
+                            let (m, mu) = film.plan(d)?;
+                            Some((film, m, mu))
+                        })
+                        .collect()
+                },
+            );
+        let extent = plans.as_ref().map(|plans| {
+            let needs: Vec<(f64, usize)> = plans
+                .iter()
+                .flatten()
+                .map(|&(_, _, mu)| (mu, a.opd_count))
+                .collect();
+            series_extent(&needs)
+        });
+        let films: Option<Vec<Option<(SingleFilm, usize)>>> = plans.map(|plans| {
+            plans
+                .into_iter()
+                .map(|p| {
+                    p.filter(|&(_, _, mu)| Some(mu) <= extent)
+                        .map(|(f, m, _)| (f, m))
+                })
+                .collect()
+        });
+        let transform = extent
+            .map(|extent| RuleTransform::new(&rule, extent))
+            .transpose()?;
         let results: Vec<nacre_optics::FilmColours> = rows
             .par_iter()
-            .map(|&(x, z)| {
+            .enumerate()
+            .map(|(i, &(x, z))| {
                 let (cos_theta, _, n) = a.texel_parameters(x, 0, z);
-                let thicknesses: Vec<f64> = (0..a.opd_count)
-                    .map(|y| a.texel_parameters(x, y, z).1)
-                    .collect();
+                let thicknesses = thicknesses(x, z);
+                if let (Some(films), Some(transform)) = (&films, &transform)
+                    && let Some((film, m)) = &films[i]
+                {
+                    progress();
+                    return Ok(film.colours_over_thickness(transform, *m, &thicknesses));
+                }
                 let film = Material::constant(format!("{n}"), C64::new(n, 0.0))?;
                 let mut layers = vec![Layer {
                     material: film,

@@ -183,11 +183,12 @@ pub fn bake_table(colorimeter: &Colorimeter, axes: FourierAxes) -> FourierTable 
         .iter()
         .zip(&axes.level_sigma_nm)
         .map(|(&n, &sigma)| {
+            let damped = spectrum.damped(sigma);
             (0..n)
                 .into_par_iter()
                 .map(|i| {
                     let mu = (i as f64 + 0.5) * axes.max_opd_nm / n as f64;
-                    let s = spectrum.transform(mu, sigma);
+                    let s = spectrum.transform_damped(mu, &damped);
                     std::array::from_fn(|j| {
                         let a =
                             s[j] * C64::from_polar(1.0, 2.0 * PI * mu * axes.carrier_nu_per_nm[j]);

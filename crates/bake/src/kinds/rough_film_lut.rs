@@ -56,7 +56,14 @@
 //!    sweep ([`Stack::colours_over_thickness`]) gives F_R and F_T on a uniform fine grid of
 //!    thicknesses d_m = m δd over [0, [`THICKNESS_EXTENSION`] · d_max] with δd chosen so
 //!    that the optical path advances by at most [`FINE_OPD_STEP_NM`] per node
-//!    (2 δd n_max ≤ 24 nm), resolving the interference fringes.
+//!    (2 δd n_max ≤ 24 nm), resolving the interference fringes. Where neither the ambient
+//!    nor the base is dispersive and no fixed layers lie under the film (the default
+//!    table), the same wavelength sums come from the film's Airy Fourier series instead
+//!    ([`nacre_optics::film_series`], after Belcour & Barla 2017 §4):
+//!    F_j = ½(c₀,s + c₀,p) Σₖ Wₖⱼ + Σ_pol Σ_{m=1}^{M} Re(c_m F_j(m D)), D = 2 d q_f, with
+//!    F_j(μ) = Σₖ Wₖⱼ e^{2πiμ/λₖ} the rule's own transform (tabulated once per bake) and M
+//!    per (c_j, n_k) such that the tail is below 10⁻¹³: the same numbers to ≈ 10⁻¹¹ at
+//!    O(M) operations per thickness instead of one Airy evaluation per wavelength node.
 //! 3. **Product**. Texel (x, y, n_k, α_a) at cos θ_o, Δ and d = Δ / (2 q(n_k, c_ref(cos θ_o,
 //!    α_a))) holds Σ_j K[x, a, j] F̃(c_j, d, n_k), with F̃ cubic Lagrange interpolation in d on
 //!    the fine grid. Thicknesses beyond the fine grid (texels outside the physical range that only
@@ -95,6 +102,9 @@ use nacre_format::rough_film_lut::{RoughFilmLut, RoughLutAxes, validate_axes};
 use nacre_format::stage::StagedTable;
 use nacre_format::table_io::{Precision, Table3};
 use nacre_optics::colour::Colorimeter;
+use nacre_optics::film_series::{
+    RuleTransform, SingleFilm, non_dispersive_surround, series_extent,
+};
 use nacre_optics::microfacet::REFRACTION_WAVELENGTH_NM;
 use nacre_optics::microfacet::kernel::{
     KERNEL_AZIMUTH_NODES, KERNEL_COS_NODES, KERNEL_RADIAL_NODES, Kernel, kernel_cos, kernels,
@@ -137,6 +147,12 @@ pub fn rounded_to_half(lut: &RoughFilmLut) -> (Table3, Option<Table3>) {
     }
     (r_out, Some(t_out))
 }
+
+/// A film on the Airy-series path: its series, harmonics M and the extent M D it reaches.
+type Planned = (SingleFilm, usize, f64);
+
+/// A film the series computes: its series and harmonics M.
+type Series = (SingleFilm, usize);
 
 /// Everything needed to bake one rough-film LUT.
 pub struct RoughLutJob {
@@ -189,6 +205,56 @@ impl RoughLutJob {
         let mut transmittance = self
             .transmittance
             .then(|| Table3::new(a.cos_theta_count, a.opd_count, depth));
+        // Non-dispersive stacks: the film colours from the Airy series (module docs, step 2),
+        // where its transform's extent pays off (film_series::series_extent).
+        let plans: Option<Vec<Vec<Option<Planned>>>> =
+            non_dispersive_surround(&self.ambient, &self.under, &self.base).map(
+                |(n_ambient, base)| {
+                    (0..a.ior_count)
+                        .map(|k| {
+                            (0..n_c)
+                                .map(|j| {
+                                    let c = kernel_cos(j, n_c).max(MIN_COS_THETA);
+                                    let film = SingleFilm::new(
+                                        n_ambient,
+                                        a.texel_ior(k),
+                                        base,
+                                        c,
+                                        self.transmittance,
+                                    )?;
+                                    let (m, mu) = film.plan(d_grid[d_nodes - 1])?;
+                                    Some((film, m, mu))
+                                })
+                                .collect()
+                        })
+                        .collect()
+                },
+            );
+        let extent = plans.as_ref().map(|plans| {
+            let needs: Vec<(f64, usize)> = plans
+                .iter()
+                .flatten()
+                .flatten()
+                .map(|&(_, _, mu)| (mu, d_nodes))
+                .collect();
+            series_extent(&needs)
+        });
+        let films: Option<Vec<Vec<Option<Series>>>> = plans.map(|plans| {
+            plans
+                .into_iter()
+                .map(|row| {
+                    row.into_iter()
+                        .map(|p| {
+                            p.filter(|&(_, _, mu)| Some(mu) <= extent)
+                                .map(|(f, m, _)| (f, m))
+                        })
+                        .collect()
+                })
+                .collect()
+        });
+        let transform = extent
+            .map(|extent| RuleTransform::new(&rule, extent))
+            .transpose()?;
         for k in 0..a.ior_count {
             let n = a.texel_ior(k);
             let film = Material::constant(format!("{n}"), C64::new(n, 0.0))?;
@@ -202,6 +268,11 @@ impl RoughLutJob {
             let colours: Vec<nacre_optics::FilmColours> = (0..n_c)
                 .into_par_iter()
                 .map(|j| {
+                    if let (Some(films), Some(transform)) = (&films, &transform)
+                        && let Some((film, m)) = &films[k][j]
+                    {
+                        return Ok(film.colours_over_thickness(transform, *m, &d_grid));
+                    }
                     let c = kernel_cos(j, n_c).max(MIN_COS_THETA);
                     Ok(stack.colours_over_thickness(1, c.acos().to_degrees(), &rule, &d_grid)?)
                 })
@@ -217,36 +288,50 @@ impl RoughLutJob {
                 })
                 .collect();
             // The product, one column x at a time: texel (x, y, k, a) =
-            // Σ_m w_m Σ_j K[x, a, j] F(c_j, d_m), w the cubic weights of its thickness.
+            // Σ_s w_s G(m₀ + s), w the cubic weights of its thickness and
+            // G(m) = Σ_j K[x, a, j] F(c_j, d_m) the kernel-weighted film colour at fine node
+            // m, computed once per node that some texel of the column reads.
             let columns: Vec<Vec<[f64; 6]>> = (0..a.cos_theta_count)
                 .into_par_iter()
                 .map(|x| {
-                    let mut out = Vec::with_capacity(a.opd_count * a.alpha_count);
-                    for y in 0..a.opd_count {
-                        for al in 0..a.alpha_count {
-                            let kern = &kernels[x * a.alpha_count + al];
-                            let (lo, hi) = supports[x * a.alpha_count + al];
-                            let d = a.texel_thickness_nm(x, y, k, al);
-                            let (m0, w) = cubic_stencil(d / d_step, d_nodes);
+                    let mut out = vec![[0.0; 6]; a.opd_count * a.alpha_count];
+                    let mut g: Vec<[f64; 6]> = Vec::new();
+                    for al in 0..a.alpha_count {
+                        let kern = &kernels[x * a.alpha_count + al];
+                        let (lo, hi) = supports[x * a.alpha_count + al];
+                        let stencils: Vec<(usize, [f64; 4])> = (0..a.opd_count)
+                            .map(|y| {
+                                let d = a.texel_thickness_nm(x, y, k, al);
+                                cubic_stencil(d / d_step, d_nodes)
+                            })
+                            .collect();
+                        let first = stencils.iter().map(|s| s.0).min().unwrap_or(0);
+                        let last = stencils.iter().map(|s| s.0 + 4).max().unwrap_or(0);
+                        g.clear();
+                        g.extend((first..last).map(|m| {
+                            let mut v = [0.0; 6];
+                            let row = m * n_c;
+                            let rows = kern.reflection[lo..hi]
+                                .iter()
+                                .zip(&kern.transmission[lo..hi])
+                                .zip(&film[row + lo..row + hi]);
+                            for ((&kr, &kt), f) in rows {
+                                for c in 0..3 {
+                                    v[c] += kr * f[c];
+                                    v[3 + c] += kt * f[3 + c];
+                                }
+                            }
+                            v
+                        }));
+                        for (y, (m0, w)) in stencils.iter().enumerate() {
                             let mut e = [0.0; 6];
                             for (s, ws) in w.iter().enumerate() {
-                                let mut v = [0.0; 6];
-                                let row = (m0 + s) * n_c;
-                                let rows = kern.reflection[lo..hi]
-                                    .iter()
-                                    .zip(&kern.transmission[lo..hi])
-                                    .zip(&film[row + lo..row + hi]);
-                                for ((&kr, &kt), f) in rows {
-                                    for c in 0..3 {
-                                        v[c] += kr * f[c];
-                                        v[3 + c] += kt * f[3 + c];
-                                    }
-                                }
+                                let v = &g[m0 + s - first];
                                 for c in 0..6 {
                                     e[c] += ws * v[c];
                                 }
                             }
-                            out.push(e);
+                            out[y * a.alpha_count + al] = e;
                         }
                     }
                     out

@@ -16,7 +16,7 @@
 //!
 //! The visible-normal domain is Heitz's unit disk (Heitz, "Sampling the GGX Distribution of
 //! Visible Normals", JCGT 7(4), 2018, Listing 1: the map (u₁, u₂) ∈ [0, 1]² → h of
-//! [`sample_ggx_vndf`] has constant density on the disk), so
+//! [`sample_ggx_vndf`](super::sample_ggx_vndf) has constant density on the disk), so
 //! E = ∫∫ F(ω_o·h(u₁, u₂)) g(u₁, u₂) du₁ du₂ with g = G₂/G₁ (0 below the horizon). The
 //! integral is taken by a deterministic product rule: [`KERNEL_RADIAL_NODES`]-point
 //! Gauss–Legendre ([`gauss_legendre_01`]) in v, u₁ = r² = 1 − (1 − v)² (nodes crowd the
@@ -31,8 +31,9 @@
 //! samples within its noise (test `furnace_kernel_matches_monte_carlo`). Every sum runs in a
 //! fixed order, so the kernels are the same bits on every run and thread count.
 
-use super::{refract, sample_ggx_vndf, smith_lambda};
+use super::{VndfFrame, refract, smith_lambda};
 use crate::quadrature::{cubic_stencil, gauss_legendre_01};
+use std::f64::consts::PI;
 
 /// Nodes of the uniform grid of microfacet cosines c = ω_o·h on which the kernels are
 /// tabulated (and a baker evaluates the film colours).
@@ -130,11 +131,17 @@ pub fn kernels_with(
         transmission: vec![0.0; n_c],
     };
     let scale = (n_c - 1) as f64;
+    // sample_ggx_vndf(wo, α, u₁, u₂) with its view-only part and the azimuths' sin/cos
+    // computed once (the same operations, the same bits).
+    let frame = VndfFrame::new(wo, alpha);
+    let phis: Vec<(f64, f64)> = (0..azimuth)
+        .map(|i| (2.0 * PI * ((i as f64 + 0.5) / azimuth as f64)).sin_cos())
+        .collect();
     for (&u1, &w1) in u1s.iter().zip(&w1s) {
         let w = w1 / azimuth as f64;
-        for i in 0..azimuth {
-            let u2 = (i as f64 + 0.5) / azimuth as f64;
-            let h = sample_ggx_vndf(wo, alpha, u1, u2);
+        let r = u1.sqrt();
+        for &(sin_phi, cos_phi) in &phis {
+            let h = frame.sample(r, sin_phi, cos_phi);
             let cos_d = wo[0] * h[0] + wo[1] * h[1] + wo[2] * h[2];
             if cos_d <= 0.0 {
                 continue;
