@@ -430,7 +430,7 @@ pub(crate) fn lane<S: Simd>(v: &[f64], start: usize) -> S::f64s {
 
 /// The vector of `v` starting at element `start`.
 #[inline(always)]
-fn lane_mut<S: Simd>(v: &mut [f64], start: usize) -> &mut S::f64s {
+pub(crate) fn lane_mut<S: Simd>(v: &mut [f64], start: usize) -> &mut S::f64s {
     &mut S::as_mut_simd_f64s(&mut v[start..start + S::F64_LANES]).0[0]
 }
 
