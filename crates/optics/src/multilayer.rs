@@ -65,9 +65,9 @@ use pulp::{Simd, WithSimd};
 const MAX_INDEX: f64 = 1e6;
 /// Smallest max(|Re ñ|, |Im ñ|) the kernel takes (|ñ² − β²|² stays far above underflow).
 const MIN_INDEX: f64 = 1e-6;
-/// Largest |phase| bound k₀ d (|Re ñ| + |Im ñ| + n₀) per film the kernel takes: below it
-/// [`sin_cos`]'s argument reduction is exact (module docs of [`crate::simd`]).
-const MAX_PHASE_RAD: f64 = 1e6;
+/// Largest bound k₀ d (|Re ñ| + |Im ñ| + n₀) on a film's phase |δ| the kernel takes: below
+/// it [`sin_cos`]'s argument reduction of 2 Re δ is exact (module docs of [`crate::simd`]).
+const MAX_PHASE_RAD: f64 = 5e5;
 /// The sign bit of an f64.
 const SIGN: u64 = 1 << 63;
 
@@ -224,20 +224,16 @@ impl MediumBlock {
 
 /// The staging arrays of one block of wavelengths. The recurrence runs medium by medium
 /// over the whole block (loops of independent elements, which the CPU overlaps), rather
-/// than element by element through the stack (one long dependency chain of square roots
-/// and divisions).
+/// than element by element through the stack (one long dependency chain).
 struct Block {
     /// Media j + 1 (below the interface being added) and j: `media[c.below]` and
     /// `media[1 - c.below]` (the roles alternate rather than the arrays being swapped).
     media: [MediumBlock; 2],
-    /// Interface j: r_s, r_p as (re, im), |t_s|², |t_p|².
-    r: [[f64; BLOCK]; 4],
-    t2: [[f64; BLOCK]; 2],
-    /// e^{iδ_{j+1}} (re, im) and |e^{iδ_{j+1}}|².
-    e: [[f64; BLOCK]; 3],
-    /// Γ_s, Γ_p as (re, im), |τ_s|², |τ_p|².
-    gamma: [[f64; BLOCK]; 4],
-    tau2: [[f64; BLOCK]; 2],
+    /// Γ = N / D per polarisation (s, p): N and D as (re, im) pairs.
+    num: [[f64; BLOCK]; 4],
+    den: [[f64; BLOCK]; 4],
+    /// |τ|² = U / |D|² per polarisation.
+    u: [[f64; BLOCK]; 2],
     /// Re q_f, Re(ñ_f² conj q_f), |ñ_f|² of the substrate.
     substrate: [[f64; BLOCK]; 3],
     /// R_s, R_p, T_s, T_p.
@@ -261,20 +257,17 @@ struct Ctx<'a> {
 const SUBSTRATE: u8 = 0;
 const MEDIUM: u8 = 1;
 const FIRST: u8 = 2;
-const PHASOR: u8 = 3;
-const STEP: u8 = 4;
-const POWERS: u8 = 5;
+const STEP: u8 = 3;
+const POWERS: u8 = 4;
 
 impl Block {
     fn new() -> Self {
         let z = [0.0; BLOCK];
         Block {
             media: [MediumBlock::new(), MediumBlock::new()],
-            r: [z; 4],
-            t2: [z; 2],
-            e: [z; 3],
-            gamma: [z; 4],
-            tau2: [z; 2],
+            num: [z; 4],
+            den: [z; 4],
+            u: [z; 2],
             substrate: [z; 3],
             out: [z; 4],
         }
@@ -290,6 +283,20 @@ impl Block {
         for i in head..n {
             self.stage::<pulp::Scalar, STAGE, SHORTCUTS>(pulp::Scalar::new(), c, i);
         }
+    }
+
+    /// Stores Γ = N/D and |τ|² = U/|D|² of polarisation `pol` for the lanes at `i`, all
+    /// three scaled by the power of two that brings |Re D| + |Im D| into [1, 2) (U by its
+    /// square): exact, and keeps N, D, U from over- or underflowing however many films.
+    #[inline(always)]
+    fn put<S: Simd>(&mut self, s: S, i: usize, pol: usize, n: Cx<S>, d: Cx<S>, u: S::f64s) {
+        let scale = power_of_two_scale(s, s.add_f64s(s.abs_f64s(d.re), s.abs_f64s(d.im)));
+        let scale2 = s.mul_f64s(scale, scale);
+        *lane_mut::<S>(&mut self.num[2 * pol], i) = s.mul_f64s(n.re, scale);
+        *lane_mut::<S>(&mut self.num[2 * pol + 1], i) = s.mul_f64s(n.im, scale);
+        *lane_mut::<S>(&mut self.den[2 * pol], i) = s.mul_f64s(d.re, scale);
+        *lane_mut::<S>(&mut self.den[2 * pol + 1], i) = s.mul_f64s(d.im, scale);
+        *lane_mut::<S>(&mut self.u[pol], i) = s.mul_f64s(u, scale2);
     }
 
     /// Stage `STAGE` for the lanes of elements `i ..`.
@@ -318,83 +325,67 @@ impl Block {
                 *lane_mut::<S>(&mut self.substrate[1], i) = re_n2_conj_q;
                 *lane_mut::<S>(&mut self.substrate[2], i) = norm_sqr(s, sub.n);
             }
-            MEDIUM | FIRST => {
+            MEDIUM => {
+                let above = medium_j(c.j);
+                self.media[1 - c.below].store(i, above);
+            }
+            FIRST => {
+                // Γ_N = r_{N,N+1} = ρ/σ, |τ_N|² = |t_{N,N+1}|² = |tσ|²/|σ|².
                 let above = medium_j(c.j);
                 self.media[1 - c.below].store(i, above);
                 let below = self.media[c.below].load::<S>(i);
-                let ([r_s, r_p], [t_s2, t_p2]) = interface(s, &above, &below);
-                let (r, t2) = if STAGE == FIRST {
-                    (&mut self.gamma, &mut self.tau2)
-                } else {
-                    (&mut self.r, &mut self.t2)
-                };
-                *lane_mut::<S>(&mut r[0], i) = r_s.re;
-                *lane_mut::<S>(&mut r[1], i) = r_s.im;
-                *lane_mut::<S>(&mut r[2], i) = r_p.re;
-                *lane_mut::<S>(&mut r[3], i) = r_p.im;
-                *lane_mut::<S>(&mut t2[0], i) = t_s2;
-                *lane_mut::<S>(&mut t2[1], i) = t_p2;
-            }
-            PHASOR => {
-                // e^{iδ} of film j + 1 (medium `below`), δ = k₀ q d.
-                let below = &self.media[c.below];
-                let (q_re, q_im) = (ld(&below.q_re), ld(&below.q_im));
-                let kd = s.mul_f64s(
-                    lane::<S>(&m.k0_per_nm, w),
-                    s.splat_f64s(m.thickness_nm[c.j]),
-                );
-                let (sin_x, cos_x) = sin_cos(s, s.mul_f64s(q_re, kd));
-                // Lanes with Im q = 0 get a decay of exactly 1, as when it is skipped.
-                let decay = if SHORTCUTS && !any_nonzero(s, q_im) {
-                    s.splat_f64s(1.0)
-                } else {
-                    exp_neg(s, s.mul_f64s(q_im, kd))
-                };
-                *lane_mut::<S>(&mut self.e[0], i) = s.mul_f64s(decay, cos_x);
-                *lane_mut::<S>(&mut self.e[1], i) = s.mul_f64s(decay, sin_x);
-                *lane_mut::<S>(&mut self.e[2], i) = s.mul_f64s(decay, decay);
+                let f = interface(s, &above, &below);
+                for pol in 0..2 {
+                    self.put(s, i, pol, f.rho[pol], f.sigma[pol], f.t_sigma2[pol]);
+                }
             }
             STEP => {
-                let one = s.splat_f64s(1.0);
-                let e = Cx::<S> {
-                    re: ld(&self.e[0]),
-                    im: ld(&self.e[1]),
+                let above = self.media[1 - c.below].load::<S>(i);
+                let below = self.media[c.below].load::<S>(i);
+                let f = interface(s, &above, &below);
+                // e^{2iδ} of film j + 1 (medium `below`), δ = k₀ q d: e^{−2 Im δ} (cos, sin)(2 Re δ).
+                let kd2 = s.mul_f64s(
+                    lane::<S>(&m.k0_per_nm, w),
+                    s.splat_f64s(2.0 * m.thickness_nm[c.j]),
+                );
+                let (sin_x, cos_x) = sin_cos(s, s.mul_f64s(below.q.re, kd2));
+                // Lanes with Im q = 0 get a decay of exactly 1, as when it is skipped.
+                let decay2 = if SHORTCUTS && !any_nonzero(s, below.q.im) {
+                    None
+                } else {
+                    Some(exp_neg(s, s.mul_f64s(below.q.im, kd2)))
                 };
-                let e2 = mul(s, e, e);
-                let mut num = [e2; 2];
-                let mut den = [e2; 2];
-                let mut den2 = [one; 2];
+                let e2 = match decay2 {
+                    Some(a) => Cx::<S> {
+                        re: s.mul_f64s(a, cos_x),
+                        im: s.mul_f64s(a, sin_x),
+                    },
+                    None => Cx::<S> {
+                        re: cos_x,
+                        im: sin_x,
+                    },
+                };
                 for pol in 0..2 {
-                    let gamma = Cx::<S> {
-                        re: ld(&self.gamma[2 * pol]),
-                        im: ld(&self.gamma[2 * pol + 1]),
+                    let n = Cx::<S> {
+                        re: ld(&self.num[2 * pol]),
+                        im: ld(&self.num[2 * pol + 1]),
                     };
-                    let r = Cx::<S> {
-                        re: ld(&self.r[2 * pol]),
-                        im: ld(&self.r[2 * pol + 1]),
+                    let d = Cx::<S> {
+                        re: ld(&self.den[2 * pol]),
+                        im: ld(&self.den[2 * pol + 1]),
                     };
-                    let ge2 = mul(s, gamma, e2);
-                    num[pol] = add(s, r, ge2);
-                    let rge2 = mul(s, r, ge2);
-                    den[pol] = Cx {
-                        re: s.add_f64s(one, rge2.re),
-                        im: rge2.im,
+                    // Γ_j = (r + Γ e^{2iδ})/(1 + r Γ e^{2iδ}) with r = ρ/σ, Γ = N/D:
+                    // N' = ρD + σNe^{2iδ}, D' = σD + ρNe^{2iδ}, U' = |tσ|² U |e^{iδ}|².
+                    let ne2 = mul(s, n, e2);
+                    let (rho, sigma) = (f.rho[pol], f.sigma[pol]);
+                    let n_new = add(s, mul(s, rho, d), mul(s, sigma, ne2));
+                    let d_new = add(s, mul(s, sigma, d), mul(s, rho, ne2));
+                    let u = s.mul_f64s(f.t_sigma2[pol], ld(&self.u[pol]));
+                    let u = match decay2 {
+                        Some(a) => s.mul_f64s(u, a),
+                        None => u,
                     };
-                    den2[pol] = norm_sqr(s, den[pol]);
-                }
-                let inv_both = s.div_f64s(one, s.mul_f64s(den2[0], den2[1]));
-                let inv = [
-                    s.mul_f64s(den2[1], inv_both),
-                    s.mul_f64s(den2[0], inv_both),
-                ];
-                let e_norm2 = ld(&self.e[2]);
-                for pol in 0..2 {
-                    let g = mul_conj_scaled(s, num[pol], den[pol], inv[pol]);
-                    *lane_mut::<S>(&mut self.gamma[2 * pol], i) = g.re;
-                    *lane_mut::<S>(&mut self.gamma[2 * pol + 1], i) = g.im;
-                    let t = s.mul_f64s(ld(&self.t2[pol]), ld(&self.tau2[pol]));
-                    let t = s.mul_f64s(t, e_norm2);
-                    *lane_mut::<S>(&mut self.tau2[pol], i) = s.mul_f64s(t, inv[pol]);
+                    self.put(s, i, pol, n_new, d_new, u);
                 }
             }
             POWERS => {
@@ -410,15 +401,19 @@ impl Block {
                     s.mul_f64s(ld(&self.substrate[1]), norm_sqr(s, amb.n)),
                     s.mul_f64s(ld(&self.substrate[2]), re_n2_conj_q),
                 );
-                let g = |k: usize| Cx::<S> {
-                    re: ld(&self.gamma[2 * k]),
-                    im: ld(&self.gamma[2 * k + 1]),
+                let cx = |v: &[[f64; BLOCK]; 4], pol: usize| Cx::<S> {
+                    re: ld(&v[2 * pol]),
+                    im: ld(&v[2 * pol + 1]),
                 };
+                // One division for both polarisations (|D|² in [0.5, 4) after scaling).
+                let d2 = [norm_sqr(s, cx(&self.den, 0)), norm_sqr(s, cx(&self.den, 1))];
+                let inv_both = s.div_f64s(s.splat_f64s(1.0), s.mul_f64s(d2[0], d2[1]));
+                let inv = [s.mul_f64s(d2[1], inv_both), s.mul_f64s(d2[0], inv_both)];
                 let p = [
-                    norm_sqr(s, g(0)),
-                    norm_sqr(s, g(1)),
-                    s.mul_f64s(ld(&self.tau2[0]), factor_s),
-                    s.mul_f64s(ld(&self.tau2[1]), factor_p),
+                    s.mul_f64s(norm_sqr(s, cx(&self.num, 0)), inv[0]),
+                    s.mul_f64s(norm_sqr(s, cx(&self.num, 1)), inv[1]),
+                    s.mul_f64s(s.mul_f64s(ld(&self.u[0]), inv[0]), factor_s),
+                    s.mul_f64s(s.mul_f64s(ld(&self.u[1]), inv[1]), factor_p),
                 ];
                 for (k, v) in p.into_iter().enumerate() {
                     *lane_mut::<S>(&mut self.out[k], i) = v;
@@ -427,6 +422,23 @@ impl Block {
             _ => unreachable!(),
         }
     }
+}
+
+/// Exponent field of an f64 (bits 52–62).
+const EXPONENT: u64 = 0x7ff << 52;
+
+/// 2^{−e} for v = f × 2^e (1 ≤ f < 2), so that v × 2^{−e} lies in [1, 2); 1 for v = 0,
+/// subnormal, infinite or NaN.
+#[inline(always)]
+fn power_of_two_scale<S: Simd>(s: S, v: S::f64s) -> S::f64s {
+    let e = s.and_u64s(s.transmute_u64s_f64s(v), s.splat_u64s(EXPONENT));
+    // Biased exponent E ↦ 2046 − E: the bits of 2^{−(E − 1023)}.
+    let scale = s.transmute_f64s_u64s(s.sub_u64s(s.splat_u64s(2046 << 52), e));
+    let special = s.or_m64s(
+        s.equal_u64s(e, s.splat_u64s(0)),
+        s.equal_u64s(e, s.splat_u64s(EXPONENT)),
+    );
+    s.select_f64s(special, s.splat_f64s(1.0), scale)
 }
 
 impl<T: PowerSlot, const SHORTCUTS: bool> WithSimd for RowOp<'_, T, SHORTCUTS> {
@@ -455,7 +467,6 @@ impl<T: PowerSlot, const SHORTCUTS: bool> WithSimd for RowOp<'_, T, SHORTCUTS> {
                     b.run::<S, FIRST, SHORTCUTS>(s, c, n);
                 } else {
                     b.run::<S, MEDIUM, SHORTCUTS>(s, c, n);
-                    b.run::<S, PHASOR, SHORTCUTS>(s, c, n);
                     b.run::<S, STEP, SHORTCUTS>(s, c, n);
                 }
                 c.below = 1 - c.below;
@@ -502,21 +513,6 @@ fn mul<S: Simd>(s: S, a: Cx<S>, b: Cx<S>) -> Cx<S> {
     Cx {
         re: s.sub_f64s(s.mul_f64s(a.re, b.re), s.mul_f64s(a.im, b.im)),
         im: s.add_f64s(s.mul_f64s(a.re, b.im), s.mul_f64s(a.im, b.re)),
-    }
-}
-
-/// a conj(b) k for real k: the quotient a / b when k = 1/|b|².
-#[inline(always)]
-fn mul_conj_scaled<S: Simd>(s: S, a: Cx<S>, b: Cx<S>, k: S::f64s) -> Cx<S> {
-    Cx {
-        re: s.mul_f64s(
-            s.add_f64s(s.mul_f64s(a.re, b.re), s.mul_f64s(a.im, b.im)),
-            k,
-        ),
-        im: s.mul_f64s(
-            s.sub_f64s(s.mul_f64s(a.im, b.re), s.mul_f64s(a.re, b.im)),
-            k,
-        ),
     }
 }
 
@@ -583,23 +579,26 @@ fn medium<S: Simd, const SHORTCUTS: bool>(s: S, n: Cx<S>, beta2: S::f64s) -> Med
     Medium { n, n2, q }
 }
 
-/// Interface from medium `i` into medium `j`: (r_s, r_p) and (|t_s|², |t_p|²).
+/// Interface from medium `i` into medium `j` as fractions r = ρ/σ per polarisation (s, p),
+/// and |t σ|²: ρ_s = q_i − q_j, σ_s = q_i + q_j, |t_s σ_s|² = 4|q_i|²;
+/// ρ_p = ñ_j² q_i − ñ_i² q_j, σ_p = ñ_j² q_i + ñ_i² q_j, |t_p σ_p|² = 4|ñ_i ñ_j q_i|².
+struct Fractions<S: Simd> {
+    rho: [Cx<S>; 2],
+    sigma: [Cx<S>; 2],
+    t_sigma2: [S::f64s; 2],
+}
+
 #[inline(always)]
-fn interface<S: Simd>(s: S, i: &Medium<S>, j: &Medium<S>) -> ([Cx<S>; 2], [S::f64s; 2]) {
-    let sum_s = add(s, i.q, j.q);
+fn interface<S: Simd>(s: S, i: &Medium<S>, j: &Medium<S>) -> Fractions<S> {
     let a = mul(s, j.n2, i.q);
     let b = mul(s, i.n2, j.q);
-    let sum_p = add(s, a, b);
-    let (ns, np) = (norm_sqr(s, sum_s), norm_sqr(s, sum_p));
-    let inv_both = s.div_f64s(s.splat_f64s(1.0), s.mul_f64s(ns, np));
-    let (inv_s, inv_p) = (s.mul_f64s(np, inv_both), s.mul_f64s(ns, inv_both));
-    let r_s = mul_conj_scaled(s, sub(s, i.q, j.q), sum_s, inv_s);
-    let r_p = mul_conj_scaled(s, sub(s, a, b), sum_p, inv_p);
     let four_qi2 = s.mul_f64s(s.splat_f64s(4.0), norm_sqr(s, i.q));
-    let t_s2 = s.mul_f64s(four_qi2, inv_s);
     let ninj2 = s.mul_f64s(norm_sqr(s, i.n), norm_sqr(s, j.n));
-    let t_p2 = s.mul_f64s(s.mul_f64s(four_qi2, ninj2), inv_p);
-    ([r_s, r_p], [t_s2, t_p2])
+    Fractions {
+        rho: [sub(s, i.q, j.q), sub(s, a, b)],
+        sigma: [add(s, i.q, j.q), add(s, a, b)],
+        t_sigma2: [four_qi2, s.mul_f64s(four_qi2, ninj2)],
+    }
 }
 
 /// Whether any lane of `v` is non-zero (NaN counts as zero).
