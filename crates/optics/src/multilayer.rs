@@ -288,15 +288,45 @@ impl Block {
     /// Stores Γ = N/D and |τ|² = U/|D|² of polarisation `pol` for the lanes at `i`, all
     /// three scaled by the power of two that brings |Re D| + |Im D| into [1, 2) (U by its
     /// square): exact, and keeps N, D, U from over- or underflowing however many films.
+    ///
+    /// The scaling is done when `rescale` (at every [`RESCALE_EVERY`]-th medium and at the
+    /// ambient: a function of the medium index only, so the same for every lane and path);
+    /// between, N, D and U grow or shrink by at most (|σ| + |ρ|)^[`RESCALE_EVERY`]
+    /// per polarisation (≤ 10⁷⁶ for indices within the kernel's range).
     #[inline(always)]
-    fn put<S: Simd>(&mut self, s: S, i: usize, pol: usize, n: Cx<S>, d: Cx<S>, u: S::f64s) {
-        let scale = power_of_two_scale(s, s.add_f64s(s.abs_f64s(d.re), s.abs_f64s(d.im)));
-        let scale2 = s.mul_f64s(scale, scale);
-        *lane_mut::<S>(&mut self.num[2 * pol], i) = s.mul_f64s(n.re, scale);
-        *lane_mut::<S>(&mut self.num[2 * pol + 1], i) = s.mul_f64s(n.im, scale);
-        *lane_mut::<S>(&mut self.den[2 * pol], i) = s.mul_f64s(d.re, scale);
-        *lane_mut::<S>(&mut self.den[2 * pol + 1], i) = s.mul_f64s(d.im, scale);
-        *lane_mut::<S>(&mut self.u[pol], i) = s.mul_f64s(u, scale2);
+    #[allow(clippy::too_many_arguments)]
+    fn put<S: Simd>(
+        &mut self,
+        s: S,
+        i: usize,
+        pol: usize,
+        n: Cx<S>,
+        d: Cx<S>,
+        u: S::f64s,
+        rescale: bool,
+    ) {
+        let (n, d, u) = if rescale {
+            let scale = power_of_two_scale(s, s.add_f64s(s.abs_f64s(d.re), s.abs_f64s(d.im)));
+            let scale2 = s.mul_f64s(scale, scale);
+            (
+                Cx::<S> {
+                    re: s.mul_f64s(n.re, scale),
+                    im: s.mul_f64s(n.im, scale),
+                },
+                Cx::<S> {
+                    re: s.mul_f64s(d.re, scale),
+                    im: s.mul_f64s(d.im, scale),
+                },
+                s.mul_f64s(u, scale2),
+            )
+        } else {
+            (n, d, u)
+        };
+        *lane_mut::<S>(&mut self.num[2 * pol], i) = n.re;
+        *lane_mut::<S>(&mut self.num[2 * pol + 1], i) = n.im;
+        *lane_mut::<S>(&mut self.den[2 * pol], i) = d.re;
+        *lane_mut::<S>(&mut self.den[2 * pol + 1], i) = d.im;
+        *lane_mut::<S>(&mut self.u[pol], i) = u;
     }
 
     /// Stage `STAGE` for the lanes of elements `i ..`.
@@ -336,7 +366,9 @@ impl Block {
                 let below = self.media[c.below].load::<S>(i);
                 let f = interface(s, &above, &below);
                 for pol in 0..2 {
-                    self.put(s, i, pol, f.rho[pol], f.sigma[pol], f.t_sigma2[pol]);
+                    let (alpha, beta) = (f.alpha[pol], f.beta[pol]);
+                    let (rho, sigma) = (sub(s, alpha, beta), add(s, alpha, beta));
+                    self.put(s, i, pol, rho, sigma, f.t_sigma2[pol], true);
                 }
             }
             STEP => {
@@ -374,18 +406,20 @@ impl Block {
                         re: ld(&self.den[2 * pol]),
                         im: ld(&self.den[2 * pol + 1]),
                     };
-                    // Γ_j = (r + Γ e^{2iδ})/(1 + r Γ e^{2iδ}) with r = ρ/σ, Γ = N/D:
-                    // N' = ρD + σNe^{2iδ}, D' = σD + ρNe^{2iδ}, U' = |tσ|² U |e^{iδ}|².
-                    let ne2 = mul(s, n, e2);
-                    let (rho, sigma) = (f.rho[pol], f.sigma[pol]);
-                    let n_new = add(s, mul(s, rho, d), mul(s, sigma, ne2));
-                    let d_new = add(s, mul(s, sigma, d), mul(s, rho, ne2));
+                    // Γ_j = (r + Γ e^{2iδ})/(1 + r Γ e^{2iδ}) with r = ρ/σ, Γ = N/D, M = N e^{2iδ}:
+                    // N' = ρD + σM, D' = σD + ρM, U' = |tσ|² U |e^{iδ}|²; with ρ = α − β,
+                    // σ = α + β: D' = α(D + M) + β(D − M), N' = α(D + M) − β(D − M).
+                    let m = mul(s, n, e2);
+                    let (alpha, beta) = (f.alpha[pol], f.beta[pol]);
+                    let a = mul(s, alpha, add(s, d, m));
+                    let b = mul(s, beta, sub(s, d, m));
+                    let (n_new, d_new) = (sub(s, a, b), add(s, a, b));
                     let u = s.mul_f64s(f.t_sigma2[pol], ld(&self.u[pol]));
                     let u = match decay2 {
                         Some(a) => s.mul_f64s(u, a),
                         None => u,
                     };
-                    self.put(s, i, pol, n_new, d_new, u);
+                    self.put(s, i, pol, n_new, d_new, u, c.j % RESCALE_EVERY == 0);
                 }
             }
             POWERS => {
@@ -423,6 +457,9 @@ impl Block {
         }
     }
 }
+
+/// Media between rescalings of the recurrence's N, D, U ([`Block::put`]).
+const RESCALE_EVERY: usize = 4;
 
 /// Exponent field of an f64 (bits 52–62).
 const EXPONENT: u64 = 0x7ff << 52;
@@ -579,12 +616,13 @@ fn medium<S: Simd, const SHORTCUTS: bool>(s: S, n: Cx<S>, beta2: S::f64s) -> Med
     Medium { n, n2, q }
 }
 
-/// Interface from medium `i` into medium `j` as fractions r = ρ/σ per polarisation (s, p),
-/// and |t σ|²: ρ_s = q_i − q_j, σ_s = q_i + q_j, |t_s σ_s|² = 4|q_i|²;
-/// ρ_p = ñ_j² q_i − ñ_i² q_j, σ_p = ñ_j² q_i + ñ_i² q_j, |t_p σ_p|² = 4|ñ_i ñ_j q_i|².
+/// Interface from medium `i` into medium `j` per polarisation (s, p): r = ρ/σ with
+/// ρ = α − β, σ = α + β (the admittances y_s = q, y_p = q/ñ² of [`crate::fresnel`],
+/// multiplied through by ñ_i² ñ_j²), and |t σ|²: α_s = q_i, β_s = q_j, |t_s σ_s|² = 4|q_i|²;
+/// α_p = ñ_j² q_i, β_p = ñ_i² q_j, |t_p σ_p|² = 4|ñ_i ñ_j q_i|².
 struct Fractions<S: Simd> {
-    rho: [Cx<S>; 2],
-    sigma: [Cx<S>; 2],
+    alpha: [Cx<S>; 2],
+    beta: [Cx<S>; 2],
     t_sigma2: [S::f64s; 2],
 }
 
@@ -595,8 +633,8 @@ fn interface<S: Simd>(s: S, i: &Medium<S>, j: &Medium<S>) -> Fractions<S> {
     let four_qi2 = s.mul_f64s(s.splat_f64s(4.0), norm_sqr(s, i.q));
     let ninj2 = s.mul_f64s(norm_sqr(s, i.n), norm_sqr(s, j.n));
     Fractions {
-        rho: [sub(s, i.q, j.q), sub(s, a, b)],
-        sigma: [add(s, i.q, j.q), add(s, a, b)],
+        alpha: [i.q, a],
+        beta: [j.q, b],
         t_sigma2: [four_qi2, s.mul_f64s(four_qi2, ninj2)],
     }
 }
