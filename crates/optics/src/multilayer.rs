@@ -75,8 +75,10 @@ const SIGN: u64 = 1 << 63;
 pub(crate) struct Media {
     /// Re ñ_j(λ_w) at `re[j][w]`, j = 0 ambient … N+1 substrate.
     re: Vec<Vec<f64>>,
-    /// Im ñ_j(λ_w).
-    im: Vec<Vec<f64>>,
+    /// ñ_j² as (re, im) and |ñ_j|², computed once per wavelength (angle-independent).
+    n2_re: Vec<Vec<f64>>,
+    n2_im: Vec<Vec<f64>>,
+    n_abs2: Vec<Vec<f64>>,
     /// Vacuum wavenumber k₀ = 2π/λ_w, rad/nm.
     k0_per_nm: Vec<f64>,
     /// Film thicknesses, top first, nm.
@@ -94,7 +96,7 @@ impl Media {
     ) -> Option<Self> {
         let media = thickness_nm.len() + 2;
         let mut re = vec![Vec::with_capacity(indices.len()); media];
-        let mut im = vec![Vec::with_capacity(indices.len()); media];
+        let (mut n2_re, mut n2_im, mut n_abs2) = (re.clone(), re.clone(), re.clone());
         let mut k0_per_nm = Vec::with_capacity(indices.len());
         for (idx, &wl) in indices.iter().zip(wavelengths_nm) {
             debug_assert_eq!(idx.len(), media);
@@ -112,13 +114,18 @@ impl Media {
                     return None;
                 }
                 re[j].push(n.re);
-                im[j].push(n.im);
+                let n2 = n * n;
+                n2_re[j].push(n2.re);
+                n2_im[j].push(n2.im);
+                n_abs2[j].push(n.norm_sqr());
             }
             k0_per_nm.push(k0);
         }
         Some(Media {
             re,
-            im,
+            n2_re,
+            n2_im,
+            n_abs2,
             k0_per_nm,
             thickness_nm: thickness_nm.to_vec(),
         })
@@ -173,8 +180,7 @@ const BLOCK: usize = 64;
 
 /// ñ, ñ², q of one medium over a block, (re, im) arrays.
 struct MediumBlock {
-    n_re: [f64; BLOCK],
-    n_im: [f64; BLOCK],
+    n_abs2: [f64; BLOCK],
     n2_re: [f64; BLOCK],
     n2_im: [f64; BLOCK],
     q_re: [f64; BLOCK],
@@ -184,8 +190,7 @@ struct MediumBlock {
 impl MediumBlock {
     fn new() -> Self {
         MediumBlock {
-            n_re: [0.0; BLOCK],
-            n_im: [0.0; BLOCK],
+            n_abs2: [0.0; BLOCK],
             n2_re: [0.0; BLOCK],
             n2_im: [0.0; BLOCK],
             q_re: [0.0; BLOCK],
@@ -196,10 +201,7 @@ impl MediumBlock {
     #[inline(always)]
     fn load<S: Simd>(&self, i: usize) -> Medium<S> {
         Medium {
-            n: Cx {
-                re: lane::<S>(&self.n_re, i),
-                im: lane::<S>(&self.n_im, i),
-            },
+            n_abs2: lane::<S>(&self.n_abs2, i),
             n2: Cx {
                 re: lane::<S>(&self.n2_re, i),
                 im: lane::<S>(&self.n2_im, i),
@@ -213,8 +215,7 @@ impl MediumBlock {
 
     #[inline(always)]
     fn store<S: Simd>(&mut self, i: usize, m: Medium<S>) {
-        *lane_mut::<S>(&mut self.n_re, i) = m.n.re;
-        *lane_mut::<S>(&mut self.n_im, i) = m.n.im;
+        *lane_mut::<S>(&mut self.n_abs2, i) = m.n_abs2;
         *lane_mut::<S>(&mut self.n2_re, i) = m.n2.re;
         *lane_mut::<S>(&mut self.n2_im, i) = m.n2.im;
         *lane_mut::<S>(&mut self.q_re, i) = m.q.re;
@@ -336,12 +337,13 @@ impl Block {
         let w = c.start + i;
         let ld = |v: &[f64; BLOCK]| lane::<S>(v, i);
         let medium_j = |j: usize| {
-            let n = Cx::<S> {
-                re: lane::<S>(&m.re[j], w),
-                im: lane::<S>(&m.im[j], w),
+            let n2 = Cx::<S> {
+                re: lane::<S>(&m.n2_re[j], w),
+                im: lane::<S>(&m.n2_im[j], w),
             };
             let beta = s.mul_f64s(lane::<S>(&m.re[0], w), s.splat_f64s(c.sin_theta));
-            medium::<S, SHORTCUTS>(s, n, s.mul_f64s(beta, beta))
+            let beta2 = s.mul_f64s(beta, beta);
+            medium::<S, SHORTCUTS>(s, lane::<S>(&m.n_abs2[j], w), n2, beta2)
         };
         match STAGE {
             SUBSTRATE => {
@@ -353,7 +355,7 @@ impl Block {
                 );
                 *lane_mut::<S>(&mut self.substrate[0], i) = sub.q.re;
                 *lane_mut::<S>(&mut self.substrate[1], i) = re_n2_conj_q;
-                *lane_mut::<S>(&mut self.substrate[2], i) = norm_sqr(s, sub.n);
+                *lane_mut::<S>(&mut self.substrate[2], i) = sub.n_abs2;
             }
             MEDIUM => {
                 let above = medium_j(c.j);
@@ -430,19 +432,28 @@ impl Block {
                     s.mul_f64s(amb.n2.re, amb.q.re),
                     s.mul_f64s(amb.n2.im, amb.q.im),
                 );
-                let factor_s = s.div_f64s(ld(&self.substrate[0]), amb.q.re);
-                let factor_p = s.div_f64s(
-                    s.mul_f64s(ld(&self.substrate[1]), norm_sqr(s, amb.n)),
-                    s.mul_f64s(ld(&self.substrate[2]), re_n2_conj_q),
-                );
                 let cx = |v: &[[f64; BLOCK]; 4], pol: usize| Cx::<S> {
                     re: ld(&v[2 * pol]),
                     im: ld(&v[2 * pol + 1]),
                 };
-                // One division for both polarisations (|D|² in [0.5, 4) after scaling).
+                // One division for the four denominators X = Re q₀,
+                // Y = |ñ_f|² Re(ñ₀² conj q₀) and |D_s|², |D_p|² (each within [10⁻⁴⁰, 10⁴⁰]:
+                // |D|² in [0.5, 4) after scaling, indices within the kernel's range).
+                let x = amb.q.re;
+                let y = s.mul_f64s(ld(&self.substrate[2]), re_n2_conj_q);
                 let d2 = [norm_sqr(s, cx(&self.den, 0)), norm_sqr(s, cx(&self.den, 1))];
-                let inv_both = s.div_f64s(s.splat_f64s(1.0), s.mul_f64s(d2[0], d2[1]));
-                let inv = [s.mul_f64s(d2[1], inv_both), s.mul_f64s(d2[0], inv_both)];
+                let xy = s.mul_f64s(x, y);
+                let dd = s.mul_f64s(d2[0], d2[1]);
+                let inv_all = s.div_f64s(s.splat_f64s(1.0), s.mul_f64s(xy, dd));
+                let inv_dd = s.mul_f64s(xy, inv_all);
+                let inv_xy = s.mul_f64s(dd, inv_all);
+                let inv = [s.mul_f64s(d2[1], inv_dd), s.mul_f64s(d2[0], inv_dd)];
+                // Re q_f / Re q₀ and Re(ñ_f² conj q_f) |ñ₀|² / (|ñ_f|² Re(ñ₀² conj q₀)).
+                let factor_s = s.mul_f64s(ld(&self.substrate[0]), s.mul_f64s(y, inv_xy));
+                let factor_p = s.mul_f64s(
+                    s.mul_f64s(ld(&self.substrate[1]), amb.n_abs2),
+                    s.mul_f64s(x, inv_xy),
+                );
                 let p = [
                     s.mul_f64s(norm_sqr(s, cx(&self.num, 0)), inv[0]),
                     s.mul_f64s(norm_sqr(s, cx(&self.num, 1)), inv[1]),
@@ -559,23 +570,27 @@ fn norm_sqr<S: Simd>(s: S, a: Cx<S>) -> S::f64s {
     s.add_f64s(s.mul_f64s(a.re, a.re), s.mul_f64s(a.im, a.im))
 }
 
-/// One medium per lane: ñ, ñ², q = ñ cos θ on the forward branch.
+/// One medium per lane: |ñ|², ñ², q = ñ cos θ on the forward branch.
 #[derive(Clone, Copy)]
 struct Medium<S: Simd> {
-    n: Cx<S>,
+    n_abs2: S::f64s,
     n2: Cx<S>,
     q: Cx<S>,
 }
 
-/// The medium of index `n` for β² = `beta2`: q = √(ñ² − β²) on the forward branch (module
-/// docs).
+/// The medium of index ñ (given as |ñ|² and ñ²) for β² = `beta2`: q = √(ñ² − β²) on the
+/// forward branch (module docs).
 #[inline(always)]
 ///
 /// With `SHORTCUTS`, where no lane has Im ñ² ≠ 0 the root takes |w| = |x| and y/2t = +0:
 /// the same bits, since √(x·x) = |x| exactly in binary floating point (no under- or
 /// overflow here) and 0/2t = +0 (t = 0 is replaced by the w = 0 case anyway).
-fn medium<S: Simd, const SHORTCUTS: bool>(s: S, n: Cx<S>, beta2: S::f64s) -> Medium<S> {
-    let n2 = mul(s, n, n);
+fn medium<S: Simd, const SHORTCUTS: bool>(
+    s: S,
+    n_abs2: S::f64s,
+    n2: Cx<S>,
+    beta2: S::f64s,
+) -> Medium<S> {
     let x = s.sub_f64s(n2.re, beta2);
     let y = n2.im;
     let zero = s.splat_f64s(0.0);
@@ -613,7 +628,7 @@ fn medium<S: Simd, const SHORTCUTS: bool>(s: S, n: Cx<S>, beta2: S::f64s) -> Med
         re: s.select_f64s(backward, s.neg_f64s(re), re),
         im: s.select_f64s(backward, s.neg_f64s(im), im),
     };
-    Medium { n, n2, q }
+    Medium { n_abs2, n2, q }
 }
 
 /// Interface from medium `i` into medium `j` per polarisation (s, p): r = ρ/σ with
@@ -631,7 +646,7 @@ fn interface<S: Simd>(s: S, i: &Medium<S>, j: &Medium<S>) -> Fractions<S> {
     let a = mul(s, j.n2, i.q);
     let b = mul(s, i.n2, j.q);
     let four_qi2 = s.mul_f64s(s.splat_f64s(4.0), norm_sqr(s, i.q));
-    let ninj2 = s.mul_f64s(norm_sqr(s, i.n), norm_sqr(s, j.n));
+    let ninj2 = s.mul_f64s(i.n_abs2, j.n_abs2);
     Fractions {
         alpha: [i.q, a],
         beta: [j.q, b],
@@ -684,7 +699,12 @@ mod tests {
                 vec![80.0, 40.0],
                 |wl| {
                     let u = (wl - 380.0) / 400.0;
-                    vec![c(1.7 + 0.02 * u, 0.0), c(1.38, 0.0), c(2.0, 0.0), c(1.0, 0.0)]
+                    vec![
+                        c(1.7 + 0.02 * u, 0.0),
+                        c(1.38, 0.0),
+                        c(2.0, 0.0),
+                        c(1.0, 0.0),
+                    ]
                 },
             ),
             (
@@ -720,7 +740,9 @@ mod tests {
     const ANGLES_DEG: [f64; 9] = [0.0, 1e-9, 10.0, 30.0, 45.0, 60.0, 75.0, 89.0, 89.999];
 
     fn wavelengths(n: usize) -> Vec<f64> {
-        (0..n).map(|k| 380.0 + 400.0 * k as f64 / n as f64).collect()
+        (0..n)
+            .map(|k| 380.0 + 400.0 * k as f64 / n as f64)
+            .collect()
     }
 
     fn run(media: &Media, sin_theta: f64, vector: bool) -> Vec<Power> {
@@ -789,8 +811,12 @@ mod tests {
             for (a, &sin_theta) in sines.iter().enumerate() {
                 let got = run(&media, sin_theta, true);
                 for (w, (g, e)) in got.iter().zip(&want[a * wl.len()..]).enumerate() {
-                    for (x, y) in [(g.R_s, e.R_s), (g.R_p, e.R_p), (g.T_s, e.T_s), (g.T_p, e.T_p)]
-                    {
+                    for (x, y) in [
+                        (g.R_s, e.R_s),
+                        (g.R_p, e.R_p),
+                        (g.T_s, e.T_s),
+                        (g.T_p, e.T_p),
+                    ] {
                         assert!(x.is_finite(), "{name}, {}°, {} nm", ANGLES_DEG[a], wl[w]);
                         worst = worst.max((x - y).abs());
                         assert!(
@@ -828,7 +854,12 @@ mod tests {
     #[test]
     fn out_of_range_indices_take_the_recurrence() {
         let d = [50.0];
-        for bad in [c(1e7, 0.0), c(1e-7, 0.0), c(f64::NAN, 0.0), c(1.5, f64::INFINITY)] {
+        for bad in [
+            c(1e7, 0.0),
+            c(1e-7, 0.0),
+            c(f64::NAN, 0.0),
+            c(1.5, f64::INFINITY),
+        ] {
             let idx = vec![vec![c(1.0, 0.0), bad, c(1.5, 0.0)]];
             assert!(Media::new(&idx, &[500.0], &d).is_none(), "{bad}");
         }

@@ -428,7 +428,12 @@ impl Stack {
         let thickness = self.thicknesses_nm();
         let (sines, indices) = self.resolve(angles_deg, wavelengths_nm)?;
         let Some(media) = Media::new(&indices, wavelengths_nm, &thickness) else {
-            return Ok(sweep_recurrence(&sines, &indices, wavelengths_nm, &thickness));
+            return Ok(sweep_recurrence(
+                &sines,
+                &indices,
+                wavelengths_nm,
+                &thickness,
+            ));
         };
         let per_angle = wavelengths_nm.len();
         let total = sines.len() * per_angle;
