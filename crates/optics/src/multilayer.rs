@@ -4,23 +4,30 @@
 //! # Layout
 //!
 //! The media indices are resolved once per wavelength (`Stack::resolve`) and stored
-//! structure-of-arrays ([`Media`]: `re[j][w]`, `im[j][w]` for medium j and wavelength w,
-//! with k₀ = 2π/λ per wavelength). A sweep's output is angle-major, so one angle's row is
-//! contiguous; each lane evaluates one wavelength of it. Wavelengths rather than angles are
-//! the lanes because the sweeps of the colour pipelines (`spectral`, `microfacet`, the bake)
-//! ask for one angle at a time over many wavelengths, and because lanes then write
-//! neighbouring elements of the output. Nothing is shared between lanes: every element is
-//! a pure function of its (angle, wavelength), so the results do not depend on the vector
-//! width, the thread count or which elements share a vector.
+//! structure-of-arrays ([`Media`]: Re ñ_j, ñ_j² and |ñ_j|² at `[j][w]` for medium j and
+//! wavelength w, with k₀ = 2π/λ per wavelength). A sweep's output is angle-major, so one
+//! angle's row is contiguous; each lane evaluates one wavelength of it. Wavelengths rather
+//! than angles are the lanes because the sweeps of the colour pipelines (`spectral`,
+//! `microfacet`, the bake) ask for one angle at a time over many wavelengths, and because
+//! lanes then write neighbouring elements of the output. Nothing is shared between lanes:
+//! every element is a pure function of its (angle, wavelength), so the results do not
+//! depend on the vector width, the thread count or which elements share a vector.
+//!
+//! A row runs in blocks of [`BLOCK`] wavelengths, medium by medium from the substrate up:
+//! each stage (a medium's q, one film of the recurrence, the powers) is a loop over the
+//! block's independent elements, which the CPU overlaps, instead of one element's long
+//! chain of square roots through the whole stack. No allocation per evaluation (one
+//! [`Block`] of staging arrays per row).
 //!
 //! # Determinism
 //!
 //! As in [`crate::simd`]: one generic kernel over [`pulp::Simd`], dispatched to the CPU's
-//! widest vectors with the remainder of a row on [`pulp::Scalar`]; IEEE 754 basic
-//! operations only (+, −, ×, ÷, √, comparisons, sign-bit manipulation) in a fixed order, no
-//! fused multiply–add, no platform `libm` (sin/cos and e^{−a} are the kernel's own
-//! [`crate::simd::sin_cos`] and [`crate::simd::exp_neg`]). Branches on "does any lane
-//! absorb" only skip multiplications by exactly 1.
+//! widest vectors (AVX-512 or AVX2 on x86-64, NEON on arm64) with the remainder of a row on
+//! [`pulp::Scalar`]; IEEE 754 basic operations only (+, −, ×, ÷, √, comparisons, sign-bit
+//! and exponent-bit manipulation) in a fixed order, no fused multiply–add, no platform
+//! `libm` (sin/cos and e^{−a} are the kernel's own [`crate::simd::sin_cos`] and
+//! [`crate::simd::exp_neg`]). Branches on "does any lane absorb" only skip operations whose
+//! result is known exactly (tested: `shortcuts_match_the_general_formula`).
 //!
 //! # Method (per element)
 //!
@@ -36,24 +43,32 @@
 //!   principal root has Re ≥ 0; it is negated where Im q < 0 and |Im q| exceeds
 //!   100 ε · max(|Re q|, |Im q|) (a wave decaying into the medium; lossless propagating
 //!   media keep Re q ≥ 0).
-//! * **Interfaces** i → j = i + 1 (Byrnes, arXiv:1603.02720, Eq. 5–8; [`crate::fresnel`]):
-//!   r_s = (q_i − q_j)/(q_i + q_j), |t_s|² = |2 q_i|²/|q_i + q_j|²,
-//!   r_p = (ñ_j² q_i − ñ_i² q_j)/(ñ_j² q_i + ñ_i² q_j),
-//!   |t_p|² = |2 ñ_i ñ_j q_i|²/|ñ_j² q_i + ñ_i² q_j|²; each complex division as
-//!   a · conj(b) / |b|², one real division for both polarisations.
+//! * **Interfaces** i → j = i + 1 (Byrnes, arXiv:1603.02720, Eq. 5–8; [`crate::fresnel`])
+//!   as r = ρ/σ = (α − β)/(α + β) with the admittances multiplied through by ñ_i² ñ_j²:
+//!   α_s = q_i, β_s = q_j; α_p = ñ_j² q_i, β_p = ñ_i² q_j; and |t σ|² = 4|q_i|² (s),
+//!   4|ñ_i ñ_j q_i|² (p), since t_s = 2q_i/σ_s, t_p = 2ñ_iñ_j q_i/σ_p.
 //! * **Recurrence** from the substrate up (Heavens 1955 §4; Born & Wolf §1.6.5; the module
-//!   docs of [`crate::stack`]): Γ_N = r_{N,N+1}, then
-//!   Γ_j = (r_{j,j+1} + Γ_{j+1} e^{2iδ_{j+1}}) / (1 + r_{j,j+1} Γ_{j+1} e^{2iδ_{j+1}}), and,
-//!   since only |τ|² enters the powers,
-//!   |τ_j|² = |t_{j,j+1}|² |τ_{j+1}|² |e^{iδ_{j+1}}|² / |1 + r_{j,j+1} Γ_{j+1} e^{2iδ_{j+1}}|²,
-//!   with e^{iδ} = e^{−Im δ} (cos Re δ, sin Re δ), δ_j = k₀ q_j d_j.
-//! * **Powers**: R = |Γ₀|², T_s = |τ₀,s|² Re q_f / Re q₀,
-//!   T_p = |τ₀,p|² Re(ñ_f² conj q_f)/|ñ_f|² ÷ Re(ñ₀² conj q₀)/|ñ₀|² (Byrnes Eq. 21–22:
-//!   Re(ñ conj(cos θ)) = Re(ñ² conj q)/|ñ|²).
+//!   docs of [`crate::stack`]):
+//!   Γ_j = (r_{j,j+1} + Γ_{j+1} e^{2iδ_{j+1}}) / (1 + r_{j,j+1} Γ_{j+1} e^{2iδ_{j+1}}),
+//!   |τ_j|² = |t_{j,j+1}|² |τ_{j+1}|² |e^{iδ_{j+1}}|² / |1 + r_{j,j+1} Γ_{j+1} e^{2iδ_{j+1}}|²
+//!   (only |τ|² enters the powers), δ_j = k₀ q_j d_j, carried as fractions Γ = N/D and
+//!   |τ|² = U/|D|² so that no film costs a division: with M = N e^{2iδ},
+//!
+//!   ```text
+//!   N' = ρD + σM = α(D + M) − β(D − M),   D' = σD + ρM = α(D + M) + β(D − M),
+//!   U' = |tσ|² U |e^{iδ}|²,               starting from N = ρ_N, D = σ_N, U = |tσ|²_N.
+//!   ```
+//!
+//!   e^{2iδ} = e^{−2 Im δ} (cos 2Re δ, sin 2Re δ). Every few media N, D, U are rescaled by
+//!   a power of two (exact), so that they neither overflow nor underflow in deep stacks.
+//! * **Powers**: R = |N₀|²/|D₀|², T_s = U₀,s/|D₀,s|² · Re q_f / Re q₀,
+//!   T_p = U₀,p/|D₀,p|² · Re(ñ_f² conj q_f)/|ñ_f|² ÷ Re(ñ₀² conj q₀)/|ñ₀|² (Byrnes
+//!   Eq. 21–22: Re(ñ conj(cos θ)) = Re(ñ² conj q)/|ñ|²), one division for all four.
 //!
 //! Against the scalar recurrence ([`crate::stack::Prepared`], which takes √ through
-//! `num_complex`'s polar form and e^{iδ} through `libm`) the powers agree to ~10⁻¹⁵ (tested:
-//! `vectorised_sweep_matches_the_recurrence`, 10⁻¹²).
+//! `num_complex`'s polar form and e^{iδ} through `libm`) the powers agree to ~10⁻¹⁴ (tested:
+//! `vectorised_sweep_matches_the_recurrence`, 10⁻¹², over total internal reflection,
+//! absorbing films and substrates, evanescent substrates, normal and grazing incidence).
 
 use crate::fresnel::BRANCH_TOLERANCE;
 use crate::simd::{ARCH, PowerSlot, exp_neg, lane, lane_mut, sin_cos};

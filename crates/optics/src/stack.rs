@@ -38,12 +38,16 @@
 //! # Sweeps
 //!
 //! [`Stack::sweep`] and [`Stack::sweep_thickness`] resolve the material indices once per
-//! wavelength, compute interface coefficients once per (angle, distinct set of indices) —
-//! so for non-dispersive stacks once per angle, shared by every wavelength and thickness —
-//! and run angles in parallel with rayon. Every value is computed by the same code whatever
-//! the thread count, so results are bit-identical across thread counts. A sweep over the top
-//! film's thickness runs the Airy closed form through the vectorised kernel of
-//! [`crate::simd`] (IEEE basic operations only, so the same bits on every CPU and vector width).
+//! wavelength and run angles in parallel with rayon. Every value is computed by the same
+//! code whatever the thread count, so results are bit-identical across thread counts.
+//! [`Stack::sweep`] runs each angle's row through the vectorised multilayer kernel of
+//! [`crate::multilayer`] (wavelengths as SIMD lanes; the same recurrence with Γ and |τ|²
+//! carried as fractions; IEEE basic operations only, so the same bits on every CPU and
+//! vector width), or, for indices or phases outside that kernel's range, through the
+//! scalar recurrence below, which computes interface coefficients once per (angle, distinct
+//! set of indices). A sweep over a film's thickness folds the stack below it once per
+//! (angle, wavelength); over the top film it runs the Airy closed form through the
+//! vectorised kernel of [`crate::simd`].
 
 use crate::error::{Error, Result};
 use crate::fresnel::{Interface, normal_component, power_factor_p, power_factor_s};
