@@ -436,7 +436,15 @@ impl Block {
                         Some(a) => s.mul_f64s(u, a),
                         None => u,
                     };
-                    self.put(s, i, pol, n_new, d_new, u, c.j % RESCALE_EVERY == 0);
+                    self.put(
+                        s,
+                        i,
+                        pol,
+                        n_new,
+                        d_new,
+                        u,
+                        c.j.is_multiple_of(RESCALE_EVERY),
+                    );
                 }
             }
             POWERS => {
@@ -452,8 +460,9 @@ impl Block {
                     im: ld(&v[2 * pol + 1]),
                 };
                 // One division for the four denominators X = Re q₀,
-                // Y = |ñ_f|² Re(ñ₀² conj q₀) and |D_s|², |D_p|² (each within [10⁻⁴⁰, 10⁴⁰]:
-                // |D|² in [0.5, 4) after scaling, indices within the kernel's range).
+                // Y = |ñ_f|² Re(ñ₀² conj q₀) and |D_s|², |D_p|² (|D|² in [0.5, 4) after the
+                // last rescaling; X and Y within 10^±60 for indices within the kernel's
+                // range and |θ₀| < 90°, so their product neither over- nor underflows).
                 let x = amb.q.re;
                 let y = s.mul_f64s(ld(&self.substrate[2]), re_n2_conj_q);
                 let d2 = [norm_sqr(s, cx(&self.den, 0)), norm_sqr(s, cx(&self.den, 1))];
