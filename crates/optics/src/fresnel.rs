@@ -46,7 +46,7 @@ use num_complex::Complex64 as C64;
 /// Relative size below which the imaginary part of q is treated as zero when choosing the
 /// forward branch (rounding noise of a lossless medium). Same role as `tmm`'s
 /// `100 * EPSILON` test.
-const BRANCH_TOLERANCE: f64 = 100.0 * f64::EPSILON;
+pub(crate) const BRANCH_TOLERANCE: f64 = 100.0 * f64::EPSILON;
 
 /// The normal component `q = ñ cos θ` of the wave vector (in units of k₀) in a medium of
 /// complex index `n`, for a tangential component `beta = n₀ sin θ₀` (Snell's law,

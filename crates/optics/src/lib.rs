@@ -31,6 +31,7 @@ pub mod fourier;
 pub mod fresnel;
 pub mod material;
 pub mod microfacet;
+pub(crate) mod multilayer;
 pub mod quadrature;
 pub(crate) mod simd;
 pub mod spectral;

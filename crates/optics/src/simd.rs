@@ -34,7 +34,7 @@ use pulp::{Simd, WithSimd};
 use std::sync::LazyLock;
 
 /// The CPU's SIMD capabilities, detected once.
-static ARCH: LazyLock<pulp::Arch> = LazyLock::new(pulp::Arch::new);
+pub(crate) static ARCH: LazyLock<pulp::Arch> = LazyLock::new(pulp::Arch::new);
 
 /// 1.5 × 2⁵²: adding and subtracting it rounds |v| < 2⁵¹ to the nearest integer.
 const SHIFTER: f64 = 6_755_399_441_055_744.0;
@@ -424,13 +424,13 @@ fn exact<S: Simd, const ABSORBING: bool>(
 
 /// The vector of `v` starting at element `start`.
 #[inline(always)]
-fn lane<S: Simd>(v: &[f64], start: usize) -> S::f64s {
+pub(crate) fn lane<S: Simd>(v: &[f64], start: usize) -> S::f64s {
     S::as_simd_f64s(&v[start..start + S::F64_LANES]).0[0]
 }
 
 /// The vector of `v` starting at element `start`.
 #[inline(always)]
-fn lane_mut<S: Simd>(v: &mut [f64], start: usize) -> &mut S::f64s {
+pub(crate) fn lane_mut<S: Simd>(v: &mut [f64], start: usize) -> &mut S::f64s {
     &mut S::as_mut_simd_f64s(&mut v[start..start + S::F64_LANES]).0[0]
 }
 

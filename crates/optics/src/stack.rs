@@ -38,16 +38,21 @@
 //! # Sweeps
 //!
 //! [`Stack::sweep`] and [`Stack::sweep_thickness`] resolve the material indices once per
-//! wavelength, compute interface coefficients once per (angle, distinct set of indices) —
-//! so for non-dispersive stacks once per angle, shared by every wavelength and thickness —
-//! and run angles in parallel with rayon. Every value is computed by the same code whatever
-//! the thread count, so results are bit-identical across thread counts. A sweep over the top
-//! film's thickness runs the Airy closed form through the vectorised kernel of
-//! [`crate::simd`] (IEEE basic operations only, so the same bits on every CPU and vector width).
+//! wavelength and run angles in parallel with rayon. Every value is computed by the same
+//! code whatever the thread count, so results are bit-identical across thread counts.
+//! [`Stack::sweep`] runs each angle's row through the vectorised multilayer kernel of
+//! [`crate::multilayer`] (wavelengths as SIMD lanes; the same recurrence with Γ and |τ|²
+//! carried as fractions; IEEE basic operations only, so the same bits on every CPU and
+//! vector width), or, for indices or phases outside that kernel's range, through the
+//! scalar recurrence below, which computes interface coefficients once per (angle, distinct
+//! set of indices). A sweep over a film's thickness folds the stack below it once per
+//! (angle, wavelength); over the top film it runs the Airy closed form through the
+//! vectorised kernel of [`crate::simd`].
 
 use crate::error::{Error, Result};
 use crate::fresnel::{Interface, normal_component, power_factor_p, power_factor_s};
 use crate::material::Material;
+use crate::multilayer::{Media, stack_powers};
 pub(crate) use crate::simd::uniform_step;
 use crate::simd::{AiryRow, PowerSlot, airy_powers};
 use num_complex::Complex64 as C64;
@@ -417,22 +422,38 @@ impl Stack {
 
     /// Powers over every (angle, wavelength) pair, angle-major: element
     /// `a * wavelengths_nm.len() + w`.
+    ///
+    /// Indices are resolved once per wavelength; each angle's row then runs through the
+    /// vectorised kernel of [`crate::multilayer`] (wavelengths as SIMD lanes, IEEE basic
+    /// operations only: the same bits on every CPU, vector width and thread count), or,
+    /// for indices or phases outside the kernel's range (|ñ| beyond [10⁻⁶, 10⁶], film phases
+    /// beyond 10⁶ rad), through the scalar recurrence of [`Prepared`].
     pub fn sweep(&self, angles_deg: &[f64], wavelengths_nm: &[f64]) -> Result<Vec<Power>> {
         let thickness = self.thicknesses_nm();
         let (sines, indices) = self.resolve(angles_deg, wavelengths_nm)?;
-        let mut out = vec![Power::default(); sines.len() * wavelengths_nm.len()];
-        if wavelengths_nm.is_empty() {
+        let Some(media) = Media::new(&indices, wavelengths_nm, &thickness) else {
+            return Ok(sweep_recurrence(
+                &sines,
+                &indices,
+                wavelengths_nm,
+                &thickness,
+            ));
+        };
+        let per_angle = wavelengths_nm.len();
+        let total = sines.len() * per_angle;
+        let mut out: Vec<Power> = Vec::with_capacity(total);
+        if per_angle == 0 {
             return Ok(out);
         }
-        out.par_chunks_mut(wavelengths_nm.len())
+        // Every slot is written once, straight into the fresh allocation (no zeroing pass).
+        out.spare_capacity_mut()[..total]
+            .par_chunks_mut(per_angle)
             .zip(&sines)
-            .for_each(|(row, &sin_theta)| {
-                let mut cache: Option<Prepared> = None;
-                for ((slot, &wl), idx) in row.iter_mut().zip(wavelengths_nm).zip(&indices) {
-                    let prepared = reuse(&mut cache, idx, sin_theta);
-                    *slot = prepared.power(&prepared.amplitudes(wl, &thickness));
-                }
-            });
+            .for_each(|(row, &sin_theta)| stack_powers(&media, sin_theta, row, true));
+        // SAFETY: the rows partition `spare_capacity_mut()[..total]` (per_angle > 0) and
+        // `stack_powers` writes every slot of its row, so the first `total` elements are
+        // initialised.
+        unsafe { out.set_len(total) };
         Ok(out)
     }
 
@@ -532,6 +553,31 @@ impl Stack {
             .collect::<Result<Vec<_>>>()?;
         Ok((sines, indices))
     }
+}
+
+/// [`Stack::sweep`] by the scalar recurrence of [`Prepared`] (one per angle and distinct set
+/// of indices): the reference the vectorised kernel is tested against, and the path for
+/// indices outside its range. `sines[a]` = sin θ₀, `indices[w]` the media at wavelength w.
+pub(crate) fn sweep_recurrence(
+    sines: &[f64],
+    indices: &[Vec<C64>],
+    wavelengths_nm: &[f64],
+    thickness_nm: &[f64],
+) -> Vec<Power> {
+    let mut out = vec![Power::default(); sines.len() * wavelengths_nm.len()];
+    if wavelengths_nm.is_empty() {
+        return out;
+    }
+    out.par_chunks_mut(wavelengths_nm.len())
+        .zip(sines)
+        .for_each(|(row, &sin_theta)| {
+            let mut cache: Option<Prepared> = None;
+            for ((slot, &wl), idx) in row.iter_mut().zip(wavelengths_nm).zip(indices) {
+                let prepared = reuse(&mut cache, idx, sin_theta);
+                *slot = prepared.power(&prepared.amplitudes(wl, thickness_nm));
+            }
+        });
+    out
 }
 
 /// [`Stack::fringe_finesse`] for media `indices` (ambient first) and tangential component
