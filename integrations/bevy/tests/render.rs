@@ -296,3 +296,296 @@ fn a_table_loads_as_an_asset_and_binds_to_materials() {
     assert_eq!(m.extension.lut_reflectance.as_ref(), Some(&table.texture));
     assert_eq!(m.extension.lut_axes, axes);
 }
+
+/// Perceptual roughness of the lobe test's quads and Bevy's α = r_p² (r_p ≥ 0.089).
+const LOBE_PERCEPTUAL_ROUGHNESS: f64 = 0.6;
+/// Film of the lobe test: index 1.8, 400 nm, on the film-lut table's base (index 1.5).
+const LOBE_FILM_IOR: f64 = 1.8;
+const LOBE_THICKNESS_NM: f64 = 400.0;
+/// Directional light's illuminance (lux) and its angle to the view direction.
+const LOBE_LUX: f64 = 10.0;
+const LOBE_LIGHT_DEG: f64 = 60.0;
+/// Quad normals' angles to the view direction, about the vertical axis (30°: the mirror
+/// configuration n = h of the 60° light).
+const LOBE_QUADS_DEG: [f64; 5] = [0.0, 15.0, 30.0, 45.0, 55.0];
+
+/// GGX normal distribution D(α, n·h) (Walter et al. 2007).
+fn ggx_d(alpha: f64, n_dot_h: f64) -> f64 {
+    let k = alpha / (1.0 - n_dot_h * n_dot_h + (n_dot_h * alpha).powi(2));
+    k * k / std::f64::consts::PI
+}
+
+/// Height-correlated Smith visibility V = G / (4 n·v n·l) (Heitz 2014).
+fn smith_v(alpha: f64, n_dot_v: f64, n_dot_l: f64) -> f64 {
+    let a2 = alpha * alpha;
+    let lv = n_dot_l * (n_dot_v * n_dot_v * (1.0 - a2) + a2).sqrt();
+    let ll = n_dot_v * (n_dot_l * n_dot_l * (1.0 - a2) + a2).sqrt();
+    0.5 / (lv + ll)
+}
+
+/// Flat film quads facing an orthographic camera at known angles, lit by one directional
+/// light, no ambient or environment light, black base (no diffuse): each quad's centre pixel
+/// is its specular radiance, read as linear floats (HDR, no tone mapping, no dithering) and
+/// compared with the CPU: exposure × E × D V R_f(v·h) × (Bevy's multiple-scattering factor)
+/// × n·l, R_f from the same film-lut table. The previous material (Schlick with an F₀ that
+/// matches R_f only at the mirror configuration) is computed too and must miss.
+#[test]
+fn the_specular_lobe_has_the_film_at_v_dot_h() {
+    use bevy::core_pipeline::tonemapping::DebandDither;
+    use bevy::render::render_resource::TextureFormat;
+
+    let n = LOBE_QUADS_DEG.len();
+    let (w, h) = (50 * n as u32, 50);
+    let mut app = headless_app(&repo_root());
+    let image = app
+        .world_mut()
+        .resource_mut::<Assets<Image>>()
+        .add(Image::new_target_texture(
+            w,
+            h,
+            TextureFormat::Rgba32Float,
+            None,
+        ));
+    let world = app.world_mut();
+    let mesh = world
+        .resource_mut::<Assets<Mesh>>()
+        .add(Rectangle::new(0.8, 0.8));
+    let material = world
+        .resource_mut::<Assets<NacreMaterial>>()
+        .add(NacreMaterial {
+            base: StandardMaterial {
+                base_color: Color::BLACK,
+                perceptual_roughness: LOBE_PERCEPTUAL_ROUGHNESS as f32,
+                ..default()
+            },
+            extension: NacreFilm {
+                film_ior: LOBE_FILM_IOR as f32,
+                thickness: FilmThickness::Gltf {
+                    min_nm: LOBE_THICKNESS_NM as f32,
+                    max_nm: LOBE_THICKNESS_NM as f32,
+                },
+                weight: 1.0,
+                ..default()
+            },
+        });
+    for (i, phi) in LOBE_QUADS_DEG.iter().enumerate() {
+        world.spawn((
+            Mesh3d(mesh.clone()),
+            MeshMaterial3d(material.clone()),
+            Transform::from_xyz(i as f32 - (n - 1) as f32 / 2.0, 0.0, 0.0)
+                .with_rotation(Quat::from_rotation_y((*phi as f32).to_radians())),
+        ));
+    }
+    world.insert_resource(GlobalAmbientLight {
+        color: Color::WHITE,
+        brightness: 0.0,
+        ..default()
+    });
+    let beta = LOBE_LIGHT_DEG.to_radians();
+    let to_light = Vec3::new(beta.sin() as f32, 0.0, beta.cos() as f32);
+    world.spawn((
+        DirectionalLight {
+            illuminance: LOBE_LUX as f32,
+            ..default()
+        },
+        Transform::default().looking_to(-to_light, Vec3::Y),
+    ));
+    let exposure = bevy::camera::Exposure { ev100: 0.0 };
+    world.spawn((
+        Camera3d::default(),
+        bevy::camera::Hdr,
+        exposure,
+        RenderTarget::Image(image.clone().into()),
+        Tonemapping::None,
+        DebandDither::Disabled,
+        Projection::Orthographic(OrthographicProjection {
+            scaling_mode: bevy::camera::ScalingMode::FixedHorizontal {
+                viewport_width: n as f32,
+            },
+            ..OrthographicProjection::default_3d()
+        }),
+        Transform::from_xyz(0.0, 0.0, 5.0).looking_at(Vec3::ZERO, Vec3::Y),
+    ));
+    let bytes = capture(&mut app, &image, 10);
+    assert_eq!(bytes.len(), 16 * (w * h) as usize, "an Rgba32Float picture");
+    let pixel = |x: usize, y: usize| -> [f64; 3] {
+        let p = &bytes[16 * (y * w as usize + x)..];
+        std::array::from_fn(|c| {
+            f64::from(f32::from_le_bytes(p[4 * c..4 * c + 4].try_into().unwrap()))
+        })
+    };
+
+    let path = repo_root().join("tables/baked/film-dielectric.json");
+    let manifest = nacre_format::Manifest::read(&path).unwrap();
+    let axes = manifest.film_lut().cloned().unwrap();
+    let table = manifest.load_table(&path, "reflectance").unwrap().unwrap();
+    let film = |cos: f64| {
+        nacre_format::film_lut::FilmLut::lookup(
+            &axes,
+            &table,
+            cos,
+            LOBE_THICKNESS_NM,
+            LOBE_FILM_IOR,
+        )
+    };
+    let rp = LOBE_PERCEPTUAL_ROUGHNESS;
+    let alpha = rp * rp;
+    // Bevy's F_AB polynomial (Karis 2014) sums to A + B = 1 − 0.55 r_p wherever its B is above
+    // its 5×10⁻⁵ floor (true for r_p = 0.6 at every n·v): the multiple-scattering factor is
+    // 1 + F₀ (1/(A + B) − 1).
+    let multiscatter = |f0: f64| 1.0 + f0 * (1.0 / (1.0 - 0.55 * rp) - 1.0);
+    let scale = f64::from(exposure.exposure()) * LOBE_LUX;
+    let v_dot_h = (beta / 2.0).cos();
+    // Bevy's HDR target is Rgba16Float (relative steps of 2⁻¹¹); the film-lut lookup is the
+    // CPU's to 5×10⁻⁷ (probe.rs).
+    let tolerance = |cpu: f64| 3e-3 * cpu + 1e-4;
+    let mut worst: f64 = 0.0;
+    for (i, phi) in LOBE_QUADS_DEG.iter().enumerate() {
+        let phi = phi.to_radians();
+        let n_dot_v = phi.cos();
+        let n_dot_l = (beta - phi).cos();
+        let n_dot_h = (beta / 2.0 - phi).cos();
+        let dv = ggx_d(alpha, n_dot_h) * smith_v(alpha, n_dot_v, n_dot_l) * n_dot_l * scale;
+        let r_mu = film(n_dot_v);
+        let r_vh = film(v_dot_h);
+        let gpu = pixel(50 * i + 25, 25);
+        // The previous material: F₀ = (R_f(μ) − x)/(1 − x), Bevy's Schlick at v·h with
+        // f₉₀ = saturate(16.5 ΣF₀).
+        let x = (1.0 - n_dot_v).powi(5).min(0.99);
+        let f0_old = r_mu.map(|r| ((r - x) / (1.0 - x)).max(0.0));
+        let f90 = (16.5 * f0_old.iter().sum::<f64>()).clamp(0.0, 1.0);
+        let mirror = (phi - beta / 2.0).abs() < 1e-9;
+        let mut old_missed = false;
+        for c in 0..3 {
+            let cpu = dv * r_vh[c] * multiscatter(r_mu[c]);
+            let f_old = f0_old[c] + (f90 - f0_old[c]) * (1.0 - v_dot_h).powi(5);
+            let old = dv * f_old * multiscatter(f0_old[c]);
+            eprintln!(
+                "quad {:.0}°, channel {c}: Bevy {:.5}, CPU {cpu:.5} (|Δ| {:.1e}), F₀-inversion {old:.5} (|Δ| {:.1e})",
+                phi.to_degrees(),
+                gpu[c],
+                (gpu[c] - cpu).abs(),
+                (old - cpu).abs(),
+            );
+            assert!(
+                (gpu[c] - cpu).abs() <= tolerance(cpu),
+                "quad {:.0}° channel {c}: Bevy {} against the film lobe's {cpu}",
+                phi.to_degrees(),
+                gpu[c]
+            );
+            worst = worst.max((gpu[c] - cpu).abs() / cpu);
+            old_missed |= (old - cpu).abs() > 10.0 * tolerance(cpu);
+            if mirror {
+                assert!(
+                    (old - cpu).abs() <= tolerance(cpu),
+                    "the two agree at the mirror"
+                );
+            }
+        }
+        // Off the mirror configuration the previous material misses by more than ten
+        // tolerances: the test tells the two apart.
+        assert!(
+            mirror || old_missed,
+            "quad {:.0}°: the F₀-inversion is within the tolerance",
+            phi.to_degrees()
+        );
+    }
+    eprintln!("largest relative difference Bevy − CPU: {worst:.1e}");
+}
+
+/// The table events seen by [`record_table_events`].
+#[derive(Resource, Default)]
+struct TableEvents(Vec<AssetEvent<bevy_nacre::NacreTable>>);
+
+fn record_table_events(
+    mut reader: bevy::ecs::message::MessageReader<AssetEvent<bevy_nacre::NacreTable>>,
+    mut seen: ResMut<TableEvents>,
+) {
+    seen.0.extend(reader.read().cloned());
+}
+
+/// Copies table `name` of `tables/baked` (manifest and KTX2 files) into `dir`, the manifest
+/// as `as_name`.
+fn copy_table(name: &str, dir: &std::path::Path, as_name: &str) {
+    let baked = repo_root().join("tables/baked");
+    std::fs::copy(baked.join(format!("{name}.json")), dir.join(as_name)).unwrap();
+    for part in ["reflectance", "transmittance"] {
+        let file = format!("{name}.{part}.ktx2");
+        std::fs::copy(baked.join(&file), dir.join(&file)).unwrap();
+    }
+}
+
+/// A re-baked table reaches the materials: a table loaded from a directory is rewritten (the
+/// manifest and its KTX2 files replaced by another table's) and reloaded through the asset
+/// server (`AssetServer::reload`, what Bevy's `file_watcher` calls on a change: the watcher
+/// itself is not built for the tests, see README), which sends `AssetEvent::Modified`; the
+/// asset then has the new axes, and a material using it is bound to the new textures.
+#[test]
+fn a_rewritten_table_reloads_into_its_materials() {
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("bevy-table-reload");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    copy_table("soap-film", &dir, "table.json");
+    let mut app = headless_app(&dir);
+    app.init_resource::<TableEvents>()
+        .add_systems(Update, record_table_events);
+    let handle: Handle<bevy_nacre::NacreTable> =
+        app.world().resource::<AssetServer>().load("table.json");
+    let material = app
+        .world_mut()
+        .resource_mut::<Assets<NacreMaterial>>()
+        .add(NacreMaterial {
+            base: StandardMaterial::default(),
+            extension: NacreFilm {
+                lut_table: handle.clone(),
+                ..default()
+            },
+        });
+    let loaded = run_until(&mut app, 500, |world| {
+        world
+            .resource::<AssetServer>()
+            .is_loaded_with_dependencies(&handle)
+    });
+    assert!(loaded, "table.json did not load");
+    let axes = |world: &World| match world
+        .resource::<Assets<bevy_nacre::NacreTable>>()
+        .get(&handle)
+        .unwrap()
+        .axes
+    {
+        bevy_nacre::tables::NacreTableAxes::FilmLut(a) => a,
+        _ => panic!("a film-lut table"),
+    };
+    let before = axes(app.world());
+
+    copy_table("oil-slick", &dir, "table.json");
+    app.world_mut().resource_mut::<TableEvents>().0.clear();
+    app.world().resource::<AssetServer>().reload("table.json");
+    let id = handle.id();
+    let modified = run_until(&mut app, 500, |world| {
+        world
+            .resource::<TableEvents>()
+            .0
+            .contains(&AssetEvent::Modified { id })
+    });
+    assert!(modified, "no AssetEvent::Modified after the reload");
+    run_until(&mut app, 3, |_| false);
+    let world = app.world();
+    let after = axes(world);
+    let table = world
+        .resource::<Assets<bevy_nacre::NacreTable>>()
+        .get(&handle)
+        .unwrap();
+    eprintln!(
+        "film index axis {}–{} → {}–{}",
+        before.ior_min, before.ior_max, after.ior_min, after.ior_max
+    );
+    assert_eq!(table.name, "oil-slick");
+    assert_ne!(before, after, "the axes did not change");
+    let m = world
+        .resource::<Assets<NacreMaterial>>()
+        .get(&material)
+        .unwrap();
+    assert_eq!(m.extension.lut_axes, after);
+    assert_eq!(m.extension.lut_reflectance.as_ref(), Some(&table.texture));
+}
