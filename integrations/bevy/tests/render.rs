@@ -322,6 +322,9 @@ enum LobeLight {
     Directional,
     /// One point light (no radius), through Bevy's clusters.
     Point,
+    /// One spot light where the point light is, aimed at the middle quad, every quad inside
+    /// its inner cone (so the same light as `Point`, through the spot branch).
+    Spot,
     /// A uniform environment map (Bevy's `EnvironmentMapLight::solid_color`), no light.
     Environment,
 }
@@ -356,7 +359,7 @@ fn specular_lobe(
     light: LobeLight,
     film: impl Fn(f64) -> [f64; 3],
 ) {
-    let point = light == LobeLight::Point;
+    let point = matches!(light, LobeLight::Point | LobeLight::Spot);
     use bevy::core_pipeline::tonemapping::DebandDither;
     use bevy::render::render_resource::TextureFormat;
 
@@ -415,7 +418,19 @@ fn specular_lobe(
     let beta = LOBE_LIGHT_DEG.to_radians();
     let to_light = DVec3::new(beta.sin(), 0.0, beta.cos());
     let point_at = to_light * LOBE_POINT_DISTANCE;
-    if point {
+    if light == LobeLight::Spot {
+        world.spawn((
+            SpotLight {
+                intensity: (LOBE_POINT_CD * 4.0 * std::f64::consts::PI) as f32,
+                range: LOBE_POINT_RANGE as f32,
+                radius: 0.0,
+                inner_angle: 1.2,
+                outer_angle: 1.4,
+                ..default()
+            },
+            Transform::from_translation(point_at.as_vec3()).looking_at(Vec3::ZERO, Vec3::Y),
+        ));
+    } else if point {
         world.spawn((
             PointLight {
                 intensity: (LOBE_POINT_CD * 4.0 * std::f64::consts::PI) as f32,
@@ -689,6 +704,7 @@ fn the_specular_lobe_has_the_film_at_v_dot_h() {
     for light in [
         LobeLight::Directional,
         LobeLight::Point,
+        LobeLight::Spot,
         LobeLight::Environment,
     ] {
         specular_lobe(FilmTechnique::Lut, C64::new(1.5, 0.0), light, film);
