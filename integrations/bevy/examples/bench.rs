@@ -13,10 +13,10 @@ use bevy::camera::RenderTarget;
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::ecs::system::RunSystemOnce;
 use bevy::prelude::*;
-use bevy::render::RenderApp;
 use bevy::render::pipelined_rendering::PipelinedRenderingPlugin;
 use bevy::render::render_resource::{PollType, TextureFormat};
 use bevy::render::renderer::RenderDevice;
+use bevy::render::{RenderApp, RenderPlugin};
 use bevy::window::ExitCondition;
 use bevy_nacre::{FilmTechnique, FilmThickness, NacreFilm, NacreMaterial, NacrePlugin};
 use std::time::Instant;
@@ -51,6 +51,14 @@ fn time_scene(kind: Kind, frames: usize) -> f64 {
                 primary_window: None,
                 exit_condition: ExitCondition::DontExit,
                 close_when_requested: false,
+                ..default()
+            })
+            // Pipelines compile before the first frame that needs them: the warm-up frames
+            // then render the scene (compiled asynchronously, a large material shader on
+            // lavapipe can still be compiling when the timed frames start, which then time
+            // an empty scene).
+            .set(RenderPlugin {
+                synchronous_pipeline_compilation: true,
                 ..default()
             })
             .disable::<PipelinedRenderingPlugin>(),

@@ -6,9 +6,12 @@
 use bevy::camera::RenderTarget;
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::gltf::GltfAssetLabel;
+use bevy::math::DVec3;
 use bevy::prelude::*;
 use bevy::world_serialization::{WorldAsset, WorldAssetRoot};
-use bevy_nacre::{FilmThickness, NacreFilm, NacreMaterial};
+use bevy_nacre::{FilmTechnique, FilmThickness, NacreFilm, NacreMaterial};
+use nacre_optics::C64;
+use nacre_optics::fourier::{FilmOnBase, Harmonics};
 
 mod support;
 use support::{
@@ -295,4 +298,448 @@ fn a_table_loads_as_an_asset_and_binds_to_materials() {
         .unwrap();
     assert_eq!(m.extension.lut_reflectance.as_ref(), Some(&table.texture));
     assert_eq!(m.extension.lut_axes, axes);
+}
+
+/// Perceptual roughness of the lobe test's quads and Bevy's α = r_p² (r_p ≥ 0.089).
+const LOBE_PERCEPTUAL_ROUGHNESS: f64 = 0.6;
+/// Film of the lobe test: index 1.8, 400 nm, on the film-lut table's base (index 1.5).
+const LOBE_FILM_IOR: f64 = 1.8;
+const LOBE_THICKNESS_NM: f64 = 400.0;
+/// Directional light's illuminance (lux) and its angle to the view direction.
+const LOBE_LUX: f64 = 10.0;
+const LOBE_LIGHT_DEG: f64 = 60.0;
+/// Point light: luminous intensity (cd), distance from the middle quad, range (m).
+const LOBE_POINT_CD: f64 = 100.0;
+const LOBE_POINT_DISTANCE: f64 = 4.0;
+const LOBE_POINT_RANGE: f64 = 20.0;
+/// Uniform environment map's radiance (cd/m²).
+const LOBE_ENVIRONMENT_NITS: f64 = 1.0;
+
+/// The light of the lobe test.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum LobeLight {
+    /// One directional light.
+    Directional,
+    /// One point light (no radius), through Bevy's clusters.
+    Point,
+    /// One spot light where the point light is, aimed at the middle quad, every quad inside
+    /// its inner cone (so the same light as `Point`, through the spot branch).
+    Spot,
+    /// A uniform environment map (Bevy's `EnvironmentMapLight::solid_color`), no light.
+    Environment,
+}
+/// Quad normals' angles to the view direction, about the vertical axis (30°: the mirror
+/// configuration n = h of the 60° light).
+const LOBE_QUADS_DEG: [f64; 5] = [0.0, 15.0, 30.0, 45.0, 55.0];
+
+/// GGX normal distribution D(α, n·h) (Walter et al. 2007).
+fn ggx_d(alpha: f64, n_dot_h: f64) -> f64 {
+    let k = alpha / (1.0 - n_dot_h * n_dot_h + (n_dot_h * alpha).powi(2));
+    k * k / std::f64::consts::PI
+}
+
+/// Height-correlated Smith visibility V = G / (4 n·v n·l) (Heitz 2014).
+fn smith_v(alpha: f64, n_dot_v: f64, n_dot_l: f64) -> f64 {
+    let a2 = alpha * alpha;
+    let lv = n_dot_l * (n_dot_v * n_dot_v * (1.0 - a2) + a2).sqrt();
+    let ll = n_dot_v * (n_dot_l * n_dot_l * (1.0 - a2) + a2).sqrt();
+    0.5 / (lv + ll)
+}
+
+/// Flat film quads facing an orthographic camera at known angles, lit by one directional
+/// light, no ambient or environment light, black base (no diffuse): each quad's centre pixel
+/// is its specular radiance, read as linear floats (HDR, no tone mapping, no dithering) and
+/// compared with the CPU: exposure × E × D V R_f(v·h) × (Bevy's multiple-scattering factor)
+/// × n·l, R_f from `film`, nacre's CPU colour of `technique` (on `base`). The previous
+/// material (Schlick with an F₀ that matches R_f only at the mirror configuration) is
+/// computed too and must miss off the mirror.
+fn specular_lobe(
+    technique: FilmTechnique,
+    base: C64,
+    light: LobeLight,
+    film: impl Fn(f64) -> [f64; 3],
+) {
+    let point = matches!(light, LobeLight::Point | LobeLight::Spot);
+    use bevy::core_pipeline::tonemapping::DebandDither;
+    use bevy::render::render_resource::TextureFormat;
+
+    let n = LOBE_QUADS_DEG.len();
+    let (w, h) = (50 * n as u32, 50);
+    let mut app = headless_app(&repo_root());
+    let image = app
+        .world_mut()
+        .resource_mut::<Assets<Image>>()
+        .add(Image::new_target_texture(
+            w,
+            h,
+            TextureFormat::Rgba32Float,
+            None,
+        ));
+    let world = app.world_mut();
+    let mesh = world
+        .resource_mut::<Assets<Mesh>>()
+        .add(Rectangle::new(0.8, 0.8));
+    let material = world
+        .resource_mut::<Assets<NacreMaterial>>()
+        .add(NacreMaterial {
+            base: StandardMaterial {
+                base_color: Color::BLACK,
+                perceptual_roughness: LOBE_PERCEPTUAL_ROUGHNESS as f32,
+                ..default()
+            },
+            extension: NacreFilm {
+                technique,
+                base_ior: Vec3::splat(base.re as f32),
+                base_kappa: Vec3::splat(base.im as f32),
+                film_ior: LOBE_FILM_IOR as f32,
+                thickness: FilmThickness::Gltf {
+                    min_nm: LOBE_THICKNESS_NM as f32,
+                    max_nm: LOBE_THICKNESS_NM as f32,
+                },
+                weight: 1.0,
+                ..default()
+            },
+        });
+    for (i, phi) in LOBE_QUADS_DEG.iter().enumerate() {
+        world.spawn((
+            Mesh3d(mesh.clone()),
+            MeshMaterial3d(material.clone()),
+            Transform::from_xyz(i as f32 - (n - 1) as f32 / 2.0, 0.0, 0.0)
+                .with_rotation(Quat::from_rotation_y((*phi as f32).to_radians())),
+        ));
+    }
+    world.insert_resource(GlobalAmbientLight {
+        color: Color::WHITE,
+        brightness: 0.0,
+        ..default()
+    });
+    // The directional light at LOBE_LIGHT_DEG to the view; the point light LOBE_POINT_DISTANCE
+    // from the middle quad in that direction (its mirror configuration).
+    let beta = LOBE_LIGHT_DEG.to_radians();
+    let to_light = DVec3::new(beta.sin(), 0.0, beta.cos());
+    let point_at = to_light * LOBE_POINT_DISTANCE;
+    if light == LobeLight::Spot {
+        world.spawn((
+            SpotLight {
+                intensity: (LOBE_POINT_CD * 4.0 * std::f64::consts::PI) as f32,
+                range: LOBE_POINT_RANGE as f32,
+                radius: 0.0,
+                inner_angle: 1.2,
+                outer_angle: 1.4,
+                ..default()
+            },
+            Transform::from_translation(point_at.as_vec3()).looking_at(Vec3::ZERO, Vec3::Y),
+        ));
+    } else if point {
+        world.spawn((
+            PointLight {
+                intensity: (LOBE_POINT_CD * 4.0 * std::f64::consts::PI) as f32,
+                range: LOBE_POINT_RANGE as f32,
+                radius: 0.0,
+                ..default()
+            },
+            Transform::from_translation(point_at.as_vec3()),
+        ));
+    } else if light == LobeLight::Directional {
+        world.spawn((
+            DirectionalLight {
+                illuminance: LOBE_LUX as f32,
+                ..default()
+            },
+            Transform::default().looking_to(-to_light.as_vec3(), Vec3::Y),
+        ));
+    }
+    let exposure = bevy::camera::Exposure { ev100: 0.0 };
+    let environment = (light == LobeLight::Environment).then(|| {
+        let mut images = world.resource_mut::<Assets<Image>>();
+        let mut map = EnvironmentMapLight::solid_color(&mut images, Color::WHITE);
+        map.intensity = LOBE_ENVIRONMENT_NITS as f32;
+        map
+    });
+    let mut camera = world.spawn((
+        Camera3d::default(),
+        bevy::camera::Hdr,
+        exposure,
+        RenderTarget::Image(image.clone().into()),
+        Tonemapping::None,
+        DebandDither::Disabled,
+        Projection::Orthographic(OrthographicProjection {
+            scaling_mode: bevy::camera::ScalingMode::FixedHorizontal {
+                viewport_width: n as f32,
+            },
+            ..OrthographicProjection::default_3d()
+        }),
+        Transform::from_xyz(0.0, 0.0, 5.0).looking_at(Vec3::ZERO, Vec3::Y),
+    ));
+    if let Some(map) = environment {
+        camera.insert(map);
+    }
+    let bytes = capture(&mut app, &image, 10);
+    assert_eq!(bytes.len(), 16 * (w * h) as usize, "an Rgba32Float picture");
+    let pixel = |x: usize, y: usize| -> [f64; 3] {
+        let p = &bytes[16 * (y * w as usize + x)..];
+        std::array::from_fn(|c| {
+            f64::from(f32::from_le_bytes(p[4 * c..4 * c + 4].try_into().unwrap()))
+        })
+    };
+
+    let rp = LOBE_PERCEPTUAL_ROUGHNESS;
+    let alpha = rp * rp;
+    // Bevy's F_AB polynomial (Karis 2014) sums to A + B = 1 − 0.55 r_p wherever its B is above
+    // its 5×10⁻⁵ floor (true for r_p = 0.6 at every n·v): the multiple-scattering factor is
+    // 1 + F₀ (1/(A + B) − 1).
+    let multiscatter = |f0: f64| 1.0 + f0 * (1.0 / (1.0 - 0.55 * rp) - 1.0);
+    // Bevy's HDR target is Rgba16Float (relative steps of 2⁻¹¹); the film-lut lookup is the
+    // CPU's to 5×10⁻⁷ (probe.rs).
+    let tolerance = |cpu: f64| 3e-3 * cpu + 1e-4;
+    let mut worst: f64 = 0.0;
+    let v = DVec3::Z;
+    let kind = format!("{light:?}");
+    for (i, phi) in LOBE_QUADS_DEG.iter().enumerate() {
+        let phi = phi.to_radians();
+        let normal = DVec3::new(phi.sin(), 0.0, phi.cos());
+        // The world point seen at the centre of pixel (50 i + 25, 25): 0.01 right of and below
+        // the quad's centre, on its plane.
+        let (px, py) = (50 * i + 25, 25);
+        let x = (px as f64 + 0.5) / f64::from(w) * n as f64 - n as f64 / 2.0;
+        let y = (f64::from(h) / 2.0 - (py as f64 + 0.5)) * n as f64 / f64::from(w);
+        let centre_x = i as f64 - (n - 1) as f64 / 2.0;
+        let z = -normal.x * (x - centre_x) / normal.z;
+        let p = DVec3::new(x, y, z);
+        // Light direction and illuminance E (lux) at p: Bevy's point light has
+        // I = Φ/4π cd and the range falloff (1 − (d²/r²)²)² (saturated) over d².
+        let (l, illuminance) = if point {
+            let to = point_at - p;
+            let d2 = to.length_squared();
+            let falloff = (1.0 - (d2 / LOBE_POINT_RANGE.powi(2)).powi(2)).clamp(0.0, 1.0);
+            (to.normalize(), LOBE_POINT_CD * falloff * falloff / d2)
+        } else {
+            (to_light, LOBE_LUX)
+        };
+        if light == LobeLight::Environment {
+            // Split sum: R_f(μ) (A + B) times the environment's radiance.
+            let gpu = pixel(px, py);
+            let r_mu = film(normal.dot(v));
+            for c in 0..3 {
+                let cpu = f64::from(exposure.exposure())
+                    * LOBE_ENVIRONMENT_NITS
+                    * r_mu[c]
+                    * (1.0 - 0.55 * rp);
+                eprintln!(
+                    "{technique:?}, environment, quad {:.0}°, channel {c}: Bevy {:.5}, CPU {cpu:.5} (|Δ| {:.1e})",
+                    phi.to_degrees(),
+                    gpu[c],
+                    (gpu[c] - cpu).abs()
+                );
+                assert!(
+                    (gpu[c] - cpu).abs() <= tolerance(cpu),
+                    "environment, quad {:.0}° channel {c}: Bevy {} against {cpu}",
+                    phi.to_degrees(),
+                    gpu[c]
+                );
+                worst = worst.max((gpu[c] - cpu).abs() / cpu);
+            }
+            continue;
+        }
+        let half = (l + v).normalize();
+        let (n_dot_v, n_dot_l, n_dot_h, v_dot_h) =
+            (normal.dot(v), normal.dot(l), normal.dot(half), v.dot(half));
+        let scale = f64::from(exposure.exposure()) * illuminance;
+        let dv = ggx_d(alpha, n_dot_h) * smith_v(alpha, n_dot_v, n_dot_l) * n_dot_l * scale;
+        let r_mu = film(n_dot_v);
+        let r_vh = film(v_dot_h);
+        let gpu = pixel(px, py);
+        // The previous material: F₀ = (R_f(μ) − x)/(1 − x), Bevy's Schlick at v·h with
+        // f₉₀ = saturate(16.5 ΣF₀).
+        let x = (1.0 - n_dot_v).powi(5).min(0.99);
+        let f0_old = r_mu.map(|r| ((r - x) / (1.0 - x)).max(0.0));
+        let f90 = (16.5 * f0_old.iter().sum::<f64>()).clamp(0.0, 1.0);
+        // Within 2° of the mirror configuration n = h the two agree.
+        let mirror = n_dot_h > 2f64.to_radians().cos();
+        let mut old_missed = false;
+        for c in 0..3 {
+            let cpu = dv * r_vh[c] * multiscatter(r_mu[c]);
+            let f_old = f0_old[c] + (f90 - f0_old[c]) * (1.0 - v_dot_h).powi(5);
+            let old = dv * f_old * multiscatter(f0_old[c]);
+            eprintln!(
+                "{technique:?}, {kind} light, quad {:.0}° (n·h {n_dot_h:.4}), channel {c}: Bevy {:.5}, CPU {cpu:.5} (|Δ| {:.1e}), F₀-inversion {old:.5} (|Δ| {:.1e})",
+                phi.to_degrees(),
+                gpu[c],
+                (gpu[c] - cpu).abs(),
+                (old - cpu).abs(),
+            );
+            assert!(
+                (gpu[c] - cpu).abs() <= tolerance(cpu),
+                "{kind} light, quad {:.0}° channel {c}: Bevy {} against the film lobe's {cpu}",
+                phi.to_degrees(),
+                gpu[c]
+            );
+            worst = worst.max((gpu[c] - cpu).abs() / cpu);
+            old_missed |= (old - cpu).abs() > 10.0 * tolerance(cpu);
+        }
+        // Off the mirror configuration the previous material misses by more than ten
+        // tolerances: the test tells the two apart.
+        assert!(
+            mirror || old_missed,
+            "{kind} light, quad {:.0}°: the F₀-inversion is within the tolerance",
+            phi.to_degrees()
+        );
+    }
+    eprintln!("{technique:?}, {kind} light: largest relative difference Bevy − CPU {worst:.1e}");
+}
+
+/// The table events seen by [`record_table_events`].
+#[derive(Resource, Default)]
+struct TableEvents(Vec<AssetEvent<bevy_nacre::NacreTable>>);
+
+fn record_table_events(
+    mut reader: bevy::ecs::message::MessageReader<AssetEvent<bevy_nacre::NacreTable>>,
+    mut seen: ResMut<TableEvents>,
+) {
+    seen.0.extend(reader.read().cloned());
+}
+
+/// Copies table `name` of `tables/baked` (manifest and KTX2 files) into `dir`, the manifest
+/// as `as_name`.
+fn copy_table(name: &str, dir: &std::path::Path, as_name: &str) {
+    let baked = repo_root().join("tables/baked");
+    std::fs::copy(baked.join(format!("{name}.json")), dir.join(as_name)).unwrap();
+    for part in ["reflectance", "transmittance"] {
+        let file = format!("{name}.{part}.ktx2");
+        std::fs::copy(baked.join(&file), dir.join(&file)).unwrap();
+    }
+}
+
+/// A re-baked table reaches the materials: a table loaded from a directory is rewritten (the
+/// manifest and its KTX2 files replaced by another table's) and reloaded through the asset
+/// server (`AssetServer::reload`, what Bevy's `file_watcher` calls on a change: the watcher
+/// itself is not built for the tests, see README), which sends `AssetEvent::Modified`; the
+/// asset then has the new axes, and a material using it is bound to the new textures.
+#[test]
+fn a_rewritten_table_reloads_into_its_materials() {
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("bevy-table-reload");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    copy_table("soap-film", &dir, "table.json");
+    let mut app = headless_app(&dir);
+    app.init_resource::<TableEvents>()
+        .add_systems(Update, record_table_events);
+    let handle: Handle<bevy_nacre::NacreTable> =
+        app.world().resource::<AssetServer>().load("table.json");
+    let material = app
+        .world_mut()
+        .resource_mut::<Assets<NacreMaterial>>()
+        .add(NacreMaterial {
+            base: StandardMaterial::default(),
+            extension: NacreFilm {
+                lut_table: handle.clone(),
+                ..default()
+            },
+        });
+    let loaded = run_until(&mut app, 500, |world| {
+        world
+            .resource::<AssetServer>()
+            .is_loaded_with_dependencies(&handle)
+    });
+    assert!(loaded, "table.json did not load");
+    let axes = |world: &World| match world
+        .resource::<Assets<bevy_nacre::NacreTable>>()
+        .get(&handle)
+        .unwrap()
+        .axes
+    {
+        bevy_nacre::tables::NacreTableAxes::FilmLut(a) => a,
+        _ => panic!("a film-lut table"),
+    };
+    let before = axes(app.world());
+
+    copy_table("oil-slick", &dir, "table.json");
+    app.world_mut().resource_mut::<TableEvents>().0.clear();
+    app.world().resource::<AssetServer>().reload("table.json");
+    let id = handle.id();
+    let modified = run_until(&mut app, 500, |world| {
+        world
+            .resource::<TableEvents>()
+            .0
+            .contains(&AssetEvent::Modified { id })
+    });
+    assert!(modified, "no AssetEvent::Modified after the reload");
+    run_until(&mut app, 3, |_| false);
+    let world = app.world();
+    let after = axes(world);
+    let table = world
+        .resource::<Assets<bevy_nacre::NacreTable>>()
+        .get(&handle)
+        .unwrap();
+    eprintln!(
+        "film index axis {}–{} → {}–{}",
+        before.ior_min, before.ior_max, after.ior_min, after.ior_max
+    );
+    assert_eq!(table.name, "oil-slick");
+    assert_ne!(before, after, "the axes did not change");
+    let m = world
+        .resource::<Assets<NacreMaterial>>()
+        .get(&material)
+        .unwrap();
+    assert_eq!(m.extension.lut_axes, after);
+    assert_eq!(m.extension.lut_reflectance.as_ref(), Some(&table.texture));
+}
+
+#[test]
+fn the_specular_lobe_has_the_film_at_v_dot_h() {
+    // film_lut on its table's base (index 1.5): `nacre color --method lut:film-dielectric`.
+    let path = repo_root().join("tables/baked/film-dielectric.json");
+    let manifest = nacre_format::Manifest::read(&path).unwrap();
+    let axes = manifest.film_lut().cloned().unwrap();
+    let table = manifest.load_table(&path, "reflectance").unwrap().unwrap();
+    let film = |cos| {
+        nacre_format::film_lut::FilmLut::lookup(
+            &axes,
+            &table,
+            cos,
+            LOBE_THICKNESS_NM,
+            LOBE_FILM_IOR,
+        )
+    };
+    for light in [
+        LobeLight::Directional,
+        LobeLight::Point,
+        LobeLight::Spot,
+        LobeLight::Environment,
+    ] {
+        specular_lobe(FilmTechnique::Lut, C64::new(1.5, 0.0), light, film);
+    }
+}
+
+#[test]
+fn the_specular_lobe_has_the_film_at_v_dot_h_on_a_metal() {
+    // film_fourier on a metal base (n = 0.27 + 2.9i): `nacre color --method fourier:auto`.
+    let path = repo_root().join("tables/baked/fourier-srgb.json");
+    let manifest = nacre_format::Manifest::read(&path).unwrap();
+    let fourier = manifest.load_fourier(&path).unwrap();
+    let colorimeter = manifest.colorimeter(&path).unwrap();
+    let base = C64::new(0.27, 2.9);
+    let film = FilmOnBase {
+        n_ambient: 1.0,
+        n_film: LOBE_FILM_IOR,
+        base: [base; 3],
+    };
+    specular_lobe(
+        FilmTechnique::Fourier,
+        base,
+        LobeLight::Directional,
+        |cos| {
+            film.fourier_colour_with(
+                &colorimeter,
+                cos,
+                LOBE_THICKNESS_NM,
+                Harmonics::Auto,
+                0.0,
+                false,
+                |mu, s| fourier.sample(mu, s),
+            )
+            .expect("a film of index 1.8 in air")
+            .colour
+        },
+    );
 }
