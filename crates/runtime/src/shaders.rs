@@ -742,6 +742,7 @@ mod tests {
             ),
             ("scene", &["material"]),
             ("mesh", &["material"]),
+            ("mip_down", &[]),
             ("probe", &["common", "<technique>"]),
             ("bench", &["common", "<technique>"]),
             ("diffraction_common", &[]),

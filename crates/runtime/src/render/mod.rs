@@ -468,7 +468,10 @@ mod tests {
 
     #[test]
     fn uniform_sizes_match_the_wgsl_layouts() {
-        assert_eq!(std::mem::size_of::<ViewUniform>(), 128);
+        assert_eq!(std::mem::size_of::<ViewUniform>(), 656);
+        assert_eq!(std::mem::size_of::<LightUniform>(), 64);
+        assert_eq!(std::mem::offset_of!(ViewUniform, light_count), 128);
+        assert_eq!(std::mem::offset_of!(ViewUniform, lights), 144);
         assert_eq!(std::mem::size_of::<MaterialUniform>(), 96);
         assert_eq!(std::mem::offset_of!(MaterialUniform, film_weight), 80);
         assert_eq!(std::mem::offset_of!(MaterialUniform, base_ior), 32);
