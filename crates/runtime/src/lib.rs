@@ -18,6 +18,7 @@ pub mod error;
 pub mod gltf_assets;
 pub mod gltf_metal;
 pub mod gltf_scene;
+pub mod gltf_textures;
 pub mod gpu;
 pub mod ibl;
 pub mod image_io;
