@@ -1204,17 +1204,14 @@ pub fn render_gltf_from(
         let no_behind_view = no_behind.create_view(&Default::default());
         let mut encoder = device.create_command_encoder(&Default::default());
         // The stand-in is cleared once (alpha 0) so that it reads as "nothing behind".
-        drop(encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("mesh no scene behind"),
-            color_attachments: &[crate::gpu::cleared_attachment(
+        drop(crate::gpu::begin_pass(
+            &mut encoder,
+            "mesh no scene behind",
+            &[crate::gpu::cleared_attachment(
                 &no_behind_view,
                 wgpu::Color::TRANSPARENT,
             )],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        }));
+        ));
         // Draws `order`'s primitives into `colour` (cleared to `clear`; depth cleared), with
         // group-3 bind groups `groups`; `linear`: the picture of the opaque scene (transmissive
         // primitives skipped).
@@ -1460,17 +1457,14 @@ impl MipDown {
                 }],
             });
             let target = level(k);
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("mip_down"),
-                color_attachments: &[crate::gpu::cleared_attachment(
+            let mut pass = crate::gpu::begin_pass(
+                encoder,
+                "mip_down",
+                &[crate::gpu::cleared_attachment(
                     &target,
                     wgpu::Color::TRANSPARENT,
                 )],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+            );
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &group, &[]);
             pass.draw(0..3, 0..1);
