@@ -750,6 +750,18 @@ pub struct Colorimeter {
     weights: Vec<[f64; 3]>,
 }
 
+#[cfg(test)]
+impl Colorimeter {
+    /// CIE 1931 2°, D65, linear sRGB: the colorimeter of the unit tests.
+    pub(crate) fn srgb_d65() -> Colorimeter {
+        Colorimeter::new(
+            Observer::Cie1931_2Deg,
+            Illuminant::D65,
+            OutputSpace::Rgb(RgbSpace::Srgb),
+        )
+    }
+}
+
 impl Colorimeter {
     /// Precomputes the conversion for `observer`, `illuminant` and `space`.
     ///

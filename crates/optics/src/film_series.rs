@@ -424,20 +424,12 @@ impl SingleFilm {
 mod tests {
     use super::*;
     use crate::Stack;
-    use crate::colour::{Colorimeter, Illuminant, Observer, OutputSpace, RgbSpace};
-
-    fn srgb() -> Colorimeter {
-        Colorimeter::new(
-            Observer::Cie1931_2Deg,
-            Illuminant::D65,
-            OutputSpace::Rgb(RgbSpace::Srgb),
-        )
-    }
+    use crate::colour::Colorimeter;
 
     /// Interpolated F against the direct sum over the rule's nodes.
     #[test]
     fn transform_interpolates_to_1e12() {
-        let rule = SpectralRule::new(&srgb(), 9000.0);
+        let rule = SpectralRule::new(&Colorimeter::srgb_d65(), 9000.0);
         let table = RuleTransform::new(&rule, 50_000.0).unwrap();
         let bound = table.bound();
         let mut worst: f64 = 0.0;
@@ -467,7 +459,7 @@ mod tests {
     /// 1.5, up to 2.5; cos θ from 10⁻³ (grazing) to 1; thickness 0–1800 nm.
     #[test]
     fn series_matches_the_wavelength_sum() {
-        let colorimeter = srgb();
+        let colorimeter = Colorimeter::srgb_d65();
         let rule = SpectralRule::new(&colorimeter, 2.0 * 1800.0 * 2.5);
         let thicknesses: Vec<f64> = (0..=150).map(|i| 12.0 * i as f64).collect();
         let base = C64::new(1.5, 0.0);

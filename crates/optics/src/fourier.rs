@@ -585,20 +585,12 @@ pub fn gltf_iridescence(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::colour::{Illuminant, Observer, OutputSpace, RgbSpace};
+    use crate::colour::{Illuminant, Observer, OutputSpace};
     use crate::{Layer, Material, Stack};
-
-    fn srgb() -> Colorimeter {
-        Colorimeter::new(
-            Observer::Cie1931_2Deg,
-            Illuminant::D65,
-            OutputSpace::Rgb(RgbSpace::Srgb),
-        )
-    }
 
     #[test]
     fn transform_is_one_at_zero_and_decays() {
-        let c = srgb();
+        let c = Colorimeter::srgb_d65();
         let s0 = sensitivity_transform(&c, 0.0, 0.0);
         for v in s0 {
             assert!((v - C64::new(1.0, 0.0)).norm() < 1e-12, "{s0:?}");
@@ -619,7 +611,7 @@ mod tests {
 
     #[test]
     fn filon_matches_direct_quadrature() {
-        let c = srgb();
+        let c = Colorimeter::srgb_d65();
         let spectrum = SensitivitySpectrum::new(&c);
         let mut worst: f64 = 0.0;
         for &(mu, sigma) in &[
@@ -681,7 +673,7 @@ mod tests {
     #[test]
     fn filon_is_within_1e6_of_a_knot_aligned_reference() {
         for c in [
-            srgb(),
+            Colorimeter::srgb_d65(),
             Colorimeter::new(Observer::Cie1964_10Deg, Illuminant::A, OutputSpace::Xyz),
         ] {
             let spectrum = SensitivitySpectrum::new(&c);
@@ -701,7 +693,7 @@ mod tests {
     #[test]
     fn cosine_integrates_through_the_transform() {
         // ∫ cos(2π μ/λ + φ) s(λ) dλ / ‖s‖ = Re(e^{iφ} conj Ŝ(μ)), by direct quadrature.
-        let c = srgb();
+        let c = Colorimeter::srgb_d65();
         let (mu, phi) = (1234.5, 0.7);
         let rule = SpectralRule::new(&c, 20.0 * mu);
         let direct = rule.colour(
@@ -722,7 +714,7 @@ mod tests {
 
     #[test]
     fn transmittance_series_and_thin_film_limit() {
-        let c = srgb();
+        let c = Colorimeter::srgb_d65();
         let film = FilmOnBase {
             n_ambient: 1.0,
             n_film: 1.8,

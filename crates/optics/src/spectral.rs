@@ -410,20 +410,12 @@ impl Stack {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::colour::{Illuminant, Observer, OutputSpace, RgbSpace, delta_e_2000, xyz_to_lab};
+    use crate::colour::{delta_e_2000, xyz_to_lab};
     use crate::{C64, Layer, Material};
-
-    fn srgb() -> Colorimeter {
-        Colorimeter::new(
-            Observer::Cie1931_2Deg,
-            Illuminant::D65,
-            OutputSpace::Rgb(RgbSpace::Srgb),
-        )
-    }
 
     #[test]
     fn sample_weights_span_400_to_700_nm_and_sum_to_white() {
-        let c = srgb();
+        let c = Colorimeter::srgb_d65();
         let white = sum3(c.weights_1nm().iter().copied());
         for n in [1, 2, 3, 16, 64] {
             let (wl, w) = sample_weights(&c, n);
@@ -512,7 +504,7 @@ mod tests {
 
     #[test]
     fn absurd_paths_are_refused_not_allocated() {
-        let c = srgb();
+        let c = Colorimeter::srgb_d65();
         assert!(SpectralRule::try_new(&c, 1e7).is_ok());
         for opd in [1e12, 1e300, f64::INFINITY] {
             let e = SpectralRule::try_new(&c, opd).unwrap_err();
@@ -545,7 +537,7 @@ mod tests {
             last = step;
         }
         // Broad fringes: the stack's rule is the finesse-blind one, node for node.
-        let c = srgb();
+        let c = Colorimeter::srgb_d65();
         let stack = film_stack(1.33, 5000.0, C64::new(1.5, 0.0));
         let opd = stack.max_opd_nm(None);
         assert_eq!(
@@ -556,7 +548,7 @@ mod tests {
 
     #[test]
     fn perfect_reflector_is_white() {
-        let c = srgb();
+        let c = Colorimeter::srgb_d65();
         for opd in [0.0, 1e3, 5e4] {
             let rule = SpectralRule::new(&c, opd);
             let w = rule.colour(std::iter::repeat_n(1.0, rule.wavelengths_nm().len()));
@@ -568,7 +560,7 @@ mod tests {
 
     #[test]
     fn thick_films_match_fine_integration() {
-        let c = srgb();
+        let c = Colorimeter::srgb_d65();
         let mut worst: f64 = 0.0;
         for &(n_film, d, base, angle) in &[
             (1.33, 400.0, C64::new(1.0, 0.0), 0.0),

@@ -2,17 +2,8 @@
 //! (θ_i, φ_i) quadrature, reciprocity, the smooth limit, determinism.
 
 use super::*;
-use crate::colour::{Illuminant, Observer, OutputSpace, RgbSpace};
 use crate::{C64, Layer, Material};
 use proptest::prelude::*;
-
-fn srgb() -> Colorimeter {
-    Colorimeter::new(
-        Observer::Cie1931_2Deg,
-        Illuminant::D65,
-        OutputSpace::Rgb(RgbSpace::Srgb),
-    )
-}
 
 fn constant(n: f64) -> Material {
     Material::constant(format!("{n}"), C64::new(n, 0.0)).unwrap()
@@ -82,7 +73,7 @@ fn quadrature(
 
 #[test]
 fn film_table_matches_exact_spectral_colour() {
-    let c = srgb();
+    let c = Colorimeter::srgb_d65();
     let mut rng = SplitMix64::stream(7, 0);
     let mut worst: f64 = 0.0;
     for d in [300.0, 800.0] {
@@ -105,7 +96,7 @@ fn film_table_matches_exact_spectral_colour() {
 
 #[test]
 fn white_furnace_matches_quadrature() {
-    let c = srgb();
+    let c = Colorimeter::srgb_d65();
     let mirror = FilmTerm::perfect_mirror(&c);
     for alpha in [0.1, 0.3, 0.6, 1.0] {
         for cos_o in [1.0, 0.5, 0.2] {
@@ -134,7 +125,7 @@ fn white_furnace_matches_quadrature() {
 
 #[test]
 fn films_match_quadrature() {
-    let c = srgb();
+    let c = Colorimeter::srgb_d65();
     for d in [300.0, 800.0] {
         let film = FilmTerm::from_stack(&soap_on_glass(d), &c).unwrap();
         for alpha in [0.2, 0.5] {
@@ -210,7 +201,7 @@ fn quadrature_transmission(
 
 #[test]
 fn transmission_matches_quadrature() {
-    let c = srgb();
+    let c = Colorimeter::srgb_d65();
     for d in [0.0, 300.0] {
         let film = FilmTerm::from_stack(&soap_on_glass(d), &c).unwrap();
         for alpha in [0.3, 0.7] {
@@ -235,7 +226,7 @@ fn transmission_matches_quadrature() {
 
 #[test]
 fn smooth_limit_is_the_specular_film_colour() {
-    let c = srgb();
+    let c = Colorimeter::srgb_d65();
     for d in [300.0, 800.0] {
         let stack = soap_on_glass(d);
         let film = FilmTerm::from_stack(&stack, &c).unwrap();
@@ -268,7 +259,7 @@ fn smooth_limit_is_the_specular_film_colour() {
 
 #[test]
 fn lossless_reflection_plus_transmission_at_most_one() {
-    let c = srgb();
+    let c = Colorimeter::srgb_d65();
     for d in [0.0, 300.0, 800.0] {
         let film = FilmTerm::from_stack(&soap_on_glass(d), &c).unwrap();
         for alpha in [0.05, 0.3, 1.0] {
@@ -288,7 +279,7 @@ fn lossless_reflection_plus_transmission_at_most_one() {
 
 #[test]
 fn deterministic_across_thread_counts() {
-    let c = srgb();
+    let c = Colorimeter::srgb_d65();
     let film = FilmTerm::from_stack(&soap_on_glass(800.0), &c).unwrap();
     let run = |threads: usize| {
         rayon::ThreadPoolBuilder::new()
