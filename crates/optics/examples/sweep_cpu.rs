@@ -5,25 +5,10 @@
 //!
 //! Run: `cargo run --release -p nacre-optics --example sweep_cpu [FILTER]`.
 
-use nacre_optics::{C64, Layer, Material, Stack};
+#[path = "../benches/common/mod.rs"]
+mod common;
+
 use std::hint::black_box;
-
-fn constant(n: f64, k: f64) -> Material {
-    Material::constant(format!("{n}"), C64::new(n, k)).unwrap()
-}
-
-fn grid(start: f64, step: f64, count: usize) -> Vec<f64> {
-    (0..count).map(|i| start + step * i as f64).collect()
-}
-
-fn dispersive(name: &str) -> Material {
-    let text = std::fs::read_to_string(format!(
-        "{}/../../tables/materials/{name}.yml",
-        env!("CARGO_MANIFEST_DIR")
-    ))
-    .unwrap();
-    Material::from_refractiveindex_yaml(name, name, &text).unwrap()
-}
 
 /// CPU seconds (user + system) this process has used.
 fn cpu_seconds() -> f64 {
@@ -60,29 +45,18 @@ fn main() {
         .num_threads(1)
         .build_global()
         .unwrap();
-    let angles = grid(0.0, 1.0, 90);
-    let wavelengths = grid(380.0, 5.0, 81);
-    let thicknesses = grid(0.0, 10.0, 100);
+    let angles = common::angles_deg();
+    let wavelengths = common::wavelengths_5nm();
+    let thicknesses = common::thicknesses_nm();
     let n = angles.len() * wavelengths.len() * thicknesses.len();
-    let film = |sub: Material, f: Material| {
-        Stack::new(
-            constant(1.0, 0.0),
-            vec![Layer {
-                material: f,
-                thickness_nm: 0.0,
-            }],
-            sub,
-        )
-        .unwrap()
-    };
-    let soap = film(constant(1.5, 0.0), constant(1.33, 0.0));
+    let soap = common::soap_film();
     measure("single film 1.0 | 1.33 | 1.5, 90x81x100", n, || {
         black_box(
             soap.sweep_thickness(1, &angles, &wavelengths, &thicknesses)
                 .unwrap(),
         );
     });
-    let metal = film(constant(0.27, 2.9), constant(1.5, 0.05));
+    let metal = common::absorbing_film_on_metal();
     measure("absorbing film on metal, 90x81x100", n, || {
         black_box(
             metal
@@ -90,21 +64,8 @@ fn main() {
                 .unwrap(),
         );
     });
-    let wavelengths_1nm = grid(380.0, 1.0, 401);
-    let layers = [
-        ("tio2", 56.45),
-        ("mgf2", 99.75),
-        ("tio2", 56.45),
-        ("fused-silica", 120.0),
-        ("au", 10.0),
-    ]
-    .iter()
-    .map(|&(m, d)| Layer {
-        material: dispersive(m),
-        thickness_nm: d,
-    })
-    .collect();
-    let five = Stack::new(dispersive("air"), layers, dispersive("bk7")).unwrap();
+    let wavelengths_1nm = common::wavelengths_1nm();
+    let five = common::five_layer_dispersive();
     measure(
         "five-layer dispersive, 90x401",
         angles.len() * wavelengths_1nm.len(),
