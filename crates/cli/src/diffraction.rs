@@ -3,6 +3,7 @@
 //! (file or synthetic spec) or a baked `diffraction` table. The evaluation is
 //! [`nacre_bake::commands::diffraction`]; this module holds the flags.
 
+use crate::ColourArgs;
 use clap::Args;
 use nacre_bake::commands::diffraction::{
     self as lib, MapRequest, Source, SurfaceSpec, ViewsRequest,
@@ -119,15 +120,8 @@ pub struct DiffractionArgs {
     /// the half-vector angle [default: F = 1, a perfect reflector].
     #[arg(long, value_name = "INDEX")]
     fresnel: Option<String>,
-    /// CIE observer: 1931 or 1964 [default: 1931, or the table's].
-    #[arg(long)]
-    observer: Option<String>,
-    /// Illuminant: d65, d50, a or e [default: d65, or the table's].
-    #[arg(long)]
-    illuminant: Option<String>,
-    /// Output space: xyz, srgb, rec2020, p3 or acescg (linear) [default: srgb, or the table's].
-    #[arg(long)]
-    space: Option<String>,
+    #[command(flatten)]
+    colour: ColourArgs,
     /// Output CSV file, or `-` for standard output.
     #[arg(
         short = 'o',
@@ -162,11 +156,7 @@ pub fn run(args: &DiffractionArgs) -> Result<()> {
             wavelengths: args.wavelengths.as_deref(),
             default_wavelengths: "380:780:5",
             fresnel: args.fresnel.as_deref(),
-            colour: [
-                args.observer.as_deref(),
-                args.illuminant.as_deref(),
-                args.space.as_deref(),
-            ],
+            colour: args.colour.settings(),
         },
         incidence: &args.incidence,
         views: &args.views,

@@ -4,6 +4,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 use clap::{Args, Parser, Subcommand};
+use nacre_bake::commands::color_request::ColourSettings;
 use nacre_bake::commands::grid::parse_range;
 use nacre_bake::commands::spectrum;
 use nacre_bake::commands::stack_spec::{StackRecipe, StackSpec};
@@ -190,6 +191,31 @@ Examples:
   nacre color --ambient 1.0 --layer 1.33@400 --substrate 1.5 --angles 0:80:10 --method rough-lut:rough-film-dielectric --roughness 0.3
   nacre color --ambient 1.0 --layer 1.33@400 --substrate 1.5 --angles 0:80:10 --method rough-mc --roughness 0.3";
 
+/// `--observer`, `--illuminant`, `--space`: shared by `color` and `diffraction`.
+#[derive(Args)]
+struct ColourArgs {
+    /// CIE observer: 1931 (2°) or 1964 (10°) [default: 1931, or the table's].
+    #[arg(long)]
+    observer: Option<String>,
+    /// Illuminant: d65, d50, a or e [default: d65, or the table's].
+    #[arg(long)]
+    illuminant: Option<String>,
+    /// Output space: xyz, srgb, rec2020, p3 or acescg (linear) [default: srgb, or the table's].
+    #[arg(long)]
+    space: Option<String>,
+}
+
+impl ColourArgs {
+    /// The settings as given (`None`: the table's, else 1931, d65, srgb).
+    fn settings(&self) -> ColourSettings<'_> {
+        ColourSettings {
+            observer: self.observer.as_deref(),
+            illuminant: self.illuminant.as_deref(),
+            space: self.space.as_deref(),
+        }
+    }
+}
+
 #[derive(Args)]
 struct ColorArgs {
     #[command(flatten)]
@@ -220,15 +246,8 @@ struct ColorArgs {
     /// GGX roughness α (0 < α ≤ 1) of the rough-lut: and rough-mc methods.
     #[arg(long, value_name = "ALPHA")]
     roughness: Option<f64>,
-    /// CIE observer: 1931 (2°) or 1964 (10°) [default: 1931, or the table's].
-    #[arg(long)]
-    observer: Option<String>,
-    /// Illuminant: d65, d50, a or e [default: d65, or the table's].
-    #[arg(long)]
-    illuminant: Option<String>,
-    /// Output space: xyz, srgb, rec2020, p3 or acescg (linear) [default: srgb, or the table's].
-    #[arg(long)]
-    space: Option<String>,
+    #[command(flatten)]
+    colour: ColourArgs,
     /// Output CSV file, or `-` for standard output.
     #[arg(
         short = 'o',
@@ -544,7 +563,7 @@ fn run_spectrum(args: &SpectrumArgs) -> Result<()> {
 
 fn run_color(args: &ColorArgs) -> Result<()> {
     use nacre_bake::commands::color::{self, Method, Quantity};
-    use nacre_bake::commands::color_request::{self as request, ColorRequest, ColourSettings};
+    use nacre_bake::commands::color_request::{self as request, ColorRequest};
     let method = Method::parse(&args.method)?;
     let (mut spec, recipe_angles, _) = load_stack(&args.stack)?;
     // A table method and no stack flags: the stack the table was baked for.
@@ -573,11 +592,7 @@ fn run_color(args: &ColorArgs) -> Result<()> {
         &ColorRequest {
             method: &args.method,
             roughness: args.roughness,
-            colour: ColourSettings {
-                observer: args.observer.as_deref(),
-                illuminant: args.illuminant.as_deref(),
-                space: args.space.as_deref(),
-            },
+            colour: args.colour.settings(),
             fourier_table: args.fourier_table.as_deref(),
         },
     )

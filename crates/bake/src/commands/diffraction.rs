@@ -4,6 +4,7 @@
 //! is [`nacre_optics::diffraction`]; the height-field sources and the table kind live in
 //! [`crate::kinds::diffraction`] and [`crate::kinds::diffraction_integrated`].
 
+use crate::commands::color_request::ColourSettings;
 use crate::commands::grid::parse_range;
 use crate::commands::spectrum::fmt_sig;
 use crate::error::{Error, Msg, Origin, Param, Result};
@@ -137,8 +138,8 @@ pub struct Source<'a> {
     /// The grid when `--wavelengths` is not given (terms layout).
     pub default_wavelengths: &'a str,
     pub fresnel: Option<&'a str>,
-    /// --observer, --illuminant, --space.
-    pub colour: [Option<&'a str>; 3],
+    /// `--observer`, `--illuminant`, `--space`.
+    pub colour: ColourSettings<'a>,
 }
 
 fn parse_wavelengths(text: &str) -> Result<Vec<f64>> {
@@ -210,9 +211,9 @@ pub fn load(src: &Source, directions: &[([f64; 3], [f64; 3])]) -> Result<Loaded>
             .unwrap_or_else(|| default.to_string())
     };
     let colorimeter_of = |table_colour: [Option<String>; 3]| -> Result<Colorimeter> {
-        let o = pick(src.colour[0], &table_colour[0], "1931");
-        let i = pick(src.colour[1], &table_colour[1], "d65");
-        let s = pick(src.colour[2], &table_colour[2], "srgb");
+        let o = pick(src.colour.observer, &table_colour[0], "1931");
+        let i = pick(src.colour.illuminant, &table_colour[1], "d65");
+        let s = pick(src.colour.space, &table_colour[2], "srgb");
         Ok(Colorimeter::new(
             o.parse()
                 .map_err(|e: nacre_optics::Error| flag(Param::Observer, &o, e.to_string()))?,
@@ -322,17 +323,17 @@ pub fn load(src: &Source, directions: &[([f64; 3], [f64; 3])]) -> Result<Loaded>
                 let baked = manifest.colorimeter(&path)?;
                 for (given, flag_name, same) in [
                     (
-                        src.colour[0],
+                        src.colour.observer,
                         Param::Observer,
                         colorimeter.observer() == baked.observer(),
                     ),
                     (
-                        src.colour[1],
+                        src.colour.illuminant,
                         Param::Illuminant,
                         colorimeter.illuminant() == baked.illuminant(),
                     ),
                     (
-                        src.colour[2],
+                        src.colour.space,
                         Param::Space,
                         colorimeter.space() == baked.space(),
                     ),
@@ -668,7 +669,7 @@ pub fn map(req: &MapRequest) -> Result<DiffractionMap> {
             wavelengths: req.wavelengths,
             default_wavelengths: "380:780:10",
             fresnel: None,
-            colour: [None, None, None],
+            colour: ColourSettings::default(),
         },
         &directions,
     )?;
