@@ -27,7 +27,7 @@
 //! |---|---|---|
 //! | [`sin_cos`], [`sin`], [`cos`] | Payne–Hanek / Cody–Waite reduction, `__kernel_sin`/`__kernel_cos` | 1 ulp |
 //! | [`exp`] | reduction by ln 2 in two parts, rational approximation | 1 ulp |
-//! | [`ln`] | reduction to [√2/2, √2], series in s = f/(2+f) | 1 ulp |
+//! | [`ln`], [`log2`], [`log10`] | reduction to [√2/2, √2], series in s = f/(2+f) | 1 ulp |
 //! | [`powf`] | `e_pow.c`: log₂ x in extra precision, then 2^(y log₂ x) | 1 ulp |
 //! | [`acos`] | rational approximation of asin on \|x\| ≤ 1/2, half-angle beyond | 1 ulp |
 //! | [`atan2`] | `s_atan.c` on the reduced ratio, quadrant fix-up | 1 ulp |
@@ -67,6 +67,18 @@ pub fn exp(x: f64) -> f64 {
 #[inline]
 pub fn ln(x: f64) -> f64 {
     libm::log(x)
+}
+
+/// log₂ x.
+#[inline]
+pub fn log2(x: f64) -> f64 {
+    libm::log2(x)
+}
+
+/// log₁₀ x.
+#[inline]
+pub fn log10(x: f64) -> f64 {
+    libm::log10(x)
 }
 
 /// x^y (C's `pow`: every special case of IEEE 754 §9.2.1).
@@ -227,8 +239,14 @@ mod tests {
             f64::ln,
             1e-3,
         );
-        println!("exp: {e} ulp, ln: {l} ulp from libm");
+        let l2 = worst(spread(1e-6, 1e6, 200_000), log2, f64::log2, 1e-3);
+        let l10 = worst(spread(1e-6, 1e6, 200_000), log10, f64::log10, 1e-3);
+        println!("exp: {e} ulp, ln: {l} ulp, log2: {l2} ulp, log10: {l10} ulp from libm");
         assert!(e <= 1 && l <= 1, "exp {e} ulp, ln {l} ulp");
+        assert!(l2 <= 1 && l10 <= 1, "log2 {l2} ulp, log10 {l10} ulp");
+        for k in -20..=20 {
+            assert_eq!(log10(powi(10.0, k)), f64::from(k));
+        }
         assert_eq!(exp(0.0), 1.0);
         assert_eq!(ln(1.0), 0.0);
         assert_eq!(exp(-800.0), 0.0);

@@ -14,6 +14,7 @@ use nacre_format::manifest::{
 use nacre_format::table_io::Precision;
 use nacre_optics::C64;
 use nacre_optics::colour::Colorimeter;
+use nacre_optics::elementary;
 use nacre_optics::fourier::SensitivitySpectrum;
 use rayon::prelude::*;
 use serde::Deserialize;
@@ -191,7 +192,7 @@ pub fn bake_table(colorimeter: &Colorimeter, axes: FourierAxes) -> FourierTable 
                     let s = spectrum.transform_damped(mu, &damped);
                     std::array::from_fn(|j| {
                         let a =
-                            s[j] * C64::from_polar(1.0, 2.0 * PI * mu * axes.carrier_nu_per_nm[j]);
+                            s[j] * elementary::from_polar(1.0, 2.0 * PI * mu * axes.carrier_nu_per_nm[j]);
                         // Stored as f32: round here so that CPU lookups see the file's values.
                         C64::new(f64::from(a.re as f32), f64::from(a.im as f32))
                     })
