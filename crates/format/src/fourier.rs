@@ -35,8 +35,8 @@
 use crate::error::{Error, Result};
 use crate::table_io::{self, Precision, Table3};
 use nacre_optics::C64;
-use nacre_optics::elementary;
 use nacre_optics::colour::Colorimeter;
+use nacre_optics::elementary;
 use nacre_optics::fourier::SensitivitySpectrum;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;

@@ -31,6 +31,7 @@
 //! | [`powf`] | `e_pow.c`: log₂ x in extra precision, then 2^(y log₂ x) | 1 ulp |
 //! | [`acos`] | rational approximation of asin on \|x\| ≤ 1/2, half-angle beyond | 1 ulp |
 //! | [`atan2`] | `s_atan.c` on the reduced ratio, quadrant fix-up | 1 ulp |
+//! | [`cbrt`] | bit-level first guess, Newton steps with exact FMA residuals | 1 ulp |
 //! | [`hypot`] | exact squares split in two parts (musl), then √ | 1 ulp |
 //!
 //! On top of them: [`from_polar`], [`norm`] and [`csqrt`] for complex numbers (num-complex's
@@ -79,6 +80,12 @@ pub fn log2(x: f64) -> f64 {
 #[inline]
 pub fn log10(x: f64) -> f64 {
     libm::log10(x)
+}
+
+/// The real cube root ∛x.
+#[inline]
+pub fn cbrt(x: f64) -> f64 {
+    libm::cbrt(x)
 }
 
 /// x^y (C's `pow`: every special case of IEEE 754 §9.2.1).
@@ -264,7 +271,9 @@ mod tests {
                 worst_ulps = worst_ulps.max(ulps(powi(x, n), x.powf(f64::from(n))));
             }
         }
-        println!("powf: {worst_ulps} ulp from libm");
+        let c = worst(spread(-1e6, 1e6, 200_000), cbrt, f64::cbrt, 1e-3);
+        assert!(c <= 1, "cbrt {c} ulp");
+        println!("powf: {worst_ulps} ulp, cbrt: {c} ulp from libm");
         assert!(worst_ulps <= 1, "powf {worst_ulps} ulp");
         assert_eq!(powf(0.0, 3.0), 0.0);
         assert_eq!(powf(2.0, 0.0), 1.0);
@@ -327,7 +336,10 @@ mod tests {
                 let rel = (ours - std).norm() / std.norm();
                 worst_rel = worst_rel.max(rel);
                 let back = ours * ours;
-                assert!((back - z).norm() <= 4.0 * f64::EPSILON * z.norm(), "{z}: {back}");
+                assert!(
+                    (back - z).norm() <= 4.0 * f64::EPSILON * z.norm(),
+                    "{z}: {back}"
+                );
             }
         }
         println!("csqrt: worst relative difference from num-complex {worst_rel:.2e}");

@@ -69,8 +69,8 @@
 //! exp(−(2π σ_μ / λ)² / 2) of each wavelength, which [`SensitivitySpectrum::transform`]
 //! applies exactly.
 
-use crate::elementary;
 use crate::colour::Colorimeter;
+use crate::elementary;
 use crate::fresnel::{Interface, normal_component, power_factor_p, power_factor_s};
 use crate::spectral::SpectralRule;
 use num_complex::Complex64 as C64;
@@ -478,7 +478,10 @@ impl FilmOnBase {
             }
             summed = m;
             if harmonics == Harmonics::Auto {
-                let s_max = s_hat.iter().map(|&v| elementary::norm(v)).fold(0.0, f64::max);
+                let s_max = s_hat
+                    .iter()
+                    .map(|&v| elementary::norm(v))
+                    .fold(0.0, f64::max);
                 let converged = (0..3).all(|j| {
                     (0..2).all(|pol| {
                         series[j][pol].tail_after(elementary::norm(cm[j][pol])) * s_max

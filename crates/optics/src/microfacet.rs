@@ -107,8 +107,8 @@
 //! # Ok::<(), nacre_optics::Error>(())
 //! ```
 
-use crate::elementary;
 use crate::colour::Colorimeter;
+use crate::elementary;
 use crate::error::{Error, Result};
 use crate::spectral::SpectralRule;
 use crate::stack::Stack;
