@@ -18,10 +18,11 @@
 //! itself Sun's fdlibm): pure Rust built from IEEE basic operations and exact bit
 //! manipulation, compiled into nacre, so the code and therefore the bits are the same on
 //! every target (x86-64 and arm64; Linux, macOS, Windows). Its only hardware shortcuts
-//! (the `arch` feature, left off here) are correctly rounded operations such as √ that give
-//! the same bits as the software path. Accuracy, as measured against the platform libm by
-//! the tests below over dense ranges (both sides are within about 1 ulp of the true value,
-//! so the difference bounds the error to about twice that):
+//! (the `arch` feature: nacre leaves it off, but num-traits turns it on in the same build)
+//! are correctly rounded operations — √, fused multiply–add inside `cbrt`, rounding to an
+//! integer — that give the bits of the software path. Accuracy, as measured against the
+//! platform libm by the tests below over dense ranges (both sides are within about 1 ulp of
+//! the true value, so the difference bounds the error to about twice that):
 //!
 //! | function | method (fdlibm) | max difference from glibc (test) |
 //! |---|---|---|
