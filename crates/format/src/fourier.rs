@@ -36,6 +36,7 @@ use crate::error::{Error, Result};
 use crate::table_io::{self, Precision, Table3};
 use nacre_optics::C64;
 use nacre_optics::colour::Colorimeter;
+use nacre_optics::elementary;
 use nacre_optics::fourier::SensitivitySpectrum;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -92,7 +93,7 @@ impl FourierAxes {
         let lod = if sigma_mu_nm < s1 {
             sigma_mu_nm / s1
         } else {
-            1.0 + (sigma_mu_nm / s1).log2()
+            1.0 + elementary::log2(sigma_mu_nm / s1)
         };
         lod.min(last)
     }
@@ -122,7 +123,7 @@ impl FourierTable {
             a0
         };
         std::array::from_fn(|j| {
-            a[j] * C64::from_polar(1.0, -2.0 * PI * mu_nm * self.axes.carrier_nu_per_nm[j])
+            a[j] * elementary::from_polar(1.0, -2.0 * PI * mu_nm * self.axes.carrier_nu_per_nm[j])
         })
     }
 

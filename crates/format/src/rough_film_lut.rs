@@ -51,6 +51,7 @@
 use crate::error::{Error, Result};
 use crate::film_lut::MIN_COS_THETA;
 use crate::table_io::Table3;
+use nacre_optics::elementary;
 use serde::{Deserialize, Serialize};
 
 /// Axes of a rough-film LUT, with the forward (physical → t ∈ [0, 1]) and inverse mappings.
@@ -118,9 +119,9 @@ impl RoughLutAxes {
 
     /// t of roughness α: ln(α/α_min) / ln(α_max/α_min) (0 when the range is one value).
     pub fn alpha_t(&self, alpha: f64) -> f64 {
-        let span = (self.alpha_max / self.alpha_min).ln();
+        let span = elementary::ln(self.alpha_max / self.alpha_min);
         if span > 0.0 {
-            (alpha / self.alpha_min).ln() / span
+            elementary::ln(alpha / self.alpha_min) / span
         } else {
             0.0
         }
@@ -161,7 +162,7 @@ impl RoughLutAxes {
             t[0] * t[0],
             t[1] * self.opd_max_nm(),
             self.ior_min + t[2] * t[2] * (self.ior_max - self.ior_min),
-            self.alpha_min * (self.alpha_max / self.alpha_min).powf(t[3]),
+            self.alpha_min * elementary::powf(self.alpha_max / self.alpha_min, t[3]),
         )
     }
 

@@ -45,6 +45,7 @@
 //! assert!(white.iter().all(|v| (v - 1.0).abs() < 1e-12));
 //! ```
 
+use crate::elementary;
 use crate::error::{Error, Result};
 use std::fmt;
 use std::str::FromStr;
@@ -950,7 +951,7 @@ pub fn xyz_to_lab(xyz: [f64; 3], white_xyz: [f64; 3]) -> [f64; 3] {
     fn f(t: f64) -> f64 {
         const EPS: f64 = (24.0 / 116.0) * (24.0 / 116.0) * (24.0 / 116.0);
         if t > EPS {
-            t.cbrt()
+            elementary::cbrt(t)
         } else {
             841.0 / 108.0 * t + 16.0 / 116.0
         }
@@ -990,16 +991,16 @@ pub fn delta_e_2000(lab1: [f64; 3], lab2: [f64; 3]) -> f64 {
     const TIE_DEG: f64 = 180.0 + 1e-9;
     let [l1, a1, b1] = lab1;
     let [l2, a2, b2] = lab2;
-    let c_bar = 0.5 * (a1.hypot(b1) + a2.hypot(b2));
-    let c_bar7 = c_bar.powi(7);
+    let c_bar = 0.5 * (elementary::hypot(a1, b1) + elementary::hypot(a2, b2));
+    let c_bar7 = elementary::powi(c_bar, 7);
     let g = 0.5 * (1.0 - (c_bar7 / (c_bar7 + POW25_7)).sqrt());
     let (a1p, a2p) = ((1.0 + g) * a1, (1.0 + g) * a2);
-    let (c1p, c2p) = (a1p.hypot(b1), a2p.hypot(b2));
+    let (c1p, c2p) = (elementary::hypot(a1p, b1), elementary::hypot(a2p, b2));
     let hue = |b: f64, ap: f64| {
         if b == 0.0 && ap == 0.0 {
             0.0
         } else {
-            let h = b.atan2(ap).to_degrees();
+            let h = elementary::atan2(b, ap).to_degrees();
             if h < 0.0 { h + 360.0 } else { h }
         }
     };
@@ -1020,7 +1021,7 @@ pub fn delta_e_2000(lab1: [f64; 3], lab2: [f64; 3]) -> f64 {
             d + 360.0
         }
     };
-    let dh_big = 2.0 * chroma_product.sqrt() * (0.5 * dh_deg).to_radians().sin();
+    let dh_big = 2.0 * chroma_product.sqrt() * elementary::sin((0.5 * dh_deg).to_radians());
 
     let l_bar = 0.5 * (l1 + l2);
     let c_bar_p = 0.5 * (c1p + c2p);
@@ -1033,19 +1034,20 @@ pub fn delta_e_2000(lab1: [f64; 3], lab2: [f64; 3]) -> f64 {
     } else {
         0.5 * (h1p + h2p - 360.0)
     };
-    let cos_deg = |deg: f64| deg.to_radians().cos();
+    let cos_deg = |deg: f64| elementary::cos(deg.to_radians());
     let t = 1.0 - 0.17 * cos_deg(h_bar - 30.0)
         + 0.24 * cos_deg(2.0 * h_bar)
         + 0.32 * cos_deg(3.0 * h_bar + 6.0)
         - 0.20 * cos_deg(4.0 * h_bar - 63.0);
-    let d_theta_deg = 30.0 * (-((h_bar - 275.0) / 25.0).powi(2)).exp();
-    let c_bar_p7 = c_bar_p.powi(7);
+    let h_off = (h_bar - 275.0) / 25.0;
+    let d_theta_deg = 30.0 * elementary::exp(-(h_off * h_off));
+    let c_bar_p7 = elementary::powi(c_bar_p, 7);
     let r_c = 2.0 * (c_bar_p7 / (c_bar_p7 + POW25_7)).sqrt();
-    let l50 = (l_bar - 50.0).powi(2);
+    let l50 = (l_bar - 50.0) * (l_bar - 50.0);
     let s_l = 1.0 + 0.015 * l50 / (20.0 + l50).sqrt();
     let s_c = 1.0 + 0.045 * c_bar_p;
     let s_h = 1.0 + 0.015 * c_bar_p * t;
-    let r_t = -(2.0 * d_theta_deg).to_radians().sin() * r_c;
+    let r_t = -elementary::sin((2.0 * d_theta_deg).to_radians()) * r_c;
     let (ql, qc, qh) = (dl / s_l, dc / s_c, dh_big / s_h);
     (ql * ql + qc * qc + qh * qh + r_t * qc * qh).sqrt()
 }

@@ -88,6 +88,7 @@
 //! grating of period d lie at sin θ_m = sin θ_i + mλ/d (m ∈ ℤ).
 
 use crate::colour::Colorimeter;
+use crate::elementary;
 use crate::error::{Error, Result};
 use crate::fresnel::{Interface, normal_component};
 use crate::microfacet::SplitMix64;
@@ -234,7 +235,7 @@ impl HeightField {
         check_length("grating period (µm)", period_um)?;
         check_height("grating amplitude (µm)", amplitude_um)?;
         let h = (0..nx)
-            .map(|i| amplitude_um * (2.0 * PI * i as f64 * pitch_um / period_um).sin())
+            .map(|i| amplitude_um * elementary::sin(2.0 * PI * i as f64 * pitch_um / period_um))
             .collect();
         Self::new(nx, 1, pitch_um, h)
     }
@@ -417,7 +418,7 @@ impl HeightField {
                     let ddy = wrap((iy as f64 + 0.5) * pitch_um - cy, ly);
                     let rho = (ddx * ddx + ddy * ddy).sqrt();
                     if rho < radius_um {
-                        let c = (0.5 * PI * rho / radius_um).cos();
+                        let c = elementary::cos(0.5 * PI * rho / radius_um);
                         h[iy * nx + ix] += height_um * c * c;
                     }
                 }
@@ -535,7 +536,7 @@ impl TaylorTerms {
                     C64::new(0.0, -1.0),
                 ][n % 4];
                 // Rows y of x samples: FFT along x, one contiguous row at a time.
-                let mut rows = heights.mapv(|h| phase * h.powi(n as i32));
+                let mut rows = heights.mapv(|h| phase * elementary::powi(h, n as i32));
                 fx.process(rows.as_slice_mut().expect("standard layout"));
                 // Columns x of y samples (the transpose, contiguous): FFT along y.
                 let mut columns = rows.t().as_standard_layout().into_owned();
@@ -687,8 +688,8 @@ impl FresnelTerm {
 /// Light and view directions in the plane of incidence (module docs): θ_i > 0 puts the
 /// light on the −x side, θ_r > 0 the viewer on the +x side; degrees.
 pub fn in_plane_directions(incidence_deg: f64, view_deg: f64) -> ([f64; 3], [f64; 3]) {
-    let (si, ci) = incidence_deg.to_radians().sin_cos();
-    let (sr, cr) = view_deg.to_radians().sin_cos();
+    let (si, ci) = elementary::sin_cos(incidence_deg.to_radians());
+    let (sr, cr) = elementary::sin_cos(view_deg.to_radians());
     ([-si, 0.0, ci], [sr, 0.0, cr])
 }
 
@@ -722,7 +723,8 @@ impl DiffractionSurface {
     /// [`Error::OutOfRange`] for a non-positive or non-finite σ_s.
     pub fn new(terms: TaylorTerms, sigma_s_um: f64) -> Result<Self> {
         check_length("coherence window σ_s (µm)", sigma_s_um)?;
-        let cut = (2.0 * (1.0 / WINDOW_CUTOFF).ln()).sqrt(); // σ|q − κ| beyond which w < cutoff
+        // σ|q − κ| beyond which w < cutoff
+        let cut = (2.0 * elementary::ln(1.0 / WINDOW_CUTOFF)).sqrt();
         let reach = |n: usize| {
             let l = n as f64 * terms.pitch_um;
             let dk = 2.0 * PI / l;
@@ -826,7 +828,7 @@ impl DiffractionSurface {
         (a..=b)
             .filter_map(move |j| {
                 let d = q - j as f64 * dk;
-                let wgt = (-0.5 * s2 * d * d).exp();
+                let wgt = elementary::exp(-0.5 * s2 * d * d);
                 (wgt >= WINDOW_CUTOFF).then_some((j, wgt))
             })
             .collect()

@@ -58,6 +58,7 @@
 //! BENCHMARKS.md; the targets are ΔE2000 p95 ≤ 0.3 and max ≤ 1.0.
 
 use crate::colour::Colorimeter;
+use crate::elementary;
 use crate::spectral::SpectralRule;
 use std::f64::consts::PI;
 
@@ -116,7 +117,7 @@ pub const MAX_ROUND_TRIPS: f64 = 3.0;
 pub fn finesse_factor(indices: &[crate::C64]) -> f64 {
     let mut r: Vec<f64> = indices
         .windows(2)
-        .map(|p| ((p[0] - p[1]) / (p[0] + p[1])).norm())
+        .map(|p| elementary::norm((p[0] - p[1]) / (p[0] + p[1])))
         .filter(|x| x.is_finite())
         .collect();
     r.sort_by(|a, b| b.total_cmp(a));
@@ -180,9 +181,9 @@ impl FewWavelengthRule {
         let mut atb = vec![[0.0; 3]; count];
         for &(w, opd) in &opds {
             let parts: &[fn(f64) -> f64] = if opd == 0.0 {
-                &[f64::cos]
+                &[elementary::cos]
             } else {
-                &[f64::cos, f64::sin]
+                &[elementary::cos, elementary::sin]
             };
             for part in parts {
                 let a: Vec<f64> = nodes
@@ -378,7 +379,7 @@ impl StackEvaluation {
                 2.0 * [380.0, 480.0, 580.0, 680.0, 780.0]
                     .iter()
                     .filter_map(|&wl| l.material.index_at(wl).ok())
-                    .map(|n| n.norm())
+                    .map(elementary::norm)
                     .fold(0.0f64, f64::max)
             })
             .collect();

@@ -64,6 +64,7 @@
 //! incidence, where the series takes q₀ = n₀ cos θ exactly and the wavelength sum takes it
 //! through the angle in degrees (q₀² = 1 − sin²θ loses ≈ 10⁻⁴ of itself at cos θ = 10⁻⁶).
 
+use crate::elementary;
 use crate::error::{Error, Result};
 use crate::fourier::AirySeries;
 use crate::fresnel::{Interface, power_factor_p, power_factor_s};
@@ -289,7 +290,7 @@ impl SingleFilm {
         let c2 = cos_theta * cos_theta;
         let q_of = |n: C64| {
             let q2 = (n * n - n0 * n0) + n0 * n0 * c2;
-            crate::fresnel::forward_branch(q2.sqrt())
+            crate::fresnel::forward_branch(elementary::csqrt(q2))
         };
         let q0 = C64::new(n0 * cos_theta, 0.0);
         let q1_sq = (n_film * n_film - n0 * n0) + n0 * n0 * c2;
@@ -305,7 +306,7 @@ impl SingleFilm {
             AirySeries::new(top.r_s, bottom.r_s),
             AirySeries::new(top.r_p, bottom.r_p),
         ];
-        if reflect.iter().any(|s| !(s.rho.norm() < 1.0)) {
+        if reflect.iter().any(|s| !(elementary::norm(s.rho) < 1.0)) {
             return None;
         }
         let transmit = transmittance.then(|| {
@@ -342,8 +343,8 @@ impl SingleFilm {
                 series
                     .iter()
                     .map(|s| {
-                        let r = s.rho.norm();
-                        s.k.norm() * r.powi(m) / (1.0 - r)
+                        let r = elementary::norm(s.rho);
+                        elementary::norm(s.k) * elementary::powi(r, m) / (1.0 - r)
                     })
                     .sum::<f64>()
             };

@@ -70,6 +70,7 @@
 //! applies exactly.
 
 use crate::colour::Colorimeter;
+use crate::elementary;
 use crate::fresnel::{Interface, normal_component, power_factor_p, power_factor_s};
 use crate::spectral::SpectralRule;
 use num_complex::Complex64 as C64;
@@ -108,7 +109,7 @@ pub enum Harmonics {
 /// The tolerance of [`Harmonics::Auto`] for a channel whose mean level (s/p average of c₀)
 /// is `level`: ε · max(level, floor)^(2/3).
 pub fn auto_tolerance(level: f64) -> f64 {
-    AUTO_TOLERANCE * level.max(AUTO_LEVEL_FLOOR).powf(2.0 / 3.0)
+    AUTO_TOLERANCE * elementary::powf(level.max(AUTO_LEVEL_FLOOR), 2.0 / 3.0)
 }
 
 /// The sensitivities of a colorimeter in the frequency domain ν = 1/λ, ready for Fourier
@@ -184,7 +185,8 @@ impl SensitivitySpectrum {
     pub fn damped(&self, sigma_mu_nm: f64) -> Vec<[f64; 3]> {
         let damp = |nu: f64| {
             if sigma_mu_nm > 0.0 {
-                (-0.5 * (2.0 * PI * sigma_mu_nm * nu).powi(2)).exp()
+                let x = 2.0 * PI * sigma_mu_nm * nu;
+                elementary::exp(-0.5 * (x * x))
             } else {
                 1.0
             }
@@ -261,11 +263,12 @@ pub fn transform_with_rule(rule: &SpectralRule, mu_nm: f64, sigma_mu_nm: f64) ->
     for (&wl, w) in rule.wavelengths_nm().iter().zip(rule.weights()) {
         let phase = -2.0 * PI * mu_nm / wl;
         let damping = if sigma_mu_nm > 0.0 {
-            (-0.5 * (2.0 * PI * sigma_mu_nm / wl).powi(2)).exp()
+            let x = 2.0 * PI * sigma_mu_nm / wl;
+            elementary::exp(-0.5 * (x * x))
         } else {
             1.0
         };
-        let e = C64::from_polar(damping, phase);
+        let e = elementary::from_polar(damping, phase);
         for j in 0..3 {
             sum[j] += e * w[j];
             norm[j] += w[j];
@@ -303,7 +306,7 @@ impl AirySeries {
     /// The bound 2|c_{m+1}| / (1 − |ρ|) of the terms after harmonic m, from |c_m| (the
     /// module docs' stopping rule, before the |Ŝ| factor).
     fn tail_after(&self, cm_norm: f64) -> f64 {
-        let r = self.rho.norm();
+        let r = elementary::norm(self.rho);
         2.0 * cm_norm * r / (1.0 - r).max(1e-12)
     }
 }
@@ -475,10 +478,14 @@ impl FilmOnBase {
             }
             summed = m;
             if harmonics == Harmonics::Auto {
-                let s_max = s_hat.iter().map(|v| v.norm()).fold(0.0, f64::max);
+                let s_max = s_hat
+                    .iter()
+                    .map(|&v| elementary::norm(v))
+                    .fold(0.0, f64::max);
                 let converged = (0..3).all(|j| {
                     (0..2).all(|pol| {
-                        series[j][pol].tail_after(cm[j][pol].norm()) * s_max <= tolerance[j]
+                        series[j][pol].tail_after(elementary::norm(cm[j][pol])) * s_max
+                            <= tolerance[j]
                     })
                 });
                 if converged {
@@ -513,13 +520,13 @@ pub fn gaussian_sensitivity_belcour2017(opd_nm: f64, shift: [f64; 3]) -> [f64; 3
     let mut xyz: [f64; 3] = std::array::from_fn(|i| {
         VAL[i]
             * (2.0 * PI * VAR[i]).sqrt()
-            * (POS[i] * phase + shift[i]).cos()
-            * (-phase * phase * VAR[i]).exp()
+            * elementary::cos(POS[i] * phase + shift[i])
+            * elementary::exp(-phase * phase * VAR[i])
     });
     xyz[0] += 9.7470e-14
         * (2.0 * PI * 4.5282e+09f64).sqrt()
-        * (2.2399e+06 * phase + shift[0]).cos()
-        * (-4.5282e+09 * phase * phase).exp();
+        * elementary::cos(2.2399e+06 * phase + shift[0])
+        * elementary::exp(-4.5282e+09 * phase * phase);
     let xyz = xyz.map(|v| v / 1.0685e-7);
     std::array::from_fn(|r| (0..3).map(|c| XYZ_TO_REC709[r][c] * xyz[c]).sum())
 }
@@ -542,14 +549,22 @@ pub fn gltf_iridescence(
         t * t * (3.0 - 2.0 * t)
     };
     let ior = n_outside + (n_film - n_outside) * smooth;
-    let sin2_t2 = (n_outside / ior).powi(2) * (1.0 - cos_theta * cos_theta);
+    let ratio = n_outside / ior;
+    let sin2_t2 = ratio * ratio * (1.0 - cos_theta * cos_theta);
     let cos2_t2 = 1.0 - sin2_t2;
     if cos2_t2 < 0.0 {
         return [1.0; 3];
     }
     let cos_t2 = cos2_t2.sqrt();
-    let schlick = |f0: f64, c: f64| f0 + (1.0 - f0) * (1.0 - c).clamp(0.0, 1.0).powi(5);
-    let f0_of = |a: f64, b: f64| ((a - b) / (a + b)).powi(2);
+    let schlick = |f0: f64, c: f64| {
+        let m = (1.0 - c).clamp(0.0, 1.0);
+        let m2 = m * m;
+        f0 + (1.0 - f0) * (m * (m2 * m2))
+    };
+    let f0_of = |a: f64, b: f64| {
+        let r = (a - b) / (a + b);
+        r * r
+    };
     let r12 = schlick(f0_of(ior, n_outside), cos_theta);
     let t121 = 1.0 - r12;
     let phi12 = if ior < n_outside { PI } else { 0.0 };

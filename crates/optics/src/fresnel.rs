@@ -53,7 +53,7 @@ pub(crate) const BRANCH_TOLERANCE: f64 = 100.0 * f64::EPSILON;
 /// `q² = ñ² − β²`), on the forward branch described in the module docs.
 #[inline]
 pub fn normal_component(n: C64, beta: f64) -> C64 {
-    let q = (n * n - beta * beta).sqrt();
+    let q = crate::elementary::csqrt(n * n - beta * beta);
     forward_branch(q)
 }
 

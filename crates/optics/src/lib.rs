@@ -24,6 +24,7 @@
 pub mod colour;
 pub mod csv_rows;
 pub mod diffraction;
+pub mod elementary;
 pub mod error;
 pub mod few_wavelengths;
 pub mod film_series;

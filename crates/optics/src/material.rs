@@ -45,6 +45,7 @@
 //! (Sums run over i = 2, 4, 6, … pairing Cᵢ with Cᵢ₊₁.) Source: the database's format
 //! description, `database/doc/Dispersion formulas.pdf`, M. N. Polyanskiy, Sci. Data 11, 94 (2024).
 
+use crate::elementary::{self, powf};
 use crate::error::{Error, Result};
 use num_complex::Complex64 as C64;
 use yaml_rust2::parser::{Event, MarkedEventReceiver, Parser};
@@ -116,15 +117,15 @@ fn eval_formula(kind: u8, c: &[f64], lambda_um: f64) -> f64 {
     match kind {
         1 => (1.0 + coef(0) + pairs(1).map(|(a, b)| a * l2 / (l2 - b * b)).sum::<f64>()).sqrt(),
         2 => (1.0 + coef(0) + pairs(1).map(|(a, b)| a * l2 / (l2 - b)).sum::<f64>()).sqrt(),
-        3 => (coef(0) + pairs(1).map(|(a, b)| a * l.powf(b)).sum::<f64>()).sqrt(),
+        3 => (coef(0) + pairs(1).map(|(a, b)| a * powf(l, b)).sum::<f64>()).sqrt(),
         4 => {
             let mut n2 = coef(0)
-                + coef(1) * l.powf(coef(2)) / (l2 - coef(3).powf(coef(4)))
-                + coef(5) * l.powf(coef(6)) / (l2 - coef(7).powf(coef(8)));
-            n2 += pairs(9).map(|(a, b)| a * l.powf(b)).sum::<f64>();
+                + coef(1) * powf(l, coef(2)) / (l2 - powf(coef(3), coef(4)))
+                + coef(5) * powf(l, coef(6)) / (l2 - powf(coef(7), coef(8)));
+            n2 += pairs(9).map(|(a, b)| a * powf(l, b)).sum::<f64>();
             n2.sqrt()
         }
-        5 => coef(0) + pairs(1).map(|(a, b)| a * l.powf(b)).sum::<f64>(),
+        5 => coef(0) + pairs(1).map(|(a, b)| a * powf(l, b)).sum::<f64>(),
         6 => 1.0 + coef(0) + pairs(1).map(|(a, b)| a / (b - 1.0 / l2)).sum::<f64>(),
         7 => {
             let u = 1.0 / (l2 - 0.028);
@@ -1033,7 +1034,7 @@ fn formula_gaps(physical: &dyn Fn(f64) -> bool, range: (f64, f64)) -> Option<(Ra
     let at = |i: usize| match i {
         0 => lo,
         i if i == last => hi,
-        i => lo * (hi / lo).powf(i as f64 / last as f64),
+        i => lo * powf(hi / lo, i as f64 / last as f64),
     };
     let ok: Vec<bool> = (0..FORMULA_SCAN_POINTS).map(|i| physical(at(i))).collect();
     if ok.iter().all(|&b| b) {
@@ -1092,7 +1093,7 @@ fn formula_gaps(physical: &dyn Fn(f64) -> bool, range: (f64, f64)) -> Option<(Ra
 /// `x` rounded to `digits` significant decimal digits, away from `from` (so that the result
 /// is not nearer to `from` than `x` is).
 fn round_away(x: f64, from: f64, digits: i32) -> f64 {
-    let scale = 10f64.powi(digits - 1 - x.abs().log10().floor() as i32);
+    let scale = elementary::powi(10.0, digits - 1 - elementary::log10(x.abs()).floor() as i32);
     let r = if x > from {
         (x * scale).ceil() / scale
     } else {

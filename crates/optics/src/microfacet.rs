@@ -108,6 +108,7 @@
 //! ```
 
 use crate::colour::Colorimeter;
+use crate::elementary;
 use crate::error::{Error, Result};
 use crate::spectral::SpectralRule;
 use crate::stack::Stack;
@@ -165,7 +166,7 @@ impl FilmTerm {
         let wavelengths = rule.wavelengths_nm();
         let white = rule.colour(std::iter::repeat_n(1.0, wavelengths.len()));
         let angles_deg: Vec<f64> = (1..=cells)
-            .map(|k| (k as f64 / cells as f64).acos().to_degrees())
+            .map(|k| elementary::acos(k as f64 / cells as f64).to_degrees())
             .collect();
         let mut reflectance = vec![white];
         let mut transmittance = vec![[0.0; 3]];
@@ -375,7 +376,7 @@ pub fn radiance_directional(
 /// h = normalize(α N_hx, α N_hy, max(0, N_hz))              (unstretch)
 /// ```
 pub fn sample_ggx_vndf(wo: [f64; 3], alpha: f64, u1: f64, u2: f64) -> [f64; 3] {
-    let (sin_phi, cos_phi) = (2.0 * PI * u2).sin_cos();
+    let (sin_phi, cos_phi) = elementary::sin_cos(2.0 * PI * u2);
     VndfFrame::new(wo, alpha).sample(u1.sqrt(), sin_phi, cos_phi)
 }
 
@@ -508,7 +509,7 @@ pub fn directional_albedo_with(
     }
     if !(cos_theta_o > 0.0 && cos_theta_o <= 1.0) {
         return Err(Error::InvalidAngle {
-            angle_deg: cos_theta_o.acos().to_degrees(),
+            angle_deg: elementary::acos(cos_theta_o).to_degrees(),
         });
     }
     let wo = [

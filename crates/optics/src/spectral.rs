@@ -52,6 +52,7 @@
 //! ΔE2000 0.0013.
 
 use crate::colour::{Colorimeter, SPECTRAL_MAX_NM, SPECTRAL_MIN_NM};
+use crate::elementary;
 use crate::error::{Error, Result};
 use crate::simd::{ColourSums, airy_accumulate};
 use crate::stack::{Prepared, Stack, ThicknessSweep, uniform_step};
@@ -103,7 +104,7 @@ pub fn phase_step_rad(rho: f64) -> f64 {
     let t = FRINGE_TOLERANCE / (2.0 * d);
     let a = 0.25 + t;
     let x = 2.0 * t / (a + (a * a + 3.0 * t).sqrt());
-    let cells = x.ln() / rho.ln();
+    let cells = elementary::ln(x) / elementary::ln(rho);
     (2.0 * PI / cells).clamp(min_step, MAX_PHASE_STEP_RAD)
 }
 
@@ -333,7 +334,7 @@ impl Stack {
                 let n = [380.0, 480.0, 580.0, 680.0, 780.0]
                     .iter()
                     .filter_map(|&wl| l.material.index_at(wl).ok())
-                    .map(|n| n.norm())
+                    .map(elementary::norm)
                     .fold(0.0f64, f64::max);
                 2.0 * d * n
             })

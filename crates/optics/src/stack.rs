@@ -49,6 +49,7 @@
 //! (angle, wavelength); over the top film it runs the Airy closed form through the
 //! vectorised kernel of [`crate::simd`].
 
+use crate::elementary;
 use crate::error::{Error, Result};
 use crate::fresnel::{Interface, normal_component, power_factor_p, power_factor_s};
 use crate::material::Material;
@@ -132,14 +133,15 @@ pub fn wavenumber(wavelength_nm: f64) -> f64 {
     2.0 * PI / wavelength_nm
 }
 
-/// `exp(i z)` for complex z, without the general complex `exp` when z is real.
+/// `exp(i z)` for complex z, without the general complex `exp` when z is real (sin, cos
+/// and exp from [`crate::elementary`]: the same bits on every machine).
 #[inline]
 fn exp_i(z: C64) -> C64 {
-    let (s, c) = z.re.sin_cos();
+    let (s, c) = elementary::sin_cos(z.re);
     if z.im == 0.0 {
         C64::new(c, s)
     } else {
-        let m = (-z.im).exp();
+        let m = elementary::exp(-z.im);
         C64::new(m * c, m * s)
     }
 }
@@ -594,7 +596,10 @@ pub(crate) fn fringe_finesse_of(indices: &[C64], beta: f64) -> f64 {
         .collect();
     let mobius = |a: f64, b: f64| ((a + b) / (1.0 + a * b)).min(1.0);
     let mut rho: f64 = 0.0;
-    for magnitude in [|i: &Interface| i.r_s.norm(), |i: &Interface| i.r_p.norm()] {
+    for magnitude in [
+        |i: &Interface| elementary::norm(i.r_s),
+        |i: &Interface| elementary::norm(i.r_p),
+    ] {
         let r: Vec<f64> = interfaces.iter().map(magnitude).collect();
         // down[j - 1]: everything below film j, seen from inside it.
         let mut down = vec![0.0; films];
@@ -630,7 +635,7 @@ fn sin_of_angle(angle_deg: f64) -> Result<f64> {
     if !(angle_deg.abs() < 90.0) {
         return Err(Error::InvalidAngle { angle_deg });
     }
-    Ok(angle_deg.to_radians().sin())
+    Ok(elementary::sin(angle_deg.to_radians()))
 }
 
 fn check_ambient(ambient: &Material, wavelength_nm: f64) -> Result<C64> {

@@ -45,6 +45,7 @@ use nacre_format::msg;
 use nacre_format::set::resolve_table;
 use nacre_format::table_io::Table3;
 use nacre_optics::colour::{Colorimeter, OutputSpace, RgbSpace};
+use nacre_optics::elementary;
 use nacre_optics::few_wavelengths::StackEvaluation;
 use nacre_optics::fourier::{FilmOnBase, Harmonics, gltf_iridescence};
 use nacre_optics::spectral::sample_weights;
@@ -503,7 +504,7 @@ impl LoadedLut {
                 )
             })?,
         };
-        let cos_theta = point.angle_deg.to_radians().cos();
+        let cos_theta = elementary::cos(point.angle_deg.to_radians());
         Ok(FilmLut::lookup(
             self.manifest.film_lut().expect("checked at load"),
             table,
@@ -531,7 +532,7 @@ pub fn check_stack_matches(m: &Manifest, path: &Path, stack: &Stack, method: &st
         Ok((0..=20).all(|i| {
             let wl = 380.0 + 20.0 * f64::from(i);
             match (a.index_at(wl), b.index_at(wl)) {
-                (Ok(x), Ok(y)) => (x - y).norm() <= 1e-12,
+                (Ok(x), Ok(y)) => elementary::norm(x - y) <= 1e-12,
                 _ => false,
             }
         }))
@@ -634,7 +635,7 @@ pub fn rough_monte_carlo(
                 ));
             }
             let film = nacre_optics::microfacet::FilmTerm::from_stack(&s, colorimeter)?;
-            let cos_theta_o = point.angle_deg.to_radians().cos();
+            let cos_theta_o = elementary::cos(point.angle_deg.to_radians());
             let e = nacre_optics::microfacet::directional_albedo_with(
                 &film,
                 alpha,
@@ -718,7 +719,7 @@ pub fn evaluate(
                         return Err(nacre_optics::Error::InvalidAngle { angle_deg: angle }.into());
                     }
                     let top = point.thickness_nm.unwrap_or(stack.layers()[0].thickness_nm);
-                    let (r, t) = eval.colour(angle.to_radians().cos(), top, [0.0; 3]);
+                    let (r, t) = eval.colour(elementary::cos(angle.to_radians()), top, [0.0; 3]);
                     Ok(match quantity {
                         Quantity::Reflectance => r,
                         Quantity::Transmittance => t,
@@ -749,7 +750,7 @@ pub fn evaluate(
                     Ok(nacre_format::rough_film_lut::RoughFilmLut::lookup(
                         &t.lut.axes,
                         table,
-                        point.angle_deg.to_radians().cos(),
+                        elementary::cos(point.angle_deg.to_radians()),
                         *alpha,
                         d,
                         n,
@@ -955,7 +956,7 @@ fn film_on_base(
             n_film,
             base,
         },
-        point.angle_deg.to_radians().cos(),
+        elementary::cos(point.angle_deg.to_radians()),
         point.thickness_nm.unwrap_or(film.thickness_nm),
     ))
 }

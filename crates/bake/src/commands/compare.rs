@@ -15,6 +15,7 @@ use nacre_format::film_lut::{FilmLut, FilmLutAxes};
 use nacre_format::msg;
 use nacre_optics::colour::{Colorimeter, Illuminant, Observer, OutputSpace, RgbSpace};
 use nacre_optics::colour::{delta_e_2000, xyz_to_lab};
+use nacre_optics::elementary;
 use nacre_optics::fourier::Harmonics;
 use nacre_optics::{C64, Layer, Material, Stack};
 use plotters::prelude::*;
@@ -169,7 +170,7 @@ pub fn compare(
             FilmLut::lookup(
                 &lut.axes,
                 &lut.reflectance,
-                p.angle_deg.to_radians().cos(),
+                elementary::cos(p.angle_deg.to_radians()),
                 p.thickness_nm.unwrap_or(0.0),
                 case.film_ior,
             )

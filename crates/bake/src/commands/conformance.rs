@@ -26,6 +26,7 @@ use crate::error::{Error, Result};
 use nacre_format::atomic::write_files_atomic;
 use nacre_optics::colour::{Colorimeter, Illuminant, Observer, OutputSpace, RgbSpace};
 use nacre_optics::colour::{delta_e_2000, xyz_to_lab};
+use nacre_optics::elementary;
 use nacre_optics::fourier::gltf_iridescence;
 use nacre_optics::{C64, Layer, Material, Stack};
 use plotters::coord::ranged1d::SegmentValue;
@@ -294,7 +295,7 @@ pub fn compute(grid: Grid) -> Result<Conformance> {
                 gltf_iridescence(
                     1.0,
                     p.film_ior.unwrap_or(1.0),
-                    p.angle_deg.to_radians().cos(),
+                    elementary::cos(p.angle_deg.to_radians()),
                     p.thickness_nm.unwrap_or(0.0),
                     f0,
                 )
@@ -806,7 +807,7 @@ pub fn srgb_u8(linear: f64) -> u8 {
     let e = if v <= 0.003_130_8 {
         12.92 * v
     } else {
-        1.055 * v.powf(1.0 / 2.4) - 0.055
+        1.055 * elementary::powf(v, 1.0 / 2.4) - 0.055
     };
     (e * 255.0).round() as u8
 }

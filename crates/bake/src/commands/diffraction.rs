@@ -19,6 +19,7 @@ use nacre_optics::diffraction::{
     DEFAULT_COHERENCE_DIAMETER_UM, DiffractionSurface, FresnelTerm, SpectralGrid, TaylorTerms,
     in_plane_directions, max_phase, taylor_order_for,
 };
+use nacre_optics::elementary;
 use rayon::prelude::*;
 use std::io::Write;
 
@@ -287,7 +288,7 @@ pub fn load(src: &Source, directions: &[([f64; 3], [f64; 3])]) -> Result<Loaded>
             }
             let max_polar_deg = directions
                 .iter()
-                .map(|(i, r)| i[2].min(r[2]).clamp(-1.0, 1.0).acos().to_degrees())
+                .map(|(i, r)| elementary::acos(i[2].min(r[2]).clamp(-1.0, 1.0)).to_degrees())
                 .fold(0.0, f64::max);
             if max_polar_deg > record.max_angle_deg + 1e-9 || max_uv > record.max_uv * (1.0 + 1e-9)
             {
@@ -657,8 +658,8 @@ pub fn map(req: &MapRequest) -> Result<DiffractionMap> {
     };
     // The extreme view directions: the rim of the disc.
     let (wi, _) = nacre_optics::diffraction::in_plane_directions(incidence, 0.0);
-    let s = max_view.to_radians().sin();
-    let c = max_view.to_radians().cos();
+    let s = elementary::sin(max_view.to_radians());
+    let c = elementary::cos(max_view.to_radians());
     let directions: Vec<_> = [[s, 0.0, c], [-s, 0.0, c], [0.0, s, c], [0.0, -s, c]]
         .into_iter()
         .map(|r| (wi, r))
@@ -883,7 +884,7 @@ impl DiffractionMap {
         colorimeter: &Colorimeter,
         exposure: Option<f64>,
     ) -> Self {
-        let radius = max_view_deg.to_radians().sin();
+        let radius = elementary::sin(max_view_deg.to_radians());
         let (omega_i, _) = in_plane_directions(incidence_deg, 0.0);
         let display = crate::commands::plot::DisplayConverter::new(colorimeter);
         let colours: Vec<Option<[f64; 3]>> = (0..cells)
@@ -912,7 +913,7 @@ impl DiffractionMap {
             radius,
             colours,
             exposure,
-            specular: [incidence_deg.to_radians().sin(), 0.0],
+            specular: [elementary::sin(incidence_deg.to_radians()), 0.0],
         }
     }
 }

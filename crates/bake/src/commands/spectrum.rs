@@ -7,6 +7,7 @@
 
 use crate::commands::grid::MAX_AXIS_SAMPLES;
 use crate::error::{Error, Param, Result};
+use nacre_optics::elementary;
 use nacre_optics::{Power, Stack};
 use std::io::Write;
 
@@ -23,7 +24,7 @@ pub fn fmt_sig(v: f64) -> String {
     if v == 0.0 || !v.is_finite() {
         return format!("{v}");
     }
-    let exponent = v.abs().log10().floor() as i32;
+    let exponent = elementary::log10(v.abs()).floor() as i32;
     if (-5..6).contains(&exponent) {
         format!("{:.*}", (DIGITS - 1 - exponent).max(0) as usize, v)
     } else {
@@ -120,14 +121,15 @@ fn check_axes(angles_deg: &[f64], wavelengths_nm: &[f64], per_row: u64) -> Resul
 fn check_phases(stack: &Stack, swept: Option<(usize, f64)>, wavelengths_nm: &[f64]) -> Result<()> {
     for &wavelength_nm in wavelengths_nm {
         let indices = stack.indices_at(wavelength_nm).map_err(optics_error)?;
-        let ambient = indices[0].norm();
+        let ambient = elementary::norm(indices[0]);
         for (j, layer) in stack.layers().iter().enumerate() {
             let d = match swept {
                 Some((k, d)) if k == j + 1 => d,
                 _ => layer.thickness_nm,
             };
             let phase =
-                2.0 * std::f64::consts::PI * (indices[j + 1].norm() + ambient) * d / wavelength_nm;
+                2.0 * std::f64::consts::PI * (elementary::norm(indices[j + 1]) + ambient) * d
+                    / wavelength_nm;
             if !phase.is_finite() {
                 return Err(Error::invalid(
                     Param::Wavelengths,

@@ -69,6 +69,7 @@ use nacre_optics::diffraction::{
     CD_PIT_DEPTH_UM, CD_TRACK_PITCH_UM, DEFAULT_COHERENCE_DIAMETER_UM, DiffractionSurface,
     HeightField, SpectralGrid, TaylorTerms, taylor_order_for,
 };
+use nacre_optics::elementary;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
@@ -917,7 +918,7 @@ pub fn plan(
     let max_phase = nacre_optics::diffraction::max_phase(field, wl_min, 2.0);
     let (order, bound) = taylor_order_for(max_phase, tolerance)?;
     let sigma_s_um = coherence_diameter_um / 4.0;
-    let max_uv = 2.0 * max_angle_deg.to_radians().sin();
+    let max_uv = 2.0 * elementary::sin(max_angle_deg.to_radians());
     // The checks need only the geometry: a one-term surface suffices.
     let probe = DiffractionSurface::new(
         TaylorTerms::from_terms(
@@ -954,7 +955,7 @@ pub fn plan(
         taylor_tolerance: tolerance,
         max_phase,
         taylor_bound: bound,
-        f32_rounding_bound: f64::from(f32::EPSILON) * 0.5 * max_phase.exp(),
+        f32_rounding_bound: f64::from(f32::EPSILON) * 0.5 * elementary::exp(max_phase),
         dc_texel: [field.nx() / 2, field.ny() / 2],
         sign_convention: SIGN_CONVENTION.into(),
         integrated: None,

@@ -70,6 +70,7 @@ use nacre_optics::diffraction::integrated::{
     IntegratedTable, MAX_INTEGRATED_SAMPLES, WarpedAxis, check_directions,
 };
 use nacre_optics::diffraction::{DiffractionSurface, SpectralGrid, TaylorTerms};
+use nacre_optics::elementary;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
@@ -200,12 +201,12 @@ impl IntegratedSettings {
 
 /// (θ, φ) of a unit vector, degrees.
 fn polar_deg(d: [f64; 3]) -> [f64; 2] {
-    let theta = d[2].clamp(-1.0, 1.0).acos().to_degrees();
+    let theta = elementary::acos(d[2].clamp(-1.0, 1.0)).to_degrees();
     // + 0.0 turns −0 into +0, so that φ of a light on the −x axis reads 180°, not −180°.
     let phi = if d[0] == 0.0 && d[1] == 0.0 {
         0.0
     } else {
-        (d[1] + 0.0).atan2(d[0] + 0.0).to_degrees()
+        elementary::atan2(d[1] + 0.0, d[0] + 0.0).to_degrees()
     };
     [theta, phi]
 }
@@ -215,7 +216,7 @@ fn sig4(v: f64) -> f64 {
     if v == 0.0 || !v.is_finite() {
         return v;
     }
-    let scale = 10f64.powi(3 - v.abs().log10().floor() as i32);
+    let scale = elementary::powi(10.0, 3 - elementary::log10(v.abs()).floor() as i32);
     (v * scale).round() / scale
 }
 
@@ -251,7 +252,7 @@ pub fn bake(
     let table = IntegratedTable::compute(&surface, &grid, c, axis);
     let pairs = check_directions(r.max_angle_deg);
     let e = table.reconstruction_error(&surface, &grid, c, &pairs);
-    let w_min = -2.0 * r.max_angle_deg.to_radians().cos();
+    let w_min = -2.0 * elementary::cos(r.max_angle_deg.to_radians());
     let storage = table.storage_error(&surface, &grid, c, (s.samples_v / 64).max(1), w_min);
     progress();
     let channel_names = c.space().channel_names();

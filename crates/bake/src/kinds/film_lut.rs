@@ -55,6 +55,7 @@ use nacre_format::ktx2::{Ktx2Format, film_lut_image_as};
 use nacre_format::manifest::{AxisRecord, KindRecord, MAX_TEXELS, Manifest, TableKind};
 use nacre_format::table_io::{Precision, Table3};
 use nacre_optics::colour::Colorimeter;
+use nacre_optics::elementary;
 use nacre_optics::film_series::{
     RuleTransform, SingleFilm, non_dispersive_surround, series_extent,
 };
@@ -390,7 +391,7 @@ impl FilmLutJob {
                 }];
                 layers.extend(self.under.iter().cloned());
                 let stack = Stack::new(self.ambient.clone(), layers, self.base.clone())?;
-                let angle_deg = cos_theta.acos().to_degrees();
+                let angle_deg = elementary::acos(cos_theta).to_degrees();
                 let colours = stack.colours_over_thickness(1, angle_deg, &rule, &thicknesses)?;
                 progress();
                 Ok(colours)

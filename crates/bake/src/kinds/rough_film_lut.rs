@@ -102,6 +102,7 @@ use nacre_format::rough_film_lut::{RoughFilmLut, RoughLutAxes, validate_axes};
 use nacre_format::stage::StagedTable;
 use nacre_format::table_io::{Precision, Table3};
 use nacre_optics::colour::Colorimeter;
+use nacre_optics::elementary;
 use nacre_optics::film_series::{
     RuleTransform, SingleFilm, non_dispersive_surround, series_extent,
 };
@@ -274,7 +275,8 @@ impl RoughLutJob {
                         return Ok(film.colours_over_thickness(transform, *m, &d_grid));
                     }
                     let c = kernel_cos(j, n_c).max(MIN_COS_THETA);
-                    Ok(stack.colours_over_thickness(1, c.acos().to_degrees(), &rule, &d_grid)?)
+                    let angle_deg = elementary::acos(c).to_degrees();
+                    Ok(stack.colours_over_thickness(1, angle_deg, &rule, &d_grid)?)
                 })
                 .collect::<Result<_>>()?;
             // F by thickness then cosine, (F_R, F_T) side by side, so that the sums over j

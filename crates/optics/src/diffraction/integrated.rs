@@ -82,6 +82,7 @@
 use super::{DiffractionSurface, FresnelTerm, SpectralGrid, geometry_over_w2, k_per_um};
 use crate::C64;
 use crate::colour::Colorimeter;
+use crate::elementary;
 use crate::error::{Error, Result};
 use ndarray::{Array2, Axis};
 use rayon::prelude::*;
@@ -138,14 +139,14 @@ impl WarpedAxis {
     /// u at the centre of texel i (inverse mapping).
     pub fn texel_centre(&self, i: usize) -> f64 {
         let t = (2.0 * i as f64 + 1.0) / self.count as f64 - 1.0;
-        self.max_uv * t.signum() * t.abs().powf(self.gamma)
+        self.max_uv * t.signum() * elementary::powf(t.abs(), self.gamma)
     }
 
     /// The continuous texel coordinate of u (forward mapping): texel i's centre is at i;
     /// clamped to [0, n − 1] (clamp-to-edge).
     pub fn coordinate(&self, u: f64) -> f64 {
         let a = (u.abs() / self.max_uv).min(1.0);
-        let t = u.signum() * a.powf(1.0 / self.gamma);
+        let t = u.signum() * elementary::powf(a, 1.0 / self.gamma);
         ((t + 1.0) * 0.5 * self.count as f64 - 0.5).clamp(0.0, self.count as f64 - 1.0)
     }
 }
@@ -516,10 +517,10 @@ pub struct ReconstructionError {
 ///   every 0.5° (across the grating lines and along them).
 pub fn check_directions(max_angle_deg: f64) -> Vec<([f64; 3], [f64; 3])> {
     let theta_max = max_angle_deg - 1e-6;
-    let radius = theta_max.to_radians().sin();
+    let radius = elementary::sin(theta_max.to_radians());
     let dir = |theta_deg: f64, phi_deg: f64| {
-        let (st, ct) = theta_deg.to_radians().sin_cos();
-        let (sp, cp) = phi_deg.to_radians().sin_cos();
+        let (st, ct) = elementary::sin_cos(theta_deg.to_radians());
+        let (sp, cp) = elementary::sin_cos(phi_deg.to_radians());
         [st * cp, st * sp, ct]
     };
     let mut lights = vec![[0.0, 0.0, 1.0]];
@@ -544,18 +545,18 @@ pub fn check_directions(max_angle_deg: f64) -> Vec<([f64; 3], [f64; 3])> {
         }
         // The specular view and the lobe around it.
         let spec = [-wi[0], -wi[1], wi[2]];
-        let theta_s = spec[2].acos().to_degrees();
+        let theta_s = elementary::acos(spec[2]).to_degrees();
         let phi_s = if spec[0] == 0.0 && spec[1] == 0.0 {
             0.0
         } else {
-            spec[1].atan2(spec[0]).to_degrees()
+            elementary::atan2(spec[1], spec[0]).to_degrees()
         };
         pairs.push((wi, spec));
         for off in [0.02, 0.05, 0.1, 0.2, 0.5, 1.0] {
             for (dt, dp) in [(off, 0.0), (-off, 0.0), (0.0, off), (0.0, -off)] {
                 let t = theta_s + dt;
                 // An azimuth step of `off` degrees of arc at θ_s.
-                let p = phi_s + dp / theta_s.to_radians().sin().max(1e-3);
+                let p = phi_s + dp / elementary::sin(theta_s.to_radians()).max(1e-3);
                 if t.abs() <= theta_max {
                     pairs.push((wi, dir(t, p)));
                 }

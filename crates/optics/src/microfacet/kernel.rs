@@ -32,6 +32,7 @@
 //! fixed order, so the kernels are the same bits on every run and thread count.
 
 use super::{VndfFrame, refract, smith_lambda};
+use crate::elementary;
 use crate::quadrature::{cubic_stencil, gauss_legendre_01};
 use std::f64::consts::PI;
 
@@ -135,7 +136,7 @@ pub fn kernels_with(
     // computed once (the same operations, the same bits).
     let frame = VndfFrame::new(wo, alpha);
     let phis: Vec<(f64, f64)> = (0..azimuth)
-        .map(|i| (2.0 * PI * ((i as f64 + 0.5) / azimuth as f64)).sin_cos())
+        .map(|i| elementary::sin_cos(2.0 * PI * ((i as f64 + 0.5) / azimuth as f64)))
         .collect();
     for (&u1, &w1) in u1s.iter().zip(&w1s) {
         let w = w1 / azimuth as f64;

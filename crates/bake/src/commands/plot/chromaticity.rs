@@ -1,6 +1,7 @@
 //! The CIE 1931 xy diagram with gamuts and a film's colour trajectory ([`ChromaticityPlot`]).
 
 use super::*;
+use nacre_optics::elementary;
 
 /// A film's colour trajectory by one method: the chromaticity at each parameter value.
 #[derive(Clone, Debug, PartialEq)]
@@ -214,7 +215,7 @@ impl Figure for ChromaticityPlot {
                 continue;
             };
             let (dx, dy) = (xy[0] - white[0], xy[1] - white[1]);
-            let norm = dx.hypot(dy).max(1e-9);
+            let norm = elementary::hypot(dx, dy).max(1e-9);
             let at = (xy[0] + 0.032 * dx / norm, xy[1] + 0.032 * dy / norm);
             chart.draw_series([Circle::new((xy[0], xy[1]), 3, BLACK.filled())])?;
             chart.draw_series([Text::new(

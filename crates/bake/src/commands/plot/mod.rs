@@ -45,6 +45,7 @@ use nacre_format::set::{default_baked_dir, resolve_table};
 use nacre_format::table_io::Table3;
 use nacre_optics::Stack;
 use nacre_optics::colour::{Colorimeter, Observer, OutputSpace, RgbSpace, xy_to_xyz, xyz_to_xy};
+use nacre_optics::elementary;
 use plotters::coord::Shift;
 use plotters::coord::types::RangedCoordf64;
 use plotters::drawing::DrawingAreaErrorKind;
@@ -188,7 +189,7 @@ pub fn srgb_encode(linear: f64) -> f64 {
     if v <= 0.003_130_8 {
         12.92 * v
     } else {
-        1.055 * v.powf(1.0 / 2.4) - 0.055
+        1.055 * elementary::powf(v, 1.0 / 2.4) - 0.055
     }
 }
 
@@ -319,7 +320,7 @@ pub fn check_angles(flag: Param, text: &str, angles_deg: &[f64]) -> Result<()> {
 
 /// The smallest of 1, 1.5, 2, 2.5, 3, 4, 5, 6, 8 × 10ᵏ that is ≥ `v` (`v` > 0).
 fn nice_ceiling(v: f64) -> f64 {
-    let e = 10f64.powf(v.log10().floor());
+    let e = elementary::powf(10.0, elementary::log10(v).floor());
     [1.0, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0]
         .iter()
         .map(|m| m * e)
@@ -333,7 +334,7 @@ fn fmt_tick(v: &f64) -> String {
     let r = if *v == 0.0 {
         0.0
     } else {
-        let e = 10f64.powf(v.abs().log10().floor() - 9.0);
+        let e = elementary::powf(10.0, elementary::log10(v.abs()).floor() - 9.0);
         (v / e).round() * e
     };
     let s = format!("{r}");
@@ -346,7 +347,7 @@ fn fmt_tick(v: &f64) -> String {
 
 /// A round step of about `v`: 1, 2, 5 × 10ᵏ.
 fn nice_step(v: f64) -> f64 {
-    let e = 10f64.powf(v.log10().floor());
+    let e = elementary::powf(10.0, elementary::log10(v).floor());
     let m = v / e;
     e * if m < 1.5 {
         1.0

@@ -1,6 +1,7 @@
 //! Pictures of baked tables: `film-lut` slices ([`FilmLutPlot`]) and `fourier` envelopes ([`FourierPlot`]).
 
 use super::*;
+use nacre_optics::elementary;
 
 /// Slices of a `film-lut` table at fixed film indices: for each, an image over cos θ (x,
 /// 0 = grazing to 1 = normal incidence) × optical path difference Δ (y, 0 to Δ_max) of
@@ -139,12 +140,12 @@ impl FourierPlot {
             .levels
             .iter()
             .flatten()
-            .flat_map(|a| a.iter().map(|c| c.norm()))
+            .flat_map(|a| a.iter().map(|&c| elementary::norm(c)))
             .fold(0.0, f64::max);
         let mut last = 0.0f64;
         for (level, &n) in table.levels.iter().zip(&table.axes.level_samples) {
             for (i, a) in level.iter().enumerate() {
-                if a.iter().any(|c| c.norm() > 0.03 * peak) {
+                if a.iter().any(|&c| elementary::norm(c) > 0.03 * peak) {
                     last = last.max((i as f64 + 0.5) * table.axes.max_opd_nm / n as f64);
                 }
             }
