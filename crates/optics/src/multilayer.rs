@@ -25,9 +25,11 @@
 //! widest vectors (AVX-512 or AVX2 on x86-64, NEON on arm64) with the remainder of a row on
 //! [`pulp::Scalar`]; IEEE 754 basic operations only (+, −, ×, ÷, √, comparisons, sign-bit
 //! and exponent-bit manipulation) in a fixed order, no fused multiply–add, no platform
-//! `libm` (sin/cos and e^{−a} are the kernel's own [`crate::simd::sin_cos`] and
-//! [`crate::simd::exp_neg`]). Branches on "does any lane absorb" only skip operations whose
-//! result is known exactly (tested: `shortcuts_match_the_general_formula`).
+//! `libm` (sin/cos and e^{−a} are the kernel's own [`crate::simd::sin_cos_bounded`] and
+//! [`crate::simd::exp_neg`]). The shortcuts — decided per block of [`BLOCK`] wavelengths
+//! and medium ("is the medium lossless over the block", "has it no Im ñ² of negative sign",
+//! "does some lane of the film decay") and compiled as separate loops — only skip
+//! operations whose result is known exactly (tested: `shortcuts_match_the_general_formula`).
 //!
 //! # Method (per element)
 //!
@@ -352,9 +354,8 @@ impl Block {
         }
     }
 
-    /// Runs stage `STAGE` with flags `F` over the first `n` elements: whole vectors (two at
-    /// a time, so that their independent chains interleave), then one lane at a time.
-    /// Returns whether a lane of the medium computed has Im q ≠ 0.
+    /// Runs stage `STAGE` with flags `F` over the first `n` elements: whole vectors, then one
+    /// lane at a time. Returns whether a lane of the medium computed has Im q ≠ 0.
     #[inline(always)]
     fn run<S: Simd, const STAGE: u8, const F: u8>(&mut self, s: S, c: Ctx, n: usize) -> bool {
         let lanes = S::F64_LANES;
