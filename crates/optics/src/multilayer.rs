@@ -25,9 +25,11 @@
 //! widest vectors (AVX-512 or AVX2 on x86-64, NEON on arm64) with the remainder of a row on
 //! [`pulp::Scalar`]; IEEE 754 basic operations only (+, −, ×, ÷, √, comparisons, sign-bit
 //! and exponent-bit manipulation) in a fixed order, no fused multiply–add, no platform
-//! `libm` (sin/cos and e^{−a} are the kernel's own [`crate::simd::sin_cos`] and
-//! [`crate::simd::exp_neg`]). Branches on "does any lane absorb" only skip operations whose
-//! result is known exactly (tested: `shortcuts_match_the_general_formula`).
+//! `libm` (sin/cos and e^{−a} are the kernel's own [`crate::simd::sin_cos_bounded`] and
+//! [`crate::simd::exp_neg`]). The shortcuts — decided per block of [`BLOCK`] wavelengths
+//! and medium ("is the medium lossless over the block", "has it no Im ñ² of negative sign",
+//! "does some lane of the film decay") and compiled as separate loops — only skip
+//! operations whose result is known exactly (tested: `shortcuts_match_the_general_formula`).
 //!
 //! # Method (per element)
 //!
@@ -71,7 +73,7 @@
 //! absorbing films and substrates, evanescent substrates, normal and grazing incidence).
 
 use crate::fresnel::BRANCH_TOLERANCE;
-use crate::simd::{ARCH, PowerSlot, exp_neg, lane, lane_mut, sin_cos};
+use crate::simd::{ARCH, PowerSlot, exp_neg, lane, lane_mut, sin_cos_bounded};
 use crate::stack::{Power, wavenumber};
 use num_complex::Complex64 as C64;
 use pulp::{Simd, WithSimd};
@@ -98,6 +100,12 @@ pub(crate) struct Media {
     k0_per_nm: Vec<f64>,
     /// Film thicknesses, top first, nm.
     thickness_nm: Vec<f64>,
+    /// Per medium: no Im ñ_j² has its sign bit set, so that Im q_j ≥ +0 in every lane and
+    /// the forward-branch correction of [`medium`] changes nothing.
+    forward: Vec<bool>,
+    /// Per medium and block of [`BLOCK`] wavelengths: Im ñ_j² = ±0 at every wavelength of
+    /// the block (the lossless root of [`medium`]).
+    lossless: Vec<Vec<bool>>,
 }
 
 impl Media {
@@ -136,6 +144,18 @@ impl Media {
             }
             k0_per_nm.push(k0);
         }
+        let forward = n2_im
+            .iter()
+            .map(|y| y.iter().all(|y| y.to_bits() & SIGN == 0))
+            .collect();
+        let lossless = n2_im
+            .iter()
+            .map(|y| {
+                y.chunks(BLOCK)
+                    .map(|b| b.iter().all(|&y| y == 0.0))
+                    .collect()
+            })
+            .collect();
         Some(Media {
             re,
             n2_re,
@@ -143,6 +163,8 @@ impl Media {
             n_abs2,
             k0_per_nm,
             thickness_nm: thickness_nm.to_vec(),
+            forward,
+            lossless,
         })
     }
 
@@ -245,6 +267,11 @@ struct Block {
     /// Media j + 1 (below the interface being added) and j: `media[c.below]` and
     /// `media[1 - c.below]` (the roles alternate rather than the arrays being swapped).
     media: [MediumBlock; 2],
+    /// β² = (n₀ sin θ₀)² per wavelength.
+    beta2: [f64; BLOCK],
+    /// e^{2iδ} of the film below the interface being added, (re, im), and its decay
+    /// e^{−2 Im δ} (not written where no lane of the block decays).
+    phase: [[f64; BLOCK]; 3],
     /// Γ = N / D per polarisation (s, p): N and D as (re, im) pairs.
     num: [[f64; BLOCK]; 4],
     den: [[f64; BLOCK]; 4],
@@ -256,14 +283,18 @@ struct Block {
     out: [[f64; BLOCK]; 4],
 }
 
-/// What one stage of [`Block`] reads besides the block.
+/// What one stage of [`Block`] reads besides the block: the block's wavelengths of medium
+/// j's arrays and of k₀.
 #[derive(Clone, Copy)]
 struct Ctx<'a> {
-    media: &'a Media,
-    /// Index in the row of the block's first element.
-    start: usize,
-    /// Medium j.
-    j: usize,
+    n2_re: &'a [f64],
+    n2_im: &'a [f64],
+    n_abs2: &'a [f64],
+    k0_per_nm: &'a [f64],
+    /// Re ñ₀ (the ambient's, for β).
+    n0_re: &'a [f64],
+    /// 2 d of the film below the interface (j + 1), nm; 0 where there is none.
+    two_d_nm: f64,
     /// Which of [`Block::media`] holds medium j + 1.
     below: usize,
     sin_theta: f64,
@@ -271,16 +302,50 @@ struct Ctx<'a> {
 
 /// Stages of the recurrence over a block.
 const SUBSTRATE: u8 = 0;
-const MEDIUM: u8 = 1;
-const FIRST: u8 = 2;
+const FIRST: u8 = 1;
+const MEDIUM_PHASE: u8 = 2;
 const STEP: u8 = 3;
 const POWERS: u8 = 4;
+
+/// Flags of a stage, uniform over a block (`const`, so that each combination is its own
+/// loop without branches); each only skips operations whose result is known exactly
+/// (tested: `shortcuts_match_the_general_formula`).
+/// Medium j is lossless over the block ([`Media::lossless`]).
+const LOSSLESS: u8 = 1;
+/// Medium j has no Im ñ² with its sign bit set ([`Media::forward`]).
+const FORWARD: u8 = 2;
+/// Some lane of the block has Im q ≠ 0 in the film below (else its decay is exactly 1).
+const DECAY: u8 = 4;
+/// N, D, U are rescaled after this interface ([`Block::put`]).
+const RESCALE: u8 = 8;
+
+/// Calls `$f::<F>` with `F` = `$flags` as a constant, for flags within `LOSSLESS | FORWARD |
+/// DECAY | RESCALE`.
+macro_rules! with_flags {
+    ($flags:expr, $f:ident, $($arg:expr),*) => {
+        match $flags {
+            0 => $f::<0>($($arg),*),
+            1 => $f::<1>($($arg),*),
+            2 => $f::<2>($($arg),*),
+            3 => $f::<3>($($arg),*),
+            4 => $f::<4>($($arg),*),
+            5 => $f::<5>($($arg),*),
+            6 => $f::<6>($($arg),*),
+            7 => $f::<7>($($arg),*),
+            8 => $f::<8>($($arg),*),
+            12 => $f::<12>($($arg),*),
+            _ => unreachable!(),
+        }
+    };
+}
 
 impl Block {
     fn new() -> Self {
         let z = [0.0; BLOCK];
         Block {
             media: [MediumBlock::new(), MediumBlock::new()],
+            beta2: z,
+            phase: [z; 3],
             num: [z; 4],
             den: [z; 4],
             u: [z; 2],
@@ -289,16 +354,20 @@ impl Block {
         }
     }
 
-    /// Runs stage `STAGE` over the first `n` elements: whole vectors, then one lane at a time.
+    /// Runs stage `STAGE` with flags `F` over the first `n` elements: whole vectors, then one
+    /// lane at a time. Returns whether a lane of the medium computed has Im q ≠ 0.
     #[inline(always)]
-    fn run<S: Simd, const STAGE: u8, const SHORTCUTS: bool>(&mut self, s: S, c: Ctx, n: usize) {
-        let head = n - n % S::F64_LANES;
-        for i in (0..head).step_by(S::F64_LANES) {
-            self.stage::<S, STAGE, SHORTCUTS>(s, c, i);
+    fn run<S: Simd, const STAGE: u8, const F: u8>(&mut self, s: S, c: Ctx, n: usize) -> bool {
+        let lanes = S::F64_LANES;
+        let head = n - n % lanes;
+        let mut decays = false;
+        for i in (0..head).step_by(lanes) {
+            decays |= self.stage::<S, STAGE, F>(s, c, i);
         }
         for i in head..n {
-            self.stage::<pulp::Scalar, STAGE, SHORTCUTS>(pulp::Scalar::new(), c, i);
+            decays |= self.stage::<pulp::Scalar, STAGE, F>(pulp::Scalar::new(), c, i);
         }
+        decays
     }
 
     /// Stores Γ = N/D and |τ|² = U/|D|² of polarisation `pol` for the lanes at `i`, all
@@ -345,24 +414,26 @@ impl Block {
         *lane_mut::<S>(&mut self.u[pol], i) = u;
     }
 
-    /// Stage `STAGE` for the lanes of elements `i ..`.
+    /// Medium j (the one `c` describes) for the lanes at `i`.
     #[inline(always)]
-    fn stage<S: Simd, const STAGE: u8, const SHORTCUTS: bool>(&mut self, s: S, c: Ctx, i: usize) {
-        let m = c.media;
-        let w = c.start + i;
-        let ld = |v: &[f64; BLOCK]| lane::<S>(v, i);
-        let medium_j = |j: usize| {
-            let n2 = Cx::<S> {
-                re: lane::<S>(&m.n2_re[j], w),
-                im: lane::<S>(&m.n2_im[j], w),
-            };
-            let beta = s.mul_f64s(lane::<S>(&m.re[0], w), s.splat_f64s(c.sin_theta));
-            let beta2 = s.mul_f64s(beta, beta);
-            medium::<S, SHORTCUTS>(s, lane::<S>(&m.n_abs2[j], w), n2, beta2)
+    fn medium_j<S: Simd, const F: u8>(&self, s: S, c: Ctx, i: usize) -> Medium<S> {
+        let n2 = Cx::<S> {
+            re: lane::<S>(c.n2_re, i),
+            im: lane::<S>(c.n2_im, i),
         };
+        medium::<S, F>(s, lane::<S>(c.n_abs2, i), n2, lane::<S>(&self.beta2, i))
+    }
+
+    /// Stage `STAGE` for the lanes of elements `i ..`; returns whether a lane of the medium
+    /// it computes has Im q ≠ 0.
+    #[inline(always)]
+    fn stage<S: Simd, const STAGE: u8, const F: u8>(&mut self, s: S, c: Ctx, i: usize) -> bool {
+        let ld = |v: &[f64; BLOCK]| lane::<S>(v, i);
         match STAGE {
             SUBSTRATE => {
-                let sub = medium_j(c.j);
+                let beta = s.mul_f64s(lane::<S>(c.n0_re, i), s.splat_f64s(c.sin_theta));
+                *lane_mut::<S>(&mut self.beta2, i) = s.mul_f64s(beta, beta);
+                let sub = self.medium_j::<S, F>(s, c, i);
                 self.media[c.below].store(i, sub);
                 let re_n2_conj_q = s.add_f64s(
                     s.mul_f64s(sub.n2.re, sub.q.re),
@@ -371,14 +442,11 @@ impl Block {
                 *lane_mut::<S>(&mut self.substrate[0], i) = sub.q.re;
                 *lane_mut::<S>(&mut self.substrate[1], i) = re_n2_conj_q;
                 *lane_mut::<S>(&mut self.substrate[2], i) = sub.n_abs2;
-            }
-            MEDIUM => {
-                let above = medium_j(c.j);
-                self.media[1 - c.below].store(i, above);
+                false
             }
             FIRST => {
                 // Γ_N = r_{N,N+1} = ρ/σ, |τ_N|² = |t_{N,N+1}|² = |tσ|²/|σ|².
-                let above = medium_j(c.j);
+                let above = self.medium_j::<S, F>(s, c, i);
                 self.media[1 - c.below].store(i, above);
                 let below = self.media[c.below].load::<S>(i);
                 let f = interface(s, &above, &below);
@@ -387,32 +455,34 @@ impl Block {
                     let (rho, sigma) = (sub(s, alpha, beta), add(s, alpha, beta));
                     self.put(s, i, pol, rho, sigma, f.t_sigma2[pol], true);
                 }
+                any_nonzero(s, above.q.im)
+            }
+            MEDIUM_PHASE => {
+                // Medium j, and e^{2iδ} of film j + 1 (medium `below`), δ = k₀ q d:
+                // e^{−2 Im δ} (cos, sin)(2 Re δ) — independent chains, side by side.
+                let above = self.medium_j::<S, F>(s, c, i);
+                self.media[1 - c.below].store(i, above);
+                let kd2 = s.mul_f64s(lane::<S>(c.k0_per_nm, i), s.splat_f64s(c.two_d_nm));
+                let q = &self.media[c.below];
+                let (sin_x, cos_x) = sin_cos_bounded(s, s.mul_f64s(lane::<S>(&q.q_re, i), kd2));
+                let (re, im) = if F & DECAY != 0 {
+                    let a = exp_neg(s, s.mul_f64s(lane::<S>(&q.q_im, i), kd2));
+                    *lane_mut::<S>(&mut self.phase[2], i) = a;
+                    (s.mul_f64s(a, cos_x), s.mul_f64s(a, sin_x))
+                } else {
+                    (cos_x, sin_x)
+                };
+                *lane_mut::<S>(&mut self.phase[0], i) = re;
+                *lane_mut::<S>(&mut self.phase[1], i) = im;
+                any_nonzero(s, above.q.im)
             }
             STEP => {
                 let above = self.media[1 - c.below].load::<S>(i);
                 let below = self.media[c.below].load::<S>(i);
                 let f = interface(s, &above, &below);
-                // e^{2iδ} of film j + 1 (medium `below`), δ = k₀ q d: e^{−2 Im δ} (cos, sin)(2 Re δ).
-                let kd2 = s.mul_f64s(
-                    lane::<S>(&m.k0_per_nm, w),
-                    s.splat_f64s(2.0 * m.thickness_nm[c.j]),
-                );
-                let (sin_x, cos_x) = sin_cos(s, s.mul_f64s(below.q.re, kd2));
-                // Lanes with Im q = 0 get a decay of exactly 1, as when it is skipped.
-                let decay2 = if SHORTCUTS && !any_nonzero(s, below.q.im) {
-                    None
-                } else {
-                    Some(exp_neg(s, s.mul_f64s(below.q.im, kd2)))
-                };
-                let e2 = match decay2 {
-                    Some(a) => Cx::<S> {
-                        re: s.mul_f64s(a, cos_x),
-                        im: s.mul_f64s(a, sin_x),
-                    },
-                    None => Cx::<S> {
-                        re: cos_x,
-                        im: sin_x,
-                    },
+                let e2 = Cx::<S> {
+                    re: ld(&self.phase[0]),
+                    im: ld(&self.phase[1]),
                 };
                 for pol in 0..2 {
                     let n = Cx::<S> {
@@ -432,20 +502,15 @@ impl Block {
                     let b = mul(s, beta, sub(s, d, m));
                     let (n_new, d_new) = (sub(s, a, b), add(s, a, b));
                     let u = s.mul_f64s(f.t_sigma2[pol], ld(&self.u[pol]));
-                    let u = match decay2 {
-                        Some(a) => s.mul_f64s(u, a),
-                        None => u,
+                    // Where no lane decays, |e^{iδ}|² = 1 exactly.
+                    let u = if F & DECAY != 0 {
+                        s.mul_f64s(u, ld(&self.phase[2]))
+                    } else {
+                        u
                     };
-                    self.put(
-                        s,
-                        i,
-                        pol,
-                        n_new,
-                        d_new,
-                        u,
-                        c.j.is_multiple_of(RESCALE_EVERY),
-                    );
+                    self.put(s, i, pol, n_new, d_new, u, F & RESCALE != 0);
                 }
+                false
             }
             POWERS => {
                 // Power factors Re q_f / Re q₀ and
@@ -487,6 +552,7 @@ impl Block {
                 for (k, v) in p.into_iter().enumerate() {
                     *lane_mut::<S>(&mut self.out[k], i) = v;
                 }
+                false
             }
             _ => unreachable!(),
         }
@@ -523,27 +589,63 @@ impl<T: PowerSlot, const SHORTCUTS: bool> WithSimd for RowOp<'_, T, SHORTCUTS> {
         let mut b = Block::new();
         for (k, row) in self.row.chunks_mut(BLOCK).enumerate() {
             let n = row.len();
-            let mut c = Ctx {
-                media,
-                start: k * BLOCK,
-                j: count - 1,
-                below: 0,
+            let w = k * BLOCK..k * BLOCK + n;
+            // The flags of medium j over this block; none for the general formula.
+            let flags = |j: usize| {
+                if !SHORTCUTS {
+                    return 0;
+                }
+                let lossless = if media.lossless[j][k] { LOSSLESS } else { 0 };
+                let forward = if media.forward[j] { FORWARD } else { 0 };
+                lossless | forward
+            };
+            let ctx = |j: usize, below: usize| Ctx {
+                n2_re: &media.n2_re[j][w.clone()],
+                n2_im: &media.n2_im[j][w.clone()],
+                n_abs2: &media.n_abs2[j][w.clone()],
+                k0_per_nm: &media.k0_per_nm[w.clone()],
+                n0_re: &media.re[0][w.clone()],
+                two_d_nm: if j + 1 < count - 1 {
+                    2.0 * media.thickness_nm[j]
+                } else {
+                    0.0
+                },
+                below,
                 sin_theta: self.sin_theta,
             };
-            b.run::<S, SUBSTRATE, SHORTCUTS>(s, c, n);
+            macro_rules! run {
+                ($stage:ident, $flags:expr, $c:expr) => {{
+                    let c = $c;
+                    let (b, s) = (&mut b, s);
+                    #[inline(always)]
+                    fn go<const F: u8>(b: &mut Block, s: impl Simd, c: Ctx, n: usize) -> bool {
+                        b.run::<_, $stage, F>(s, c, n)
+                    }
+                    with_flags!($flags, go, b, s, c, n)
+                }};
+            }
+            let mut below = 0;
+            run!(SUBSTRATE, flags(count - 1), ctx(count - 1, below));
             // Substrate up: interface j between medium j (above) and j + 1 (below).
+            let mut decays = false;
             for j in (0..count - 1).rev() {
-                c.j = j;
+                let c = ctx(j, below);
+                let decay = if SHORTCUTS && !decays { 0 } else { DECAY };
                 if j == count - 2 {
                     // Γ_N = r_{N,N+1}, |τ_N|² = |t_{N,N+1}|².
-                    b.run::<S, FIRST, SHORTCUTS>(s, c, n);
+                    decays = run!(FIRST, flags(j), c);
                 } else {
-                    b.run::<S, MEDIUM, SHORTCUTS>(s, c, n);
-                    b.run::<S, STEP, SHORTCUTS>(s, c, n);
+                    decays = run!(MEDIUM_PHASE, flags(j) | decay, c);
+                    let rescale = if j.is_multiple_of(RESCALE_EVERY) {
+                        RESCALE
+                    } else {
+                        0
+                    };
+                    run!(STEP, rescale | decay, c);
                 }
-                c.below = 1 - c.below;
+                below = 1 - below;
             }
-            b.run::<S, POWERS, SHORTCUTS>(s, c, n);
+            b.run::<S, POWERS, 0>(s, ctx(0, below), n);
             for (k, slot) in row.iter_mut().enumerate() {
                 slot.put(Power {
                     R_s: b.out[0][k],
@@ -604,22 +706,31 @@ struct Medium<S: Simd> {
 
 /// The medium of index ñ (given as |ñ|² and ñ²) for β² = `beta2`: q = √(ñ² − β²) on the
 /// forward branch (module docs).
-#[inline(always)]
 ///
-/// With `SHORTCUTS`, where no lane has Im ñ² ≠ 0 the root takes |w| = |x| and y/2t = +0:
-/// the same bits, since √(x·x) = |x| exactly in binary floating point (no under- or
-/// overflow here) and 0/2t = +0 (t = 0 is replaced by the w = 0 case anyway).
-fn medium<S: Simd, const SHORTCUTS: bool>(
-    s: S,
-    n_abs2: S::f64s,
-    n2: Cx<S>,
-    beta2: S::f64s,
-) -> Medium<S> {
+/// Flags `F` (uniform over the block; the same bits as the general formula):
+/// * [`LOSSLESS`] (Im ñ² = ±0 in every lane): the root takes |w| = |x| and y/2t = +0, since
+///   √(x·x) = |x| exactly in binary floating point (no under- or overflow here) and
+///   0/2t = +0 (t = 0 is replaced by the w = 0 case anyway);
+/// * [`FORWARD`] (no Im ñ² with its sign bit set): copysign(·, y) changes nothing and
+///   Im q ≥ +0, so the backward-branch correction never applies;
+/// * both: t = √|x| ((|x| + |x|)/2 = |x| exactly) and q = (t, +0) or (+0, t), which is
+///   also the w = 0 case (t = +0).
+#[inline(always)]
+fn medium<S: Simd, const F: u8>(s: S, n_abs2: S::f64s, n2: Cx<S>, beta2: S::f64s) -> Medium<S> {
+    let (lossless, forward) = (F & LOSSLESS != 0, F & FORWARD != 0);
     let x = s.sub_f64s(n2.re, beta2);
     let y = n2.im;
     let zero = s.splat_f64s(0.0);
     let ax = s.abs_f64s(x);
-    let lossless = SHORTCUTS && !any_nonzero(s, y);
+    let right = s.greater_than_or_equal_f64s(x, zero);
+    if lossless && forward {
+        let t = s.sqrt_f64s(ax);
+        let q = Cx {
+            re: s.select_f64s(right, t, zero),
+            im: s.select_f64s(right, zero, t),
+        };
+        return Medium { n_abs2, n2, q };
+    }
     let modulus = if lossless {
         ax
     } else {
@@ -628,18 +739,30 @@ fn medium<S: Simd, const SHORTCUTS: bool>(
     let t = s.sqrt_f64s(s.mul_f64s(s.add_f64s(modulus, ax), s.splat_f64s(0.5)));
     let u = if lossless {
         zero
+    } else if forward {
+        s.div_f64s(y, s.add_f64s(t, t))
     } else {
         s.div_f64s(s.abs_f64s(y), s.add_f64s(t, t))
     };
-    let right = s.greater_than_or_equal_f64s(x, zero);
     let re = s.select_f64s(right, t, u);
     let im_abs = s.select_f64s(right, u, t);
-    // copysign(im_abs, y)
-    let sign = s.and_u64s(s.transmute_u64s_f64s(y), s.splat_u64s(SIGN));
-    let im = s.transmute_f64s_u64s(s.or_u64s(s.transmute_u64s_f64s(im_abs), sign));
+    let im = if forward {
+        im_abs
+    } else {
+        // copysign(im_abs, y)
+        let sign = s.and_u64s(s.transmute_u64s_f64s(y), s.splat_u64s(SIGN));
+        s.transmute_f64s_u64s(s.or_u64s(s.transmute_u64s_f64s(im_abs), sign))
+    };
     let origin = s.equal_f64s(t, zero);
     let re = s.select_f64s(origin, zero, re);
     let im = s.select_f64s(origin, zero, im);
+    if forward {
+        return Medium {
+            n_abs2,
+            n2,
+            q: Cx { re, im },
+        };
+    }
     // Forward branch: re ≥ 0 here, so max(|re|, |im|) < |im| / tol reduces to |im| > tol re.
     let backward = s.and_m64s(
         s.less_than_f64s(im, zero),

@@ -79,25 +79,23 @@ pub(crate) fn sin_cos<S: Simd>(s: S, x: S::f64s) -> (S::f64s, S::f64s) {
     // Phases beyond HUGE_PHASE rad (fringes no spectrum resolves; past 2⁵² π/2 the reduction
     // below would overflow) are taken as 0, so that the result stays finite; NaN stays NaN.
     let big = s.greater_than_f64s(s.abs_f64s(x), s.splat_f64s(HUGE_PHASE));
-    let x = s.select_f64s(big, s.splat_f64s(0.0), x);
+    sin_cos_bounded(s, s.select_f64s(big, s.splat_f64s(0.0), x))
+}
+
+/// [`sin_cos`] for |x| ≤ 2⁴⁰ rad (or NaN), where it gives the same bits without its range
+/// check.
+#[inline(always)]
+pub(crate) fn sin_cos_bounded<S: Simd>(s: S, x: S::f64s) -> (S::f64s, S::f64s) {
     let shifter = s.splat_f64s(SHIFTER);
-    // m = round(x · 2/π); y = x − m π/2 in three parts.
-    let m = s.sub_f64s(
-        s.add_f64s(s.mul_f64s(x, s.splat_f64s(FRAC_2_PI)), shifter),
-        shifter,
-    );
+    // m = round(x · 2/π); y = x − m π/2 in three parts. x · 2/π + 1.5 × 2⁵² has unit last
+    // place, so its low mantissa bits hold m's (two's complement, |m| < 2⁵¹): quadrant
+    // m mod 4 is its bits 0–1.
+    let m_shifted = s.add_f64s(s.mul_f64s(x, s.splat_f64s(FRAC_2_PI)), shifter);
+    let m = s.sub_f64s(m_shifted, shifter);
     let y = s.sub_f64s(x, s.mul_f64s(m, s.splat_f64s(PIO2_1)));
     let y = s.sub_f64s(y, s.mul_f64s(m, s.splat_f64s(PIO2_2)));
     let y = s.sub_f64s(y, s.mul_f64s(m, s.splat_f64s(PIO2_2T)));
-    // Quadrant q = m mod 4 = m − 4 floor(m/4), floor(m/4) = round((m − 1.5)/4) (never a tie).
-    let floor4 = s.sub_f64s(
-        s.add_f64s(
-            s.mul_f64s(s.sub_f64s(m, s.splat_f64s(1.5)), s.splat_f64s(0.25)),
-            shifter,
-        ),
-        shifter,
-    );
-    let q = s.sub_f64s(m, s.mul_f64s(floor4, s.splat_f64s(4.0)));
+    let quadrant = s.transmute_u64s_f64s(m_shifted);
     // __kernel_sin(y, 0, 0) and __kernel_cos(y, 0).
     let z = s.mul_f64s(y, y);
     let w = s.mul_f64s(z, z);
@@ -148,22 +146,18 @@ pub(crate) fn sin_cos<S: Simd>(s: S, x: S::f64s) -> (S::f64s, S::f64s) {
         wc,
         s.add_f64s(s.sub_f64s(s.sub_f64s(one, wc), hz), s.mul_f64s(z, rc)),
     );
-    // q = 0: (s, c); 1: (c, −s); 2: (−s, −c); 3: (−c, s).
-    let q1 = s.equal_f64s(q, s.splat_f64s(1.0));
-    let q2 = s.equal_f64s(q, s.splat_f64s(2.0));
-    let q3 = s.equal_f64s(q, s.splat_f64s(3.0));
-    let (ns, nc) = (s.neg_f64s(sin_y), s.neg_f64s(cos_y));
-    let sin_x = s.select_f64s(
-        q1,
-        cos_y,
-        s.select_f64s(q2, ns, s.select_f64s(q3, nc, sin_y)),
-    );
-    let cos_x = s.select_f64s(
-        q1,
-        ns,
-        s.select_f64s(q2, nc, s.select_f64s(q3, sin_y, cos_y)),
-    );
-    (sin_x, cos_x)
+    // Quadrant q = 0: (s, c); 1: (c, −s); 2: (−s, −c); 3: (−c, s): the pair swapped where
+    // bit 0 of q is set, sin negated where bit 1 of q is, cos where bit 1 of q + 1 is.
+    let (one, two) = (s.splat_u64s(1), s.splat_u64s(2));
+    let swap = s.equal_u64s(s.and_u64s(quadrant, one), one);
+    let neg_sin = s.equal_u64s(s.and_u64s(quadrant, two), two);
+    let neg_cos = s.equal_u64s(s.and_u64s(s.add_u64s(quadrant, one), two), two);
+    let sin_x = s.select_f64s(swap, cos_y, sin_y);
+    let cos_x = s.select_f64s(swap, sin_y, cos_y);
+    (
+        s.select_f64s(neg_sin, s.neg_f64s(sin_x), sin_x),
+        s.select_f64s(neg_cos, s.neg_f64s(cos_x), cos_x),
+    )
 }
 
 /// e^{−a} lane by lane for a ≤ 708 (a < −708 is clamped there); 0 beyond; see the module docs.
