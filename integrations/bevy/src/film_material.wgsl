@@ -8,7 +8,9 @@
 // microfacet angle cos θ = v·h). nacre's functions come from the repository's shaders,
 // registered as naga_oil modules (src/shaders.rs): `film_lut::film_colour` (a baked
 // film-lut table, bindings 100–103) and `film_fourier::film_colour` (any film on any base,
-// metals included, bindings 104–105). Bevy's functions are imported, never copied.
+// metals included, bindings 104–105). The technique is a shader def from the material's
+// pipeline key (`NACRE_FILM_LUT` or `NACRE_FILM_FOURIER`, src/material.rs), so a pipeline
+// compiles one of them. Bevy's functions are imported, never copied.
 //
 // Symbols
 //
@@ -33,9 +35,9 @@
 // f₉₀ = saturate(16.5 ΣF₀) is then exactly 0, and so are its ambient and environment
 // specular (F₀ A + B times that same f₉₀ occlusion), so it gives Bevy's diffuse (direct,
 // ambient, environment, lightmaps, irradiance volumes), emissive and transmission unchanged
-// and no specular. This shader adds the specular itself, one loop over Bevy's lights
-// (`mesh_view_bindings::lights.directional_lights`, the fragment's cluster of
-// `clustered_lights` for point and spot lights, their shadows through
+// and no specular. This shader adds the specular itself, looping over Bevy's lights as
+// `apply_pbr_lighting` does (`mesh_view_bindings::lights.directional_lights`, then the
+// fragment's cluster of `clustered_lights` for point and spot lights, their shadows through
 // `bevy_pbr::shadows::fetch_*`), each light l:
 //   F_l   = mix(Schlick(F₀, v·h), R_f(v·h), w)                   (Bevy's `lighting::fresnel`)
 //   f_r,l = D(α_l, n·h) V(α_l, μ, n·l) F_l · s_l · (1 + F₀ₘ (1/(A + B) − 1))
@@ -50,8 +52,8 @@
 // Everything times the view's exposure, before Bevy's post-lighting steps (fog, alpha).
 // Where the material transmits (specular_transmission > 0) the transmitted light (whose
 // Fresnel factor is then 1) is tinted by mix(1, T_f(μ), w).
-// nacre's film is evaluated at one call site: the loop's slot 0 is μ (environment,
-// transmittance), slot k > 0 the v·h of light k.
+// nacre's film is evaluated once at μ (environment, transmittance, F₀ₘ) and once per light
+// at its v·h (`nacre_light_lobe`).
 // Not covered: clearcoat does not darken the film's lobe, anisotropy is ignored (isotropic
 // lobe), light textures, atmosphere transmittance and contact shadows are not applied to
 // the film's lobe, rectangle lights (AREA_LIGHT_LUTS) get no film specular, screen-space
@@ -99,7 +101,7 @@
 
 // Mirror of `NacreFilmUniform` (src/material.rs, 64 bytes).
 struct NacreFilmUniform {
-    // 0: film_lut, 1: film_fourier.
+    // 0: film_lut, 1: film_fourier (the shader compiles one, chosen by shader def).
     technique: u32,
     // 0: glTF d = mix(a, b, g); 1: SVT d = a + b (2g − 1).
     thickness_mode: u32,
@@ -126,10 +128,11 @@ struct NacreFilmUniform {
 
 // The film's colour through the material's technique.
 fn nacre_film_colour(input: FilmInput) -> FilmOutput {
-    if nacre_film.technique == 0u {
-        return film_lut::film_colour(input);
-    }
+#ifdef NACRE_FILM_FOURIER
     return film_fourier::film_colour(input);
+#else
+    return film_lut::film_colour(input);
+#endif
 }
 
 // Film thickness d (nm) from the thickness texture's green channel g.
@@ -147,8 +150,35 @@ struct NacreSpecular {
     transmittance: vec3<f32>,
 }
 
-// Slot 0: the environment at μ; slots 1 … n_dir: directional lights; then the cluster's
-// point and spot lights. One call of the film per slot, from one site (see the header).
+// The film's lobe for one light l: Bevy's GGX D and V with F_l = mix(Schlick(F₀, v·h),
+// R_f(v·h), w) and Bevy's multiple-scattering factor (see the header), times n·l · E_l.
+fn nacre_light_lobe(
+    N: vec3<f32>,
+    V: vec3<f32>,
+    L: vec3<f32>,
+    n_dot_v: f32,
+    a: f32,
+    intensity: f32,
+    light: vec3<f32>,
+    film_template: FilmInput,
+    f0_base: vec3<f32>,
+    f0_multiscatter: vec3<f32>,
+    f_ab: vec2<f32>,
+    weight: f32,
+) -> vec3<f32> {
+    let derived = lighting::derive_lighting_input(N, V, L);
+    var film_input = film_template;
+    film_input.cos_theta_i = saturate(dot(V, derived.H));
+    let film = nacre_film_colour(film_input);
+    let F = mix(lighting::fresnel(f0_base, derived.LdotH), film.reflectance, weight);
+    let D = lighting::D_GGX(a, derived.NdotH);
+    let vis = lighting::V_SmithGGXCorrelated(a, n_dot_v, derived.NdotL);
+    let f_r = lighting::specular_multiscatter(D, vis, F, f0_multiscatter, f_ab, intensity);
+    return f_r * derived.NdotL * light;
+}
+
+// The environment at μ, then Bevy's directional lights and the cluster's point and spot
+// lights, each in a loop of its own as in `apply_pbr_lighting`.
 fn nacre_specular(
     pbr_input: PbrInput,
     film_template: FilmInput,
@@ -187,8 +217,6 @@ fn nacre_specular(
     ), pbr_input.world_position);
     let cluster_index = clustering::view_fragment_cluster_index(pbr_input.frag_coord.xy, view_z, pbr_input.is_orthographic);
     var ranges = clustering::unpack_clusterable_object_index_ranges(cluster_index);
-    let n_directional = view_bindings::lights.n_directional_lights;
-    let n_clustered = ranges.first_reflection_probe_index_offset - ranges.first_point_light_index_offset;
 
     // Environment light reaching the split sum (ambient light and environment map).
     var environment = view_bindings::lights.ambient_color.rgb * pbr_input.diffuse_occlusion;
@@ -197,86 +225,71 @@ fn nacre_specular(
     environment += radiances.radiance * pbr_input.specular_occlusion;
 #endif
 
-    var out: NacreSpecular;
-    out.light = vec3<f32>(0.0);
-    out.transmittance = vec3<f32>(1.0);
-    var f0_multiscatter = f0_base;
+    // The film at μ: environment, transmittance, multiple scattering.
     var film_input = film_template;
-    for (var slot = 0u; slot <= n_directional + n_clustered; slot += 1u) {
-        // Per slot: l, the lobe's roughness α_l and intensity s_l, and the light E_l · shadow.
-        var L = N;
-        var a = roughness;
-        var intensity = 1.0;
-        var light = vec3<f32>(0.0);
-        if slot == 0u {
-            film_input.cos_theta_i = n_dot_v;
-        } else if slot <= n_directional {
-            let i = slot - 1u;
-            let directional = &view_bindings::lights.directional_lights[i];
-            L = (*directional).direction_to_light;
-            light = (*directional).color.rgb;
-            if receives_shadows && ((*directional).flags & mesh_view_types::DIRECTIONAL_LIGHT_FLAGS_SHADOWS_ENABLED_BIT) != 0u {
-                light *= shadows::fetch_directional_shadow(i, pbr_input.world_position, pbr_input.world_normal, view_z, pbr_input.frag_coord.xy);
+    film_input.cos_theta_i = n_dot_v;
+    let film_mu = nacre_film_colour(film_input);
+    let e_spec = mix(
+        lighting::EnvBRDFApprox(f0_base, f_ab) * saturate(dot(f0_base, vec3<f32>(50.0 * 0.33))),
+        film_mu.reflectance * (f_ab.x + f_ab.y),
+        weight,
+    );
+    var out: NacreSpecular;
+    out.light = e_spec * environment;
+    out.transmittance = mix(vec3<f32>(1.0), max(film_mu.transmittance, vec3<f32>(0.0)), weight);
+    let f0_multiscatter = mix(f0_base, film_mu.reflectance, weight);
+
+    // Directional lights.
+    let n_directional = view_bindings::lights.n_directional_lights;
+    for (var i = 0u; i < n_directional; i += 1u) {
+        let directional = &view_bindings::lights.directional_lights[i];
+        var light = (*directional).color.rgb;
+        if receives_shadows && ((*directional).flags & mesh_view_types::DIRECTIONAL_LIGHT_FLAGS_SHADOWS_ENABLED_BIT) != 0u {
+            light *= shadows::fetch_directional_shadow(i, pbr_input.world_position, pbr_input.world_normal, view_z, pbr_input.frag_coord.xy);
+        }
+        out.light += nacre_light_lobe(N, V, (*directional).direction_to_light, n_dot_v, roughness, 1.0, light,
+            film_template, f0_base, f0_multiscatter, f_ab, weight);
+    }
+
+    // The cluster's point and spot lights.
+    for (var index = ranges.first_point_light_index_offset; index < ranges.first_reflection_probe_index_offset; index += 1u) {
+        let light_id = clustering::get_clusterable_object_id(index);
+        let clustered = &view_bindings::clustered_lights.data[light_id];
+        let light_to_frag = (*clustered).position_radius.xyz - P;
+        let distance_squared = dot(light_to_frag, light_to_frag);
+        let distance = sqrt(distance_squared);
+        let radius = (*clustered).position_radius.w;
+        let l_a = lighting::compute_specular_layer_values_for_point_light(&lighting_input, LAYER_BASE, V, light_to_frag, radius, distance);
+        let L = l_a.xyz;
+        let a = mix(roughness, l_a.w, lighting::specular_fix_remap(roughness));
+        let intensity = (roughness / l_a.w) * (roughness / l_a.w);
+        var light = (*clustered).color_inverse_square_range.rgb
+            * lighting::getDistanceAttenuation(distance_squared, (*clustered).color_inverse_square_range.w);
+        let n_dot_l = saturate(dot(N, L));
+        if radius > 0.0 {
+            let solid_angle = radius * radius / distance_squared;
+            light *= saturate(n_dot_l / max(n_dot_l + solid_angle, 1e-4));
+        }
+        let shadowed = receives_shadows && ((*clustered).flags & mesh_view_types::POINT_LIGHT_FLAGS_SHADOWS_ENABLED_BIT) != 0u;
+        if index < ranges.first_spot_light_index_offset {
+            if shadowed {
+                light *= shadows::fetch_point_shadow(light_id, pbr_input.world_position, pbr_input.world_normal, pbr_input.frag_coord.xy);
             }
         } else {
-            let index = ranges.first_point_light_index_offset + slot - 1u - n_directional;
-            let light_id = clustering::get_clusterable_object_id(index);
-            let clustered = &view_bindings::clustered_lights.data[light_id];
-            let light_to_frag = (*clustered).position_radius.xyz - P;
-            let distance_squared = dot(light_to_frag, light_to_frag);
-            let distance = sqrt(distance_squared);
-            let radius = (*clustered).position_radius.w;
-            let l_a = lighting::compute_specular_layer_values_for_point_light(&lighting_input, LAYER_BASE, V, light_to_frag, radius, distance);
-            L = l_a.xyz;
-            a = mix(roughness, l_a.w, lighting::specular_fix_remap(roughness));
-            intensity = (roughness / l_a.w) * (roughness / l_a.w);
-            light = (*clustered).color_inverse_square_range.rgb
-                * lighting::getDistanceAttenuation(distance_squared, (*clustered).color_inverse_square_range.w);
-            let n_dot_l = saturate(dot(N, L));
-            if radius > 0.0 {
-                let solid_angle = radius * radius / distance_squared;
-                light *= saturate(n_dot_l / max(n_dot_l + solid_angle, 1e-4));
+            // The spot's cone: the axis is stored as x, z and the sign of y.
+            var axis = vec3<f32>((*clustered).light_custom_data.x, 0.0, (*clustered).light_custom_data.y);
+            axis.y = sqrt(max(0.0, 1.0 - axis.x * axis.x - axis.z * axis.z));
+            if ((*clustered).flags & mesh_view_types::POINT_LIGHT_FLAGS_SPOT_LIGHT_Y_NEGATIVE) != 0u {
+                axis.y = -axis.y;
             }
-            let shadowed = receives_shadows && ((*clustered).flags & mesh_view_types::POINT_LIGHT_FLAGS_SHADOWS_ENABLED_BIT) != 0u;
-            if index < ranges.first_spot_light_index_offset {
-                if shadowed {
-                    light *= shadows::fetch_point_shadow(light_id, pbr_input.world_position, pbr_input.world_normal, pbr_input.frag_coord.xy);
-                }
-            } else {
-                // The spot's cone: the axis is stored as x, z and the sign of y.
-                var axis = vec3<f32>((*clustered).light_custom_data.x, 0.0, (*clustered).light_custom_data.y);
-                axis.y = sqrt(max(0.0, 1.0 - axis.x * axis.x - axis.z * axis.z));
-                if ((*clustered).flags & mesh_view_types::POINT_LIGHT_FLAGS_SPOT_LIGHT_Y_NEGATIVE) != 0u {
-                    axis.y = -axis.y;
-                }
-                let cone = saturate(dot(-axis, normalize(light_to_frag)) * (*clustered).light_custom_data.z + (*clustered).light_custom_data.w);
-                light *= cone * cone;
-                if shadowed {
-                    light *= shadows::fetch_spot_shadow(light_id, pbr_input.world_position, pbr_input.world_normal, (*clustered).shadow_map_near_z, pbr_input.frag_coord.xy);
-                }
+            let cone = saturate(dot(-axis, normalize(light_to_frag)) * (*clustered).light_custom_data.z + (*clustered).light_custom_data.w);
+            light *= cone * cone;
+            if shadowed {
+                light *= shadows::fetch_spot_shadow(light_id, pbr_input.world_position, pbr_input.world_normal, (*clustered).shadow_map_near_z, pbr_input.frag_coord.xy);
             }
         }
-        var derived = lighting::derive_lighting_input(N, V, L);
-        if slot > 0u {
-            film_input.cos_theta_i = saturate(dot(V, derived.H));
-        }
-        let film = nacre_film_colour(film_input);
-        if slot == 0u {
-            let e_spec = mix(
-                lighting::EnvBRDFApprox(f0_base, f_ab) * saturate(dot(f0_base, vec3<f32>(50.0 * 0.33))),
-                film.reflectance * (f_ab.x + f_ab.y),
-                weight,
-            );
-            out.light += e_spec * environment;
-            out.transmittance = mix(vec3<f32>(1.0), max(film.transmittance, vec3<f32>(0.0)), weight);
-            f0_multiscatter = mix(f0_base, film.reflectance, weight);
-        } else {
-            let F = mix(lighting::fresnel(f0_base, derived.LdotH), film.reflectance, weight);
-            let D = lighting::D_GGX(a, derived.NdotH);
-            let vis = lighting::V_SmithGGXCorrelated(a, n_dot_v, derived.NdotL);
-            let f_r = lighting::specular_multiscatter(D, vis, F, f0_multiscatter, f_ab, intensity);
-            out.light += f_r * derived.NdotL * light;
-        }
+        out.light += nacre_light_lobe(N, V, L, n_dot_v, a, intensity, light,
+            film_template, f0_base, f0_multiscatter, f_ab, weight);
     }
     return out;
 }

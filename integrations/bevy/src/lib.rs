@@ -39,7 +39,7 @@ pub mod material;
 pub mod shaders;
 pub mod tables;
 
-pub use material::{FilmTechnique, FilmThickness, NacreFilm, NacreMaterial};
+pub use material::{FilmTechnique, FilmThickness, NacreFilm, NacreFilmKey, NacreMaterial};
 pub use tables::{DEFAULT_FILM_LUT, DEFAULT_FOURIER, NacreTable, NacreTableLoader};
 
 use bevy::app::{App, Plugin, PostUpdate};

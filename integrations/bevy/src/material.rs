@@ -10,19 +10,28 @@ use bevy::asset::{AssetEvent, Assets, Handle};
 use bevy::ecs::message::MessageReader;
 use bevy::image::Image;
 use bevy::math::Vec3;
-use bevy::pbr::{ExtendedMaterial, MaterialExtension, StandardMaterial};
+use bevy::mesh::MeshVertexBufferLayoutRef;
+use bevy::pbr::{
+    ExtendedMaterial, MaterialExtension, MaterialExtensionKey, MaterialExtensionPipeline,
+    StandardMaterial,
+};
 use bevy::prelude::{Asset, ResMut};
 use bevy::reflect::Reflect;
 use bevy::render::render_asset::RenderAssets;
-use bevy::render::render_resource::{AsBindGroup, AsBindGroupShaderType, ShaderType};
+use bevy::render::render_resource::{
+    AsBindGroup, AsBindGroupShaderType, RenderPipelineDescriptor, ShaderType,
+    SpecializedMeshPipelineError,
+};
 use bevy::render::texture::GpuImage;
 use bevy::shader::ShaderRef;
 
 /// `StandardMaterial` with a nacre thin film on top.
 pub type NacreMaterial = ExtendedMaterial<StandardMaterial, NacreFilm>;
 
-/// Which of nacre's techniques colours the film.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Reflect)]
+/// Which of nacre's techniques colours the film. Part of the material's pipeline key: each
+/// technique is its own pipeline, whose fragment shader compiles that technique only
+/// (shader def `NACRE_FILM_LUT` or `NACRE_FILM_FOURIER`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Reflect)]
 pub enum FilmTechnique {
     /// One trilinear lookup in a baked `film-lut` table (`film_lut.wgsl`): the table's ambient
     /// and base are baked in ([`NacreFilm::base_ior`] and `base_kappa` are ignored).
@@ -100,6 +109,7 @@ pub struct NacreFilmUniform {
 /// set unless set otherwise.
 #[derive(Asset, AsBindGroup, Reflect, Debug, Clone)]
 #[uniform(106, NacreFilmUniform)]
+#[bind_group_data(NacreFilmKey)]
 pub struct NacreFilm {
     /// The film-lut table whose textures are bound (see the struct docs).
     pub lut_table: Handle<NacreTable>,
@@ -143,6 +153,31 @@ pub struct NacreFilm {
     /// fourier axes (from [`NacreFilm::fourier_table`]).
     #[uniform(105)]
     pub fourier_axes: FourierUniform,
+}
+
+/// The film's part of the material's pipeline key (see [`FilmTechnique`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct NacreFilmKey {
+    /// The technique the pipeline's fragment shader compiles.
+    pub technique: FilmTechnique,
+}
+
+impl From<&NacreFilm> for NacreFilmKey {
+    fn from(film: &NacreFilm) -> Self {
+        NacreFilmKey {
+            technique: film.technique,
+        }
+    }
+}
+
+impl FilmTechnique {
+    /// The shader def that selects this technique in `film_material.wgsl`.
+    pub fn shader_def(self) -> &'static str {
+        match self {
+            FilmTechnique::Lut => "NACRE_FILM_LUT",
+            FilmTechnique::Fourier => "NACRE_FILM_FOURIER",
+        }
+    }
 }
 
 impl Default for NacreFilm {
@@ -236,6 +271,22 @@ impl AsBindGroupShaderType<NacreFilmUniform> for NacreFilm {
 impl MaterialExtension for NacreFilm {
     fn fragment_shader() -> ShaderRef {
         ShaderRef::Handle(FILM_MATERIAL_HANDLE)
+    }
+
+    /// One technique per pipeline: a technique chosen at run time through the uniform
+    /// compiles both into every call site, and a SIMD rasteriser such as lavapipe executes
+    /// both sides of a branch under masks, so each film evaluation would cost both.
+    fn specialize(
+        _pipeline: &MaterialExtensionPipeline,
+        descriptor: &mut RenderPipelineDescriptor,
+        _layout: &MeshVertexBufferLayoutRef,
+        key: MaterialExtensionKey<Self>,
+    ) -> Result<(), SpecializedMeshPipelineError> {
+        if let Some(fragment) = descriptor.fragment.as_mut() {
+            let technique = key.bind_group_data.technique;
+            fragment.shader_defs.push(technique.shader_def().into());
+        }
+        Ok(())
     }
 }
 
