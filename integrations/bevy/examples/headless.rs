@@ -44,21 +44,23 @@ fn main() {
         .unwrap_or_else(|| PathBuf::from("."));
 
     let mut app = App::new();
-    app.add_plugins(
-        DefaultPlugins
-            .set(WindowPlugin {
-                primary_window: None,
-                exit_condition: ExitCondition::DontExit,
-                close_when_requested: false,
-                ..default()
-            })
-            .set(AssetPlugin {
-                file_path: root.to_string_lossy().into_owned(),
-                ..default()
-            })
-            .disable::<PipelinedRenderingPlugin>(),
-    )
-    .add_plugins(NacrePlugin);
+    let plugins = DefaultPlugins
+        .set(WindowPlugin {
+            primary_window: None,
+            exit_condition: ExitCondition::DontExit,
+            close_when_requested: false,
+            ..default()
+        })
+        .set(AssetPlugin {
+            file_path: root.to_string_lossy().into_owned(),
+            ..default()
+        })
+        .disable::<PipelinedRenderingPlugin>();
+    // Built with the `viewer` feature (as test.sh builds everything), Bevy's default plugins
+    // would open winit's event loop, which needs a display: not here.
+    #[cfg(feature = "viewer")]
+    let plugins = plugins.disable::<bevy::winit::WinitPlugin>();
+    app.add_plugins(plugins).add_plugins(NacrePlugin);
     while app.plugins_state() == PluginsState::Adding {
         bevy::tasks::tick_global_task_pools_on_main_thread();
     }

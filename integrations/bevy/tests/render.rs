@@ -743,3 +743,501 @@ fn the_specular_lobe_has_the_film_at_v_dot_h_on_a_metal() {
         },
     );
 }
+
+/// `nacre color --method lut:film-dielectric` for the lobe tests' film (index 1.8, 400 nm):
+/// R_f(cos θ) from the film-lut table on its base (index 1.5).
+fn lobe_film_lut() -> impl Fn(f64) -> [f64; 3] {
+    let path = repo_root().join("tables/baked/film-dielectric.json");
+    let manifest = nacre_format::Manifest::read(&path).unwrap();
+    let axes = manifest.film_lut().cloned().unwrap();
+    let table = manifest.load_table(&path, "reflectance").unwrap().unwrap();
+    move |cos| {
+        nacre_format::film_lut::FilmLut::lookup(
+            &axes,
+            &table,
+            cos,
+            LOBE_THICKNESS_NM,
+            LOBE_FILM_IOR,
+        )
+    }
+}
+
+/// The lobe tests' film material: black base (no diffuse), roughness
+/// `LOBE_PERCEPTUAL_ROUGHNESS`, film index 1.8, 400 nm, `film_lut`.
+fn lobe_film_material() -> NacreMaterial {
+    NacreMaterial {
+        base: StandardMaterial {
+            base_color: Color::BLACK,
+            perceptual_roughness: LOBE_PERCEPTUAL_ROUGHNESS as f32,
+            ..default()
+        },
+        extension: NacreFilm {
+            film_ior: LOBE_FILM_IOR as f32,
+            thickness: FilmThickness::Gltf {
+                min_nm: LOBE_THICKNESS_NM as f32,
+                max_nm: LOBE_THICKNESS_NM as f32,
+            },
+            weight: 1.0,
+            ..default()
+        },
+    }
+}
+
+/// The film's specular radiance on the CPU where the film's normal `normal` faces the view
+/// direction `v` (unit vectors towards the viewer and, `l`, the light), under
+/// `illuminance` (lux, before exposure): exposure × E × D V R_f(v·h) × n·l × Bevy's
+/// multiple-scattering factor 1 + R_f(n·v) (1/(A + B) − 1), A + B = 1 − 0.55 r_p (Bevy's
+/// F_AB at r_p = 0.6, see `specular_lobe`).
+fn lobe_radiance(
+    film: &impl Fn(f64) -> [f64; 3],
+    normal: DVec3,
+    v: DVec3,
+    l: DVec3,
+    illuminance: f64,
+) -> [f64; 3] {
+    let rp = LOBE_PERCEPTUAL_ROUGHNESS;
+    let alpha = rp * rp;
+    let half = (l + v).normalize();
+    let (n_dot_v, n_dot_l, n_dot_h, v_dot_h) =
+        (normal.dot(v), normal.dot(l), normal.dot(half), v.dot(half));
+    if n_dot_l <= 0.0 {
+        return [0.0; 3];
+    }
+    let exposure = f64::from(bevy::camera::Exposure { ev100: 0.0 }.exposure());
+    let dv = ggx_d(alpha, n_dot_h) * smith_v(alpha, n_dot_v, n_dot_l) * n_dot_l;
+    let (r_mu, r_vh) = (film(n_dot_v), film(v_dot_h));
+    std::array::from_fn(|c| {
+        exposure * illuminance * dv * r_vh[c] * (1.0 + r_mu[c] * (1.0 / (1.0 - 0.55 * rp) - 1.0))
+    })
+}
+
+/// Pictures of the plane z = 0 through an orthographic camera on the z axis looking down −z,
+/// `width_m` metres across `width` pixels (`height` pixels high): HDR, no tone mapping, no
+/// dithering, exposure ev100 = 0, read back as linear floats; no ambient light.
+struct PlaneView {
+    width: u32,
+    height: u32,
+    width_m: f64,
+}
+
+impl PlaneView {
+    /// A headless app with the camera and an Rgba32Float target; the scene is the caller's.
+    fn app(&self) -> (App, Handle<Image>) {
+        use bevy::core_pipeline::tonemapping::DebandDither;
+        use bevy::render::render_resource::TextureFormat;
+        let mut app = headless_app(&repo_root());
+        let image = app
+            .world_mut()
+            .resource_mut::<Assets<Image>>()
+            .add(Image::new_target_texture(
+                self.width,
+                self.height,
+                TextureFormat::Rgba32Float,
+                None,
+            ));
+        let world = app.world_mut();
+        world.insert_resource(GlobalAmbientLight {
+            color: Color::WHITE,
+            brightness: 0.0,
+            ..default()
+        });
+        world.spawn((
+            Camera3d::default(),
+            bevy::camera::Hdr,
+            bevy::camera::Exposure { ev100: 0.0 },
+            RenderTarget::Image(image.clone().into()),
+            Tonemapping::None,
+            DebandDither::Disabled,
+            Projection::Orthographic(OrthographicProjection {
+                scaling_mode: bevy::camera::ScalingMode::FixedHorizontal {
+                    viewport_width: self.width_m as f32,
+                },
+                ..OrthographicProjection::default_3d()
+            }),
+            Transform::from_xyz(0.0, 0.0, 5.0).looking_at(Vec3::ZERO, Vec3::Y),
+        ));
+        (app, image)
+    }
+
+    /// Renders and reads back: linear RGB per pixel, row by row.
+    fn render(&self, app: &mut App, image: &Handle<Image>) -> Vec<[f64; 3]> {
+        let bytes = capture(app, image, 10);
+        assert_eq!(
+            bytes.len(),
+            16 * (self.width * self.height) as usize,
+            "an Rgba32Float picture"
+        );
+        bytes
+            .chunks_exact(16)
+            .map(|p| {
+                std::array::from_fn(|c| {
+                    f64::from(f32::from_le_bytes(p[4 * c..4 * c + 4].try_into().unwrap()))
+                })
+            })
+            .collect()
+    }
+
+    /// The point of the plane z = 0 seen at the centre of pixel (`px`, `py`).
+    fn point(&self, px: usize, py: usize) -> DVec3 {
+        let m_per_px = self.width_m / f64::from(self.width);
+        DVec3::new(
+            (px as f64 + 0.5) * m_per_px - self.width_m / 2.0,
+            (f64::from(self.height) / 2.0 - (py as f64 + 0.5)) * m_per_px,
+            0.0,
+        )
+    }
+}
+
+/// Bevy's spot cone at `p` for a spot at `position` aimed along `axis` (unit) with cone
+/// angles `inner`, `outer` (rad): t = saturate(cos ψ s + o), s = 1/(cos inner − cos outer),
+/// o = −cos outer · s, ψ the angle between the axis and p − position; the light is scaled
+/// by t² (Filament's spot attenuation, as `bevy_pbr`'s `spot_light`).
+fn spot_cone(position: DVec3, axis: DVec3, inner: f64, outer: f64, p: DVec3) -> f64 {
+    let scale = 1.0 / (inner.cos() - outer.cos()).max(1e-4);
+    let t = ((p - position).normalize().dot(axis) * scale - outer.cos() * scale).clamp(0.0, 1.0);
+    t * t
+}
+
+/// A spot light's cone edge crosses a flat film and, beside it, a flat `StandardMaterial`:
+/// the film's specular is cut where Bevy's own lit area is. Two pictures of the same scene,
+/// under the spot light and under a point light in its place (same intensity): their ratio
+/// at every pixel of a row crossing the cone's edge on both quads is the CPU's cone factor
+/// t² (`spot_cone`), to 0.3 % — for `StandardMaterial` (which checks the CPU's cone against
+/// Bevy's) and for the film (whose lobe has its own spot code). The spot points down
+/// (its axis's y < 0, stored as a flag) and sideways, so the axis's packing is exercised; a
+/// film without the cone (ratio 1), with t in place of t² or the axis's y sign lost misses
+/// by more than ten tolerances.
+#[test]
+fn the_film_lobe_is_cut_by_spot_cones() {
+    let view = PlaneView {
+        width: 400,
+        height: 80,
+        width_m: 5.0,
+    };
+    let position = DVec3::new(0.0, 1.8, 2.5);
+    let aim = DVec3::new(0.25, 0.0, 0.0);
+    let axis = (aim - position).normalize();
+    let (inner, outer) = (0.25, 0.45);
+    let intensity_lm = (LOBE_POINT_CD * 4.0 * std::f64::consts::PI) as f32;
+    // Film quad on the left, StandardMaterial (white diffuse) on the right.
+    const QUAD_HALF_WIDTH: f64 = 1.2;
+    let quads = [(-1.25f64, true), (1.25, false)];
+    let render = |spot: bool| {
+        let (mut app, image) = view.app();
+        let world = app.world_mut();
+        let mesh = world
+            .resource_mut::<Assets<Mesh>>()
+            .add(Rectangle::new(2.0 * QUAD_HALF_WIDTH as f32, 0.9));
+        let film = world
+            .resource_mut::<Assets<NacreMaterial>>()
+            .add(lobe_film_material());
+        let standard = world
+            .resource_mut::<Assets<StandardMaterial>>()
+            .add(StandardMaterial {
+                base_color: Color::WHITE,
+                perceptual_roughness: LOBE_PERCEPTUAL_ROUGHNESS as f32,
+                ..default()
+            });
+        for (x, is_film) in quads {
+            let mut quad = world.spawn((
+                Mesh3d(mesh.clone()),
+                Transform::from_xyz(x as f32, 0.0, 0.0),
+            ));
+            if is_film {
+                quad.insert(MeshMaterial3d(film.clone()));
+            } else {
+                quad.insert(MeshMaterial3d(standard.clone()));
+            }
+        }
+        let transform =
+            Transform::from_translation(position.as_vec3()).looking_at(aim.as_vec3(), Vec3::Y);
+        if spot {
+            world.spawn((
+                SpotLight {
+                    intensity: intensity_lm,
+                    range: LOBE_POINT_RANGE as f32,
+                    radius: 0.0,
+                    inner_angle: inner as f32,
+                    outer_angle: outer as f32,
+                    ..default()
+                },
+                transform,
+            ));
+        } else {
+            world.spawn((
+                PointLight {
+                    intensity: intensity_lm,
+                    range: LOBE_POINT_RANGE as f32,
+                    radius: 0.0,
+                    ..default()
+                },
+                transform,
+            ));
+        }
+        view.render(&mut app, &image)
+    };
+    let (spot, point) = (render(true), render(false));
+
+    let py = view.height as usize / 2;
+    let tolerance = |point: f64| 3e-3 * point + 1e-5;
+    for (centre, is_film) in quads {
+        let name = if is_film { "film" } else { "StandardMaterial" };
+        let (mut dark, mut edge, mut full) = (0, 0, 0);
+        let mut worst: f64 = 0.0;
+        for px in 0..view.width as usize {
+            let p = view.point(px, py);
+            if (p.x - centre).abs() > QUAD_HALF_WIDTH - 0.05 {
+                continue;
+            }
+            let cone = spot_cone(position, axis, inner, outer, p);
+            let (s, q) = (
+                spot[py * view.width as usize + px],
+                point[py * view.width as usize + px],
+            );
+            if cone == 0.0 {
+                dark += 1;
+            } else if cone == 1.0 {
+                full += 1;
+            } else if (0.05..0.95).contains(&cone) {
+                edge += 1;
+            }
+            for c in 0..3 {
+                assert!(
+                    q[c] > 1e-3,
+                    "{name} at x = {:.3}: {} under the point light",
+                    p.x,
+                    q[c]
+                );
+                let diff = (s[c] - cone * q[c]).abs();
+                assert!(
+                    diff <= tolerance(q[c]),
+                    "{name} at x = {:.3}, channel {c}: spot {} against t² = {cone:.4} × point {} = {}",
+                    p.x,
+                    s[c],
+                    q[c],
+                    cone * q[c]
+                );
+                worst = worst.max(diff / q[c]);
+            }
+        }
+        eprintln!(
+            "{name}: {dark} pixels outside the cone, {edge} on its edge (0.05 < t² < 0.95), {full} inside; largest |spot − t² point|/point {worst:.1e}"
+        );
+        // The row crosses the cone's edge on both quads.
+        assert!(
+            dark >= 10 && edge >= 20 && full >= 10,
+            "{name}: {dark} dark, {edge} edge, {full} full pixels"
+        );
+    }
+}
+
+/// The light of the shadow test.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum ShadowLight {
+    Point,
+    Spot,
+    Directional,
+}
+
+/// Whether the segment from `from` along `direction` (t in [0, `t_max`]) meets the
+/// axis-aligned box `centre` ± `half` (slab test).
+fn ray_hits_box(from: DVec3, direction: DVec3, t_max: f64, centre: DVec3, half: f64) -> bool {
+    let (mut t0, mut t1) = (0.0f64, t_max);
+    for k in 0..3 {
+        let (lo, hi) = (centre[k] - half, centre[k] + half);
+        if direction[k].abs() < 1e-12 {
+            if from[k] < lo || from[k] > hi {
+                return false;
+            }
+            continue;
+        }
+        let (a, b) = ((lo - from[k]) / direction[k], (hi - from[k]) / direction[k]);
+        t0 = t0.max(a.min(b));
+        t1 = t1.min(a.max(b));
+    }
+    t0 <= t1
+}
+
+/// A cube between a shadow-casting light and a flat film: the film's specular vanishes in
+/// the cube's shadow and is the unshadowed lobe elsewhere. One picture per light (point:
+/// `fetch_point_shadow`, spot: `fetch_spot_shadow`, directional: `fetch_directional_shadow`);
+/// along a row crossing the shadow each pixel is classified on the CPU by casting its ray to
+/// the light against the cube shrunk and grown by 3 cm (so the shadow map's filtering and
+/// biases at the edge are left out): in the shadow the film is below 1 % of the CPU's
+/// unshadowed lobe (`lobe_radiance`, which is ≥ 0.01 there), outside it within the lobe
+/// tests' 0.3 % + 10⁻⁴. A film lobe that ignored the shadow maps would keep its full value in
+/// the shadow.
+fn film_shadow(light: ShadowLight) {
+    let view = PlaneView {
+        width: 400,
+        height: 60,
+        width_m: 4.0,
+    };
+    let film = lobe_film_lut();
+    let position = DVec3::new(1.5, 0.0, 2.0);
+    let to_light = position.normalize();
+    let (cube_centre, cube_half) = (DVec3::new(0.9, 0.0, 1.2), 0.2);
+    let (inner, outer) = (0.7, 0.9);
+    let (mut app, image) = view.app();
+    let world = app.world_mut();
+    let plane = world
+        .resource_mut::<Assets<Mesh>>()
+        .add(Rectangle::new(view.width_m as f32, 1.0));
+    let material = world
+        .resource_mut::<Assets<NacreMaterial>>()
+        .add(lobe_film_material());
+    world.spawn((
+        Mesh3d(plane),
+        MeshMaterial3d(material),
+        Transform::default(),
+    ));
+    let cube = world
+        .resource_mut::<Assets<Mesh>>()
+        .add(Cuboid::from_length(2.0 * cube_half as f32));
+    let grey = world
+        .resource_mut::<Assets<StandardMaterial>>()
+        .add(StandardMaterial::default());
+    world.spawn((
+        Mesh3d(cube),
+        MeshMaterial3d(grey),
+        Transform::from_translation(cube_centre.as_vec3()),
+    ));
+    let at_light = Transform::from_translation(position.as_vec3()).looking_at(Vec3::ZERO, Vec3::Y);
+    let intensity_lm = (LOBE_POINT_CD * 4.0 * std::f64::consts::PI) as f32;
+    match light {
+        ShadowLight::Point => {
+            world.spawn((
+                PointLight {
+                    intensity: intensity_lm,
+                    range: LOBE_POINT_RANGE as f32,
+                    radius: 0.0,
+                    shadow_maps_enabled: true,
+                    ..default()
+                },
+                at_light,
+            ));
+        }
+        ShadowLight::Spot => {
+            world.spawn((
+                SpotLight {
+                    intensity: intensity_lm,
+                    range: LOBE_POINT_RANGE as f32,
+                    radius: 0.0,
+                    inner_angle: inner as f32,
+                    outer_angle: outer as f32,
+                    shadow_maps_enabled: true,
+                    ..default()
+                },
+                at_light,
+            ));
+        }
+        ShadowLight::Directional => {
+            world.spawn((
+                DirectionalLight {
+                    illuminance: LOBE_LUX as f32,
+                    shadow_maps_enabled: true,
+                    ..default()
+                },
+                // One cascade over the whole scene (the camera is 5 m from the film).
+                bevy::light::CascadeShadowConfigBuilder {
+                    num_cascades: 1,
+                    maximum_distance: 10.0,
+                    first_cascade_far_bound: 10.0,
+                    ..default()
+                }
+                .build(),
+                at_light,
+            ));
+        }
+    }
+    let pixels = view.render(&mut app, &image);
+
+    let py = view.height as usize / 2;
+    let v = DVec3::Z;
+    let normal = DVec3::Z;
+    let (mut shadowed, mut lit) = (0, 0);
+    let mut worst: f64 = 0.0;
+    let mut darkest: f64 = 0.0;
+    for px in 0..view.width as usize {
+        let p = view.point(px, py);
+        // Skip where the camera sees the cube rather than the film.
+        if ray_hits_box(p, v, 10.0, cube_centre, cube_half + 0.02) || p.x.abs() > 1.9 {
+            continue;
+        }
+        let (l, distance, illuminance) = match light {
+            ShadowLight::Directional => (to_light, 100.0, LOBE_LUX),
+            ShadowLight::Point | ShadowLight::Spot => {
+                let to = position - p;
+                let d2 = to.length_squared();
+                let falloff = (1.0 - (d2 / LOBE_POINT_RANGE.powi(2)).powi(2)).clamp(0.0, 1.0);
+                let cone = if light == ShadowLight::Spot {
+                    spot_cone(position, -position.normalize(), inner, outer, p)
+                } else {
+                    1.0
+                };
+                (
+                    to.normalize(),
+                    d2.sqrt(),
+                    LOBE_POINT_CD * falloff * falloff / d2 * cone,
+                )
+            }
+        };
+        let inside = ray_hits_box(p, l, distance, cube_centre, cube_half - 0.03);
+        let outside = !ray_hits_box(p, l, distance, cube_centre, cube_half + 0.03);
+        let cpu = lobe_radiance(&film, normal, v, l, illuminance);
+        let gpu = pixels[py * view.width as usize + px];
+        for c in 0..3 {
+            if inside {
+                assert!(
+                    cpu[c] >= 0.01,
+                    "{light:?}: the unshadowed lobe at x = {:.3} is {} (too faint to tell)",
+                    p.x,
+                    cpu[c]
+                );
+                assert!(
+                    gpu[c] <= 0.01 * cpu[c],
+                    "{light:?} light, x = {:.3} (in the cube's shadow), channel {c}: the film's specular is {} against {} unshadowed",
+                    p.x,
+                    gpu[c],
+                    cpu[c]
+                );
+                darkest = darkest.max(gpu[c] / cpu[c]);
+            } else if outside {
+                assert!(
+                    (gpu[c] - cpu[c]).abs() <= 3e-3 * cpu[c] + 1e-4,
+                    "{light:?} light, x = {:.3} (lit), channel {c}: Bevy {} against the lobe's {}",
+                    p.x,
+                    gpu[c],
+                    cpu[c]
+                );
+                if cpu[c] > 0.0 {
+                    worst = worst.max((gpu[c] - cpu[c]).abs() / cpu[c]);
+                }
+            }
+        }
+        shadowed += usize::from(inside);
+        lit += usize::from(outside);
+    }
+    eprintln!(
+        "{light:?} light: {shadowed} shadowed pixels (largest film/unshadowed {darkest:.1e}), {lit} lit pixels (largest relative difference to the lobe {worst:.1e})"
+    );
+    assert!(
+        shadowed >= 20 && lit >= 100,
+        "{light:?}: {shadowed} shadowed and {lit} lit pixels on the row"
+    );
+}
+
+#[test]
+fn the_film_lobe_is_shadowed_by_point_lights() {
+    film_shadow(ShadowLight::Point);
+}
+
+#[test]
+fn the_film_lobe_is_shadowed_by_spot_lights() {
+    film_shadow(ShadowLight::Spot);
+}
+
+#[test]
+fn the_film_lobe_is_shadowed_by_directional_lights() {
+    film_shadow(ShadowLight::Directional);
+}

@@ -25,29 +25,31 @@ pub fn repo_root() -> PathBuf {
 /// `asset_root`. Panics, naming the cause, when no Vulkan adapter is found.
 pub fn headless_app(asset_root: &Path) -> App {
     let mut app = App::new();
-    app.add_plugins(
-        DefaultPlugins
-            .set(WindowPlugin {
-                primary_window: None,
-                exit_condition: ExitCondition::DontExit,
-                close_when_requested: false,
+    let plugins = DefaultPlugins
+        .set(WindowPlugin {
+            primary_window: None,
+            exit_condition: ExitCondition::DontExit,
+            close_when_requested: false,
+            ..default()
+        })
+        .set(AssetPlugin {
+            file_path: asset_root.to_string_lossy().into_owned(),
+            ..default()
+        })
+        .set(RenderPlugin {
+            render_creation: RenderCreation::Automatic(Box::new(WgpuSettings {
+                backends: Some(Backends::VULKAN),
                 ..default()
-            })
-            .set(AssetPlugin {
-                file_path: asset_root.to_string_lossy().into_owned(),
-                ..default()
-            })
-            .set(RenderPlugin {
-                render_creation: RenderCreation::Automatic(Box::new(WgpuSettings {
-                    backends: Some(Backends::VULKAN),
-                    ..default()
-                })),
-                synchronous_pipeline_compilation: true,
-                ..default()
-            })
-            .disable::<PipelinedRenderingPlugin>(),
-    )
-    .add_plugins(NacrePlugin);
+            })),
+            synchronous_pipeline_compilation: true,
+            ..default()
+        })
+        .disable::<PipelinedRenderingPlugin>();
+    // With the `viewer` feature (test.sh builds the tests with it, so that the viewer's test
+    // shares their build) Bevy's default plugins open windows through winit: not here.
+    #[cfg(feature = "viewer")]
+    let plugins = plugins.disable::<bevy::winit::WinitPlugin>();
+    app.add_plugins(plugins).add_plugins(NacrePlugin);
     while app.plugins_state() == PluginsState::Adding {
         bevy::tasks::tick_global_task_pools_on_main_thread();
     }
