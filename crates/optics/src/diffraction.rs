@@ -45,7 +45,7 @@
 //!
 //! **Discretisation.** On M samples the transform of the periodic extension of the patch
 //! has Fourier-series coefficients Tₙ[j] = (1/M) Σ_m (ih_m)ⁿ e^{+iκ_j·x_m}, a DFT with a
-//! positive exponent (rustfft's "inverse" direction, unnormalised, divided by M here),
+//! positive exponent (an "inverse" FFT, unnormalised, divided by M here),
 //! stored with DC at index ⌊Mₓ/2⌋, ⌊M_y/2⌋. Tₙ[0] is the mean of (ih)ⁿ; T₀ = δ_j0.
 //!
 //! **Coherence window** (Dhillon et al. 2014): only light within a spatial coherence
@@ -503,7 +503,8 @@ pub fn k_per_um(wavelength_nm: f64) -> f64 {
 }
 
 /// The DFTs of the powers of a height field: Tₙ[j] = (1/M) Σ_m (i h_m)ⁿ e^{+iκ_j·x_m}
-/// for n = 0 … N, DC centred (module docs). Computed in f64 with rustfft.
+/// for n = 0 … N, DC centred (module docs). Computed in f64 by [`dft`] (the same bits on
+/// every machine).
 #[derive(Clone, Debug, PartialEq)]
 pub struct TaylorTerms {
     nx: usize,
@@ -520,14 +521,19 @@ impl TaylorTerms {
     pub fn compute(field: &HeightField, order: usize) -> Self {
         let (nx, ny) = (field.nx, field.ny);
         let m = (nx * ny) as f64;
-        let mut planner = rustfft::FftPlanner::<f64>::new();
-        let fx = planner.plan_fft_inverse(nx);
-        let fy = planner.plan_fft_inverse(ny);
+        let fx = dft::Dft::new(nx);
+        let fy = dft::Dft::new(ny);
         let heights =
             ArrayView2::from_shape((ny, nx), &field.heights_um[..]).expect("nx × ny heights");
         let terms: Vec<Vec<C64>> = (0..=order)
             .into_par_iter()
             .map(|n| {
+                if n == 0 {
+                    // (ih)⁰ = 1: T₀ = δ_j0 exactly (a transform would add rounding noise).
+                    let mut out = vec![C64::new(0.0, 0.0); nx * ny];
+                    out[(ny / 2) * nx + nx / 2] = C64::new(1.0, 0.0);
+                    return out;
+                }
                 // iⁿ hⁿ
                 let phase = [
                     C64::new(1.0, 0.0),
@@ -947,6 +953,7 @@ impl SpectralGrid {
     }
 }
 
+mod dft;
 pub mod integrated;
 
 #[cfg(test)]
