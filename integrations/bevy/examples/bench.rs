@@ -45,25 +45,26 @@ fn base() -> StandardMaterial {
 /// Median milliseconds per frame of `frames` frames after 10 warm-up frames.
 fn time_scene(kind: Kind, frames: usize) -> f64 {
     let mut app = App::new();
-    app.add_plugins(
-        DefaultPlugins
-            .set(WindowPlugin {
-                primary_window: None,
-                exit_condition: ExitCondition::DontExit,
-                close_when_requested: false,
-                ..default()
-            })
-            // Pipelines compile before the first frame that needs them: the warm-up frames
-            // then render the scene (compiled asynchronously, a large material shader on
-            // lavapipe can still be compiling when the timed frames start, which then time
-            // an empty scene).
-            .set(RenderPlugin {
-                synchronous_pipeline_compilation: true,
-                ..default()
-            })
-            .disable::<PipelinedRenderingPlugin>(),
-    )
-    .add_plugins(NacrePlugin);
+    let plugins = DefaultPlugins
+        .set(WindowPlugin {
+            primary_window: None,
+            exit_condition: ExitCondition::DontExit,
+            close_when_requested: false,
+            ..default()
+        })
+        // Pipelines compile before the first frame that needs them: the warm-up frames then
+        // render the scene (compiled asynchronously, a large material shader on lavapipe can
+        // still be compiling when the timed frames start, which then time an empty scene).
+        .set(RenderPlugin {
+            synchronous_pipeline_compilation: true,
+            ..default()
+        })
+        .disable::<PipelinedRenderingPlugin>();
+    // Built with the `viewer` feature (as test.sh builds everything), Bevy's default plugins
+    // would open winit's event loop, which needs a display: not here.
+    #[cfg(feature = "viewer")]
+    let plugins = plugins.disable::<bevy::winit::WinitPlugin>();
+    app.add_plugins(plugins).add_plugins(NacrePlugin);
     while app.plugins_state() == PluginsState::Adding {
         bevy::tasks::tick_global_task_pools_on_main_thread();
     }
