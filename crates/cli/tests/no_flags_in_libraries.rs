@@ -4,59 +4,12 @@
 //! nacre-optics, nacre-format, nacre-bake or nacre-runtime holds a string literal that starts
 //! with a flag (`"--angles"`, `"-o/--output"`).
 
-use std::path::{Path, PathBuf};
+mod source_scan;
+
+use source_scan::{rust_files, without_test_items};
+use std::path::Path;
 
 const LIBRARIES: &[&str] = &["optics", "format", "bake", "runtime"];
-
-fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    let mut entries: Vec<_> = std::fs::read_dir(dir)
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .map(|e| e.unwrap().path())
-        .collect();
-    entries.sort();
-    for path in entries {
-        if path.is_dir() {
-            rust_files(&path, out);
-        } else if path.extension().is_some_and(|x| x == "rs") {
-            out.push(path);
-        }
-    }
-}
-
-/// `text` without its `#[cfg(test)]` items (the attribute up to the item's closing brace).
-fn without_test_items(text: &str) -> String {
-    let mut out = String::new();
-    let mut rest = text;
-    while let Some(at) = rest.find("#[cfg(test)]") {
-        out.push_str(&rest[..at]);
-        let item = &rest[at..];
-        let Some(open) = item.find(['{', ';']) else {
-            return out;
-        };
-        if item.as_bytes()[open] == b';' {
-            rest = &item[open + 1..];
-            continue;
-        }
-        let mut depth = 0usize;
-        let mut end = item.len();
-        for (i, c) in item[open..].char_indices() {
-            match c {
-                '{' => depth += 1,
-                '}' => {
-                    depth -= 1;
-                    if depth == 0 {
-                        end = open + i + 1;
-                        break;
-                    }
-                }
-                _ => {}
-            }
-        }
-        rest = &item[end..];
-    }
-    out.push_str(rest);
-    out
-}
 
 /// True when `line` holds a string literal that starts with a flag: `"--x` or `"-x/--y`.
 fn names_a_flag(line: &str) -> bool {
