@@ -8,19 +8,19 @@
 //! cargo run --release --example bench [-- FRAMES]
 //! ```
 
-use bevy::app::PluginsState;
 use bevy::camera::RenderTarget;
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::ecs::system::RunSystemOnce;
 use bevy::prelude::*;
-use bevy::render::pipelined_rendering::PipelinedRenderingPlugin;
 use bevy::render::render_resource::{PollType, TextureFormat};
 use bevy::render::renderer::RenderDevice;
 use bevy::render::{RenderApp, RenderPlugin};
-use bevy::window::ExitCondition;
-use bevy_nacre::{FilmTechnique, FilmThickness, NacreFilm, NacreMaterial, NacrePlugin};
+use bevy_nacre::{FilmTechnique, FilmThickness, NacreFilm, NacreMaterial};
+use std::path::Path;
 use std::time::Instant;
 
+#[path = "common/headless.rs"]
+mod headless;
 #[path = "common/scene.rs"]
 mod scene;
 
@@ -44,32 +44,16 @@ fn base() -> StandardMaterial {
 
 /// Median milliseconds per frame of `frames` frames after 10 warm-up frames.
 fn time_scene(kind: Kind, frames: usize) -> f64 {
-    let mut app = App::new();
-    let plugins = DefaultPlugins
-        .set(WindowPlugin {
-            primary_window: None,
-            exit_condition: ExitCondition::DontExit,
-            close_when_requested: false,
-            ..default()
-        })
-        // Pipelines compile before the first frame that needs them: the warm-up frames then
-        // render the scene (compiled asynchronously, a large material shader on lavapipe can
-        // still be compiling when the timed frames start, which then time an empty scene).
-        .set(RenderPlugin {
+    // Pipelines compile before the first frame that needs them: the warm-up frames then
+    // render the scene (compiled asynchronously, a large material shader on lavapipe can
+    // still be compiling when the timed frames start, which then time an empty scene).
+    let mut app = headless::headless_app(
+        Path::new("assets"),
+        RenderPlugin {
             synchronous_pipeline_compilation: true,
             ..default()
-        })
-        .disable::<PipelinedRenderingPlugin>();
-    // Built with the `viewer` feature (as test.sh builds everything), Bevy's default plugins
-    // would open winit's event loop, which needs a display: not here.
-    #[cfg(feature = "viewer")]
-    let plugins = plugins.disable::<bevy::winit::WinitPlugin>();
-    app.add_plugins(plugins).add_plugins(NacrePlugin);
-    while app.plugins_state() == PluginsState::Adding {
-        bevy::tasks::tick_global_task_pools_on_main_thread();
-    }
-    app.finish();
-    app.cleanup();
+        },
+    );
     app.world_mut()
         .run_system_once(
             move |mut commands: Commands,

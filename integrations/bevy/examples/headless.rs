@@ -7,20 +7,20 @@
 //!
 //! Vulkan (`WGPU_BACKEND` is honoured by Bevy; Mesa's lavapipe works without a GPU).
 
-use bevy::app::PluginsState;
 use bevy::camera::RenderTarget;
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::ecs::system::RunSystemOnce;
 use bevy::gltf::GltfAssetLabel;
 use bevy::prelude::*;
-use bevy::render::pipelined_rendering::PipelinedRenderingPlugin;
+use bevy::render::RenderPlugin;
 use bevy::render::render_resource::TextureFormat;
 use bevy::render::view::screenshot::{Screenshot, save_to_disk};
-use bevy::window::ExitCondition;
 use bevy::world_serialization::{WorldAsset, WorldAssetRoot};
-use bevy_nacre::{NacreMaterial, NacrePlugin};
+use bevy_nacre::NacreMaterial;
 use std::path::PathBuf;
 
+#[path = "common/headless.rs"]
+mod headless;
 #[path = "common/scene.rs"]
 mod scene;
 
@@ -43,29 +43,7 @@ fn main() {
         .map(|p| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf()))
         .unwrap_or_else(|| PathBuf::from("."));
 
-    let mut app = App::new();
-    let plugins = DefaultPlugins
-        .set(WindowPlugin {
-            primary_window: None,
-            exit_condition: ExitCondition::DontExit,
-            close_when_requested: false,
-            ..default()
-        })
-        .set(AssetPlugin {
-            file_path: root.to_string_lossy().into_owned(),
-            ..default()
-        })
-        .disable::<PipelinedRenderingPlugin>();
-    // Built with the `viewer` feature (as test.sh builds everything), Bevy's default plugins
-    // would open winit's event loop, which needs a display: not here.
-    #[cfg(feature = "viewer")]
-    let plugins = plugins.disable::<bevy::winit::WinitPlugin>();
-    app.add_plugins(plugins).add_plugins(NacrePlugin);
-    while app.plugins_state() == PluginsState::Adding {
-        bevy::tasks::tick_global_task_pools_on_main_thread();
-    }
-    app.finish();
-    app.cleanup();
+    let mut app = headless::headless_app(&root, RenderPlugin::default());
 
     let world = app.world_mut();
     let image = world

@@ -381,25 +381,7 @@ fn specular_lobe(
         .add(Rectangle::new(0.8, 0.8));
     let material = world
         .resource_mut::<Assets<NacreMaterial>>()
-        .add(NacreMaterial {
-            base: StandardMaterial {
-                base_color: Color::BLACK,
-                perceptual_roughness: LOBE_PERCEPTUAL_ROUGHNESS as f32,
-                ..default()
-            },
-            extension: NacreFilm {
-                technique,
-                base_ior: Vec3::splat(base.re as f32),
-                base_kappa: Vec3::splat(base.im as f32),
-                film_ior: LOBE_FILM_IOR as f32,
-                thickness: FilmThickness::Gltf {
-                    min_nm: LOBE_THICKNESS_NM as f32,
-                    max_nm: LOBE_THICKNESS_NM as f32,
-                },
-                weight: 1.0,
-                ..default()
-            },
-        });
+        .add(lobe_material(technique, base));
     for (i, phi) in LOBE_QUADS_DEG.iter().enumerate() {
         world.spawn((
             Mesh3d(mesh.clone()),
@@ -763,8 +745,8 @@ fn lobe_film_lut() -> impl Fn(f64) -> [f64; 3] {
 }
 
 /// The lobe tests' film material: black base (no diffuse), roughness
-/// `LOBE_PERCEPTUAL_ROUGHNESS`, film index 1.8, 400 nm, `film_lut`.
-fn lobe_film_material() -> NacreMaterial {
+/// `LOBE_PERCEPTUAL_ROUGHNESS`, film index 1.8, 400 nm, with `technique` on `base`.
+fn lobe_material(technique: FilmTechnique, base: C64) -> NacreMaterial {
     NacreMaterial {
         base: StandardMaterial {
             base_color: Color::BLACK,
@@ -772,6 +754,9 @@ fn lobe_film_material() -> NacreMaterial {
             ..default()
         },
         extension: NacreFilm {
+            technique,
+            base_ior: Vec3::splat(base.re as f32),
+            base_kappa: Vec3::splat(base.im as f32),
             film_ior: LOBE_FILM_IOR as f32,
             thickness: FilmThickness::Gltf {
                 min_nm: LOBE_THICKNESS_NM as f32,
@@ -781,6 +766,11 @@ fn lobe_film_material() -> NacreMaterial {
             ..default()
         },
     }
+}
+
+/// [`lobe_material`] with `film_lut` on the default base (1.5, the film-lut table's).
+fn lobe_film_material() -> NacreMaterial {
+    lobe_material(FilmTechnique::Lut, C64::new(1.5, 0.0))
 }
 
 /// The film's specular radiance on the CPU where the film's normal `normal` faces the view

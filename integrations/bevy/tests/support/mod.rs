@@ -3,17 +3,16 @@
 //! fails the test that asked for it.
 #![allow(dead_code)]
 
-use bevy::app::PluginsState;
 use bevy::prelude::*;
 use bevy::render::RenderPlugin;
-use bevy::render::pipelined_rendering::PipelinedRenderingPlugin;
 use bevy::render::render_resource::TextureFormat;
 use bevy::render::settings::{Backends, RenderCreation, WgpuSettings};
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
-use bevy::window::ExitCondition;
-use bevy_nacre::NacrePlugin;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
+
+#[path = "../../examples/common/headless.rs"]
+mod headless;
 
 /// The repository root (`integrations/bevy/../..`).
 pub fn repo_root() -> PathBuf {
@@ -24,37 +23,17 @@ pub fn repo_root() -> PathBuf {
 /// rendering, synchronous pipeline compilation) and [`NacrePlugin`], reading assets under
 /// `asset_root`. Panics, naming the cause, when no Vulkan adapter is found.
 pub fn headless_app(asset_root: &Path) -> App {
-    let mut app = App::new();
-    let plugins = DefaultPlugins
-        .set(WindowPlugin {
-            primary_window: None,
-            exit_condition: ExitCondition::DontExit,
-            close_when_requested: false,
-            ..default()
-        })
-        .set(AssetPlugin {
-            file_path: asset_root.to_string_lossy().into_owned(),
-            ..default()
-        })
-        .set(RenderPlugin {
+    let app = headless::headless_app(
+        asset_root,
+        RenderPlugin {
             render_creation: RenderCreation::Automatic(Box::new(WgpuSettings {
                 backends: Some(Backends::VULKAN),
                 ..default()
             })),
             synchronous_pipeline_compilation: true,
             ..default()
-        })
-        .disable::<PipelinedRenderingPlugin>();
-    // With the `viewer` feature (test.sh builds the tests with it, so that the viewer's test
-    // shares their build) Bevy's default plugins open windows through winit: not here.
-    #[cfg(feature = "viewer")]
-    let plugins = plugins.disable::<bevy::winit::WinitPlugin>();
-    app.add_plugins(plugins).add_plugins(NacrePlugin);
-    while app.plugins_state() == PluginsState::Adding {
-        bevy::tasks::tick_global_task_pools_on_main_thread();
-    }
-    app.finish();
-    app.cleanup();
+        },
+    );
     assert!(
         app.get_sub_app(bevy::render::RenderApp).is_some(),
         "no Vulkan adapter: Bevy could not create its renderer (install Mesa's lavapipe, \
