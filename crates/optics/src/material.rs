@@ -70,6 +70,13 @@ enum Dispersion {
 
 impl Dispersion {
     fn eval(&self, wavelength_nm: f64) -> f64 {
+        self.eval_from(wavelength_nm, &mut Cursor::default())
+    }
+
+    /// [`Dispersion::eval`] (the same bits), a tabulated value found from `cursor` (the
+    /// segment of the previous wavelength asked for) when the wavelengths ascend, so that a
+    /// sweep walks the table once instead of searching it per wavelength.
+    fn eval_from(&self, wavelength_nm: f64, cursor: &mut Cursor) -> f64 {
         match self {
             Dispersion::Constant(v) => *v,
             Dispersion::Tabulated {
@@ -80,7 +87,7 @@ impl Dispersion {
                 if *zero_outside && !(wavelength_nm >= w[0] && wavelength_nm <= w[w.len() - 1]) {
                     0.0
                 } else {
-                    interpolate(w, value, wavelength_nm)
+                    cursor.interpolate(w, value, wavelength_nm)
                 }
             }
             Dispersion::Formula { kind, coefficients } => {
@@ -90,16 +97,50 @@ impl Dispersion {
     }
 }
 
-/// Linear interpolation in `x` (strictly increasing, `x[0] <= at <= x[last]`).
-fn interpolate(x: &[f64], y: &[f64], at: f64) -> f64 {
-    if x.len() == 1 {
-        return y[0];
+/// Where the previous interpolation in a table was: the first sample strictly greater than
+/// the previous wavelength `at` (+∞ before any, so that the first is searched for).
+#[derive(Clone, Copy, Debug)]
+struct Cursor {
+    first_above: usize,
+    at: f64,
+}
+
+impl Default for Cursor {
+    fn default() -> Self {
+        Cursor {
+            first_above: 0,
+            at: f64::INFINITY,
+        }
     }
-    // First sample strictly greater than `at`, clamped so that [i-1, i] is a segment.
-    let i = x.partition_point(|&v| v <= at).clamp(1, x.len() - 1);
-    let (x0, x1, y0, y1) = (x[i - 1], x[i], y[i - 1], y[i]);
-    let t = (at - x0) / (x1 - x0);
-    y0 + t * (y1 - y0)
+}
+
+impl Cursor {
+    /// Linear interpolation in `x` (strictly increasing, `x[0] <= at <= x[last]`).
+    fn interpolate(&mut self, x: &[f64], y: &[f64], at: f64) -> f64 {
+        if x.len() == 1 {
+            return y[0];
+        }
+        // First sample strictly greater than `at`: a few steps on from the previous one while
+        // the wavelengths ascend, else searched for (the same index either way).
+        let mut first_above = 0;
+        if at >= self.at {
+            first_above = self.first_above;
+            for _ in 0..4 {
+                if first_above < x.len() && x[first_above] <= at {
+                    first_above += 1;
+                }
+            }
+        }
+        if first_above < x.len() && x[first_above] <= at {
+            first_above += x[first_above..].partition_point(|&v| v <= at);
+        }
+        *self = Cursor { first_above, at };
+        // Clamped so that [i-1, i] is a segment.
+        let i = first_above.clamp(1, x.len() - 1);
+        let (x0, x1, y0, y1) = (x[i - 1], x[i], y[i - 1], y[i]);
+        let t = (at - x0) / (x1 - x0);
+        y0 + t * (y1 - y0)
+    }
 }
 
 /// Evaluates refractiveindex.info formula `kind` at `lambda_um`; returns n (NaN when the
@@ -720,6 +761,22 @@ impl Material {
     ///
     /// Errors outside the covered range or where a formula is non-physical.
     pub fn index_at(&self, wavelength_nm: f64) -> Result<C64> {
+        self.index_from(wavelength_nm, &mut [Cursor::default(); 2])
+    }
+
+    /// [`Material::index_at`] at each of `wavelengths_nm` (the same values, and the error of
+    /// the first wavelength that has one); ascending wavelengths walk a tabulated index's
+    /// table once.
+    pub fn indices_at(&self, wavelengths_nm: &[f64]) -> Result<Vec<C64>> {
+        let mut cursors = [Cursor::default(); 2];
+        wavelengths_nm
+            .iter()
+            .map(|&wl| self.index_from(wl, &mut cursors))
+            .collect()
+    }
+
+    /// [`Material::index_at`] with the tables' cursors (n, κ) of [`Dispersion::eval_from`].
+    fn index_from(&self, wavelength_nm: f64, cursors: &mut [Cursor; 2]) -> Result<C64> {
         if !(wavelength_nm > 0.0) || !wavelength_nm.is_finite() {
             return Err(Error::InvalidWavelength { wavelength_nm });
         }
@@ -744,7 +801,10 @@ impl Material {
                 to_nm,
             });
         }
-        let index = C64::new(self.n.eval(wavelength_nm), self.k.eval(wavelength_nm));
+        let index = C64::new(
+            self.n.eval_from(wavelength_nm, &mut cursors[0]),
+            self.k.eval_from(wavelength_nm, &mut cursors[1]),
+        );
         if !(index.re > 0.0 && index.re.is_finite() && index.im >= 0.0 && index.im.is_finite()) {
             return Err(Error::NonPhysicalIndex {
                 material: self.name.clone(),
@@ -1323,6 +1383,50 @@ DATA:
         assert_eq!(m.index_at(400.0).unwrap(), C64::new(1.5, 1.9));
         assert!(m.index_at(600.0001).is_err());
         assert!(m.index_at(399.9).is_err());
+    }
+
+    /// The table walk of `indices_at` gives `index_at`'s bits and errors in any order of
+    /// wavelengths: ascending (walked), descending and shuffled (searched), repeated,
+    /// on the samples, between them, and outside the range.
+    #[test]
+    fn indices_at_is_index_at_in_any_order() {
+        let text = std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../tables/materials/au.yml"
+        ))
+        .unwrap();
+        let gold = Material::from_refractiveindex_yaml("au", "au.yml", &text).unwrap();
+        let metal = Material::from_refractiveindex_yaml("m", "m.yml", METAL).unwrap();
+        let silica = Material::from_refractiveindex_yaml("s", "s.yml", SILICA).unwrap();
+        let ascending: Vec<f64> = (0..2000).map(|k| 200.0 + 0.37 * k as f64).collect();
+        let mut shuffled = ascending.clone();
+        // A fixed permutation (multiplicative, 2000 and 1237 coprime).
+        for (k, w) in shuffled.iter_mut().enumerate() {
+            *w = ascending[(k * 1237) % ascending.len()];
+        }
+        let descending: Vec<f64> = ascending.iter().rev().copied().collect();
+        let mut sparse: Vec<f64> = vec![400.0, 400.0, 400.0, 450.0, 500.0, 500.0, 600.0];
+        sparse.extend([401.0, 599.9, 600.0, 1e-3, 0.0, -5.0, f64::NAN, 800.0, 430.0]);
+        for m in [&gold, &metal, &silica] {
+            for list in [&ascending, &shuffled, &descending, &sparse] {
+                // Every prefix: the values' bits, or the first wavelength's error.
+                let one: Vec<Result<C64>> = list.iter().map(|&w| m.index_at(w)).collect();
+                for k in 0..list.len() {
+                    let want: Result<Vec<C64>> = one[..=k].iter().cloned().collect();
+                    let bits = |v: Vec<C64>| -> Vec<(u64, u64)> {
+                        v.iter().map(|n| (n.re.to_bits(), n.im.to_bits())).collect()
+                    };
+                    let got = m.indices_at(&list[..=k]);
+                    assert_eq!(
+                        want.map(bits).map_err(|e| e.to_string()),
+                        got.map(bits).map_err(|e| e.to_string()),
+                        "{} at {} nm",
+                        m.name(),
+                        list[k]
+                    );
+                }
+            }
+        }
     }
 
     #[test]

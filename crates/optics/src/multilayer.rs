@@ -3,7 +3,8 @@
 //!
 //! # Layout
 //!
-//! The media indices are resolved once per wavelength (`Stack::resolve`) and stored
+//! The media indices are resolved once per wavelength and medium (a tabulated index by
+//! walking its table along the ascending wavelengths, `Material::indices_at`) and stored
 //! structure-of-arrays ([`Media`]: Re ñ_j, ñ_j² and |ñ_j|² at `[j][w]` for medium j and
 //! wavelength w, with k₀ = 2π/λ per wavelength). A sweep's output is angle-major, so one
 //! angle's row is contiguous; each lane evaluates one wavelength of it. Wavelengths rather
@@ -17,7 +18,13 @@
 //! each stage (a medium's q, one film of the recurrence, the powers) is a loop over the
 //! block's independent elements, which the CPU overlaps, instead of one element's long
 //! chain of square roots through the whole stack. No allocation per evaluation (one
-//! [`Block`] of staging arrays per row).
+//! [`Block`] of staging arrays per thread).
+//!
+//! Repeated media are computed once per element ([`Slots`]): a medium with the same index
+//! bits at every wavelength as one below it has the same q, and a film of the same medium
+//! and thickness the same e^{2iδ} — the H and L layers of a periodic mirror, or the TiO₂
+//! twice in TiO₂/MgF₂/TiO₂. The copies are the same bits (tested:
+//! `repeats_are_computed_once_with_the_same_bits`).
 //!
 //! # Determinism
 //!
@@ -77,6 +84,7 @@ use crate::simd::{ARCH, PowerSlot, exp_neg, lane, lane_mut, sin_cos_bounded};
 use crate::stack::{Power, wavenumber};
 use num_complex::Complex64 as C64;
 use pulp::{Simd, WithSimd};
+use std::cell::RefCell;
 
 /// Largest |Re ñ| or |Im ñ| the kernel takes (|ñ² − β²|² stays below 10²⁵).
 const MAX_INDEX: f64 = 1e6;
@@ -106,44 +114,114 @@ pub(crate) struct Media {
     /// Per medium and block of [`BLOCK`] wavelengths: Im ñ_j² = ±0 at every wavelength of
     /// the block (the lossless root of [`medium`]).
     lossless: Vec<Vec<bool>>,
+    /// Where each medium's q and each film's e^{2iδ} are kept in a [`Block`] ([`Slots`]).
+    media_slots: Slots,
+    film_slots: Slots,
+}
+
+/// Where each item (medium, or film) of a stack is kept in a [`Block`], so that repeated
+/// items are computed once per element: a medium with the same index bits at every
+/// wavelength has the same q, a film of the same medium and thickness the same e^{2iδ}
+/// (the H and L of a periodic mirror). Items are computed from the last (the substrate) to
+/// the first; a repeated item (up to `shared` of them) keeps a slot of its own from its first
+/// computation on, the others share `rotating` slots by position.
+struct Slots {
+    /// Per item: its slot.
+    slot: Vec<usize>,
+    /// Per item: whether an earlier-computed repeat has already filled its slot.
+    known: Vec<bool>,
+}
+
+impl Slots {
+    /// Slots for `count` items, `same(i, j)` saying whether items i and j have the same
+    /// value: item j takes slot j mod `rotating` unless it is repeated, and the first
+    /// `shared` repeated values take slots `rotating`, `rotating` + 1, ….
+    fn new(
+        count: usize,
+        rotating: usize,
+        shared: usize,
+        same: impl Fn(usize, usize) -> bool,
+    ) -> Self {
+        let mut slot: Vec<usize> = (0..count).map(|j| j % rotating).collect();
+        let mut known = vec![false; count];
+        let mut next = rotating;
+        let mut assigned = vec![false; count];
+        for j in (0..count).rev() {
+            if assigned[j] || next == rotating + shared {
+                continue;
+            }
+            let repeats: Vec<usize> = (0..j).filter(|&i| !assigned[i] && same(i, j)).collect();
+            if repeats.is_empty() {
+                continue;
+            }
+            for &i in repeats.iter().chain([&j]) {
+                slot[i] = next;
+                assigned[i] = true;
+                known[i] = i != j;
+            }
+            next += 1;
+        }
+        Slots { slot, known }
+    }
 }
 
 impl Media {
-    /// The media of `indices` (per wavelength: ambient, films top first, substrate) at
-    /// `wavelengths_nm`, or `None` when an index or a film's phase is outside the ranges the
-    /// kernel takes (see the constants; the caller then runs the scalar recurrence).
+    /// [`Media::from_columns`] for indices given per wavelength (ambient, films top first,
+    /// substrate).
+    #[cfg(test)]
     pub(crate) fn new(
         indices: &[Vec<C64>],
         wavelengths_nm: &[f64],
         thickness_nm: &[f64],
     ) -> Option<Self> {
+        let columns: Vec<Vec<C64>> = (0..thickness_nm.len() + 2)
+            .map(|j| indices.iter().map(|idx| idx[j]).collect())
+            .collect();
+        Self::from_columns(&columns, wavelengths_nm, thickness_nm)
+    }
+
+    /// The media of `columns` (per medium — ambient, films top first, substrate — its index
+    /// at each of `wavelengths_nm`), or `None` when an index or a film's phase is outside the
+    /// ranges the kernel takes (see the constants; the caller then runs the scalar
+    /// recurrence).
+    pub(crate) fn from_columns(
+        columns: &[Vec<C64>],
+        wavelengths_nm: &[f64],
+        thickness_nm: &[f64],
+    ) -> Option<Self> {
         let media = thickness_nm.len() + 2;
-        let mut re = vec![Vec::with_capacity(indices.len()); media];
-        let (mut n2_re, mut n2_im, mut n_abs2) = (re.clone(), re.clone(), re.clone());
-        let mut k0_per_nm = Vec::with_capacity(indices.len());
-        for (idx, &wl) in indices.iter().zip(wavelengths_nm) {
-            debug_assert_eq!(idx.len(), media);
-            let k0 = wavenumber(wl);
-            let n0 = idx[0].re.abs();
-            for (j, n) in idx.iter().enumerate() {
+        debug_assert_eq!(columns.len(), media);
+        let k0_per_nm: Vec<f64> = wavelengths_nm.iter().map(|&wl| wavenumber(wl)).collect();
+        for (j, column) in columns.iter().enumerate() {
+            debug_assert_eq!(column.len(), wavelengths_nm.len());
+            for (w, n) in column.iter().enumerate() {
                 let (a, b) = (n.re.abs(), n.im.abs());
                 // Negated comparisons: NaN fails them.
                 if !(a <= MAX_INDEX && b <= MAX_INDEX && a.max(b) >= MIN_INDEX) {
                     return None;
                 }
+                let n0 = columns[0][w].re.abs();
                 if (1..media - 1).contains(&j)
-                    && !(k0 * thickness_nm[j - 1] * (a + b + n0) <= MAX_PHASE_RAD)
+                    && !(k0_per_nm[w] * thickness_nm[j - 1] * (a + b + n0) <= MAX_PHASE_RAD)
                 {
                     return None;
                 }
-                re[j].push(n.re);
-                let n2 = n * n;
-                n2_re[j].push(n2.re);
-                n2_im[j].push(n2.im);
-                n_abs2[j].push(n.norm_sqr());
             }
-            k0_per_nm.push(k0);
         }
+        let map = |f: fn(&C64) -> f64| -> Vec<Vec<f64>> {
+            columns.iter().map(|c| c.iter().map(f).collect()).collect()
+        };
+        let re = map(|n| n.re);
+        let n2_re = map(|n| (n * n).re);
+        let n2_im = map(|n| (n * n).im);
+        let n_abs2 = map(|n| n.norm_sqr());
+        let column = |j: usize| columns[j].iter().map(|n| (n.re.to_bits(), n.im.to_bits()));
+        let same_medium = |i: usize, j: usize| column(i).eq(column(j));
+        let media_slots = Slots::new(media, 2, MEDIA_SLOTS - 2, same_medium);
+        // Films 1..=N as items 0..N − 1.
+        let film_slots = Slots::new(media - 2, 1, FILM_SLOTS - 1, |i, j| {
+            thickness_nm[i].to_bits() == thickness_nm[j].to_bits() && same_medium(i + 1, j + 1)
+        });
         let forward = n2_im
             .iter()
             .map(|y| y.iter().all(|y| y.to_bits() & SIGN == 0))
@@ -165,6 +243,8 @@ impl Media {
             thickness_nm: thickness_nm.to_vec(),
             forward,
             lossless,
+            media_slots,
+            film_slots,
         })
     }
 
@@ -194,19 +274,29 @@ fn row_powers<T: PowerSlot, const SHORTCUTS: bool>(
     vector: bool,
 ) {
     assert_eq!(row.len(), media.wavelengths());
-    let op = RowOp::<T, SHORTCUTS> {
-        media,
-        sin_theta,
-        row,
-    };
-    if vector {
-        ARCH.dispatch(op)
-    } else {
-        op.with_simd(pulp::Scalar::new())
+    thread_local! {
+        /// The staging arrays, allocated once per thread (zeroing them for every row costs
+        /// as much as a stage). What a row leaves in them is never read by the next: every
+        /// stage writes the lanes it reads before reading them.
+        static BLOCK: RefCell<Box<Block>> = RefCell::new(Box::new(Block::new()));
     }
+    BLOCK.with_borrow_mut(|block| {
+        let op = RowOp::<T, SHORTCUTS> {
+            block,
+            media,
+            sin_theta,
+            row,
+        };
+        if vector {
+            ARCH.dispatch(op)
+        } else {
+            op.with_simd(pulp::Scalar::new())
+        }
+    })
 }
 
 struct RowOp<'a, T, const SHORTCUTS: bool> {
+    block: &'a mut Block,
     media: &'a Media,
     sin_theta: f64,
     row: &'a mut [T],
@@ -214,6 +304,13 @@ struct RowOp<'a, T, const SHORTCUTS: bool> {
 
 /// Wavelengths per block of the staging arrays (a multiple of every vector width).
 const BLOCK: usize = 64;
+
+/// Media kept in a [`Block`]: two for the media of the interface being added, the rest for
+/// repeated media ([`Slots`]).
+const MEDIA_SLOTS: usize = 6;
+/// Film phases kept in a [`Block`]: one for the film below the interface being added, the
+/// rest for repeated films.
+const FILM_SLOTS: usize = 4;
 
 /// ñ, ñ², q of one medium over a block, (re, im) arrays.
 struct MediumBlock {
@@ -264,14 +361,14 @@ impl MediumBlock {
 /// over the whole block (loops of independent elements, which the CPU overlaps), rather
 /// than element by element through the stack (one long dependency chain).
 struct Block {
-    /// Media j + 1 (below the interface being added) and j: `media[c.below]` and
-    /// `media[1 - c.below]` (the roles alternate rather than the arrays being swapped).
-    media: [MediumBlock; 2],
+    /// The media ([`Media::media_slots`]): j + 1 (below the interface being added) and j
+    /// at `media[c.below]` and `media[c.above]`.
+    media: [MediumBlock; MEDIA_SLOTS],
     /// β² = (n₀ sin θ₀)² per wavelength.
     beta2: [f64; BLOCK],
-    /// e^{2iδ} of the film below the interface being added, (re, im), and its decay
-    /// e^{−2 Im δ} (not written where no lane of the block decays).
-    phase: [[f64; BLOCK]; 3],
+    /// The films' e^{2iδ} ([`Media::film_slots`]), (re, im), and decay e^{−2 Im δ} (not
+    /// written where no lane of the block decays): film j + 1's at `phase[c.film]`.
+    phase: [[[f64; BLOCK]; 3]; FILM_SLOTS],
     /// Γ = N / D per polarisation (s, p): N and D as (re, im) pairs.
     num: [[f64; BLOCK]; 4],
     den: [[f64; BLOCK]; 4],
@@ -295,8 +392,11 @@ struct Ctx<'a> {
     n0_re: &'a [f64],
     /// 2 d of the film below the interface (j + 1), nm; 0 where there is none.
     two_d_nm: f64,
-    /// Which of [`Block::media`] holds medium j + 1.
+    /// Which of [`Block::media`] hold media j and j + 1, and which of [`Block::phase`] film
+    /// j + 1 (0 where there is none).
+    above: usize,
     below: usize,
+    film: usize,
     sin_theta: f64,
 }
 
@@ -306,6 +406,10 @@ const FIRST: u8 = 1;
 const MEDIUM_PHASE: u8 = 2;
 const STEP: u8 = 3;
 const POWERS: u8 = 4;
+/// The halves of `MEDIUM_PHASE`, for when the other is known (a repeat, [`Slots`]): medium
+/// j alone, film j + 1's phase alone.
+const MEDIUM: u8 = 5;
+const PHASE: u8 = 6;
 
 /// Flags of a stage, uniform over a block (`const`, so that each combination is its own
 /// loop without branches); each only skips operations whose result is known exactly
@@ -318,9 +422,11 @@ const FORWARD: u8 = 2;
 const DECAY: u8 = 4;
 /// N, D, U are rescaled after this interface ([`Block::put`]).
 const RESCALE: u8 = 8;
+/// Medium j is known (a repeat, [`Slots`]): `FIRST` only adds the interface.
+const KNOWN: u8 = 16;
 
 /// Calls `$f::<F>` with `F` = `$flags` as a constant, for flags within `LOSSLESS | FORWARD |
-/// DECAY | RESCALE`.
+/// DECAY`, `DECAY | RESCALE` or `KNOWN`.
 macro_rules! with_flags {
     ($flags:expr, $f:ident, $($arg:expr),*) => {
         match $flags {
@@ -334,6 +440,7 @@ macro_rules! with_flags {
             7 => $f::<7>($($arg),*),
             8 => $f::<8>($($arg),*),
             12 => $f::<12>($($arg),*),
+            16 => $f::<16>($($arg),*),
             _ => unreachable!(),
         }
     };
@@ -343,9 +450,9 @@ impl Block {
     fn new() -> Self {
         let z = [0.0; BLOCK];
         Block {
-            media: [MediumBlock::new(), MediumBlock::new()],
+            media: std::array::from_fn(|_| MediumBlock::new()),
             beta2: z,
-            phase: [z; 3],
+            phase: [[z; 3]; FILM_SLOTS],
             num: [z; 4],
             den: [z; 4],
             u: [z; 2],
@@ -434,7 +541,7 @@ impl Block {
                 let beta = s.mul_f64s(lane::<S>(c.n0_re, i), s.splat_f64s(c.sin_theta));
                 *lane_mut::<S>(&mut self.beta2, i) = s.mul_f64s(beta, beta);
                 let sub = self.medium_j::<S, F>(s, c, i);
-                self.media[c.below].store(i, sub);
+                self.media[c.above].store(i, sub);
                 let re_n2_conj_q = s.add_f64s(
                     s.mul_f64s(sub.n2.re, sub.q.re),
                     s.mul_f64s(sub.n2.im, sub.q.im),
@@ -442,12 +549,17 @@ impl Block {
                 *lane_mut::<S>(&mut self.substrate[0], i) = sub.q.re;
                 *lane_mut::<S>(&mut self.substrate[1], i) = re_n2_conj_q;
                 *lane_mut::<S>(&mut self.substrate[2], i) = sub.n_abs2;
-                false
+                any_nonzero(s, sub.q.im)
             }
             FIRST => {
                 // Γ_N = r_{N,N+1} = ρ/σ, |τ_N|² = |t_{N,N+1}|² = |tσ|²/|σ|².
-                let above = self.medium_j::<S, F>(s, c, i);
-                self.media[1 - c.below].store(i, above);
+                let above = if F & KNOWN != 0 {
+                    self.media[c.above].load::<S>(i)
+                } else {
+                    let above = self.medium_j::<S, F>(s, c, i);
+                    self.media[c.above].store(i, above);
+                    above
+                };
                 let below = self.media[c.below].load::<S>(i);
                 let f = interface(s, &above, &below);
                 for pol in 0..2 {
@@ -457,32 +569,40 @@ impl Block {
                 }
                 any_nonzero(s, above.q.im)
             }
-            MEDIUM_PHASE => {
+            MEDIUM_PHASE | MEDIUM | PHASE => {
                 // Medium j, and e^{2iδ} of film j + 1 (medium `below`), δ = k₀ q d:
                 // e^{−2 Im δ} (cos, sin)(2 Re δ) — independent chains, side by side.
-                let above = self.medium_j::<S, F>(s, c, i);
-                self.media[1 - c.below].store(i, above);
-                let kd2 = s.mul_f64s(lane::<S>(c.k0_per_nm, i), s.splat_f64s(c.two_d_nm));
-                let q = &self.media[c.below];
-                let (sin_x, cos_x) = sin_cos_bounded(s, s.mul_f64s(lane::<S>(&q.q_re, i), kd2));
-                let (re, im) = if F & DECAY != 0 {
-                    let a = exp_neg(s, s.mul_f64s(lane::<S>(&q.q_im, i), kd2));
-                    *lane_mut::<S>(&mut self.phase[2], i) = a;
-                    (s.mul_f64s(a, cos_x), s.mul_f64s(a, sin_x))
-                } else {
-                    (cos_x, sin_x)
-                };
-                *lane_mut::<S>(&mut self.phase[0], i) = re;
-                *lane_mut::<S>(&mut self.phase[1], i) = im;
-                any_nonzero(s, above.q.im)
+                let mut decays = false;
+                if STAGE != PHASE {
+                    let above = self.medium_j::<S, F>(s, c, i);
+                    self.media[c.above].store(i, above);
+                    decays = any_nonzero(s, above.q.im);
+                }
+                if STAGE != MEDIUM {
+                    let kd2 = s.mul_f64s(lane::<S>(c.k0_per_nm, i), s.splat_f64s(c.two_d_nm));
+                    let q = &self.media[c.below];
+                    let (q_re, q_im) = (lane::<S>(&q.q_re, i), lane::<S>(&q.q_im, i));
+                    let phase = &mut self.phase[c.film];
+                    let (sin_x, cos_x) = sin_cos_bounded(s, s.mul_f64s(q_re, kd2));
+                    let (re, im) = if F & DECAY != 0 {
+                        let a = exp_neg(s, s.mul_f64s(q_im, kd2));
+                        *lane_mut::<S>(&mut phase[2], i) = a;
+                        (s.mul_f64s(a, cos_x), s.mul_f64s(a, sin_x))
+                    } else {
+                        (cos_x, sin_x)
+                    };
+                    *lane_mut::<S>(&mut phase[0], i) = re;
+                    *lane_mut::<S>(&mut phase[1], i) = im;
+                }
+                decays
             }
             STEP => {
-                let above = self.media[1 - c.below].load::<S>(i);
+                let above = self.media[c.above].load::<S>(i);
                 let below = self.media[c.below].load::<S>(i);
                 let f = interface(s, &above, &below);
                 let e2 = Cx::<S> {
-                    re: ld(&self.phase[0]),
-                    im: ld(&self.phase[1]),
+                    re: ld(&self.phase[c.film][0]),
+                    im: ld(&self.phase[c.film][1]),
                 };
                 for pol in 0..2 {
                     let n = Cx::<S> {
@@ -504,7 +624,7 @@ impl Block {
                     let u = s.mul_f64s(f.t_sigma2[pol], ld(&self.u[pol]));
                     // Where no lane decays, |e^{iδ}|² = 1 exactly.
                     let u = if F & DECAY != 0 {
-                        s.mul_f64s(u, ld(&self.phase[2]))
+                        s.mul_f64s(u, ld(&self.phase[c.film][2]))
                     } else {
                         u
                     };
@@ -514,8 +634,8 @@ impl Block {
             }
             POWERS => {
                 // Power factors Re q_f / Re q₀ and
-                // Re(ñ_f² conj q_f)/|ñ_f|² ÷ Re(ñ₀² conj q₀)/|ñ₀|²; `below` is the ambient.
-                let amb = self.media[c.below].load::<S>(i);
+                // Re(ñ_f² conj q_f)/|ñ_f|² ÷ Re(ñ₀² conj q₀)/|ñ₀|²; `above` is the ambient.
+                let amb = self.media[c.above].load::<S>(i);
                 let re_n2_conj_q = s.add_f64s(
                     s.mul_f64s(amb.n2.re, amb.q.re),
                     s.mul_f64s(amb.n2.im, amb.q.im),
@@ -586,7 +706,7 @@ impl<T: PowerSlot, const SHORTCUTS: bool> WithSimd for RowOp<'_, T, SHORTCUTS> {
     fn with_simd<S: Simd>(self, s: S) {
         let media = self.media;
         let count = media.re.len();
-        let mut b = Block::new();
+        let b: &mut Block = self.block;
         for (k, row) in self.row.chunks_mut(BLOCK).enumerate() {
             let n = row.len();
             let w = k * BLOCK..k * BLOCK + n;
@@ -599,7 +719,8 @@ impl<T: PowerSlot, const SHORTCUTS: bool> WithSimd for RowOp<'_, T, SHORTCUTS> {
                 let forward = if media.forward[j] { FORWARD } else { 0 };
                 lossless | forward
             };
-            let ctx = |j: usize, below: usize| Ctx {
+            // Interface j between media j and j + 1 (the substrate alone for j = N + 1).
+            let ctx = |j: usize| Ctx {
                 n2_re: &media.n2_re[j][w.clone()],
                 n2_im: &media.n2_im[j][w.clone()],
                 n_abs2: &media.n_abs2[j][w.clone()],
@@ -610,13 +731,19 @@ impl<T: PowerSlot, const SHORTCUTS: bool> WithSimd for RowOp<'_, T, SHORTCUTS> {
                 } else {
                     0.0
                 },
-                below,
+                above: media.media_slots.slot[j],
+                below: media.media_slots.slot[(j + 1).min(count - 1)],
+                film: if j + 1 < count - 1 {
+                    media.film_slots.slot[j]
+                } else {
+                    0
+                },
                 sin_theta: self.sin_theta,
             };
             macro_rules! run {
                 ($stage:ident, $flags:expr, $c:expr) => {{
                     let c = $c;
-                    let (b, s) = (&mut b, s);
+                    let (b, s) = (&mut *b, s);
                     #[inline(always)]
                     fn go<const F: u8>(b: &mut Block, s: impl Simd, c: Ctx, n: usize) -> bool {
                         b.run::<_, $stage, F>(s, c, n)
@@ -624,28 +751,45 @@ impl<T: PowerSlot, const SHORTCUTS: bool> WithSimd for RowOp<'_, T, SHORTCUTS> {
                     with_flags!($flags, go, b, s, c, n)
                 }};
             }
-            let mut below = 0;
-            run!(SUBSTRATE, flags(count - 1), ctx(count - 1, below));
+            // Per media slot: whether a lane of the medium in it has Im q ≠ 0.
+            let mut decays = [false; MEDIA_SLOTS];
+            let sub = ctx(count - 1);
+            decays[sub.above] = run!(SUBSTRATE, flags(count - 1), sub);
             // Substrate up: interface j between medium j (above) and j + 1 (below).
-            let mut decays = false;
             for j in (0..count - 1).rev() {
-                let c = ctx(j, below);
-                let decay = if SHORTCUTS && !decays { 0 } else { DECAY };
+                let c = ctx(j);
+                let known = media.media_slots.known[j];
                 if j == count - 2 {
                     // Γ_N = r_{N,N+1}, |τ_N|² = |t_{N,N+1}|².
-                    decays = run!(FIRST, flags(j), c);
-                } else {
-                    decays = run!(MEDIUM_PHASE, flags(j) | decay, c);
-                    let rescale = if j.is_multiple_of(RESCALE_EVERY) {
-                        RESCALE
+                    if known {
+                        run!(FIRST, KNOWN, c);
                     } else {
-                        0
-                    };
-                    run!(STEP, rescale | decay, c);
+                        decays[c.above] = run!(FIRST, flags(j), c);
+                    }
+                    continue;
                 }
-                below = 1 - below;
+                let decay = if SHORTCUTS && !decays[c.below] {
+                    0
+                } else {
+                    DECAY
+                };
+                // Film j + 1 is film item j.
+                match (known, media.film_slots.known[j]) {
+                    (false, false) => decays[c.above] = run!(MEDIUM_PHASE, flags(j) | decay, c),
+                    (false, true) => decays[c.above] = run!(MEDIUM, flags(j), c),
+                    (true, false) => {
+                        run!(PHASE, decay, c);
+                    }
+                    (true, true) => {}
+                }
+                let rescale = if j.is_multiple_of(RESCALE_EVERY) {
+                    RESCALE
+                } else {
+                    0
+                };
+                run!(STEP, rescale | decay, c);
             }
-            b.run::<S, POWERS, 0>(s, ctx(0, below), n);
+            b.run::<S, POWERS, 0>(s, ctx(0), n);
             for (k, slot) in row.iter_mut().enumerate() {
                 slot.put(Power {
                     R_s: b.out[0][k],
@@ -876,6 +1020,19 @@ mod tests {
                 |_| vec![c(1.33, 0.0), c(1.8, 0.5), c(1.4, 0.0), c(1.5, 0.0)],
             ),
             (
+                // A periodic mirror whose media repeat everywhere: the ambient is the L
+                // material, the substrate the H one, two adjacent films share a material,
+                // and films of one material come in two thicknesses.
+                "periodic mirror",
+                vec![60.0, 100.0, 60.0, 100.0, 60.0, 30.0, 60.0, 150.0, 60.0],
+                |wl| {
+                    let u = (wl - 380.0) / 400.0;
+                    let h = c(2.4 - 0.2 * u, (0.02 - 0.04 * u).max(0.0));
+                    let l = c(1.38 - 0.01 * u, 0.0);
+                    vec![l, h, l, h, l, h, h, l, l, h, h]
+                },
+            ),
+            (
                 // A negative-zero imaginary part must not pick the growing wave.
                 "negative zero",
                 vec![70.0],
@@ -944,6 +1101,56 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Computing repeated media and films once changes no bit.
+    #[test]
+    fn repeats_are_computed_once_with_the_same_bits() {
+        for (name, d, index) in cases() {
+            for n in [1, 9, 67, 130] {
+                let wl = wavelengths(n);
+                let idx: Vec<Vec<C64>> = wl.iter().map(|&w| index(w)).collect();
+                let shared = Media::new(&idx, &wl, &d).unwrap();
+                // No sharing, and fewer slots than repeated items (the rest computed).
+                let mut apart = Media::new(&idx, &wl, &d).unwrap();
+                apart.media_slots = Slots::new(d.len() + 2, 2, 0, |_, _| false);
+                apart.film_slots = Slots::new(d.len(), 1, 0, |_, _| false);
+                let mut capped = Media::new(&idx, &wl, &d).unwrap();
+                let column = |j: usize| {
+                    idx.iter()
+                        .map(move |i| (i[j].re.to_bits(), i[j].im.to_bits()))
+                };
+                capped.media_slots = Slots::new(d.len() + 2, 2, 1, |i, j| column(i).eq(column(j)));
+                capped.film_slots = Slots::new(d.len(), 1, 1, |i, j| {
+                    d[i] == d[j] && column(i + 1).eq(column(j + 1))
+                });
+                for angle in ANGLES_DEG {
+                    let sin_theta = angle.to_radians().sin();
+                    for vector in [true, false] {
+                        let want = bits(&run(&apart, sin_theta, vector));
+                        for media in [&shared, &capped] {
+                            assert_eq!(
+                                bits(&run(media, sin_theta, vector)),
+                                want,
+                                "{name}, n = {n}, {angle}°"
+                            );
+                        }
+                    }
+                }
+            }
+        }
+        // The mirror shares L (ambient, films 2, 4, 8, 9) and H (films 1, 3, 5, 6, 7, substrate);
+        // its films H 60 nm (1, 3, 5, 7) and L 100 nm (2, 4).
+        let (_, d, index) = cases()
+            .into_iter()
+            .find(|c| c.0 == "periodic mirror")
+            .unwrap();
+        let media = Media::new(&[index(500.0)], &[500.0], &d).unwrap();
+        let slots = &media.media_slots;
+        assert_eq!(slots.slot[0], slots.slot[2]);
+        assert_eq!(slots.slot[1], slots.slot[10]);
+        assert_eq!(slots.known.iter().filter(|&&k| k).count(), 9);
+        assert_eq!(media.film_slots.known.iter().filter(|&&k| k).count(), 4);
     }
 
     #[test]

@@ -432,8 +432,11 @@ impl Stack {
     /// beyond 10⁶ rad), through the scalar recurrence of [`Prepared`].
     pub fn sweep(&self, angles_deg: &[f64], wavelengths_nm: &[f64]) -> Result<Vec<Power>> {
         let thickness = self.thicknesses_nm();
-        let (sines, indices) = self.resolve(angles_deg, wavelengths_nm)?;
-        let Some(media) = Media::new(&indices, wavelengths_nm, &thickness) else {
+        let (sines, columns) = self.resolve_columns(angles_deg, wavelengths_nm)?;
+        let Some(media) = Media::from_columns(&columns, wavelengths_nm, &thickness) else {
+            let indices: Vec<Vec<C64>> = (0..wavelengths_nm.len())
+                .map(|w| columns.iter().map(|c| c[w]).collect())
+                .collect();
             return Ok(sweep_recurrence(
                 &sines,
                 &indices,
@@ -537,6 +540,36 @@ impl Stack {
         let sin_theta = sin_of_angle(angle_deg)?;
         let indices = self.indices_at(wavelength_nm)?;
         Ok(fringe_finesse_of(&indices, indices[0].re * sin_theta))
+    }
+
+    /// [`Stack::resolve`] with the indices per medium (ambient, films top first, substrate),
+    /// each over `wavelengths_nm`: the same values and the same first error.
+    fn resolve_columns(
+        &self,
+        angles_deg: &[f64],
+        wavelengths_nm: &[f64],
+    ) -> Result<(Vec<f64>, Vec<Vec<C64>>)> {
+        let media = std::iter::once(&self.ambient)
+            .chain(self.layers.iter().map(|l| &l.material))
+            .chain([&self.substrate]);
+        let columns: Result<Vec<Vec<C64>>> = media.map(|m| m.indices_at(wavelengths_nm)).collect();
+        match columns {
+            Ok(columns) if columns[0].iter().all(|n| n.im == 0.0) => {
+                let sines = angles_deg
+                    .iter()
+                    .map(|&a| sin_of_angle(a))
+                    .collect::<Result<Vec<_>>>()?;
+                Ok((sines, columns))
+            }
+            // An error: the one the per-wavelength order meets first.
+            _ => {
+                let (sines, indices) = self.resolve(angles_deg, wavelengths_nm)?;
+                let columns = (0..self.layers.len() + 2)
+                    .map(|j| indices.iter().map(|idx| idx[j]).collect())
+                    .collect();
+                Ok((sines, columns))
+            }
+        }
     }
 
     /// Validates angles and resolves indices once per wavelength.
