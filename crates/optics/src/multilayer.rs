@@ -80,7 +80,9 @@
 //! absorbing films and substrates, evanescent substrates, normal and grazing incidence).
 
 use crate::fresnel::BRANCH_TOLERANCE;
-use crate::simd::{ARCH, PowerSlot, exp_neg, lane, lane_mut, sin_cos_bounded};
+use crate::simd::{
+    ARCH, PowerSlot, exp_neg_with, lane, lane_mut, madd, nmadd, sin_cos_bounded_with,
+};
 use crate::stack::{Power, wavenumber};
 use num_complex::Complex64 as C64;
 use pulp::{Simd, WithSimd};
@@ -542,10 +544,8 @@ impl Block {
                 *lane_mut::<S>(&mut self.beta2, i) = s.mul_f64s(beta, beta);
                 let sub = self.medium_j::<S, F>(s, c, i);
                 self.media[c.above].store(i, sub);
-                let re_n2_conj_q = s.add_f64s(
-                    s.mul_f64s(sub.n2.re, sub.q.re),
-                    s.mul_f64s(sub.n2.im, sub.q.im),
-                );
+                let re_n2_conj_q =
+                    madd::<S, true>(s, sub.n2.im, sub.q.im, s.mul_f64s(sub.n2.re, sub.q.re));
                 *lane_mut::<S>(&mut self.substrate[0], i) = sub.q.re;
                 *lane_mut::<S>(&mut self.substrate[1], i) = re_n2_conj_q;
                 *lane_mut::<S>(&mut self.substrate[2], i) = sub.n_abs2;
@@ -583,9 +583,9 @@ impl Block {
                     let q = &self.media[c.below];
                     let (q_re, q_im) = (lane::<S>(&q.q_re, i), lane::<S>(&q.q_im, i));
                     let phase = &mut self.phase[c.film];
-                    let (sin_x, cos_x) = sin_cos_bounded(s, s.mul_f64s(q_re, kd2));
+                    let (sin_x, cos_x) = sin_cos_bounded_with::<S, true>(s, s.mul_f64s(q_re, kd2));
                     let (re, im) = if F & DECAY != 0 {
-                        let a = exp_neg(s, s.mul_f64s(q_im, kd2));
+                        let a = exp_neg_with::<S, true>(s, s.mul_f64s(q_im, kd2));
                         *lane_mut::<S>(&mut phase[2], i) = a;
                         (s.mul_f64s(a, cos_x), s.mul_f64s(a, sin_x))
                     } else {
@@ -636,10 +636,8 @@ impl Block {
                 // Power factors Re q_f / Re q₀ and
                 // Re(ñ_f² conj q_f)/|ñ_f|² ÷ Re(ñ₀² conj q₀)/|ñ₀|²; `above` is the ambient.
                 let amb = self.media[c.above].load::<S>(i);
-                let re_n2_conj_q = s.add_f64s(
-                    s.mul_f64s(amb.n2.re, amb.q.re),
-                    s.mul_f64s(amb.n2.im, amb.q.im),
-                );
+                let re_n2_conj_q =
+                    madd::<S, true>(s, amb.n2.im, amb.q.im, s.mul_f64s(amb.n2.re, amb.q.re));
                 let cx = |v: &[[f64; BLOCK]; 4], pol: usize| Cx::<S> {
                     re: ld(&v[2 * pol]),
                     im: ld(&v[2 * pol + 1]),
@@ -829,15 +827,15 @@ fn sub<S: Simd>(s: S, a: Cx<S>, b: Cx<S>) -> Cx<S> {
 #[inline(always)]
 fn mul<S: Simd>(s: S, a: Cx<S>, b: Cx<S>) -> Cx<S> {
     Cx {
-        re: s.sub_f64s(s.mul_f64s(a.re, b.re), s.mul_f64s(a.im, b.im)),
-        im: s.add_f64s(s.mul_f64s(a.re, b.im), s.mul_f64s(a.im, b.re)),
+        re: nmadd::<S, true>(s, a.im, b.im, s.mul_f64s(a.re, b.re)),
+        im: madd::<S, true>(s, a.im, b.re, s.mul_f64s(a.re, b.im)),
     }
 }
 
 /// |a|².
 #[inline(always)]
 fn norm_sqr<S: Simd>(s: S, a: Cx<S>) -> S::f64s {
-    s.add_f64s(s.mul_f64s(a.re, a.re), s.mul_f64s(a.im, a.im))
+    madd::<S, true>(s, a.im, a.im, s.mul_f64s(a.re, a.re))
 }
 
 /// One medium per lane: |ñ|², ñ², q = ñ cos θ on the forward branch.
@@ -878,7 +876,7 @@ fn medium<S: Simd, const F: u8>(s: S, n_abs2: S::f64s, n2: Cx<S>, beta2: S::f64s
     let modulus = if lossless {
         ax
     } else {
-        s.sqrt_f64s(s.add_f64s(s.mul_f64s(x, x), s.mul_f64s(y, y)))
+        s.sqrt_f64s(madd::<S, true>(s, y, y, s.mul_f64s(x, x)))
     };
     let t = s.sqrt_f64s(s.mul_f64s(s.add_f64s(modulus, ax), s.splat_f64s(0.5)));
     let u = if lossless {

@@ -86,15 +86,24 @@ pub(crate) fn sin_cos<S: Simd>(s: S, x: S::f64s) -> (S::f64s, S::f64s) {
 /// check.
 #[inline(always)]
 pub(crate) fn sin_cos_bounded<S: Simd>(s: S, x: S::f64s) -> (S::f64s, S::f64s) {
+    sin_cos_bounded_with::<S, false>(s, x)
+}
+
+/// [`sin_cos_bounded`], its products and sums fused where `FUSED` ([`madd`]).
+#[inline(always)]
+pub(crate) fn sin_cos_bounded_with<S: Simd, const FUSED: bool>(
+    s: S,
+    x: S::f64s,
+) -> (S::f64s, S::f64s) {
     let shifter = s.splat_f64s(SHIFTER);
     // m = round(x · 2/π); y = x − m π/2 in three parts. x · 2/π + 1.5 × 2⁵² has unit last
     // place, so its low mantissa bits hold m's (two's complement, |m| < 2⁵¹): quadrant
     // m mod 4 is its bits 0–1.
-    let m_shifted = s.add_f64s(s.mul_f64s(x, s.splat_f64s(FRAC_2_PI)), shifter);
+    let m_shifted = madd::<S, FUSED>(s, x, s.splat_f64s(FRAC_2_PI), shifter);
     let m = s.sub_f64s(m_shifted, shifter);
-    let y = s.sub_f64s(x, s.mul_f64s(m, s.splat_f64s(PIO2_1)));
-    let y = s.sub_f64s(y, s.mul_f64s(m, s.splat_f64s(PIO2_2)));
-    let y = s.sub_f64s(y, s.mul_f64s(m, s.splat_f64s(PIO2_2T)));
+    let y = nmadd::<S, FUSED>(s, m, s.splat_f64s(PIO2_1), x);
+    let y = nmadd::<S, FUSED>(s, m, s.splat_f64s(PIO2_2), y);
+    let y = nmadd::<S, FUSED>(s, m, s.splat_f64s(PIO2_2T), y);
     let quadrant = s.transmute_u64s_f64s(m_shifted);
     // __kernel_sin(y, 0, 0) and __kernel_cos(y, 0).
     let z = s.mul_f64s(y, y);
@@ -104,18 +113,18 @@ pub(crate) fn sin_cos_bounded<S: Simd>(s: S, x: S::f64s) -> (S::f64s, S::f64s) {
             s.splat_f64s(S2),
             s.mul_f64s(
                 z,
-                s.add_f64s(s.splat_f64s(S3), s.mul_f64s(z, s.splat_f64s(S4))),
+                madd::<S, FUSED>(s, z, s.splat_f64s(S4), s.splat_f64s(S3)),
             ),
         ),
         s.mul_f64s(
             s.mul_f64s(z, w),
-            s.add_f64s(s.splat_f64s(S5), s.mul_f64s(z, s.splat_f64s(S6))),
+            madd::<S, FUSED>(s, z, s.splat_f64s(S6), s.splat_f64s(S5)),
         ),
     );
     let v = s.mul_f64s(z, y);
     let sin_y = s.add_f64s(
         y,
-        s.mul_f64s(v, s.add_f64s(s.splat_f64s(S1), s.mul_f64s(z, r))),
+        s.mul_f64s(v, madd::<S, FUSED>(s, z, r, s.splat_f64s(S1))),
     );
     let rc = s.add_f64s(
         s.mul_f64s(
@@ -124,7 +133,7 @@ pub(crate) fn sin_cos_bounded<S: Simd>(s: S, x: S::f64s) -> (S::f64s, S::f64s) {
                 s.splat_f64s(C1),
                 s.mul_f64s(
                     z,
-                    s.add_f64s(s.splat_f64s(C2), s.mul_f64s(z, s.splat_f64s(C3))),
+                    madd::<S, FUSED>(s, z, s.splat_f64s(C3), s.splat_f64s(C2)),
                 ),
             ),
         ),
@@ -134,7 +143,7 @@ pub(crate) fn sin_cos_bounded<S: Simd>(s: S, x: S::f64s) -> (S::f64s, S::f64s) {
                 s.splat_f64s(C4),
                 s.mul_f64s(
                     z,
-                    s.add_f64s(s.splat_f64s(C5), s.mul_f64s(z, s.splat_f64s(C6))),
+                    madd::<S, FUSED>(s, z, s.splat_f64s(C6), s.splat_f64s(C5)),
                 ),
             ),
         ),
@@ -144,7 +153,7 @@ pub(crate) fn sin_cos_bounded<S: Simd>(s: S, x: S::f64s) -> (S::f64s, S::f64s) {
     let wc = s.sub_f64s(one, hz);
     let cos_y = s.add_f64s(
         wc,
-        s.add_f64s(s.sub_f64s(s.sub_f64s(one, wc), hz), s.mul_f64s(z, rc)),
+        madd::<S, FUSED>(s, z, rc, s.sub_f64s(s.sub_f64s(one, wc), hz)),
     );
     // Quadrant q = 0: (s, c); 1: (c, −s); 2: (−s, −c); 3: (−c, s): the pair swapped where
     // bit 0 of q is set, sin negated where bit 1 of q is, cos where bit 1 of q + 1 is.
@@ -163,6 +172,12 @@ pub(crate) fn sin_cos_bounded<S: Simd>(s: S, x: S::f64s) -> (S::f64s, S::f64s) {
 /// e^{−a} lane by lane for a ≤ 708 (a < −708 is clamped there); 0 beyond; see the module docs.
 #[inline(always)]
 pub(crate) fn exp_neg<S: Simd>(s: S, a: S::f64s) -> S::f64s {
+    exp_neg_with::<S, false>(s, a)
+}
+
+/// [`exp_neg`], its products and sums fused where `FUSED` ([`madd`]).
+#[inline(always)]
+pub(crate) fn exp_neg_with<S: Simd, const FUSED: bool>(s: S, a: S::f64s) -> S::f64s {
     let limit = s.splat_f64s(MAX_DECAY);
     let neg_limit = s.splat_f64s(-MAX_DECAY);
     let beyond = s.greater_than_f64s(a, limit);
@@ -172,10 +187,10 @@ pub(crate) fn exp_neg<S: Simd>(s: S, a: S::f64s) -> S::f64s {
     let shifter = s.splat_f64s(SHIFTER);
     // k = round(x / ln 2), |k| ≤ 1022.
     let k = s.sub_f64s(
-        s.add_f64s(s.mul_f64s(x, s.splat_f64s(INV_LN2)), shifter),
+        madd::<S, FUSED>(s, x, s.splat_f64s(INV_LN2), shifter),
         shifter,
     );
-    let hi = s.sub_f64s(x, s.mul_f64s(k, s.splat_f64s(LN2_HI)));
+    let hi = nmadd::<S, FUSED>(s, k, s.splat_f64s(LN2_HI), x);
     let lo = s.mul_f64s(k, s.splat_f64s(LN2_LO));
     let r = s.sub_f64s(hi, lo);
     let t = s.mul_f64s(r, r);
@@ -191,14 +206,14 @@ pub(crate) fn exp_neg<S: Simd>(s: S, a: S::f64s) -> S::f64s {
                         s.splat_f64s(P3),
                         s.mul_f64s(
                             t,
-                            s.add_f64s(s.splat_f64s(P4), s.mul_f64s(t, s.splat_f64s(P5))),
+                            madd::<S, FUSED>(s, t, s.splat_f64s(P5), s.splat_f64s(P4)),
                         ),
                     ),
                 ),
             ),
         ),
     );
-    let c = s.sub_f64s(r, s.mul_f64s(t, poly));
+    let c = nmadd::<S, FUSED>(s, t, poly, r);
     let one = s.splat_f64s(1.0);
     // y = 1 − ((lo − r c / (2 − c)) − hi) = e^r.
     let y = s.sub_f64s(
@@ -217,6 +232,38 @@ pub(crate) fn exp_neg<S: Simd>(s: S, a: S::f64s) -> S::f64s {
     let biased = s.sub_u64s(biased, s.transmute_u64s_f64s(two52));
     let scale = s.transmute_f64s_u64s(s.mul_u64s(biased, s.splat_u64s(1u64 << 52)));
     s.select_f64s(beyond, s.splat_f64s(0.0), s.mul_f64s(y, scale))
+}
+
+/// a·b + c lane by lane: fused where `FUSED` (IEEE 754 fusedMultiplyAdd, one rounding:
+/// `vfmadd` on x86-64 v3/v4, `fmla` on NEON, `f64::mul_add` on one lane — the same bits on
+/// every target), else the product rounded, then the sum.
+#[inline(always)]
+pub(crate) fn madd<S: Simd, const FUSED: bool>(
+    s: S,
+    a: S::f64s,
+    b: S::f64s,
+    c: S::f64s,
+) -> S::f64s {
+    if FUSED {
+        s.mul_add_f64s(a, b, c)
+    } else {
+        s.add_f64s(s.mul_f64s(a, b), c)
+    }
+}
+
+/// c − a·b lane by lane, fused where `FUSED` ([`madd`]).
+#[inline(always)]
+pub(crate) fn nmadd<S: Simd, const FUSED: bool>(
+    s: S,
+    a: S::f64s,
+    b: S::f64s,
+    c: S::f64s,
+) -> S::f64s {
+    if FUSED {
+        s.mul_add_f64s(s.neg_f64s(a), b, c)
+    } else {
+        s.sub_f64s(c, s.mul_f64s(a, b))
+    }
 }
 
 /// `sin[k]`, `cos[k]` = sin, cos of `x[k]` ([`sin_cos`]) on the CPU's widest vectors, the
