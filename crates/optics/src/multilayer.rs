@@ -132,20 +132,27 @@ struct Slots {
     slot: Vec<usize>,
     /// Per item: whether an earlier-computed repeat has already filled its slot.
     known: Vec<bool>,
+    /// Per item: whether its slot, once filled in a row's first block, holds it for the
+    /// row's other blocks too (a medium whose index and the ambient's are the same at every
+    /// wavelength has the same q along a row).
+    whole_row: Vec<bool>,
 }
 
 impl Slots {
     /// Slots for `count` items, `same(i, j)` saying whether items i and j have the same
-    /// value: item j takes slot j mod `rotating` unless it is repeated, and the first
-    /// `shared` repeated values take slots `rotating`, `rotating` + 1, ….
+    /// value and `constant(j)` whether item j's value is the same along a row: item j
+    /// takes slot j mod `rotating` unless it is repeated or constant, and the first `shared`
+    /// repeated or constant values take slots `rotating`, `rotating` + 1, ….
     fn new(
         count: usize,
         rotating: usize,
         shared: usize,
         same: impl Fn(usize, usize) -> bool,
+        constant: impl Fn(usize) -> bool,
     ) -> Self {
         let mut slot: Vec<usize> = (0..count).map(|j| j % rotating).collect();
         let mut known = vec![false; count];
+        let mut whole_row = vec![false; count];
         let mut next = rotating;
         let mut assigned = vec![false; count];
         for j in (0..count).rev() {
@@ -153,17 +160,23 @@ impl Slots {
                 continue;
             }
             let repeats: Vec<usize> = (0..j).filter(|&i| !assigned[i] && same(i, j)).collect();
-            if repeats.is_empty() {
+            let constant = constant(j);
+            if repeats.is_empty() && !constant {
                 continue;
             }
             for &i in repeats.iter().chain([&j]) {
                 slot[i] = next;
                 assigned[i] = true;
                 known[i] = i != j;
+                whole_row[i] = constant;
             }
             next += 1;
         }
-        Slots { slot, known }
+        Slots {
+            slot,
+            known,
+            whole_row,
+        }
     }
 }
 
@@ -219,11 +232,21 @@ impl Media {
         let n_abs2 = map(|n| n.norm_sqr());
         let column = |j: usize| columns[j].iter().map(|n| (n.re.to_bits(), n.im.to_bits()));
         let same_medium = |i: usize, j: usize| column(i).eq(column(j));
-        let media_slots = Slots::new(media, 2, MEDIA_SLOTS - 2, same_medium);
-        // Films 1..=N as items 0..N − 1.
-        let film_slots = Slots::new(media - 2, 1, FILM_SLOTS - 1, |i, j| {
-            thickness_nm[i].to_bits() == thickness_nm[j].to_bits() && same_medium(i + 1, j + 1)
-        });
+        // q = √(ñ² − β²) is the same along a row where ñ and the ambient's index (β = n₀ sin θ₀)
+        // are.
+        let uniform = |j: usize| column(j).all(|n| Some(n) == column(j).next());
+        let constant = |j: usize| uniform(j) && uniform(0);
+        let media_slots = Slots::new(media, 2, MEDIA_SLOTS - 2, same_medium, constant);
+        // Films 1..=N as items 0..N − 1 (a film's phase depends on the wavelength).
+        let film_slots = Slots::new(
+            media - 2,
+            1,
+            FILM_SLOTS - 1,
+            |i, j| {
+                thickness_nm[i].to_bits() == thickness_nm[j].to_bits() && same_medium(i + 1, j + 1)
+            },
+            |_| false,
+        );
         let forward = n2_im
             .iter()
             .map(|y| y.iter().all(|y| y.to_bits() & SIGN == 0))
@@ -705,6 +728,8 @@ impl<T: PowerSlot, const SHORTCUTS: bool> WithSimd for RowOp<'_, T, SHORTCUTS> {
         let media = self.media;
         let count = media.re.len();
         let b: &mut Block = self.block;
+        // Per media slot: whether a lane of the medium in it has Im q ≠ 0.
+        let mut decays = [false; MEDIA_SLOTS];
         for (k, row) in self.row.chunks_mut(BLOCK).enumerate() {
             let n = row.len();
             let w = k * BLOCK..k * BLOCK + n;
@@ -749,14 +774,16 @@ impl<T: PowerSlot, const SHORTCUTS: bool> WithSimd for RowOp<'_, T, SHORTCUTS> {
                     with_flags!($flags, go, b, s, c, n)
                 }};
             }
-            // Per media slot: whether a lane of the medium in it has Im q ≠ 0.
-            let mut decays = [false; MEDIA_SLOTS];
+            // Medium j is in its slot already: a repeat's, or a constant medium's from the
+            // row's first block (which has the most lanes).
+            let slots = &media.media_slots;
+            let known = |j: usize| slots.known[j] || (k > 0 && slots.whole_row[j]);
             let sub = ctx(count - 1);
             decays[sub.above] = run!(SUBSTRATE, flags(count - 1), sub);
             // Substrate up: interface j between medium j (above) and j + 1 (below).
             for j in (0..count - 1).rev() {
                 let c = ctx(j);
-                let known = media.media_slots.known[j];
+                let known = known(j);
                 if j == count - 2 {
                     // Γ_N = r_{N,N+1}, |τ_N|² = |t_{N,N+1}|².
                     if known {
@@ -1111,17 +1138,22 @@ mod tests {
                 let shared = Media::new(&idx, &wl, &d).unwrap();
                 // No sharing, and fewer slots than repeated items (the rest computed).
                 let mut apart = Media::new(&idx, &wl, &d).unwrap();
-                apart.media_slots = Slots::new(d.len() + 2, 2, 0, |_, _| false);
-                apart.film_slots = Slots::new(d.len(), 1, 0, |_, _| false);
+                apart.media_slots = Slots::new(d.len() + 2, 2, 0, |_, _| false, |_| false);
+                apart.film_slots = Slots::new(d.len(), 1, 0, |_, _| false, |_| false);
                 let mut capped = Media::new(&idx, &wl, &d).unwrap();
                 let column = |j: usize| {
                     idx.iter()
                         .map(move |i| (i[j].re.to_bits(), i[j].im.to_bits()))
                 };
-                capped.media_slots = Slots::new(d.len() + 2, 2, 1, |i, j| column(i).eq(column(j)));
-                capped.film_slots = Slots::new(d.len(), 1, 1, |i, j| {
-                    d[i] == d[j] && column(i + 1).eq(column(j + 1))
-                });
+                let same = |i: usize, j: usize| column(i).eq(column(j));
+                capped.media_slots = Slots::new(d.len() + 2, 2, 1, same, |_| false);
+                capped.film_slots = Slots::new(
+                    d.len(),
+                    1,
+                    1,
+                    |i, j| d[i] == d[j] && same(i + 1, j + 1),
+                    |_| false,
+                );
                 for angle in ANGLES_DEG {
                     let sin_theta = angle.to_radians().sin();
                     for vector in [true, false] {
