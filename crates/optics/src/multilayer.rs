@@ -108,6 +108,8 @@ pub(crate) struct Media {
     n_abs2: Vec<Vec<f64>>,
     /// Vacuum wavenumber k₀ = 2π/λ_w, rad/nm.
     k0_per_nm: Vec<f64>,
+    /// Number of wavelengths (the arrays are padded beyond it to a multiple of [`PAD`]).
+    wavelengths: usize,
     /// Film thicknesses, top first, nm.
     thickness_nm: Vec<f64>,
     /// Per medium: no Im ñ_j² has its sign bit set, so that Im q_j ≥ +0 in every lane and
@@ -223,13 +225,27 @@ impl Media {
                 }
             }
         }
+        // Each array padded to a multiple of `PAD` with its last wavelength's values, so that
+        // a row's last vector is whole (its extra lanes repeat a real one, and are dropped).
+        let wavelengths = wavelengths_nm.len();
+        let padded = wavelengths.next_multiple_of(PAD);
+        let pad = |mut v: Vec<f64>| {
+            if let Some(&last) = v.last() {
+                v.resize(padded, last);
+            }
+            v
+        };
         let map = |f: fn(&C64) -> f64| -> Vec<Vec<f64>> {
-            columns.iter().map(|c| c.iter().map(f).collect()).collect()
+            columns
+                .iter()
+                .map(|c| pad(c.iter().map(f).collect()))
+                .collect()
         };
         let re = map(|n| n.re);
         let n2_re = map(|n| (n * n).re);
         let n2_im = map(|n| (n * n).im);
         let n_abs2 = map(|n| n.norm_sqr());
+        let k0_per_nm = pad(k0_per_nm);
         let column = |j: usize| columns[j].iter().map(|n| (n.re.to_bits(), n.im.to_bits()));
         let same_medium = |i: usize, j: usize| column(i).eq(column(j));
         // q = √(ñ² − β²) is the same along a row where ñ and the ambient's index (β = n₀ sin θ₀)
@@ -265,6 +281,7 @@ impl Media {
             n2_im,
             n_abs2,
             k0_per_nm,
+            wavelengths,
             thickness_nm: thickness_nm.to_vec(),
             forward,
             lossless,
@@ -275,7 +292,7 @@ impl Media {
 
     /// Number of wavelengths.
     pub(crate) fn wavelengths(&self) -> usize {
-        self.k0_per_nm.len()
+        self.wavelengths
     }
 }
 
@@ -329,6 +346,9 @@ struct RowOp<'a, T, const SHORTCUTS: bool> {
 
 /// Wavelengths per block of the staging arrays (a multiple of every vector width).
 const BLOCK: usize = 64;
+/// The per-wavelength arrays of [`Media`] are padded to a multiple of this (a multiple of
+/// every vector width, a divisor of [`BLOCK`]).
+const PAD: usize = 8;
 
 /// Media kept in a [`Block`]: two for the media of the interface being added, the rest for
 /// repeated media ([`Slots`]).
@@ -731,7 +751,9 @@ impl<T: PowerSlot, const SHORTCUTS: bool> WithSimd for RowOp<'_, T, SHORTCUTS> {
         // Per media slot: whether a lane of the medium in it has Im q ≠ 0.
         let mut decays = [false; MEDIA_SLOTS];
         for (k, row) in self.row.chunks_mut(BLOCK).enumerate() {
-            let n = row.len();
+            // Whole vectors: the last one's extra lanes are padding ([`Media::from_columns`]),
+            // computed like real lanes (each lane is independent) and dropped.
+            let n = row.len().next_multiple_of(S::F64_LANES);
             let w = k * BLOCK..k * BLOCK + n;
             // The flags of medium j over this block; none for the general formula.
             let flags = |j: usize| {
