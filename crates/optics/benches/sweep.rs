@@ -71,6 +71,20 @@ fn benches(c: &mut Criterion) {
         b.iter(|| black_box(five.sweep(&angles, &wavelengths_1nm).unwrap()))
     });
     g.finish();
+
+    // The same with no repeated medium (the second TiO₂ replaced by silicon).
+    let distinct = common::five_distinct_dispersive();
+    let mut g = c.benchmark_group("five-distinct-dispersive");
+    g.throughput(Throughput::Elements(
+        (angles.len() * wavelengths_1nm.len()) as u64,
+    ));
+    g.sample_size(20);
+    g.bench_function("90x401 one thread", |b| {
+        one_thread.install(|| {
+            b.iter(|| black_box(distinct.sweep(&angles, &wavelengths_1nm).unwrap()))
+        })
+    });
+    g.finish();
 }
 
 criterion_group!(sweep, benches);

@@ -73,4 +73,12 @@ fn main() {
             black_box(five.sweep(&angles, &wavelengths_1nm).unwrap());
         },
     );
+    let distinct = common::five_distinct_dispersive();
+    measure(
+        "five distinct dispersive layers, 90x401",
+        angles.len() * wavelengths_1nm.len(),
+        || {
+            black_box(distinct.sweep(&angles, &wavelengths_1nm).unwrap());
+        },
+    );
 }

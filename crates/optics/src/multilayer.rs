@@ -29,11 +29,15 @@
 //! # Determinism
 //!
 //! As in [`crate::simd`]: one generic kernel over [`pulp::Simd`], dispatched to the CPU's
-//! widest vectors (AVX-512 or AVX2 on x86-64, NEON on arm64) with the remainder of a row on
-//! [`pulp::Scalar`]; IEEE 754 basic operations only (+, −, ×, ÷, √, comparisons, sign-bit
-//! and exponent-bit manipulation) in a fixed order, no fused multiply–add, no platform
-//! `libm` (sin/cos and e^{−a} are the kernel's own [`crate::simd::sin_cos_bounded`] and
-//! [`crate::simd::exp_neg`]). The shortcuts — decided per block of [`BLOCK`] wavelengths
+//! widest vectors (AVX-512 or AVX2 on x86-64, NEON on arm64; a row's last vector padded to
+//! whole lanes) or run on [`pulp::Scalar`] (one lane: CPUs without them, and the tests'
+//! reference); IEEE 754 operations only, each correctly rounded (+, −, ×, ÷, √, fused
+//! multiply–add, comparisons, sign-bit and exponent-bit manipulation) in a fixed order, no
+//! platform `libm` (sin/cos and e^{−a} are the kernel's own
+//! [`crate::simd::sin_cos_bounded_with`] and [`crate::simd::exp_neg_with`]). The fused
+//! multiply–adds are written out ([`crate::simd::madd`]: one rounding, `vfmadd` on x86-64,
+//! `fmla` on NEON, `f64::mul_add` on one lane), never left to the compiler, so every path
+//! rounds the same way. The shortcuts — decided per block of [`BLOCK`] wavelengths
 //! and medium ("is the medium lossless over the block", "has it no Im ñ² of negative sign",
 //! "does some lane of the film decay") and compiled as separate loops — only skip
 //! operations whose result is known exactly (tested: `shortcuts_match_the_general_formula`).

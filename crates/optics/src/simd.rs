@@ -10,6 +10,12 @@
 //! multiply–add, no platform `libm` — so the result has the same bits whatever the vector
 //! width, the CPU or the operating system (tested: `simd_and_scalar_paths_are_bit_identical`).
 //!
+//! The multilayer kernel ([`crate::multilayer`]) takes sin/cos and e^{−a} in a fused form
+//! ([`sin_cos_bounded_with`] and [`exp_neg_with`] with `FUSED`): the same methods with each
+//! a·b + c a fused multiply–add ([`madd`]), one correctly rounded operation on every target,
+//! so the bits are again the same everywhere; fewer operations, and no larger error (tests
+//! `sin_cos_matches_libm`, `exp_neg_matches_libm`).
+//!
 //! # Elementary functions
 //!
 //! * [`sin_cos`]: argument reduction x = m π/2 + y, |y| ≤ π/4, with π/2 split in three parts

@@ -67,18 +67,35 @@ pub fn absorbing_film_on_metal() -> Stack {
 /// Five dispersive layers (refractiveindex.info data in `tables/materials/`): TiO₂ 56.45 nm,
 /// MgF₂ 99.75, TiO₂ 56.45, fused silica 120, gold 10, on BK7 in air.
 pub fn five_layer_dispersive() -> Stack {
-    let layers = [
+    stack_of(&[
         ("tio2", 56.45),
         ("mgf2", 99.75),
         ("tio2", 56.45),
         ("fused-silica", 120.0),
         ("au", 10.0),
-    ]
-    .iter()
-    .map(|&(m, d)| Layer {
-        material: dispersive(m),
-        thickness_nm: d,
-    })
-    .collect();
+    ])
+}
+
+/// Films of bundled materials (name, thickness in nm), top first, on BK7 in air.
+fn stack_of(films: &[(&str, f64)]) -> Stack {
+    let layers = films
+        .iter()
+        .map(|&(m, d)| Layer {
+            material: dispersive(m),
+            thickness_nm: d,
+        })
+        .collect();
     Stack::new(dispersive("air"), layers, dispersive("bk7")).unwrap()
+}
+
+/// Five distinct dispersive layers: [`five_layer_dispersive`] with the second TiO₂ replaced by
+/// 20 nm of silicon, so that no medium repeats (the kernel computes a repeated medium once).
+pub fn five_distinct_dispersive() -> Stack {
+    stack_of(&[
+        ("tio2", 56.45),
+        ("mgf2", 99.75),
+        ("si", 20.0),
+        ("fused-silica", 120.0),
+        ("au", 10.0),
+    ])
 }
