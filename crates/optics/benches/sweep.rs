@@ -80,9 +80,8 @@ fn benches(c: &mut Criterion) {
     ));
     g.sample_size(20);
     g.bench_function("90x401 one thread", |b| {
-        one_thread.install(|| {
-            b.iter(|| black_box(distinct.sweep(&angles, &wavelengths_1nm).unwrap()))
-        })
+        one_thread
+            .install(|| b.iter(|| black_box(distinct.sweep(&angles, &wavelengths_1nm).unwrap())))
     });
     g.finish();
 }
