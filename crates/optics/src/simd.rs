@@ -890,24 +890,23 @@ mod tests {
     }
 
     /// sin, cos and e^{−a}: `sin_cos` and `exp_neg`, or their fused variants.
+    fn sin_cos_of<S: Simd, const FUSED: bool>(s: S, x: S::f64s) -> (S::f64s, S::f64s) {
+        if FUSED {
+            sin_cos_bounded_with::<S, true>(s, x)
+        } else {
+            sin_cos(s, x)
+        }
+    }
     struct Sin<const FUSED: bool>;
     impl<const FUSED: bool> LaneFn for Sin<FUSED> {
         fn apply<S: Simd>(&self, s: S, x: S::f64s) -> S::f64s {
-            if FUSED {
-                sin_cos_bounded_with::<S, true>(s, x).0
-            } else {
-                sin_cos(s, x).0
-            }
+            sin_cos_of::<S, FUSED>(s, x).0
         }
     }
     struct Cos<const FUSED: bool>;
     impl<const FUSED: bool> LaneFn for Cos<FUSED> {
         fn apply<S: Simd>(&self, s: S, x: S::f64s) -> S::f64s {
-            if FUSED {
-                sin_cos_bounded_with::<S, true>(s, x).1
-            } else {
-                sin_cos(s, x).1
-            }
+            sin_cos_of::<S, FUSED>(s, x).1
         }
     }
     struct ExpNeg<const FUSED: bool>;
