@@ -45,7 +45,7 @@
 //! Draco, `transmissionTexture`, `thicknessTexture`, `KHR_materials_clearcoat`, `_sheen` and
 //! `_anisotropy` are not read. The default scene's cameras (perspective and orthographic, placed by their
 //! nodes: [`GltfScene::cameras`]) and `KHR_lights_punctual` lights ([`GltfScene::lights`])
-//! are read; see `mesh.rs` for how the renderer lights the scene with them.
+//! are read; see `mesh/lights.rs` for how the renderer lights the scene with them.
 //!
 //! # Metals from a base colour
 //!

@@ -1,0 +1,152 @@
+//! Which technique draws each glTF material: `film-lut` only where the loaded table baked
+//! the material's base (see the module documentation of [`super`]), `fourier` otherwise.
+
+use crate::error::{Error, Result};
+use crate::gltf_scene::{GltfScene, is_gold_like};
+use crate::render::{BaseKind, MaterialOptions, check_film_lut};
+use crate::shaders::Technique;
+use crate::tables::TableSet;
+use nacre_format::msg;
+use nacre_format::param::{Msg, Piece};
+use nacre_optics::colour::Colorimeter;
+use std::sync::Arc;
+
+/// Whether the loaded `film-lut` table can draw `material` (see the module documentation);
+/// a gold-like metal gets the table's base. `Err` holds the reason it cannot.
+fn lut_material(
+    tables: &TableSet,
+    material: &MaterialOptions,
+    base_colour: [f32; 3],
+) -> std::result::Result<MaterialOptions, Msg> {
+    let Some(lut) = &tables.film_lut else {
+        return Err("no film-lut table is loaded".into());
+    };
+    // Errors are kept whole, so that a front end names their parameters its own way.
+    let quoted = |e: Error| Msg::from_pieces(vec![Piece::Nested(Arc::new(e))]);
+    let context = format!("{} (base)", lut.manifest_path.display());
+    let table_base =
+        nacre_format::materials::resolve(&lut.manifest.base, &context, lut.manifest_path.parent())
+            .map_err(|e| quoted(e.into()))?;
+    let table_kind = BaseKind::of(&table_base);
+    let mut m = material.clone();
+    match (material.base_kind, table_kind) {
+        (BaseKind::Dielectric, BaseKind::Dielectric) => {
+            let a = material
+                .base
+                .index_at(550.0)
+                .map_err(|e| quoted(e.into()))?;
+            let b = table_base.index_at(550.0).map_err(|e| quoted(e.into()))?;
+            if (a - b).norm() > 1e-3 {
+                return Err(format!(
+                    "base index {} differs from the table `{}`'s {}",
+                    a.re, lut.name, b.re
+                )
+                .into());
+            }
+        }
+        (BaseKind::Metal, BaseKind::Metal) if is_gold_like(base_colour) => {
+            m.base = table_base;
+        }
+        (BaseKind::Metal, _) => {
+            return Err(format!(
+                "a metal base needs a table baked on that metal (film-gold for a gold-coloured base), not `{}`",
+                lut.name
+            )
+            .into());
+        }
+        _ => return Err(format!("the base differs from the table `{}`'s", lut.name).into()),
+    }
+    check_film_lut(tables, &m).map_err(quoted)?;
+    Ok(m)
+}
+
+/// How the mesh renderer draws a scene's materials.
+pub(super) struct Choice {
+    /// Per material of the file (used or not): nacre's options and the technique.
+    pub drawn: Vec<(MaterialOptions, Technique)>,
+    /// The used materials' notes (ignored extensions, approximations), in the file's order.
+    pub notes: Vec<Msg>,
+    /// One line summing up the used materials drawn with `fourier` instead of `technique`.
+    pub fallback_note: Option<Msg>,
+}
+
+/// The options and technique of every material of `scene` drawn with `technique`; `used`
+/// (sorted) lists the materials a primitive refers to, the only ones noted. With `lut`, a
+/// material the loaded `film-lut` table cannot draw ([`lut_material`]), and with `spectral`
+/// one that mixes a dielectric and a metal lobe, falls back to `fourier`.
+pub(super) fn choose(
+    scene: &GltfScene,
+    tables: &TableSet,
+    technique: Technique,
+    colorimeter: &Colorimeter,
+    used: &[usize],
+) -> Result<Choice> {
+    let mut notes = Vec::new();
+    let mut drawn = Vec::with_capacity(scene.materials.len());
+    // Technique fallbacks, summarised in one line: (material, reason).
+    let mut fallbacks: Vec<(String, Msg)> = Vec::new();
+    for (i, gm) in scene.materials.iter().enumerate() {
+        let (mut m, material_notes) = gm.material_options(colorimeter)?;
+        if used.contains(&i) {
+            notes.extend(material_notes.into_iter().map(Msg::from));
+        }
+        let (lo, hi) = gm.metallic_range();
+        let one_lobe = hi <= 0.0 || lo >= 1.0;
+        let mut t = technique;
+        if technique == Technique::Lut {
+            let colour = [gm.base_colour[0], gm.base_colour[1], gm.base_colour[2]];
+            let result = if one_lobe {
+                lut_material(tables, &m, colour)
+            } else {
+                Err(Msg::from(
+                    "its metallic value varies (a partial factor or a texture): the table bakes one base",
+                ))
+            };
+            match result {
+                Ok(lm) => m = lm,
+                Err(why) => {
+                    if used.contains(&i) {
+                        fallbacks.push((gm.name.clone(), why));
+                    }
+                    t = Technique::Fourier;
+                }
+            }
+        } else if technique == Technique::Spectral && !one_lobe {
+            if used.contains(&i) {
+                fallbacks.push((
+                    gm.name.clone(),
+                    Msg::from(
+                        "it mixes a dielectric and a metal lobe; spectral holds one base per pass",
+                    ),
+                ));
+            }
+            t = Technique::Fourier;
+        }
+        if t == Technique::Lut {
+            // The table's ambient (checked above) must be the material's.
+            m.ambient_ior = tables
+                .film_lut
+                .as_ref()
+                .map_or(1.0, |l| l.axes.ambient_index as f32);
+        }
+        drawn.push((m, t));
+    }
+    let fallback_note = fallbacks.first().map(|(name, why)| {
+        msg![
+            format!(
+                "drawn with fourier instead of {}: {} of {} materials (e.g. `{name}`: ",
+                technique.name(),
+                fallbacks.len(),
+                used.len()
+            ),
+            why.clone(),
+            ")"
+        ]
+    });
+
+    Ok(Choice {
+        drawn,
+        notes,
+        fallback_note,
+    })
+}
