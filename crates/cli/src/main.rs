@@ -233,7 +233,7 @@ struct ColorArgs {
     /// film's thickness and real index.
     #[arg(long, value_name = "FILE.csv")]
     points: Option<PathBuf>,
-    /// spectral | lut:NAME|PATH | rgb3 | samples:N | fourier:… | stack[:N] | … (below).
+    /// spectral | lut:NAME|PATH | rgb3 | samples:N | fourier:… | stack | stack:N | … (below).
     #[arg(long, default_value = "spectral")]
     method: String,
     /// The fourier table for fourier:… methods: a default-set name or a manifest path

@@ -12,7 +12,7 @@
 //! | ω_i, ω_r | `omega_i`, `omega_r` | unit vectors towards the light and towards the viewer |
 //! | (u, v, w) | `u, v, w` | −ω_i − ω_r (Single 2014, Eq. 1.5); w = −(cos θ_i + cos θ_r) < 0 |
 //! | k = 2π/λ | `k_per_um` | vacuum wavenumber, rad/µm (λ in nm in the API) |
-//! | Tₙ[j] | [`TaylorTerms`] | DFT{(i h)ⁿ}[j] / M, DC centred |
+//! | Tₙ\[j\] | [`TaylorTerms`] | DFT{(i h)ⁿ}\[j\] / M, DC centred |
 //! | σ_s | `sigma_s_um` | standard deviation of the Gaussian coherence window, µm (4σ_s = coherence diameter) |
 //! | κ_j = 2π j / L | | angular spatial frequency of DFT bin j, rad/µm |
 //!
@@ -44,9 +44,9 @@
 //! choose N for the shortest wavelength, |w| ≤ 2 and the largest |h|.
 //!
 //! **Discretisation.** On M samples the transform of the periodic extension of the patch
-//! has Fourier-series coefficients Tₙ[j] = (1/M) Σ_m (ih_m)ⁿ e^{+iκ_j·x_m}, a DFT with a
+//! has Fourier-series coefficients Tₙ\[j\] = (1/M) Σ_m (ih_m)ⁿ e^{+iκ_j·x_m}, a DFT with a
 //! positive exponent (an "inverse" FFT, unnormalised, divided by M here),
-//! stored with DC at index ⌊Mₓ/2⌋, ⌊M_y/2⌋. Tₙ[0] is the mean of (ih)ⁿ; T₀ = δ_j0.
+//! stored with DC at index ⌊Mₓ/2⌋, ⌊M_y/2⌋. Tₙ\[0\] is the mean of (ih)ⁿ; T₀ = δ_j0.
 //!
 //! **Coherence window** (Dhillon et al. 2014): only light within a spatial coherence
 //! area interferes. Weighting the periodic surface by a Gaussian g(x) = e^{−|x|²/(2σ_s²)}
@@ -502,8 +502,8 @@ pub fn k_per_um(wavelength_nm: f64) -> f64 {
     2.0 * PI / (wavelength_nm * 1e-3)
 }
 
-/// The DFTs of the powers of a height field: Tₙ[j] = (1/M) Σ_m (i h_m)ⁿ e^{+iκ_j·x_m}
-/// for n = 0 … N, DC centred (module docs). Computed in f64 by [`dft`] (the same bits on
+/// The DFTs of the powers of a height field: Tₙ\[j\] = (1/M) Σ_m (i h_m)ⁿ e^{+iκ_j·x_m}
+/// for n = 0 … N, DC centred (module docs). Computed in f64 by `dft` (the same bits on
 /// every machine).
 #[derive(Clone, Debug, PartialEq)]
 pub struct TaylorTerms {
@@ -618,7 +618,7 @@ impl TaylorTerms {
             .then_some((sy as usize, sx as usize))
     }
 
-    /// The Taylor sum P_j = Σₙ (kw)ⁿ/n! Tₙ[j] at every bin (DC centred, x fastest): the
+    /// The Taylor sum P_j = Σₙ (kw)ⁿ/n! Tₙ\[j\] at every bin (DC centred, x fastest): the
     /// DFT coefficients of e^{ikwh} up to the truncation.
     pub fn series(&self, kw: f64) -> Vec<C64> {
         let c = taylor_coefficients(kw, self.order);
@@ -794,7 +794,7 @@ impl DiffractionSurface {
         self.transform_with(k * u, k * v, &|i| self.terms.sum_at(i, &c))
     }
 
-    /// The windowed transforms of the terms alone, P̃ₙ(ku, kv) = Σ_j Tₙ[j]
+    /// The windowed transforms of the terms alone, P̃ₙ(ku, kv) = Σ_j Tₙ\[j\]
     /// exp(−σ_s²|(ku, kv) − κ_j|²/2) for n = 0 … N, so that P̃ = Σₙ (kw)ⁿ/n! P̃ₙ (the
     /// building blocks of the integrated layout, [`integrated`]).
     pub fn transform_terms(&self, wavelength_nm: f64, u: f64, v: f64) -> Vec<C64> {

@@ -234,7 +234,7 @@ impl FewWavelengthRule {
         self.fit_opd_nm
     }
 
-    /// Σ_j values[j] W_j.
+    /// Σ_j values\[j\] W_j.
     pub fn colour(&self, values: impl IntoIterator<Item = f64>) -> [f64; 3] {
         let mut c = [0.0; 3];
         for (v, w) in values.into_iter().zip(&self.weights) {
@@ -317,7 +317,7 @@ impl StackEvaluation {
     /// nodes (1 to 256).
     ///
     /// # Errors
-    /// [`crate::Error::Invalid`] for a film count, relative thickness or sample count out
+    /// [`crate::Error::OutOfRange`] for a film count, relative thickness or sample count out
     /// of range; a material's error where it has no data at a node.
     pub fn new(
         colorimeter: &Colorimeter,

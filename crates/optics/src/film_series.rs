@@ -54,7 +54,7 @@
 //! and Approximation*, 1963, Thm. 3.1.1), for n = 8 and the central cell
 //! 43.1 · (2π h ν_max)⁸ / 8! = 6·10⁻¹³ relative to Σₖ |Wₖⱼ| at h = 4 nm. The grid is
 //! filled by the recurrence e^{2πi(p+1)h/λ} = e^{2πiph/λ} e^{2πih/λ} restarted from the
-//! deterministic sin/cos of [`crate::simd`] every [`TRANSFORM_BLOCK`] points (rounding
+//! deterministic sin/cos of the `simd` module every [`TRANSFORM_BLOCK`] points (rounding
 //! ≲ 10⁻¹⁴), so the table, like everything else here, is the same bits on every machine:
 //! only IEEE basic operations in a fixed order.
 //!

@@ -248,7 +248,7 @@ impl SpectralRule {
         &self.weights
     }
 
-    /// Σₖ values[k] Wₖ.
+    /// Σₖ values\[k\] Wₖ.
     pub fn colour(&self, values: impl IntoIterator<Item = f64>) -> [f64; 3] {
         let mut c = [0.0; 3];
         for (v, w) in values.into_iter().zip(&self.weights) {

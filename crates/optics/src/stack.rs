@@ -41,13 +41,13 @@
 //! wavelength and run angles in parallel with rayon. Every value is computed by the same
 //! code whatever the thread count, so results are bit-identical across thread counts.
 //! [`Stack::sweep`] runs each angle's row through the vectorised multilayer kernel of
-//! [`crate::multilayer`] (wavelengths as SIMD lanes; the same recurrence with Γ and |τ|²
+//! the `multilayer` module (wavelengths as SIMD lanes; the same recurrence with Γ and |τ|²
 //! carried as fractions; IEEE basic operations only, so the same bits on every CPU and
 //! vector width), or, for indices or phases outside that kernel's range, through the
 //! scalar recurrence below, which computes interface coefficients once per (angle, distinct
 //! set of indices). A sweep over a film's thickness folds the stack below it once per
 //! (angle, wavelength); over the top film it runs the Airy closed form through the
-//! vectorised kernel of [`crate::simd`].
+//! vectorised kernel of the `simd` module.
 
 use crate::elementary;
 use crate::error::{Error, Result};
@@ -426,7 +426,7 @@ impl Stack {
     /// `a * wavelengths_nm.len() + w`.
     ///
     /// Indices are resolved once per wavelength; each angle's row then runs through the
-    /// vectorised kernel of [`crate::multilayer`] (wavelengths as SIMD lanes, IEEE basic
+    /// vectorised kernel of the `multilayer` module (wavelengths as SIMD lanes, IEEE basic
     /// operations only: the same bits on every CPU, vector width and thread count), or,
     /// for indices or phases outside the kernel's range (|ñ| beyond [10⁻⁶, 10⁶], film phases
     /// beyond 10⁶ rad), through the scalar recurrence of [`Prepared`].

@@ -30,7 +30,7 @@ pub fn metal_index_gulbrandsen2014(f0: f64, edge_tint: f64) -> C64 {
     C64::new(n.max(1e-3), k2.max(0.0).sqrt())
 }
 
-/// Whether a linear base colour is within 0.1 per channel of [`GOLD_F0`](crate::gltf_scene::GOLD_F0).
+/// Whether a linear base colour is within 0.1 per channel of [`GOLD_F0`].
 pub fn is_gold_like(base_colour: [f32; 3]) -> bool {
     base_colour
         .iter()
@@ -46,8 +46,8 @@ pub struct MetalBands {
     /// first exceeds the blue one, and its red weight the green one (sRGB under D65 and the
     /// CIE 1931 observer: about 492 and 571 nm).
     pub boundaries_nm: [f64; 2],
-    /// M[j][k]: the share of channel j's weights (Σ_λ w_j(λ) = 1 for white) that falls in
-    /// band k, so that a reflectance ρ_k per band has the colour C_j = Σ_k M[j][k] ρ_k.
+    /// M\[j\]\[k\]: the share of channel j's weights (Σ_λ w_j(λ) = 1 for white) that falls in
+    /// band k, so that a reflectance ρ_k per band has the colour C_j = Σ_k M\[j\]\[k\] ρ_k.
     pub share: [[f64; 3]; 3],
 }
 
@@ -102,7 +102,7 @@ impl MetalBands {
         }
     }
 
-    /// The band reflectances ρ ∈ [0, 0.99]³ whose colour Σ_k M[j][k] ρ_k is closest to
+    /// The band reflectances ρ ∈ \[0, 0.99\]³ whose colour Σ_k M\[j\]\[k\] ρ_k is closest to
     /// `f0` (RGB): the 3 × 3 solution when it lies in the box, else a projected
     /// Gauss–Seidel least-squares fit (a few hundred sweeps; deterministic).
     pub fn band_reflectance(&self, f0: [f64; 3]) -> [f64; 3] {
@@ -140,7 +140,7 @@ impl MetalBands {
         rho
     }
 
-    /// The colour Σ_k M[j][k] ρ_k of band reflectances ρ.
+    /// The colour Σ_k M\[j\]\[k\] ρ_k of band reflectances ρ.
     pub fn colour(&self, rho: [f64; 3]) -> [f64; 3] {
         std::array::from_fn(|j| (0..3).map(|k| self.share[j][k] * rho[k]).sum())
     }

@@ -70,7 +70,7 @@ pub struct GltfTexture {
 /// A material's use of a texture: which, through which coordinates.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TextureRef {
-    /// Index into [`GltfScene::textures`].
+    /// Index into [`crate::gltf_scene::GltfScene::textures`].
     pub texture: usize,
     /// TEXCOORD set (0 or 1; `KHR_texture_transform`'s `texCoord` overrides the texture
     /// info's).

@@ -37,7 +37,7 @@
 //! taylor_tolerance = 1e-4         # bound on the Taylor remainder |kwh|^{N+1}/(N+1)!
 //! ```
 //!
-//! What every texel holds: layer n of the terms is Tₙ[j] = DFT{(i h)ⁿ}[j] / M (M = Mₓ·M_y
+//! What every texel holds: layer n of the terms is Tₙ\[j\] = DFT{(i h)ⁿ}\[j\] / M (M = Mₓ·M_y
 //! samples, positive exponent e^{+iκ_j·x}), computed in f64 and stored as f32, DC at
 //! texel (⌊Mₓ/2⌋, ⌊M_y/2⌋); texel (s, t) is frequency κ = 2π (s − ⌊Mₓ/2⌋, t − ⌊M_y/2⌋) / L.
 //! The EXR file `NAME.terms.exr` is an atlas Mₓ wide and M_y·(N+1) high (term n in rows
@@ -46,7 +46,7 @@
 //! layer l = (Re T₂ₗ, Im T₂ₗ, Re T₂ₗ₊₁, Im T₂ₗ₊₁) (zero when 2l + 1 > N).
 //!
 //! How a shader rebuilds the colour: for each wavelength λ of the grid, k = 2π/λ,
-//! (u, v, w) = −ω_i − ω_r, P_j = Σₙ (kw)ⁿ/n! Tₙ[j] at the texels j near (ku, kv)·L/2π,
+//! (u, v, w) = −ω_i − ω_r, P_j = Σₙ (kw)ⁿ/n! Tₙ\[j\] at the texels j near (ku, kv)·L/2π,
 //! P̃ = Σ_j P_j exp(−σ_s²|(ku, kv) − κ_j|²/2), ρ = F² · G/w² · |P̃|²
 //! (G/w² = (1 + ω_i·ω_r)²/(cos θ_i cos θ_r (cos θ_i + cos θ_r)²)), then
 //! colour = M · Σ_λ ρ(λ) u(λ) with the CIE weights of the recorded observer and illuminant

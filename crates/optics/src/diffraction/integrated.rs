@@ -38,7 +38,7 @@
 //! colour = C · Σₚ wᵖ (M·Iₚ) is what `SpectralGrid` + `output_from_xyz` give from the
 //! terms layout, and a shader needs no matrix.
 //!
-//! **Point symmetry: half the table.** A real height field has Tₙ[−j] = (−1)ⁿ conj Tₙ[j],
+//! **Point symmetry: half the table.** A real height field has Tₙ\[−j\] = (−1)ⁿ conj Tₙ\[j\],
 //! hence P̃ₙ(−q) = (−1)ⁿ conj P̃ₙ(q) and Iₚ(−u, −v) = (−1)ᵖ Iₚ(u, v). The table stores
 //! u ≥ 0 only and a shader folds the other half over:
 //!
@@ -167,7 +167,7 @@ impl IntegratedTable {
     /// fixed order, so the values do not depend on the thread count.
     ///
     /// Per row (fixed v) and wavelength the window's y factor is applied once to every
-    /// column of bins (R_n[jₓ] = Σ_{j_y} g_y Tₙ[jₓ, j_y]); each texel then needs only
+    /// column of bins (R_n\[jₓ\] = Σ_{j_y} g_y Tₙ\[jₓ, j_y\]); each texel then needs only
     /// its x factor.
     pub fn compute(
         surface: &DiffractionSurface,
