@@ -33,6 +33,20 @@ pub(crate) fn texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     }
 }
 
+/// A 2-D float texture read with `textureLoad` (so it need not be filterable).
+pub(crate) fn loaded_texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
 pub(crate) fn sampler_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
@@ -57,24 +71,43 @@ pub(crate) fn upload_mips<const C: usize>(
     format: wgpu::TextureFormat,
     levels: &[Level<C>],
 ) -> Result<wgpu::Texture> {
-    let (width, height, _) = &levels[0];
-    let limit = ctx.device.limits().max_texture_dimension_2d;
-    for n in [*width, *height] {
-        if n as u64 > u64::from(limit) {
-            return Err(Error::Limit {
-                what: label.to_string(),
-                needed: n as u64,
-                limit: u64::from(limit),
-                adapter: ctx.info.name.clone(),
-            });
-        }
-    }
+    let bytes: Vec<(u32, u32, Vec<u8>)> = levels
+        .iter()
+        .map(|(w, h, texels)| {
+            let halves: Vec<u8> = texels
+                .iter()
+                .flat_map(|t| t.map(|v| f16::from_f32(v).to_bits()))
+                .flat_map(u16::to_ne_bytes)
+                .collect();
+            (*w as u32, *h as u32, halves)
+        })
+        .collect();
+    upload_levels(ctx, label, format, (C * 2) as u32, &bytes)
+}
+
+/// Uploads a mip chain as a sampled 2-D texture of `format`: level k is (width, height,
+/// texels packed row after row, `texel_bytes` each). A level 0 wider or taller than the
+/// adapter allows is an [`Error::Limit`] naming `label`.
+pub(crate) fn upload_levels(
+    ctx: &GpuContext,
+    label: &str,
+    format: wgpu::TextureFormat,
+    texel_bytes: u32,
+    levels: &[(u32, u32, Vec<u8>)],
+) -> Result<wgpu::Texture> {
+    let (width, height) = levels.first().map_or((0, 0), |(w, h, _)| (*w, *h));
+    crate::tables::check_limit(
+        ctx,
+        label,
+        u64::from(width.max(height)),
+        ctx.device.limits().max_texture_dimension_2d,
+    )?;
     ctx.checked(&format!("uploading {label}"), || {
         let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
             label: Some(label),
             size: wgpu::Extent3d {
-                width: *width as u32,
-                height: *height as u32,
+                width,
+                height,
                 depth_or_array_layers: 1,
             },
             mip_level_count: levels.len() as u32,
@@ -85,10 +118,6 @@ pub(crate) fn upload_mips<const C: usize>(
             view_formats: &[],
         });
         for (k, (w, h, texels)) in levels.iter().enumerate() {
-            let halves: Vec<u16> = texels
-                .iter()
-                .flat_map(|t| t.map(|v| f16::from_f32(v).to_bits()))
-                .collect();
             ctx.queue.write_texture(
                 wgpu::TexelCopyTextureInfo {
                     texture: &texture,
@@ -96,15 +125,15 @@ pub(crate) fn upload_mips<const C: usize>(
                     origin: wgpu::Origin3d::ZERO,
                     aspect: wgpu::TextureAspect::All,
                 },
-                bytemuck::cast_slice(&halves),
+                texels,
                 wgpu::TexelCopyBufferLayout {
                     offset: 0,
-                    bytes_per_row: Some((*w * C * 2) as u32),
-                    rows_per_image: Some(*h as u32),
+                    bytes_per_row: Some(w * texel_bytes),
+                    rows_per_image: Some(*h),
                 },
                 wgpu::Extent3d {
-                    width: *w as u32,
-                    height: *h as u32,
+                    width: *w,
+                    height: *h,
                     depth_or_array_layers: 1,
                 },
             );

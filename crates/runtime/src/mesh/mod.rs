@@ -35,7 +35,7 @@ pub use textures::rgba8_mip_chain;
 use crate::context::BufferInitExt;
 use crate::context::GpuContext;
 use crate::environment::EnvironmentMap;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::gltf_scene::{
     AlphaMode, GltfMaterial, GltfPrimitive, GltfScene, IDENTITY_TRANSFORM, TextureRef,
 };
@@ -44,7 +44,7 @@ use crate::gpu::{group_layout, uniform_texture_group, upload_mips};
 use crate::image_io::RenderedImage;
 use crate::render::{MaterialUniform, SceneOptions, TARGET_FORMAT, ViewUniform};
 use crate::shaders::Technique;
-use crate::tables::TableSet;
+use crate::tables::{TableSet, check_limit};
 use crate::thickness_map::ThicknessMap;
 use bytemuck::{Pod, Zeroable};
 use camera::view_depth;
@@ -129,17 +129,9 @@ impl MeshUniform {
     /// The uniform of glTF material `m` seen through `view_proj`.
     pub fn new(view_proj: [[f32; 4]; 4], m: &GltfMaterial) -> MeshUniform {
         let t = &m.textures;
-        let slots = [
-            t.base_colour,
-            t.metallic_roughness,
-            t.normal,
-            t.occlusion,
-            t.emissive,
-            t.iridescence,
-            t.specular,
-            t.specular_colour,
-            t.thickness,
-        ];
+        let in_order = textures::slots_of(m);
+        let slots: [Option<TextureRef>; 9] =
+            std::array::from_fn(|k| in_order.get(k).copied().unwrap_or(t.thickness));
         let transforms = slots.map(|slot| {
             let r = slot.unwrap_or(TextureRef {
                 texture: 0,
@@ -236,15 +228,12 @@ pub fn render_gltf_from(
         None => EnvironmentMap::default_map()?,
     };
     let (width, height) = (options.width, options.height);
-    let limit = ctx.device.limits().max_texture_dimension_2d;
-    if width.max(height) > limit {
-        return Err(Error::Limit {
-            what: "render target".into(),
-            needed: u64::from(width.max(height)),
-            limit: u64::from(limit),
-            adapter: ctx.info.name.clone(),
-        });
-    }
+    check_limit(
+        ctx,
+        "render target",
+        u64::from(width.max(height)),
+        ctx.device.limits().max_texture_dimension_2d,
+    )?;
     let camera = view_camera(scene, view, f64::from(width) / f64::from(height))?;
     let mut view_options = options.clone();
     view_options.camera.eye = camera.eye;
@@ -350,13 +339,6 @@ pub fn render_gltf_from(
         None
     };
     let (target, submitted) = ctx.checked("rendering the glTF scene", || {
-        let group = |layout: &wgpu::BindGroupLayout,
-                     label: &str,
-                     contents: &[u8],
-                     texture: &wgpu::Texture,
-                     repeat_v: bool| {
-            uniform_texture_group(device, layout, label, contents, texture, repeat_v)
-        };
         let view_group = env.bind_group(
             device,
             &view_layout,
@@ -367,7 +349,8 @@ pub fn render_gltf_from(
             .iter()
             .zip(&thickness_textures)
             .map(|(u, t)| {
-                group(
+                uniform_texture_group(
+                    device,
                     &material_layout,
                     "mesh material",
                     bytemuck::bytes_of(u),

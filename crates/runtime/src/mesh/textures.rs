@@ -3,12 +3,12 @@
 
 use super::{BEHIND_FORMAT, TEXTURE_SLOTS};
 use crate::context::GpuContext;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::gltf_scene::{GltfMaterial, GltfScene, GltfTexture, SamplerSpec, TextureRef, Wrap};
 use crate::shaders;
 
 /// A material's textures in group 3's slot order ([`TEXTURE_SLOTS`]).
-fn slots_of(gm: &GltfMaterial) -> [Option<TextureRef>; 8] {
+pub(super) fn slots_of(gm: &GltfMaterial) -> [Option<TextureRef>; 8] {
     let t = &gm.textures;
     [
         t.base_colour,
@@ -136,59 +136,13 @@ pub fn rgba8_mip_chain(
 /// Uploads a glTF texture as `Rgba8UnormSrgb` (colour: the GPU decodes sRGB before
 /// filtering) or `Rgba8Unorm` (data), with its full mip chain.
 fn upload_rgba8(ctx: &GpuContext, t: &GltfTexture) -> Result<wgpu::Texture> {
-    let limit = ctx.device.limits().max_texture_dimension_2d;
-    if t.width.max(t.height) > limit {
-        return Err(Error::Limit {
-            what: t.name.clone(),
-            needed: u64::from(t.width.max(t.height)),
-            limit: u64::from(limit),
-            adapter: ctx.info.name.clone(),
-        });
-    }
-    let levels = rgba8_mip_chain(t.width, t.height, &t.rgba, t.srgb);
     let format = if t.srgb {
         wgpu::TextureFormat::Rgba8UnormSrgb
     } else {
         wgpu::TextureFormat::Rgba8Unorm
     };
-    ctx.checked(&format!("uploading {}", t.name), || {
-        let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(&t.name),
-            size: wgpu::Extent3d {
-                width: t.width,
-                height: t.height,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: levels.len() as u32,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
-        for (k, (w, h, texels)) in levels.iter().enumerate() {
-            ctx.queue.write_texture(
-                wgpu::TexelCopyTextureInfo {
-                    texture: &texture,
-                    mip_level: k as u32,
-                    origin: wgpu::Origin3d::ZERO,
-                    aspect: wgpu::TextureAspect::All,
-                },
-                texels,
-                wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(w * 4),
-                    rows_per_image: Some(*h),
-                },
-                wgpu::Extent3d {
-                    width: *w,
-                    height: *h,
-                    depth_or_array_layers: 1,
-                },
-            );
-        }
-        texture
-    })
+    let levels = rgba8_mip_chain(t.width, t.height, &t.rgba, t.srgb);
+    crate::gpu::upload_levels(ctx, &t.name, format, 4, &levels)
 }
 
 /// The box-filter pass of `shaders/mip_down.wgsl` and its one binding (level k, read).
@@ -204,16 +158,7 @@ impl MipDown {
         let module = shaders::create_module(ctx, "mip_down", &source)?;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("mip_down"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                    multisampled: false,
-                },
-                count: None,
-            }],
+            entries: &[crate::gpu::loaded_texture_entry(0)],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("mip_down"),
@@ -284,16 +229,7 @@ pub(super) fn mesh_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout 
         entries.push(crate::gpu::sampler_entry(2 + 2 * k));
     }
     // The scene behind (textureLoad: a float texture that need not be filterable).
-    entries.push(wgpu::BindGroupLayoutEntry {
-        binding: BEHIND_BINDING,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable: false },
-            view_dimension: wgpu::TextureViewDimension::D2,
-            multisampled: false,
-        },
-        count: None,
-    });
+    entries.push(crate::gpu::loaded_texture_entry(BEHIND_BINDING));
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("mesh material (glTF)"),
         entries: &entries,

@@ -51,7 +51,7 @@ use crate::gpu::{
     uniform_texture_group, upload_mips,
 };
 use crate::shaders::{self, Technique};
-use crate::tables::TableSet;
+use crate::tables::{TableSet, check_limit};
 use std::path::Path;
 
 mod options;
@@ -270,15 +270,12 @@ impl Renderer {
         }
         check_film_eval(tables, options)?;
         let (width, height) = (options.width, options.height);
-        let limit = ctx.device.limits().max_texture_dimension_2d;
-        if width.max(height) > limit {
-            return Err(Error::Limit {
-                what: "render target".into(),
-                needed: u64::from(width.max(height)),
-                limit: u64::from(limit),
-                adapter: ctx.info.name.clone(),
-            });
-        }
+        check_limit(
+            ctx,
+            "render target",
+            u64::from(width.max(height)),
+            ctx.device.limits().max_texture_dimension_2d,
+        )?;
         let env = EnvironmentTextures::new(
             ctx,
             environment,
