@@ -1,0 +1,144 @@
+//! Opening a glTF 2.0 / GLB file: its version, its accessors' existence, `extensionsRequired`
+//! (glTF §3.12), and its buffers (the GLB chunk, base64 `data:` URIs or files beside it).
+
+use super::{MAX_FILE_BYTES, SUPPORTED_EXTENSIONS, invalid};
+use crate::error::{Error, Result};
+use std::path::Path;
+
+/// The document of glTF or GLB `bytes`: a glTF 2.x asset whose primitives' attribute
+/// accessors exist and whose `extensionsRequired` nacre implements (then cleared, since the
+/// `gltf` crate knows only its own features' extensions), validated by the `gltf` crate.
+pub(super) fn open(bytes: &[u8], path: &Path) -> Result<gltf::Gltf> {
+    let not_valid = |e: gltf::Error| invalid(path, format!("not a valid glTF 2.0 / GLB file: {e}"));
+    let raw = gltf::Gltf::from_slice_without_validation(bytes).map_err(not_valid)?;
+    let json = raw.document.as_json();
+    let version = &json.asset.version;
+    if !version.starts_with("2.") {
+        return Err(invalid(
+            path,
+            format!("asset version `{version}`: expected a glTF 2.x file"),
+        ));
+    }
+    // gltf-json 1.4 validates a primitive by indexing its POSITION accessor before
+    // checking that it exists (a panic): check every attribute's accessor first.
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            if let Some(index) = primitive
+                .attributes
+                .values()
+                .find(|i| i.value() >= json.accessors.len())
+            {
+                return Err(invalid(
+                    path,
+                    format!(
+                        "meshes[{m}].primitives[{p}].attributes: accessor {} does not exist (the file has {})",
+                        index.value(),
+                        json.accessors.len()
+                    ),
+                ));
+            }
+        }
+    }
+    // extensionsRequired (glTF §3.12): every entry must be one nacre implements; they
+    // are checked here (the gltf crate knows only its own features' extensions).
+    if let Some(ext) = json
+        .extensions_required
+        .iter()
+        .find(|e| !SUPPORTED_EXTENSIONS.contains(&e.as_str()))
+    {
+        return Err(invalid(
+            path,
+            format!(
+                "the file requires the extension `{ext}`, which nacre does not implement (it implements {})",
+                SUPPORTED_EXTENSIONS.join(", ")
+            ),
+        ));
+    }
+    let mut root = raw.document.into_json();
+    root.extensions_required.clear();
+    Ok(gltf::Gltf {
+        document: gltf::Document::from_json(root).map_err(not_valid)?,
+        blob: raw.blob,
+    })
+}
+
+/// The bytes of every buffer of `gltf`, each at least as long as the file declares.
+pub(super) fn read_buffers(gltf: &gltf::Gltf, path: &Path) -> Result<Vec<Vec<u8>>> {
+    let doc = &gltf.document;
+    let mut buffers = Vec::new();
+    for buffer in doc.buffers() {
+        let data = match buffer.source() {
+            gltf::buffer::Source::Bin => gltf
+                .blob
+                .clone()
+                .ok_or_else(|| invalid(path, "the GLB binary chunk is missing"))?,
+            gltf::buffer::Source::Uri(uri) => {
+                if let Some(rest) = uri.strip_prefix("data:") {
+                    let (_, b64) = rest
+                        .split_once(";base64,")
+                        .ok_or_else(|| invalid(path, "only base64 `data:` URIs are supported"))?;
+                    base64_decode(b64)
+                        .ok_or_else(|| invalid(path, "a buffer's base64 data is malformed"))?
+                } else {
+                    let file = path.parent().unwrap_or(Path::new(".")).join(uri);
+                    let len = std::fs::metadata(&file)
+                        .map_err(|source| Error::Io {
+                            path: file.clone(),
+                            source,
+                        })?
+                        .len();
+                    if len > MAX_FILE_BYTES {
+                        return Err(invalid(&file, format!("{len} bytes (too large)")));
+                    }
+                    std::fs::read(&file).map_err(|source| Error::Io {
+                        path: file.clone(),
+                        source,
+                    })?
+                }
+            }
+        };
+        if data.len() < buffer.length() {
+            return Err(invalid(
+                path,
+                format!(
+                    "buffer {} holds {} bytes, the file declares {} (truncated?)",
+                    buffer.index(),
+                    data.len(),
+                    buffer.length()
+                ),
+            ));
+        }
+        buffers.push(data);
+    }
+    Ok(buffers)
+}
+
+/// Decodes standard base64 (RFC 4648, `=` padding optional, no whitespace).
+pub(crate) fn base64_decode(text: &str) -> Option<Vec<u8>> {
+    let value = |c: u8| -> Option<u32> {
+        Some(match c {
+            b'A'..=b'Z' => u32::from(c - b'A'),
+            b'a'..=b'z' => u32::from(c - b'a') + 26,
+            b'0'..=b'9' => u32::from(c - b'0') + 52,
+            b'+' | b'-' => 62,
+            b'/' | b'_' => 63,
+            _ => return None,
+        })
+    };
+    let bytes = text.trim_end_matches('=').as_bytes();
+    let mut out = Vec::with_capacity(bytes.len() * 3 / 4);
+    for chunk in bytes.chunks(4) {
+        let mut acc = 0u32;
+        for (i, &c) in chunk.iter().enumerate() {
+            acc |= value(c)? << (18 - 6 * i);
+        }
+        let n = match chunk.len() {
+            4 => 3,
+            3 => 2,
+            2 => 1,
+            _ => return None,
+        };
+        out.extend_from_slice(&acc.to_be_bytes()[1..1 + n]);
+    }
+    Some(out)
+}
