@@ -308,7 +308,7 @@ fn mesh_fs(in: MeshVertexOut, @builtin(front_facing) front: bool) -> @location(0
     let roughness = clamp(finite_or(q.roughness * mr_tex.g, 1.0), 0.0, 1.0);
     // The metal lobe's index: where the colour is the factor's alone (no texture or vertex
     // colour changes it), the uniform's metal (built per channel where that channel's
-    // sensitivity lies: gltf_metal.rs), else Gulbrandsen's fit to the fragment's colour.
+    // sensitivity lies: gltf_scene/metal.rs), else Gulbrandsen's fit to the fragment's colour.
     let fitted_metal = mesh_metal_index(base.rgb);
     let from_factor = all(abs(base.rgb - clamp(q.base_colour.rgb, vec3<f32>(0.0), vec3<f32>(1.0))) <= vec3<f32>(1e-6));
     let uniform_metal = material_params.base_kind != MATERIAL_BASE_DIELECTRIC && from_factor;

@@ -15,10 +15,7 @@ pub mod context;
 pub mod diffraction;
 pub mod environment;
 pub mod error;
-pub mod gltf_assets;
-pub mod gltf_metal;
 pub mod gltf_scene;
-pub mod gltf_textures;
 pub mod gpu;
 pub mod ibl;
 pub mod image_io;
@@ -37,6 +34,8 @@ pub use context::{BufferInitExt, GpuContext};
 /// Layout "integrated" of the `diffraction` technique ([`diffraction::integrated`]).
 pub use diffraction::integrated as diffraction_integrated;
 pub use error::{Error, Result};
+/// The glTF test assets, metals and textures under their former paths.
+pub use gltf_scene::{assets as gltf_assets, metal as gltf_metal, textures as gltf_textures};
 pub use params::{FilmInput, FilmOutput};
 pub use render::{RenderedImage, Renderer, SceneKind, SceneOptions, render_scene};
 pub use scene::Scene;

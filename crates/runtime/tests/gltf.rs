@@ -1,6 +1,6 @@
-//! glTF scenes (`nacre_runtime::gltf_scene`, `mesh`, `gltf_assets`, `shaders/mesh.wgsl`):
+//! glTF scenes (`nacre_runtime::gltf_scene`, `mesh`, `gltf_scene::assets`, `shaders/mesh.wgsl`):
 //!
-//! * the committed sweeps under `tests/golden/gltf/` are what `gltf_assets` writes, byte for
+//! * the committed sweeps under `tests/golden/gltf/` are what `gltf_scene::assets` writes, byte for
 //!   byte (`NACRE_UPDATE_GOLDEN=1` rewrites them and the golden image);
 //! * naga validates and translates the mesh pipeline of every technique (no GPU);
 //! * every sweep renders with lut and fourier, the spheres show colour, and spheres whose
@@ -8,8 +8,8 @@
 //! * one golden image (the thickness sweep, lut) under the thresholds of `tests/render.rs`;
 //! * bad files (missing, truncated, non-triangle primitives, absurd sizes) are errors.
 
-use nacre_runtime::gltf_assets::{SPHERE_SPACING, SWEEPS, sweep_glb};
 use nacre_runtime::gltf_scene::GltfScene;
+use nacre_runtime::gltf_scene::assets::{SPHERE_SPACING, SWEEPS, sweep_glb};
 use nacre_runtime::mesh::{fit_camera, render_gltf};
 use nacre_runtime::render::{FilmEval, RenderedImage, SceneKind, SceneOptions};
 use nacre_runtime::shaders::{MATERIAL, MESH, compose};
@@ -48,7 +48,7 @@ fn options() -> SceneOptions {
 #[test]
 fn committed_assets_are_reproduced_byte_for_byte() {
     if updating() {
-        nacre_runtime::gltf_assets::write_sweeps(&asset_dir()).unwrap();
+        nacre_runtime::gltf_scene::assets::write_sweeps(&asset_dir()).unwrap();
     }
     for sweep in &SWEEPS {
         let path = asset_dir().join(sweep.file);
@@ -60,7 +60,7 @@ fn committed_assets_are_reproduced_byte_for_byte() {
         });
         assert!(
             committed == sweep_glb(sweep),
-            "{} differs from gltf_assets::sweep_glb",
+            "{} differs from gltf_scene::assets::sweep_glb",
             path.display()
         );
         assert!(
@@ -342,7 +342,7 @@ fn bad_gltf_files_are_errors() {
         let mut doc: serde_json::Value = serde_json::from_slice(&good[20..20 + json_len]).unwrap();
         edit(&mut doc);
         let bin_start = 20 + json_len + 8;
-        nacre_runtime::gltf_assets::glb(&doc, &good[bin_start..])
+        nacre_runtime::gltf_scene::assets::glb(&doc, &good[bin_start..])
     };
     let lines = dir.path().join("lines.glb");
     std::fs::write(
@@ -399,7 +399,7 @@ fn bad_gltf_files_are_errors() {
     let gif = dir.path().join("gif.glb");
     std::fs::write(
         &gif,
-        nacre_runtime::gltf_assets::glb(&doc, &textured[20 + json_len + 8..]),
+        nacre_runtime::gltf_scene::assets::glb(&doc, &textured[20 + json_len + 8..]),
     )
     .unwrap();
     let scene = GltfScene::load(&gif).unwrap();
@@ -475,7 +475,7 @@ fn cameras_and_lights_come_from_the_file() {
     for k in first..first + 4 {
         scene_nodes.push(k.into());
     }
-    let bytes = nacre_runtime::gltf_assets::glb(&doc, &bin);
+    let bytes = nacre_runtime::gltf_scene::assets::glb(&doc, &bin);
     let scene = GltfScene::from_bytes(&bytes, &dir.path().join("lit.glb")).unwrap();
     assert_eq!(scene.cameras.len(), 2);
     assert!(matches!(
@@ -536,7 +536,7 @@ fn cameras_and_lights_come_from_the_file() {
             .unwrap()
             .push(k.into());
     }
-    let bytes = nacre_runtime::gltf_assets::glb(&many, &bin);
+    let bytes = nacre_runtime::gltf_scene::assets::glb(&many, &bin);
     let crowded = GltfScene::from_bytes(&bytes, &dir.path().join("many.glb")).unwrap();
     assert_eq!(crowded.lights.len(), 13);
     let (_, punctual, note) = scene_lights(&crowded);
@@ -556,7 +556,7 @@ fn cameras_and_lights_come_from_the_file() {
     // A range that is not a positive number is refused, naming the light.
     let mut bad = doc.clone();
     bad["extensions"]["KHR_lights_punctual"]["lights"][1]["range"] = (-1.0).into();
-    let bytes = nacre_runtime::gltf_assets::glb(&bad, &bin);
+    let bytes = nacre_runtime::gltf_scene::assets::glb(&bad, &bin);
     let e = GltfScene::from_bytes(&bytes, &dir.path().join("range.glb")).unwrap_err();
     assert!(
         e.to_string().contains("bulb") && e.to_string().contains("range"),
@@ -564,7 +564,7 @@ fn cameras_and_lights_come_from_the_file() {
     );
     // A dangling light index is an error, not a panic.
     doc["nodes"][first + 3]["extensions"]["KHR_lights_punctual"]["light"] = 7.into();
-    let bytes = nacre_runtime::gltf_assets::glb(&doc, &bin);
+    let bytes = nacre_runtime::gltf_scene::assets::glb(&doc, &bin);
     assert!(GltfScene::from_bytes(&bytes, &dir.path().join("dangling.glb")).is_err());
 }
 

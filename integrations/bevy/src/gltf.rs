@@ -48,7 +48,7 @@ pub struct NacreGltfHandler {
 
 /// The complex index n + iκ whose normal-incidence reflectance from air is `f0` with edge
 /// tint `g` (Gulbrandsen 2014, "Artist Friendly Metallic Fresnel", JCGT 3(4), Eq. 1–2; f0
-/// clamped to [0, 0.99]), as nacre's runtime maps a glTF metal (`gltf_metal.rs`).
+/// clamped to [0, 0.99]), as nacre's runtime maps a glTF metal (`gltf_scene/metal.rs`).
 pub fn metal_index_gulbrandsen2014(f0: f32, g: f32) -> (f32, f32) {
     let r = if f0.is_finite() {
         f0.clamp(0.0, 0.99)

@@ -1,9 +1,24 @@
 //! Opening a glTF 2.0 / GLB file: its version, its accessors' existence, `extensionsRequired`
 //! (glTF §3.12), and its buffers (the GLB chunk, base64 `data:` URIs or files beside it).
 
-use super::{MAX_FILE_BYTES, SUPPORTED_EXTENSIONS, invalid};
+use super::error::invalid;
+use super::limits::MAX_FILE_BYTES;
 use crate::error::{Error, Result};
 use std::path::Path;
+
+/// The glTF extensions nacre implements: a file whose `extensionsRequired` lists only these
+/// loads (`KHR_materials_transmission` and `_volume` refract the opaque scene in screen
+/// space, as the glTF Sample Viewer does: `shaders/mesh.wgsl`).
+pub const SUPPORTED_EXTENSIONS: [&str; 8] = [
+    "KHR_lights_punctual",
+    "KHR_materials_iridescence",
+    "KHR_materials_ior",
+    "KHR_materials_specular",
+    "KHR_materials_emissive_strength",
+    "KHR_materials_transmission",
+    "KHR_materials_volume",
+    "KHR_texture_transform",
+];
 
 /// The document of glTF or GLB `bytes`: a glTF 2.x asset whose primitives' attribute
 /// accessors exist and whose `extensionsRequired` nacre implements (then cleared, since the

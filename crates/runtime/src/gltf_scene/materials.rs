@@ -1,8 +1,8 @@
 //! The document's materials (glTF §3.9 and the extensions nacre implements) with the
 //! textures they read, and the `iridescenceThicknessTexture` of each as a thickness map.
 
-use super::{AlphaMode, GltfMaterial, Iridescence, MaterialTextures, Volume};
-use crate::gltf_textures::{
+use super::model::{AlphaMode, GltfMaterial, Iridescence, MaterialTextures, Volume};
+use super::textures::{
     GltfTexture, TextureLoader, TextureRef, thickness_texture, transform_from_json,
 };
 use crate::thickness_map::ThicknessMap;

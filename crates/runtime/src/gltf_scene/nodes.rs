@@ -1,10 +1,9 @@
 //! The scene's node trees (glTF §3.5): the meshes, cameras and `KHR_lights_punctual`
 //! lights they place, in world space.
 
+use super::error::invalid;
+use super::model::{GltfCamera, GltfLight, GltfMaterial, GltfPrimitive, GltfProjection, LightKind};
 use super::primitive::{self, Totals};
-use super::{
-    GltfCamera, GltfLight, GltfMaterial, GltfPrimitive, GltfProjection, LightKind, invalid,
-};
 use crate::error::Result;
 use std::path::Path;
 

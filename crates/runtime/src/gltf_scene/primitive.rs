@@ -1,7 +1,9 @@
 //! One triangle primitive (glTF §3.7.2): its accessors checked, its attributes read and
 //! placed in world space, flat normals and MikkTSpace tangents where the file has none.
 
-use super::{GltfMaterial, GltfPrimitive, MAX_INDICES, MAX_VERTICES, invalid};
+use super::error::invalid;
+use super::limits::{MAX_INDICES, MAX_VERTICES};
+use super::model::{GltfMaterial, GltfPrimitive};
 use crate::error::Result;
 use std::path::Path;
 

@@ -1,6 +1,10 @@
 //! Tests of the glTF material mapping and the loader's helpers.
 
+use super::document::base64_decode;
 use super::*;
+use crate::render::BaseKind;
+use nacre_optics::colour::Colorimeter;
+use nacre_optics::{C64, Material};
 
 #[test]
 fn gulbrandsen_reproduces_f0_at_normal_incidence() {

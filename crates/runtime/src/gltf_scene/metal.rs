@@ -6,9 +6,12 @@
 //! channel's sensitivity lies.
 
 use crate::error::{Error, Result};
-use crate::gltf_scene::GOLD_F0;
 use nacre_optics::colour::Colorimeter;
 use nacre_optics::{C64, Material};
+
+/// Linear base colour of gold at normal incidence (the glTF specification's reference metal
+/// table, "gold": 1.000, 0.766, 0.336).
+pub const GOLD_F0: [f32; 3] = [1.0, 0.766, 0.336];
 
 /// The complex index n + iκ whose normal-incidence reflectance from air is `f0`, with edge
 /// tint `edge_tint` (both in [0, 1]; f0 clamped to [0, 0.99]): Gulbrandsen 2014, Eq. (1)–(2)

@@ -4,7 +4,8 @@
 //! glTF sampler, `KHR_texture_transform`, and the iridescence thickness texture as a
 //! [`ThicknessMap`]. What cannot be decoded is skipped with a note, its factor kept.
 
-use crate::gltf_scene::{MAX_FILE_BYTES, base64_decode};
+use super::document::base64_decode;
+use super::limits::MAX_FILE_BYTES;
 use crate::thickness_map::ThicknessMap;
 use std::path::Path;
 

@@ -1,0 +1,10 @@
+//! The loader's size limits, shared by the document, primitive and texture readers.
+
+/// Largest glTF/GLB file read, bytes (and largest external buffer).
+pub const MAX_FILE_BYTES: u64 = 256 << 20;
+
+/// Largest number of vertices over all primitives.
+pub const MAX_VERTICES: usize = 4_000_000;
+
+/// Largest number of triangle corners (indices) over all primitives.
+pub const MAX_INDICES: usize = 12_000_000;
