@@ -103,7 +103,17 @@ impl TableSet {
 
     /// Loads another table into the set, replacing a table of the same kind.
     pub fn add(&mut self, ctx: &GpuContext, manifest_path: &Path) -> Result<()> {
-        let manifest = Manifest::read(manifest_path)?;
+        self.add_read(ctx, Manifest::read(manifest_path)?, manifest_path)
+    }
+
+    /// [`TableSet::add`] with the manifest already read (from `manifest_path`): checks its
+    /// files and uploads them.
+    pub fn add_read(
+        &mut self,
+        ctx: &GpuContext,
+        manifest: Manifest,
+        manifest_path: &Path,
+    ) -> Result<()> {
         verify_files(&manifest, manifest_path)?;
         match manifest.kind {
             TableKind::FilmLut => {

@@ -14,12 +14,16 @@
 //! Bind groups: 0 view, 1 technique, 2 material (as the analytic scenes), 3 the mesh pass
 //! (`MeshUniform`: view-projection).
 //!
-//! Files: `camera.rs` (orbit and file cameras), `lights.rs` (`KHR_lights_punctual`),
-//! `materials.rs` (the technique of each material), `pipeline.rs` (the passes and their
-//! pipelines), `textures.rs` (glTF textures, samplers and group 3); this file holds the
-//! uniform and the frame ([`render_gltf_from`]).
+//! Files: `inputs.rs` (what a frame reads, loaded before the device: [`RenderInputs`]),
+//! `frame.rs` (the GPU side of a frame, pass by pass), `camera.rs` (orbit and file cameras),
+//! `lights.rs` (`KHR_lights_punctual`), `materials.rs` (the technique of each material),
+//! `pipeline.rs` (the passes and their pipelines), `textures.rs` (glTF textures, samplers
+//! and group 3); this file holds the uniform and the entry points ([`render`],
+//! [`render_gltf_from`]).
 
 mod camera;
+mod frame;
+mod inputs;
 mod lights;
 mod materials;
 mod pipeline;
@@ -29,28 +33,21 @@ pub use camera::{
     DEFAULT_PITCH_DEG, FIT_FOV_X_DEG, FIT_FOV_Y_DEG, FittedCamera, Orbit, ViewPoint, file_camera,
     fit_camera, orbit_camera, view_camera,
 };
+pub use inputs::{RenderInputs, TableFile, load_environment};
 pub use lights::scene_lights;
 pub use textures::rgba8_mip_chain;
 
-use crate::context::BufferInitExt;
 use crate::context::GpuContext;
-use crate::environment::EnvironmentMap;
 use crate::error::Result;
 use crate::gltf_scene::{
     AlphaMode, GltfMaterial, GltfPrimitive, GltfScene, IDENTITY_TRANSFORM, TextureRef,
 };
-use crate::gpu::read_texture;
-use crate::gpu::{group_layout, uniform_texture_group, upload_mips};
 use crate::image_io::RenderedImage;
-use crate::render::{MaterialUniform, SceneOptions, TARGET_FORMAT, ViewUniform};
+use crate::render::SceneOptions;
 use crate::shaders::Technique;
-use crate::tables::{TableSet, check_limit};
-use crate::thickness_map::ThicknessMap;
+use crate::tables::TableSet;
 use bytemuck::{Pod, Zeroable};
-use camera::view_depth;
 use nacre_format::param::Msg;
-use pipeline::{Passes, PipelineState, transmits};
-use textures::{GltfTextures, MipDown, mesh_group_layout};
 
 /// Depth buffer format.
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -222,375 +219,23 @@ pub fn render_gltf_from(
     options: &SceneOptions,
     view: ViewPoint,
 ) -> Result<MeshRender> {
-    options.validate()?;
-    let environment = match &options.environment {
-        Some(path) => EnvironmentMap::load(path)?,
-        None => EnvironmentMap::default_map()?,
-    };
-    let (width, height) = (options.width, options.height);
-    check_limit(
-        ctx,
-        "render target",
-        u64::from(width.max(height)),
-        ctx.device.limits().max_texture_dimension_2d,
-    )?;
-    let camera = view_camera(scene, view, f64::from(width) / f64::from(height))?;
-    let mut view_options = options.clone();
-    view_options.camera.eye = camera.eye;
-    view_options.camera.target = camera.target;
-    view_options.camera.up = camera.up;
-    view_options.camera.fov_y_deg = camera.fov_y_deg;
-    let (light, punctual_lights, light_note) = scene_lights(scene);
-    view_options.light = light;
-    view_options.punctual_lights = punctual_lights;
-
-    // Materials: nacre's options and the technique that draws each.
-    let colorimeter = tables.colorimeter()?;
-    let used: Vec<usize> = {
-        let mut v: Vec<usize> = scene.primitives.iter().map(|p| p.material).collect();
-        v.sort_unstable();
-        v.dedup();
-        v
-    };
-    let used_name = |n: &str| {
-        // A note about a material names it first (`name: …`); other notes are kept.
-        let about = |i: usize| n.starts_with(&format!("{}:", scene.materials[i].name));
-        !(0..scene.materials.len()).any(about) || used.iter().any(|&i| about(i))
-    };
-    let mut notes: Vec<Msg> = scene
-        .notes
-        .iter()
-        .filter(|n| used_name(n))
-        .map(|n| Msg::from(n.as_str()))
-        .collect();
-    let choice = materials::choose(scene, tables, technique, &colorimeter, &used)?;
-    notes.extend(choice.notes);
-    let drawn = choice.drawn;
-    if let Some(note) = light_note {
-        notes.push(Msg::from(note));
-    }
-    if let Some(note) = choice.fallback_note {
-        notes.push(note);
-    }
-
-    let device = &ctx.device;
-    let view_layout = crate::render::view_group_layout(device, "mesh view");
-    let material_layout = group_layout(device, "mesh material");
-    let mesh_layout = mesh_group_layout(device);
-    let passes = Passes::new(
+    render(
         ctx,
         tables,
-        &options.technique_options(),
-        &colorimeter,
-        scene,
-        &drawn,
-        &used,
-        [&view_layout, &material_layout, &mesh_layout],
-    )?;
-    let behind_needed = passes.behind_needed;
-    let state_of = |i: usize| PipelineState::of(&scene.materials[i]);
-    let transmissive = |i: usize| transmits(&scene.materials[i]);
-    let pass_of = |i: usize| passes.pass_of[i];
+        technique,
+        &RenderInputs::load(scene, options, view)?,
+    )
+}
 
-    crate::render::check_film_eval(tables, options)?;
-    let env = crate::render::EnvironmentTextures::new(
-        ctx,
-        &environment,
-        options.film_eval,
-        tables.rough_film_lut.as_ref(),
-    )?;
-    let view_uniform = ViewUniform::new(&view_options, env.env_levels)?;
-    // Per material its thickness texture, or a 1×1 map of g = 1 (d = d_max) without one.
-    let flat = ThicknessMap {
-        width: 1,
-        height: 1,
-        values: vec![1.0],
-        green_blue: None,
-    };
-    let flat_texture = upload_mips(
-        ctx,
-        "thickness map",
-        wgpu::TextureFormat::Rg16Float,
-        &flat.mip_chain(),
-    )?;
-    let mut thickness_textures = Vec::with_capacity(drawn.len());
-    for i in 0..drawn.len() {
-        thickness_textures.push(match scene.thickness_maps.get(i).and_then(Option::as_ref) {
-            Some(map) if used.contains(&i) => Some(upload_mips(
-                ctx,
-                "thickness map",
-                wgpu::TextureFormat::Rg16Float,
-                &map.mip_chain(),
-            )?),
-            _ => None,
-        });
-    }
-    let mut material_uniforms = Vec::with_capacity(drawn.len());
-    for (m, _) in &drawn {
-        let mut u = MaterialUniform::new(m, tables)?;
-        u.film_eval = options.film_eval.id();
-        material_uniforms.push(u);
-    }
-    let textures = GltfTextures::upload(ctx, scene, &used)?;
-
-    let mip_down = if behind_needed {
-        Some(MipDown::new(ctx)?)
-    } else {
-        None
-    };
-    let (target, submitted) = ctx.checked("rendering the glTF scene", || {
-        let view_group = env.bind_group(
-            device,
-            &view_layout,
-            "mesh view",
-            bytemuck::bytes_of(&view_uniform),
-        );
-        let material_groups: Vec<wgpu::BindGroup> = material_uniforms
-            .iter()
-            .zip(&thickness_textures)
-            .map(|(u, t)| {
-                uniform_texture_group(
-                    device,
-                    &material_layout,
-                    "mesh material",
-                    bytemuck::bytes_of(u),
-                    t.as_ref().unwrap_or(&flat_texture),
-                    true,
-                )
-            })
-            .collect();
-        // Group 3 per used material: its MeshUniform (with `extra_flags`), textures and
-        // samplers, and the picture of the scene behind.
-        let samplers = textures.samplers(device, scene, &used);
-        let mesh_groups_with = |extra_flags: u32, behind: &wgpu::TextureView| {
-            let mut mesh_groups: Vec<Option<wgpu::BindGroup>> = Vec::new();
-            for (i, gm) in scene.materials.iter().enumerate() {
-                if !used.contains(&i) {
-                    mesh_groups.push(None);
-                    continue;
-                }
-                let mut uniform = MeshUniform::new(camera.view_proj, gm);
-                uniform.flags |= extra_flags;
-                let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("mesh material (glTF)"),
-                    contents: bytemuck::bytes_of(&uniform),
-                    usage: wgpu::BufferUsages::UNIFORM,
-                });
-                mesh_groups.push(Some(textures.mesh_group(
-                    device,
-                    &mesh_layout,
-                    scene,
-                    gm,
-                    &samplers,
-                    &buffer,
-                    behind,
-                )));
-            }
-            mesh_groups
-        };
-        let geometry: Vec<(wgpu::Buffer, wgpu::Buffer, u32, usize, f64)> = scene
-            .primitives
-            .iter()
-            .filter(|p| !p.indices.is_empty())
-            .map(|p| {
-                let vertices = vertex_data(p);
-                let vb = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("mesh vertices"),
-                    contents: bytemuck::cast_slice(&vertices),
-                    usage: wgpu::BufferUsages::VERTEX,
-                });
-                let ib = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("mesh indices"),
-                    contents: bytemuck::cast_slice(&p.indices),
-                    usage: wgpu::BufferUsages::INDEX,
-                });
-                (
-                    vb,
-                    ib,
-                    p.indices.len() as u32,
-                    p.material,
-                    view_depth(&camera, p),
-                )
-            })
-            .collect();
-        // Draw order: opaque and masked primitives by pass, then blended ones back to front.
-        let mut order: Vec<usize> = (0..geometry.len()).collect();
-        order.sort_by(|&a, &b| {
-            let (ma, mb) = (geometry[a].3, geometry[b].3);
-            let (ba, bb) = (state_of(ma).blend, state_of(mb).blend);
-            ba.cmp(&bb).then_with(|| {
-                if ba {
-                    geometry[b].4.total_cmp(&geometry[a].4)
-                } else {
-                    (pass_of(ma), state_of(ma)).cmp(&(pass_of(mb), state_of(mb)))
-                }
-            })
-        });
-        let size = wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        };
-        let extent = (size.width, size.height);
-        let target = crate::gpu::render_target(device, "mesh target", extent, TARGET_FORMAT, true);
-        let depth = crate::gpu::render_target(device, "mesh depth", extent, DEPTH_FORMAT, false);
-        let target_view = target.create_view(&Default::default());
-        let depth_view = depth.create_view(&Default::default());
-        // The picture of the opaque scene (cleared to alpha 0: nothing drawn there), or a
-        // 1 × 1 stand-in when no material transmits.
-        let linear_texture = |label: &str, size: wgpu::Extent3d| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size,
-                // The full chain (mip_down.wgsl): rough surfaces refract a blurred picture.
-                mip_level_count: size.max_mips(wgpu::TextureDimension::D2),
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: BEHIND_FORMAT,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                    | wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            })
-        };
-        let one = wgpu::Extent3d {
-            width: 1,
-            height: 1,
-            depth_or_array_layers: 1,
-        };
-        let behind = linear_texture("mesh scene behind", if behind_needed { size } else { one });
-        let behind_view = behind.create_view(&Default::default());
-        // Level k of the picture, alone: a render attachment holds one level.
-        let behind_level = |k: u32| {
-            behind.create_view(&wgpu::TextureViewDescriptor {
-                base_mip_level: k,
-                mip_level_count: Some(1),
-                ..Default::default()
-            })
-        };
-        let no_behind = linear_texture("mesh no scene behind", one);
-        let no_behind_view = no_behind.create_view(&Default::default());
-        let mut encoder = device.create_command_encoder(&Default::default());
-        // The stand-in is cleared once (alpha 0) so that it reads as "nothing behind".
-        drop(crate::gpu::begin_pass(
-            &mut encoder,
-            "mesh no scene behind",
-            &[crate::gpu::cleared_attachment(
-                &no_behind_view,
-                wgpu::Color::TRANSPARENT,
-            )],
-        ));
-        // Draws `order`'s primitives into `colour` (cleared to `clear`; depth cleared), with
-        // group-3 bind groups `groups`; `linear`: the picture of the opaque scene (transmissive
-        // primitives skipped).
-        let draw = |encoder: &mut wgpu::CommandEncoder,
-                    colour: &wgpu::TextureView,
-                    clear: wgpu::Color,
-                    groups: &[Option<wgpu::BindGroup>],
-                    linear: bool| {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("mesh"),
-                color_attachments: &[crate::gpu::cleared_attachment(colour, clear)],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &depth_view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Discard,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_bind_group(0, &view_group, &[]);
-            let mut current: Option<(usize, PipelineState)> = None;
-            for &g in &order {
-                let (vb, ib, count, material, _) = &geometry[g];
-                if linear && transmissive(*material) {
-                    continue;
-                }
-                let (Some(mesh_group), k) = (&groups[*material], pass_of(*material)) else {
-                    continue;
-                };
-                let key = (
-                    k,
-                    PipelineState {
-                        linear,
-                        ..state_of(*material)
-                    },
-                );
-                let Some(pipeline) = passes.pipelines.get(&key) else {
-                    continue;
-                };
-                if current != Some(key) {
-                    pass.set_pipeline(pipeline);
-                    pass.set_bind_group(1, &passes.bindings[k].bind_group, &[]);
-                    current = Some(key);
-                }
-                pass.set_bind_group(2, &material_groups[*material], &[]);
-                pass.set_bind_group(3, mesh_group, &[]);
-                pass.set_vertex_buffer(0, vb.slice(..));
-                pass.set_index_buffer(ib.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed(0..*count, 0, 0..1);
-            }
-        };
-        if behind_needed {
-            let groups = mesh_groups_with(FLAG_LINEAR_OUTPUT, &no_behind_view);
-            draw(
-                &mut encoder,
-                &behind_level(0),
-                wgpu::Color::TRANSPARENT,
-                &groups,
-                true,
-            );
-            if let Some(mip_down) = &mip_down {
-                mip_down.fill(
-                    device,
-                    &mut encoder,
-                    &behind_level,
-                    behind.mip_level_count(),
-                );
-            }
-        }
-        // The background: the environment seen by the camera is not drawn (a clear colour
-        // keeps the spheres' silhouettes readable).
-        let groups = if behind_needed {
-            mesh_groups_with(FLAG_BEHIND, &behind_view)
-        } else {
-            mesh_groups_with(0, &no_behind_view)
-        };
-        draw(
-            &mut encoder,
-            &target_view,
-            wgpu::Color {
-                r: 0.18,
-                g: 0.18,
-                b: 0.2,
-                a: 1.0,
-            },
-            &groups,
-            false,
-        );
-        let _ = device.poll(wgpu::PollType::wait_indefinitely());
-        let submitted = std::time::Instant::now();
-        ctx.queue.submit([encoder.finish()]);
-        (target, submitted)
-    })?;
-    ctx.wait("rendering the glTF scene")?;
-    let gpu_seconds = submitted.elapsed().as_secs_f64();
-    let mut pixels = read_texture(ctx, &target, 4)?;
-    for p in pixels.chunks_exact_mut(4) {
-        p[3] = 255;
-    }
-    Ok(MeshRender {
-        image: RenderedImage {
-            width,
-            height,
-            pixels,
-            gpu_seconds,
-        },
-        notes,
-    })
+/// Renders `inputs` (loaded and validated before the device: [`RenderInputs`]) with
+/// `technique` from `tables`: uploads them and draws the frame pass by pass (`frame.rs`).
+pub fn render(
+    ctx: &GpuContext,
+    tables: &TableSet,
+    technique: Technique,
+    inputs: &RenderInputs,
+) -> Result<MeshRender> {
+    frame::draw(ctx, tables, technique, inputs)
 }
 
 /// The interleaved vertices of a primitive ([`VERTEX_FLOATS`] floats each).
