@@ -46,7 +46,7 @@ void NacreFilmLut_float(UnityTexture3D Reflectance, UnityTexture3D Transmittance
 // The fourier technique: Belcour & Barla 2017 Eq. 10 with exact Fresnel over a `fourier`
 // table. MaxOpdNm = max_opd_nm; LevelCount = the number of levels (≤ the texture's mips);
 // Sigma1Nm = level_sigma_nm[1] (0 with one level); Carrier = ν̄_j (1/nm); White = ‖s_j‖;
-// Harmonics = M (3 is the runtime's default, 0 = automatic).
+// Harmonics = M (0 = automatic, the runtime's default; a positive M is a fixed count).
 void NacreFilmFourier_float(UnityTexture2DArray Table,
     float MaxOpdNm, float LevelCount, float Sigma1Nm, float3 Carrier, float3 White, float Harmonics,
     float CosTheta, float ThicknessNm, float FilmIor, float SigmaThicknessNm, float AmbientIor, float3 BaseIor, float3 BaseKappa,

@@ -1,0 +1,105 @@
+// Types of @nacre/three (src/index.js).
+import type {
+  Data3DTexture,
+  DataArrayTexture,
+  MeshPhysicalMaterial,
+  MeshPhysicalMaterialParameters,
+} from 'three';
+
+/** Axes of a film-lut table (the fields of nacre.glsl's NacreFilmLutParams). */
+export interface NacreFilmLutParams {
+  cosThetaCount: number;
+  opdCount: number;
+  iorCount: number;
+  thicknessMinNm: number;
+  thicknessMaxNm: number;
+  iorMin: number;
+  iorMax: number;
+  ambientIndex: number;
+  hasTransmittance: boolean;
+}
+
+/** Axes of a fourier table (the fields of nacre.glsl's NacreFourierParams but M). */
+export interface NacreFourierParams {
+  maxOpdNm: number;
+  /** 1: three.js uploads one level of a DataArrayTexture (no σ_d prefilter). */
+  levelCount: number;
+  sigma1Nm: number;
+  carrierNuPerNm: [number, number, number];
+  white: [number, number, number];
+}
+
+export type NacreTable =
+  | {
+      kind: 'film-lut';
+      name: string;
+      reflectance: Data3DTexture;
+      transmittance: Data3DTexture | null;
+      params: NacreFilmLutParams;
+    }
+  | { kind: 'fourier'; name: string; texture: DataArrayTexture; params: NacreFourierParams };
+
+export class NacreTableError extends Error {
+  url: string;
+}
+
+export interface Ktx2Image {
+  vkFormat: number;
+  width: number;
+  height: number;
+  depth: number;
+  layers: number;
+  levels: { width: number; height: number; depth: number; data: Uint16Array | Float32Array }[];
+  keyValue: Record<string, string>;
+}
+
+/** Parses the uncompressed KTX 2.0 files nacre writes (RGBA16F / RGBA32F). */
+export function parseKtx2(buffer: ArrayBuffer, url?: string): Ktx2Image;
+/** Loads a baked table (film-lut or fourier) through its manifest `NAME.json`. */
+export function loadNacreTable(manifestUrl: string): Promise<NacreTable>;
+/** Loads a film-lut quantity exported by `nacre export` (`FILE.raw` + `FILE.json`). */
+export function loadNacreRawTable(rawUrl: string): Promise<NacreTable>;
+
+export const NacreDebugView: Readonly<{ NONE: 0; FILM: 1; UNIT_FILM: 2 }>;
+export type NacreDebugViewValue = 0 | 1 | 2;
+
+export interface NacreFilmOptions {
+  /** Fourier harmonics M; 0 (default) = automatic, as `nacre color --method fourier`. */
+  harmonics?: number;
+  debugView?: NacreDebugViewValue;
+}
+
+export interface NacreFilmMaterialParameters extends MeshPhysicalMaterialParameters, NacreFilmOptions {
+  table: NacreTable;
+  /** Sets iridescenceThicknessRange to [d, d] (nm). */
+  filmThicknessNm?: number;
+  /** The film index (three's iridescenceIOR). */
+  filmIor?: number;
+}
+
+export class NacreFilmMaterial extends MeshPhysicalMaterial {
+  constructor(parameters?: NacreFilmMaterialParameters);
+  readonly isNacreFilmMaterial: true;
+  table: NacreTable;
+  filmThicknessNm: number;
+  filmIor: number;
+  harmonics: number;
+  debugView: NacreDebugViewValue;
+}
+
+/** Gives an existing MeshPhysicalMaterial nacre's film; returns it. */
+export function applyNacreFilm<T extends MeshPhysicalMaterial>(material: T, table: NacreTable, options?: NacreFilmOptions): T;
+/** Throws when three.js's chunks lack the hooks; returns three's REVISION. */
+export function checkThreeHooks(): string;
+
+export class NacreGLTFPlugin {
+  constructor(parser: unknown, table: NacreTable, options?: NacreFilmOptions);
+  readonly name: 'NACRE_film';
+  materials: MeshPhysicalMaterial[];
+  afterRoot(result: { scene: import('three').Group; scenes: import('three').Group[] }): Promise<void>;
+}
+/** The callback for `GLTFLoader.register`: every KHR_materials_iridescence material gets nacre's film. */
+export function nacreGLTFPlugin(table: NacreTable, options?: NacreFilmOptions): (parser: unknown) => NacreGLTFPlugin;
+
+/** nacre's GLSL library (shaders/glsl/nacre.glsl). */
+export const nacreGlsl: string;

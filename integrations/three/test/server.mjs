@@ -1,0 +1,90 @@
+// A small static file server on 127.0.0.1 for the browser tests (WebGL and WebGPU need a
+// page served over http from a secure-context origin; 127.0.0.1 is one).
+//
+//   /pkg/...            integrations/three/src (the package)
+//   /test/...           integrations/three/test
+//   /three/NAME/...     integrations/three/node_modules/NAME (three = newest, three-r160 = oldest)
+//   /tables/...         tables/baked (the default table set)
+//   /samples/...        ../shared/gltf-samples (Khronos glTF samples; not in the repository)
+//   /page/NAME.html     an empty page whose import map points `three` at node_modules/NAME
+import { createServer } from 'node:http';
+import { readFile, stat } from 'node:fs/promises';
+import { extname, join, normalize, sep } from 'node:path';
+import { fileURLToPath } from 'node:url';
+
+const here = fileURLToPath(new URL('.', import.meta.url));
+export const packageRoot = normalize(join(here, '..'));
+export const repoRoot = normalize(join(packageRoot, '..', '..'));
+// ../shared beside the repository (DATA.md), or NACRE_SHARED where it lives elsewhere.
+export const sharedRoot = process.env.NACRE_SHARED ?? normalize(join(repoRoot, '..', 'shared'));
+export const samplesRoot = join(sharedRoot, 'gltf-samples');
+
+const roots = {
+  pkg: join(packageRoot, 'src'),
+  test: join(packageRoot, 'test'),
+  three: join(packageRoot, 'node_modules'),
+  tables: join(repoRoot, 'tables', 'baked'),
+  samples: samplesRoot,
+};
+
+const types = {
+  '.js': 'text/javascript',
+  '.mjs': 'text/javascript',
+  '.json': 'application/json',
+  '.html': 'text/html',
+  '.glb': 'model/gltf-binary',
+  '.gltf': 'model/gltf+json',
+  '.bin': 'application/octet-stream',
+  '.ktx2': 'image/ktx2',
+  '.png': 'image/png',
+  '.jpg': 'image/jpeg',
+  '.jpeg': 'image/jpeg',
+};
+
+function page(threeName) {
+  return `<!doctype html>
+<html><head><meta charset="utf-8"><title>nacre three.js test (${threeName})</title>
+<script type="importmap">{"imports": {
+  "three": "/three/${threeName}/build/three.module.js",
+  "three/addons/": "/three/${threeName}/examples/jsm/",
+  "@nacre/three": "/pkg/index.js"
+}}</script>
+<style>body { margin: 0; background: #000 }</style>
+</head><body></body></html>`;
+}
+
+/** Starts the server on an ephemeral port of 127.0.0.1; resolves to {url, close}. */
+export function startServer() {
+  const server = createServer(async (req, res) => {
+    try {
+      const path = decodeURIComponent(new URL(req.url, 'http://127.0.0.1').pathname);
+      if (path === '/favicon.ico') {
+        res.writeHead(204).end();
+        return;
+      }
+      const pageMatch = /^\/page\/([\w.-]+)\.html$/.exec(path);
+      if (pageMatch) {
+        res.writeHead(200, { 'content-type': 'text/html' });
+        res.end(page(pageMatch[1]));
+        return;
+      }
+      const [, root, ...rest] = path.split('/');
+      const base = roots[root];
+      const file = base && normalize(join(base, ...rest));
+      if (!file || !(file === base || file.startsWith(base + sep)) || !(await stat(file)).isFile()) {
+        res.writeHead(404).end();
+        return;
+      }
+      res.writeHead(200, { 'content-type': types[extname(file)] ?? 'application/octet-stream' });
+      res.end(await readFile(file));
+    } catch {
+      res.writeHead(404).end();
+    }
+  });
+  return new Promise((resolve) => {
+    server.listen(0, '127.0.0.1', () => {
+      const { port } = server.address();
+      resolve({ url: `http://127.0.0.1:${port}`, close: () => new Promise((r) => server.close(r)) });
+    });
+  });
+}
