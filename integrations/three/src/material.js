@@ -83,6 +83,17 @@ function multiscatteringHook() {
   return `${macro}\n${calls}`;
 }
 
+/**
+ * True when three's lights_fragment_begin evaluates the film twice, for the dielectric F0
+ * (material.specularColor) and then for the metal's (material.diffuseColor) and mixes them
+ * by metalness (r187): the second evaluation is skipped at metalness 0.
+ */
+function secondFilmIsMetal() {
+  const calls = [...(ShaderChunk.lights_fragment_begin ?? '').matchAll(/evalIridescence\s*\(([^;]*)\)\s*;/g)].map((m) => m[1]);
+  return calls.length === 2 && /material\.specularColor\s*$/.test(calls[0]) && /material\.diffuseColor\s*$/.test(calls[1]) &&
+    /material\.iridescenceFresnel\s*=\s*mix\s*\([^;]*material\.metalness\s*\)/.test(ShaderChunk.lights_fragment_begin);
+}
+
 const DECLARATIONS = /* glsl */ `
 #ifdef NACRE_FILM_LUT
 uniform highp sampler3D nacreReflectance;
@@ -109,7 +120,13 @@ vec3 nacreFilmReflectanceUncached(float ambientIor, float filmIor, float cosThet
 // nacre's film reflectance at cos θ₁ for a film of index n₂ and thickness d (nm) over a base
 // of normal-incidence reflectance F0 in an ambient of index n₁; replaces three's
 // evalIridescence(n₁, n₂, cos θ₁, d, F0).
-vec3 nacreFilmReflectance(float ambientIor, float filmIor, float cosTheta, float thicknessNm, vec3 baseF0) {
+vec3 nacreFilmReflectance(float ambientIor, float filmIor, float cosTheta, float thicknessNm, vec3 baseF0, float metalness) {
+#ifdef NACRE_SECOND_FILM_IS_METAL
+  // three evaluates the metal's film second and weights it by metalness: not needed at 0.
+  if (nacreFilmCount == 1 && metalness == 0.0) {
+    return vec3(0.0);
+  }
+#endif
   vec3 film = nacreFilmReflectanceUncached(ambientIor, filmIor, cosTheta, thicknessNm, baseF0);
   if (nacreFilmCount == 0) {
     nacreFilmBaseF0[0] = baseF0;
@@ -167,7 +184,7 @@ vec3 nacreFilmReflectanceUncached(float ambientIor, float filmIor, float cosThet
 `;
 
 const HOOK = /* glsl */ `
-#define evalIridescence(outsideIOR, eta2, cosTheta1, thinFilmThickness, baseF0) nacreFilmReflectance(outsideIOR, eta2, cosTheta1, thinFilmThickness, baseF0)
+#define evalIridescence(outsideIOR, eta2, cosTheta1, thinFilmThickness, baseF0) nacreFilmReflectance(outsideIOR, eta2, cosTheta1, thinFilmThickness, baseF0, metalnessFactor)
 #include <lights_fragment_begin>
 #undef evalIridescence
 `;
@@ -238,6 +255,7 @@ class NacreFilmState {
 
   defines() {
     const d = { NACRE_DEBUG_VIEW: String(this.debugView) };
+    if (secondFilmIsMetal()) d.NACRE_SECOND_FILM_IS_METAL = '';
     d[this.table.kind === 'film-lut' ? 'NACRE_FILM_LUT' : 'NACRE_FOURIER'] = '';
     return d;
   }

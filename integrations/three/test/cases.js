@@ -141,7 +141,7 @@ export async function gltfScene(url, size, tableName) {
   const centre = box.getCenter(new THREE.Vector3());
   const radius = box.getSize(new THREE.Vector3()).length() / 2;
   const camera = new THREE.PerspectiveCamera(40, 1, radius / 100, radius * 100);
-  camera.position.copy(centre).add(new THREE.Vector3(0, radius * 0.2, radius * 1.7));
+  camera.position.copy(centre).add(new THREE.Vector3(0, radius * 0.2, radius * 2.6));
   camera.lookAt(centre);
   renderer.render(scene, camera);
   let iridescent = 0;
@@ -206,4 +206,84 @@ export async function frameTime(size, frames, rounds) {
   const median = (a) => [...a].sort((x, y) => x - y)[Math.floor(a.length / 2)];
   renderer.dispose();
   return Object.fromEntries(Object.entries(times).map(([k, v]) => [k, median(v)]));
+}
+
+/**
+ * The control for the "film lost on direct light" check: the recipe docs/engines/threejs.md
+ * gave before this package (`material.specularColor = film` after lights_physical_fragment),
+ * with the same plane, light and unit-film reference as filmCases. On three.js releases whose
+ * direct specular reads `specularColorBlended` (r187) its highlight is as white as the unit
+ * film's; run.mjs checks that its detector sees that.
+ */
+export async function legacyRecipeDirectional(c) {
+  const { nacreGlsl } = await import('@nacre/three');
+  const t = await table(c.table);
+  const p = t.params;
+  const renderer = makeRenderer(1, 1);
+  const target = new THREE.WebGLRenderTarget(1, 1, { type: THREE.FloatType });
+  const camera = new THREE.OrthographicCamera(-2, 2, 2, -2, 0.1, 100);
+  camera.position.set(0, 0, 10);
+  camera.lookAt(0, 0, 0);
+  const unit = { value: 0 };
+  const material = new THREE.MeshPhysicalMaterial({ color: 0x000000, roughness: 0.3, metalness: 0, ior: c.baseIor });
+  material.onBeforeCompile = (shader) => {
+    Object.assign(shader.uniforms, {
+      nacreReflectance: { value: t.reflectance },
+      nacreCounts: { value: new THREE.Vector3(p.cosThetaCount, p.opdCount, p.iorCount) },
+      nacreThicknessRange: { value: new THREE.Vector2(p.thicknessMinNm, p.thicknessMaxNm) },
+      nacreIorRange: { value: new THREE.Vector2(p.iorMin, p.iorMax) },
+      nacreAmbient: { value: p.ambientIndex },
+      nacreThickness: { value: c.thicknessNm },
+      nacreFilmIor: { value: c.filmIor },
+      nacreUnit: unit,
+    });
+    shader.fragmentShader = shader.fragmentShader
+      .replace('#include <common>', `#include <common>
+precision highp sampler3D;
+precision highp sampler2DArray;
+${nacreGlsl}
+uniform highp sampler3D nacreReflectance;
+uniform vec3 nacreCounts;
+uniform vec2 nacreThicknessRange;
+uniform vec2 nacreIorRange;
+uniform float nacreAmbient;
+uniform float nacreThickness;
+uniform float nacreFilmIor;
+uniform float nacreUnit;`)
+      .replace('#include <lights_physical_fragment>', `#include <lights_physical_fragment>
+{
+  NacreFilmLutParams nacreParams = nacre_make_film_lut_params(uvec3(nacreCounts + 0.5),
+      nacreThicknessRange, nacreIorRange, nacreAmbient, false);
+  float nacreCos = clamp(dot(normal, normalize(vViewPosition)), 0.0, 1.0);
+  NacreFilmInput nacreIn = nacre_make_film_input(nacreCos, nacreThickness, nacreFilmIor, 0.0,
+      nacreAmbient, vec3(1.5), vec3(0.0));
+  NacreFilmOutput nacreOut = nacre_film_lut_colour(nacreReflectance, nacreReflectance, nacreParams, nacreIn);
+  material.specularColor = nacreUnit > 0.5 ? vec3(1.0) : nacreOut.reflectance;
+  material.specularF90 = 1.0;
+}`);
+  };
+  const mesh = new THREE.Mesh(new THREE.PlaneGeometry(20, 20), material);
+  const scene = new THREE.Scene();
+  const sun = new THREE.DirectionalLight(0xffffff, 1);
+  scene.add(mesh, sun, sun.target);
+  const pixel = new Float32Array(4);
+  const rows = [];
+  for (const deg of c.anglesDeg) {
+    const theta = (deg * Math.PI) / 180;
+    mesh.rotation.set(0, theta, 0);
+    const n = new THREE.Vector3(Math.sin(theta), 0, Math.cos(theta));
+    sun.position.copy(n.clone().multiplyScalar(2 * n.z).sub(new THREE.Vector3(0, 0, 1)));
+    const row = { deg };
+    for (const [key, u] of [['lit', 0], ['unit', 1]]) {
+      unit.value = u;
+      renderer.setRenderTarget(target);
+      renderer.render(scene, camera);
+      renderer.readRenderTargetPixels(target, 0, 0, 1, 1, pixel);
+      row[key] = Array.from(pixel);
+    }
+    renderer.setRenderTarget(null);
+    rows.push(row);
+  }
+  renderer.dispose();
+  return rows;
 }

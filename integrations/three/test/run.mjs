@@ -67,6 +67,13 @@ async function openPage(threeName) {
   return { page, errors };
 }
 
+// The film lost on a direct light: a highlight as white as the unit film's (ratio 1 within
+// 10⁻³) at an angle where nacre's film is coloured (CPU colour 10⁻² or more away from white).
+function filmLost(row, cpu) {
+  const ratio = [0, 1, 2].map((k) => row.lit[k] / row.unit[k]);
+  return maxAbs(ratio, [1, 1, 1]) < 1e-3 && maxAbs(cpu, [1, 1, 1]) > 1e-2;
+}
+
 function maxAbs(a, b) {
   return Math.max(...a.map((v, i) => Math.abs(v - b[i])));
 }
@@ -98,7 +105,7 @@ async function filmTests(threeName) {
         if (process.env.NACRE_VERBOSE) console.log(`  ${want.name} ${row.deg}° ${light}: ratio ${ratio.map((v) => v.toFixed(5))} cpu ${cpu.map((v) => v.toFixed(5))}`);
         worst[light] = Math.max(worst[light], d);
         // The film lost on a direct light: the highlight as bright as the unit film's.
-        if (light !== 'environment' && maxAbs(ratio, [1, 1, 1]) < 1e-3 && maxAbs(cpu, [1, 1, 1]) > 1e-2) lostOnDirect = true;
+        if (light !== 'environment' && filmLost(row[light], cpu)) lostOnDirect = true;
       }
     }
     summary.cases[want.name] = worst;
@@ -112,6 +119,16 @@ async function filmTests(threeName) {
     if (!(worst.point <= tol)) fail(`${threeName} ${want.name}: point light off by ${worst.point} > ${tol}`);
     if (!(worst.environment <= tol)) fail(`${threeName} ${want.name}: environment light off by ${worst.environment} > ${tol}`);
     if (!(worst.cosTheta <= 1e-5)) fail(`${threeName} ${want.name}: n·v off by ${worst.cosTheta}`);
+  }
+  // The control: the earlier recipe of docs/engines/threejs.md. On r187 the detector must
+  // see its film lost on the directional light (or the check above could never fail).
+  const lutCase = expected.cases.find((c) => c.technique === 'lut');
+  const legacy = await page.evaluate(async (c) => (await import('/test/cases.js')).legacyRecipeDirectional(c), lutCase);
+  const lostAngles = legacy.filter((row, j) => filmLost(row, lutCase.expected[j])).map((r) => r.deg);
+  summary.legacyRecipeLostAt = lostAngles;
+  console.log(`${threeName} control, the earlier guide's recipe (specularColor = film): film lost on the directional light at ${lostAngles.length ? lostAngles.join('°, ') + '°' : 'no angle'}`);
+  if (Number(out.info.revision) >= 187 && lostAngles.length !== lutCase.anglesDeg.length) {
+    fail(`${threeName}: the lost-film detector missed the earlier recipe's white highlights (lost at ${lostAngles.length} of ${lutCase.anglesDeg.length} angles)`);
   }
   await page.close();
   return summary;
