@@ -1,35 +1,96 @@
 #!/usr/bin/env bash
-# The whole test suite (the README's test command). Installs what the tests need first:
-# the GPU tests run on whatever Vulkan adapter wgpu finds, and on machines without a GPU
-# that is Mesa's software rasteriser lavapipe (Debian package mesa-vulkan-drivers); the
-# engine shader libraries (shaders/glsl, shaders/hlsl) are compiled by glslangValidator
-# (Debian package glslang-tools).
+# Every test the project has, in one command: the README's second set-up command, and what
+# CI runs (.ci/run calls it on a fresh clone). The steps run in the order of STEPS below;
+#
+#   bash scripts/test.sh              # every step
+#   bash scripts/test.sh rust python  # only these steps (still in STEPS order)
+#
+# Each step installs what it needs (Debian packages through apt-get, pinned tools through
+# cargo install) and fails — never skips — when something is missing. To add a step: write
+# a function step_NAME below (usually one line calling a script of its own) and add NAME
+# to STEPS. docs/guide/src/testing.md describes every step.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-if ! ls /usr/share/vulkan/icd.d/lvp_icd.*.json >/dev/null 2>&1 \
-    && ! ls /etc/vulkan/icd.d/*.json >/dev/null 2>&1 \
-    && ! ls /usr/share/vulkan/icd.d/nvidia*.json >/dev/null 2>&1; then
-    echo "scripts/test.sh: installing mesa-vulkan-drivers (software Vulkan for the GPU tests)" >&2
-    SUDO=""
-    if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-    if ! $SUDO apt-get install -y --no-install-recommends mesa-vulkan-drivers >/dev/null; then
-        $SUDO apt-get update >/dev/null
-        $SUDO apt-get install -y --no-install-recommends mesa-vulkan-drivers >/dev/null
+STEPS=(rust python guide bevy three fuzz)
+
+# Debian packages, with one `apt-get update` retry (a fresh machine has no package lists).
+apt_install() {
+    local sudo=""
+    if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
+    if ! $sudo apt-get install -y --no-install-recommends "$@" >/dev/null; then
+        $sudo apt-get update >/dev/null
+        $sudo apt-get install -y --no-install-recommends "$@" >/dev/null
     fi
-fi
+}
 
-if ! command -v glslangValidator >/dev/null 2>&1; then
-    echo "scripts/test.sh: installing glslang-tools (glslangValidator for the engine shader libraries)" >&2
-    SUDO=""
-    if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-    if ! $SUDO apt-get install -y --no-install-recommends glslang-tools >/dev/null; then
-        $SUDO apt-get update >/dev/null
-        $SUDO apt-get install -y --no-install-recommends glslang-tools >/dev/null
+# The Rust workspace. The GPU tests run on whatever Vulkan adapter wgpu finds, and on
+# machines without a GPU that is Mesa's software rasteriser lavapipe (Debian package
+# mesa-vulkan-drivers); the engine shader libraries (shaders/glsl, shaders/hlsl) are
+# compiled by glslangValidator (Debian package glslang-tools). The workspace's tests include
+# the user guide's checks: every relative link and anchor of the Markdown resolves
+# (tests/tests/doc_links.rs) and every command has a chapter (crates/cli/tests/guide.rs).
+step_rust() {
+    if ! ls /usr/share/vulkan/icd.d/lvp_icd.*.json >/dev/null 2>&1 \
+        && ! ls /etc/vulkan/icd.d/*.json >/dev/null 2>&1 \
+        && ! ls /usr/share/vulkan/icd.d/nvidia*.json >/dev/null 2>&1; then
+        echo "scripts/test.sh: installing mesa-vulkan-drivers (software Vulkan for the GPU tests)" >&2
+        apt_install mesa-vulkan-drivers
     fi
-fi
+    if ! command -v glslangValidator >/dev/null 2>&1; then
+        echo "scripts/test.sh: installing glslang-tools (glslangValidator for the engine shader libraries)" >&2
+        apt_install glslang-tools
+    fi
+    cargo test --workspace --locked
+}
 
-cargo test --workspace --locked
+# The Python package: a fresh virtual environment, `pip install ./python`, pytest. After
+# the Rust step, whose `nacre` binary (target/debug/nacre) checks the committed CLI fixtures.
+step_python() {
+    bash scripts/test_python.sh
+}
 
-# The Python package: a fresh virtual environment, `pip install ./python`, pytest.
-bash scripts/test_python.sh
+# The user guide: `mdbook build docs/guide` with a pinned mdBook (its links are checked by
+# the Rust step).
+step_guide() {
+    bash scripts/test_guide.sh
+}
+
+# The Bevy integration (a cargo workspace of its own, integrations/bevy/). In CI the
+# workspace's build is not needed any more (each later step has its own cargo workspace and
+# target folder): its disk is freed first, as the Bevy build needs as much.
+step_bevy() {
+    if [ -n "${CI:-}" ] && [ -z "${CARGO_TARGET_DIR:-}" ]; then
+        rm -rf target
+    fi
+    bash integrations/bevy/test.sh
+}
+
+# The three.js package (integrations/three, Node.js): browser tests in Debian's Chromium on
+# SwiftShader against nacre's CPU colours; installs chromium (apt) and its npm packages
+# (`npm ci`) itself; never skips in CI. About 3 min from a cold npm cache (its author's figure).
+step_three() {
+    bash integrations/three/test.sh
+}
+
+# A 30-second smoke run of every fuzz target (fuzz/README.md).
+step_fuzz() {
+    bash scripts/test_fuzz.sh 30
+}
+
+selected=("$@")
+for name in "${selected[@]}"; do
+    if ! [[ " ${STEPS[*]} " == *" $name "* ]]; then
+        echo "scripts/test.sh: unknown step \`$name\` (the steps: ${STEPS[*]})" >&2
+        exit 2
+    fi
+done
+for name in "${STEPS[@]}"; do
+    if [ ${#selected[@]} -gt 0 ] && ! [[ " ${selected[*]} " == *" $name "* ]]; then
+        continue
+    fi
+    echo "scripts/test.sh: step $name" >&2
+    start=$(date +%s)
+    "step_$name"
+    echo "scripts/test.sh: step $name passed in $(($(date +%s) - start)) s" >&2
+done

@@ -160,7 +160,7 @@ Examples:
   nacre bake
   # one recipe into another folder
   nacre bake tables/recipes/film-gold.toml --out /tmp/tables
-The recipe format is documented in the README (\"Table recipes\").";
+The recipe format is documented in the user guide (docs/guide/src/bake.md, \"Table recipes\").";
 
 const COLOR_EXAMPLES: &str = "\
 Methods: spectral (exact reference), lut:NAME|PATH (a baked film-lut, default-set name or
@@ -477,7 +477,7 @@ Examples:
   nacre spectrum --layer au@30 --substrate 1.52 --angles 45 --wavelengths 380:780:1
   # oil slick: oil film on water, seen from air
   nacre spectrum --ambient air --layer oil@450 --substrate water -o oil.csv
-  # the same stack from a recipe file (see README)
+  # the same stack from a recipe file (docs/guide/src/spectrum.md, \"Stack recipes\")
   nacre spectrum --recipe tables/examples/ar-coating.toml -o ar.csv";
 
 #[derive(Args)]
