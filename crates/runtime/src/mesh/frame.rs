@@ -86,65 +86,17 @@ pub(super) fn draw(
         let bound = Bound::new(device, inputs, &plan.used, &resources, &layouts);
         let targets = Targets::new(device, (width, height), passes.behind_needed);
         let frame = Frame {
-            scene,
+            device,
+            inputs,
+            resources: &resources,
+            mesh_layout: &layouts[2],
             passes: &passes,
             bound: &bound,
             order: draw_order(&bound.geometry, scene, &passes),
             depth: &targets.depth_view,
         };
         let mut encoder = device.create_command_encoder(&Default::default());
-        // The stand-in is cleared once (alpha 0) so that it reads as "nothing behind".
-        drop(crate::gpu::begin_pass(
-            &mut encoder,
-            "mesh no scene behind",
-            &[crate::gpu::cleared_attachment(
-                &targets.no_behind_view,
-                wgpu::Color::TRANSPARENT,
-            )],
-        ));
-        let groups = if passes.behind_needed {
-            // The opaque pass: the picture of the scene behind, then its mip chain.
-            let groups = bound.mesh_groups(
-                device,
-                inputs,
-                &resources,
-                &layouts[2],
-                FLAG_LINEAR_OUTPUT,
-                &targets.no_behind_view,
-            );
-            frame.pass(
-                &mut encoder,
-                &targets.behind_level(0),
-                wgpu::Color::TRANSPARENT,
-                &groups,
-                true,
-            );
-            if let Some(mip_down) = &resources.mip_down {
-                mip_down.fill(
-                    device,
-                    &mut encoder,
-                    &|k| targets.behind_level(k),
-                    targets.behind.mip_level_count(),
-                );
-            }
-            bound.mesh_groups(
-                device,
-                inputs,
-                &resources,
-                &layouts[2],
-                FLAG_BEHIND,
-                &targets.behind_view,
-            )
-        } else {
-            bound.mesh_groups(
-                device,
-                inputs,
-                &resources,
-                &layouts[2],
-                0,
-                &targets.no_behind_view,
-            )
-        };
+        let groups = frame.opaque_pass(&mut encoder, &targets);
         // The main pass.
         frame.pass(&mut encoder, &targets.view, BACKGROUND, &groups, false);
         let _ = device.poll(wgpu::PollType::wait_indefinitely());
@@ -503,9 +455,13 @@ impl Targets {
     }
 }
 
-/// What one render pass of the frame draws with.
+/// What the render passes of the frame draw with.
 struct Frame<'f> {
-    scene: &'f GltfScene,
+    device: &'f wgpu::Device,
+    inputs: &'f RenderInputs<'f>,
+    resources: &'f Resources,
+    /// Group 3's layout.
+    mesh_layout: &'f wgpu::BindGroupLayout,
     passes: &'f Passes,
     bound: &'f Bound<'f>,
     /// Indices into the bound geometry ([`draw_order`]).
@@ -515,6 +471,62 @@ struct Frame<'f> {
 }
 
 impl Frame<'_> {
+    /// Group 3 per material ([`Bound::mesh_groups`]) with `extra_flags` and the picture
+    /// `behind`.
+    fn mesh_groups(
+        &self,
+        extra_flags: u32,
+        behind: &wgpu::TextureView,
+    ) -> Vec<Option<wgpu::BindGroup>> {
+        self.bound.mesh_groups(
+            self.device,
+            self.inputs,
+            self.resources,
+            self.mesh_layout,
+            extra_flags,
+            behind,
+        )
+    }
+
+    /// Clears the 1 × 1 stand-in (alpha 0: "nothing behind") and, when a material transmits,
+    /// draws the opaque pass — every non-transmissive primitive in linear radiance into the
+    /// picture behind, then its mip chain. Returns the main pass's group 3, which reads the
+    /// picture (or the stand-in).
+    fn opaque_pass(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &Targets,
+    ) -> Vec<Option<wgpu::BindGroup>> {
+        drop(crate::gpu::begin_pass(
+            encoder,
+            "mesh no scene behind",
+            &[crate::gpu::cleared_attachment(
+                &targets.no_behind_view,
+                wgpu::Color::TRANSPARENT,
+            )],
+        ));
+        if !self.passes.behind_needed {
+            return self.mesh_groups(0, &targets.no_behind_view);
+        }
+        let groups = self.mesh_groups(FLAG_LINEAR_OUTPUT, &targets.no_behind_view);
+        self.pass(
+            encoder,
+            &targets.behind_level(0),
+            wgpu::Color::TRANSPARENT,
+            &groups,
+            true,
+        );
+        if let Some(mip_down) = &self.resources.mip_down {
+            mip_down.fill(
+                self.device,
+                encoder,
+                &|k| targets.behind_level(k),
+                targets.behind.mip_level_count(),
+            );
+        }
+        self.mesh_groups(FLAG_BEHIND, &targets.behind_view)
+    }
+
     /// Draws the primitives in `order` into `colour` (cleared to `clear`; depth
     /// cleared), with group-3 bind groups `groups`; `linear`: the picture of the opaque
     /// scene (transmissive primitives skipped).
@@ -526,7 +538,7 @@ impl Frame<'_> {
         groups: &[Option<wgpu::BindGroup>],
         linear: bool,
     ) {
-        let (scene, passes, bound) = (self.scene, self.passes, self.bound);
+        let (scene, passes, bound) = (self.inputs.scene, self.passes, self.bound);
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("mesh"),
             color_attachments: &[crate::gpu::cleared_attachment(colour, clear)],
