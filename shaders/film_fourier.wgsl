@@ -203,10 +203,13 @@ fn fourier_sample_level(level: u32, mu_nm: f32) -> ComplexRgb {
     let i0 = min(u32(floor(x)), n - 1u);
     let i1 = min(i0 + 1u, n - 1u);
     let f = x - f32(i0);
-    let re0 = textureLoad(fourier_table, vec2<u32>(i0, 0u), 0u, level).rgb;
-    let re1 = textureLoad(fourier_table, vec2<u32>(i1, 0u), 0u, level).rgb;
-    let im0 = textureLoad(fourier_table, vec2<u32>(i0, 0u), 1u, level).rgb;
-    let im1 = textureLoad(fourier_table, vec2<u32>(i1, 0u), 1u, level).rgb;
+    // An i32 level: naga's GLSL backend passes a u32 level through to its bounds check's
+    // textureSize(sampler2DArray, uint), which GLSL has no overload for.
+    let level_i32 = i32(level);
+    let re0 = textureLoad(fourier_table, vec2<u32>(i0, 0u), 0u, level_i32).rgb;
+    let re1 = textureLoad(fourier_table, vec2<u32>(i1, 0u), 0u, level_i32).rgb;
+    let im0 = textureLoad(fourier_table, vec2<u32>(i0, 0u), 1u, level_i32).rgb;
+    let im1 = textureLoad(fourier_table, vec2<u32>(i1, 0u), 1u, level_i32).rgb;
     return ComplexRgb(mix(re0, re1, f), mix(im0, im1, f));
 }
 

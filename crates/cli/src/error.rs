@@ -1,5 +1,6 @@
 //! The `nacre` binary's error: the libraries' errors side by side, displayed as
-//! `nacre: error: …` with exit status 2 by `main`.
+//! `nacre: error: …` by `main`, with exit status 2, or 3 where no usable GPU was found
+//! ([`CliError::exit_status`]).
 //!
 //! The libraries name the inputs that went wrong with [`Param`] values; [`Flags`] spells
 //! each as the flag (or argument) that supplies it, from the one table [`flag`].
@@ -100,6 +101,9 @@ pub enum CliError {
     Runtime(nacre_runtime::Error),
 }
 
+/// The exit status when no usable GPU was found (documented in the top-level help).
+pub const NO_GPU_STATUS: u8 = 3;
+
 /// Shorthand for the commands' results.
 pub type Result<T, E = CliError> = std::result::Result<T, E>;
 
@@ -123,6 +127,16 @@ impl fmt::Display for CliError {
 impl std::error::Error for CliError {}
 
 impl CliError {
+    /// The exit status for this error: [`NO_GPU_STATUS`] where no usable GPU was found (no
+    /// adapter, or it refused a device), 2 for everything else (bad input, a refused or
+    /// failed command, a wgpu error or a lost device).
+    pub fn exit_status(&self) -> u8 {
+        match self {
+            CliError::Runtime(e) if e.is_no_gpu() => NO_GPU_STATUS,
+            _ => 2,
+        }
+    }
+
     /// True when the error is a write into a closed pipe (`nacre spectrum | head`): the
     /// reader has what it wanted, and Unix tools end quietly then.
     pub fn is_broken_pipe(&self) -> bool {

@@ -18,6 +18,7 @@ use std::process::ExitCode;
 mod choices;
 mod diffraction;
 mod error;
+mod gpu;
 mod plot;
 
 use choices::{FilmEvalArg, QuantityArg, SceneArg, TechniqueArg};
@@ -27,7 +28,8 @@ use error::Result;
 #[command(
     name = "nacre",
     version,
-    about = "Bake lookup tables and spectra for real-time structural colour (thin-film interference)."
+    about = "Bake lookup tables and spectra for real-time structural colour (thin-film interference).",
+    after_help = gpu::HELP
 )]
 struct Cli {
     #[command(subcommand)]
@@ -695,7 +697,7 @@ fn run_bake(args: &BakeArgs) -> Result<()> {
 
 fn run_render(args: &RenderArgs) -> Result<()> {
     use nacre_runtime::render::{FilmEval, SceneOptions, render_scene};
-    use nacre_runtime::{GpuContext, Scene, TableSet, Technique};
+    use nacre_runtime::{Scene, TableSet, Technique};
     let film_eval = FilmEval::from(args.film_eval);
     let all = Scene::from(args.scene);
     let scene = match all {
@@ -771,7 +773,7 @@ fn run_render(args: &RenderArgs) -> Result<()> {
         }
         None => None,
     };
-    let ctx = GpuContext::new_headless()?;
+    let ctx = gpu::context()?;
     eprintln!("adapter: {}", ctx.describe());
     let mut tables = TableSet::default();
     for name in &names {
@@ -840,7 +842,6 @@ fn run_render_diffraction(
     args: &RenderArgs,
     scene: nacre_runtime::diffraction::DiffractionScene,
 ) -> Result<()> {
-    use nacre_runtime::GpuContext;
     use nacre_runtime::diffraction::{
         DiffractionLayout, DiffractionSceneOptions, DiffractionTables, render_diffraction_scene,
         wavelength_grid,
@@ -901,7 +902,7 @@ fn run_render_diffraction(
     if let Some(path) = &options.environment {
         nacre_runtime::render::EnvironmentMap::load(path)?;
     }
-    let ctx = GpuContext::new_headless()?;
+    let ctx = gpu::context()?;
     eprintln!("adapter: {}", ctx.describe());
     let table = DiffractionTables::load(&ctx, &path, options.technique.fresnel)?;
     let start = std::time::Instant::now();
@@ -946,7 +947,7 @@ fn refuse_step_for_integrated(
 /// `nacre render --scene rough-row`: the shortcut, exact and Monte Carlo rows.
 fn run_render_rough_row(args: &RenderArgs) -> Result<()> {
     use nacre_runtime::rough_reference::{RoughRowOptions, render_rough_row};
-    use nacre_runtime::{GpuContext, TableSet, Technique};
+    use nacre_runtime::{TableSet, Technique};
     if !(16..=1 << 20).contains(&args.reference_samples) {
         return Err(nacre_bake::error::Error::invalid(
             Param::ReferenceSamples,
@@ -969,7 +970,7 @@ fn run_render_rough_row(args: &RenderArgs) -> Result<()> {
         environment: args.env.clone(),
         ..RoughRowOptions::default()
     };
-    let ctx = GpuContext::new_headless()?;
+    let ctx = gpu::context()?;
     eprintln!("adapter: {}", ctx.describe());
     let mut tables = TableSet::default();
     for name in &names {
@@ -999,7 +1000,7 @@ fn run_bench_gpu(args: &BenchGpuArgs) -> Result<()> {
     use nacre_runtime::bench::{BenchOptions, BenchPass, run_bench_with_diffraction};
     use nacre_runtime::bindings::TechniqueOptions;
     use nacre_runtime::diffraction::{DiffractionLayout, DiffractionOptions, DiffractionTables};
-    use nacre_runtime::{GpuContext, TableSet, Technique};
+    use nacre_runtime::{TableSet, Technique};
     let names: Vec<String> = if args.tables.is_empty() {
         vec!["film-dielectric".into(), "fourier-srgb".into()]
     } else {
@@ -1058,7 +1059,7 @@ fn run_bench_gpu(args: &BenchGpuArgs) -> Result<()> {
         film_ior: args.film_ior,
         base_ior: args.base_ior,
     };
-    let ctx = GpuContext::new_headless()?;
+    let ctx = gpu::context()?;
     eprintln!("adapter: {}", ctx.describe());
     let mut tables = TableSet::default();
     for name in &names {
@@ -1278,7 +1279,7 @@ fn main() -> ExitCode {
         Err(e) if e.is_broken_pipe() => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("nacre: error: {e}");
-            ExitCode::from(2)
+            ExitCode::from(e.exit_status())
         }
     }
 }

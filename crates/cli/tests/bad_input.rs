@@ -19,6 +19,8 @@ struct Case {
     needles: Vec<&'static str>,
     /// Environment variables set for the run.
     env: Vec<(&'static str, &'static str)>,
+    /// The exit status: 2, or 3 where no usable GPU is found.
+    status: i32,
 }
 
 fn case(name: &'static str, args: &[&str], needles: &[&'static str]) -> Case {
@@ -27,6 +29,7 @@ fn case(name: &'static str, args: &[&str], needles: &[&'static str]) -> Case {
         args: args.iter().map(|a| a.to_string()).collect(),
         needles: needles.to_vec(),
         env: Vec::new(),
+        status: 2,
     }
 }
 
@@ -40,6 +43,19 @@ fn case_env(
     Case {
         env: env.to_vec(),
         ..case(name, args, needles)
+    }
+}
+
+/// A case where no usable GPU is found: exit status 3.
+fn no_gpu(
+    name: &'static str,
+    env: &[(&'static str, &'static str)],
+    args: &[&str],
+    needles: &[&'static str],
+) -> Case {
+    Case {
+        status: 3,
+        ..case_env(name, env, args, needles)
     }
 }
 
@@ -516,6 +532,7 @@ fn fixtures(d: &Path) -> Vec<Case> {
         gltf("nope.bin", 36, 3, ""),
     );
     write(&d.join("g/short-buffer.gltf"), gltf("tri.bin", 360, 3, ""));
+    write(&d.join("g/tri.gltf"), gltf("tri.bin", 36, 3, ""));
     write(
         &d.join("g/accessor-overrun.gltf"),
         gltf("tri.bin", 36, 30, ""),
@@ -614,6 +631,7 @@ fn fixtures(d: &Path) -> Vec<Case> {
         args,
         needles: needles.to_vec(),
         env: Vec::new(),
+        status: 2,
     };
 
     vec![
@@ -1104,17 +1122,47 @@ fn fixtures(d: &Path) -> Vec<Case> {
             &["--height-scale"],
         ),
         // --- the GPU runtime ---
-        case_env(
+        no_gpu(
             "runtime: no adapter for the requested backend",
             &[("WGPU_BACKEND", "dx12")],
             &["render", "--width", "8", "--height", "8", "-o", "out.png"],
             &["no GPU adapter"],
         ),
-        case_env(
+        no_gpu(
             "runtime: WGPU_ADAPTER_NAME matches no adapter",
             &[("WGPU_ADAPTER_NAME", "no-such-gpu")],
             &["render", "--width", "8", "--height", "8", "-o", "out.png"],
             &["WGPU_ADAPTER_NAME=no-such-gpu", "matches none"],
+        ),
+        // wgpu errors injected through the test hook (nacre_runtime::Fault): wgpu refuses
+        // the object, and the render fails with the runtime's error, not wgpu's panic.
+        case_env(
+            "runtime: a shader that does not compile (injected)",
+            &[("NACRE_TEST_GPU_FAULT", "broken-shader")],
+            &["render", "--width", "8", "--height", "8", "-o", "out.png"],
+            &["render: GPU error while", "injected broken shader"],
+        ),
+        case_env(
+            "runtime: a texture beyond the device's limits (injected)",
+            &[("NACRE_TEST_GPU_FAULT", "impossible-texture")],
+            &["render", "--width", "8", "--height", "8", "-o", "out.png"],
+            &["render: GPU error while", "injected impossible texture"],
+        ),
+        case_env(
+            "runtime: a shader that does not compile in the glTF renderer (injected)",
+            &[("NACRE_TEST_GPU_FAULT", "broken-shader")],
+            &[
+                "render",
+                "--gltf",
+                "g/tri.gltf",
+                "--width",
+                "8",
+                "--height",
+                "8",
+                "-o",
+                "out.png",
+            ],
+            &["render: GPU error while", "injected broken shader"],
         ),
         with(
             "runtime: table beyond the device's 3-D texture limit",
@@ -1298,7 +1346,7 @@ fn every_bad_input_exits_2_naming_the_culprit_and_writes_nothing() {
         let o = nacre_env(d, &c.args, &c.env);
         let err = String::from_utf8_lossy(&o.stderr).into_owned();
         let mut problems = Vec::new();
-        if o.status.code() != Some(2) {
+        if o.status.code() != Some(c.status) {
             problems.push(format!("exit status {:?}", o.status.code()));
         }
         if err.contains("panicked") {

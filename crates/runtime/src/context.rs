@@ -16,6 +16,14 @@ use std::sync::{Arc, Mutex};
 /// [`GpuContext::checked`]'s error scopes). Buffers with initial contents are created through
 /// [`BufferInitExt`], which returns an invalid buffer (reported by the next use) where
 /// wgpu's own `DeviceExt::create_buffer_init` would panic; `clippy.toml` forbids the latter.
+///
+/// # wgpu errors
+///
+/// wgpu's default handler for an error raised outside an error scope panics. A context from
+/// [`GpuContext::new_headless`] installs its own: the first such error is kept and returned
+/// by the next [`GpuContext::checked`] or [`GpuContext::wait`] ([`Error::Gpu`], or
+/// [`Error::OutOfMemory`]), so that work recorded between two checks (a render pass, a
+/// submission) fails with an error naming the check that found it.
 pub struct GpuContext {
     /// The adapter.
     pub adapter: wgpu::Adapter,
@@ -27,12 +35,74 @@ pub struct GpuContext {
     pub info: wgpu::AdapterInfo,
     /// wgpu's reason and message once the device-lost callback has run.
     lost: Arc<Mutex<Option<String>>>,
+    /// The first error wgpu raised outside an error scope, not yet reported.
+    uncaptured: Arc<Mutex<Option<wgpu::Error>>>,
+    /// A failure to inject into the next [`GpuContext::checked`] ([`GpuContext::inject_fault`]).
+    fault: Mutex<Option<Fault>>,
+}
+
+/// A failure [`GpuContext::inject_fault`] makes wgpu raise, to test the error paths of a
+/// program built on the runtime (the `nacre` binary's `NACRE_TEST_GPU_FAULT`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Fault {
+    /// A shader module whose WGSL does not parse (label [`Fault::SHADER_LABEL`]).
+    BrokenShader,
+    /// A 2-D texture one texel wider and taller than the device allows (label
+    /// [`Fault::TEXTURE_LABEL`]).
+    ImpossibleTexture,
+}
+
+impl Fault {
+    /// The label of [`Fault::BrokenShader`]'s module.
+    pub const SHADER_LABEL: &'static str = "injected broken shader";
+    /// The label of [`Fault::ImpossibleTexture`]'s texture.
+    pub const TEXTURE_LABEL: &'static str = "injected impossible texture";
+
+    /// The fault named `name` (`broken-shader`, `impossible-texture`).
+    pub fn from_name(name: &str) -> Option<Fault> {
+        match name {
+            "broken-shader" => Some(Fault::BrokenShader),
+            "impossible-texture" => Some(Fault::ImpossibleTexture),
+            _ => None,
+        }
+    }
+
+    /// Raises the fault on `device` (inside the caller's error scopes).
+    fn raise(self, device: &wgpu::Device) {
+        match self {
+            Fault::BrokenShader => {
+                drop(device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                    label: Some(Fault::SHADER_LABEL),
+                    source: wgpu::ShaderSource::Wgsl("fn broken( -> f32 { return 1.0 }".into()),
+                }));
+            }
+            Fault::ImpossibleTexture => {
+                let side = device.limits().max_texture_dimension_2d.saturating_add(1);
+                drop(device.create_texture(&wgpu::TextureDescriptor {
+                    label: Some(Fault::TEXTURE_LABEL),
+                    size: wgpu::Extent3d {
+                        width: side,
+                        height: side,
+                        depth_or_array_layers: 1,
+                    },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format: wgpu::TextureFormat::Rgba8Unorm,
+                    usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                    view_formats: &[],
+                }));
+            }
+        }
+    }
 }
 
 impl GpuContext {
     /// Creates a headless context on the adapter wgpu prefers (hardware first; Mesa's
     /// software Vulkan driver lavapipe where there is no GPU). The usual wgpu environment
-    /// variables apply (`WGPU_BACKEND`, `WGPU_ADAPTER_NAME`, `WGPU_POWER_PREF`). Requests
+    /// variables apply (`WGPU_BACKEND`, `WGPU_ADAPTER_NAME`, `WGPU_POWER_PREF`):
+    /// `WGPU_BACKEND=vulkan` or `WGPU_BACKEND=gl` (OpenGL ES through EGL, e.g. Mesa's
+    /// llvmpipe) selects the backend. Requests
     /// timestamp queries where the adapter has them, and the adapter's own limits.
     pub fn new_headless() -> Result<Self> {
         let instance =
@@ -85,18 +155,30 @@ impl GpuContext {
             };
             *flag.lock().unwrap_or_else(|e| e.into_inner()) = Some(text);
         });
+        let uncaptured = Arc::new(Mutex::new(None));
+        let first = Arc::clone(&uncaptured);
+        device.on_uncaptured_error(Arc::new(move |error: wgpu::Error| {
+            first
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .get_or_insert(error);
+        }));
         Ok(GpuContext {
             adapter,
             device,
             queue,
             info,
             lost,
+            uncaptured,
+            fault: Mutex::new(None),
         })
     }
 
     /// Wraps a host engine's adapter, device and queue. The host keeps its own device-lost
-    /// callback (wgpu allows one): a loss then surfaces as [`Error::Gpu`] from the first
-    /// operation wgpu refuses rather than as [`Error::DeviceLost`].
+    /// callback and uncaptured-error handler (wgpu allows one of each): a loss then surfaces
+    /// as [`Error::Gpu`] from the first operation wgpu refuses rather than as
+    /// [`Error::DeviceLost`], and errors outside the runtime's error scopes go to the host's
+    /// handler.
     pub fn from_parts(adapter: wgpu::Adapter, device: wgpu::Device, queue: wgpu::Queue) -> Self {
         let info = adapter.get_info();
         GpuContext {
@@ -105,6 +187,43 @@ impl GpuContext {
             queue,
             info,
             lost: Arc::new(Mutex::new(None)),
+            uncaptured: Arc::new(Mutex::new(None)),
+            fault: Mutex::new(None),
+        }
+    }
+
+    /// Makes the next [`GpuContext::checked`] raise `fault` inside its error scopes, so that
+    /// it fails with the error wgpu reports for it (a test hook: the error paths of a whole
+    /// program, up to its message and exit status, without a faulty driver).
+    pub fn inject_fault(&self, fault: Fault) {
+        *self.fault.lock().unwrap_or_else(|e| e.into_inner()) = Some(fault);
+    }
+
+    /// The error wgpu raised outside any error scope since the last check, as the error of
+    /// `context`.
+    fn check_uncaptured(&self, context: &str) -> Result<()> {
+        let taken = self
+            .uncaptured
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .take();
+        match taken {
+            Some(e) => Err(self.gpu_error(context, &e)),
+            None => Ok(()),
+        }
+    }
+
+    /// The runtime's error for wgpu's `error` raised while `context`.
+    fn gpu_error(&self, context: &str, error: &wgpu::Error) -> Error {
+        match error {
+            wgpu::Error::OutOfMemory { .. } => Error::OutOfMemory {
+                adapter: self.info.name.clone(),
+                context: context.to_string(),
+            },
+            other => Error::Gpu {
+                context: context.to_string(),
+                message: one_line(&other.to_string()),
+            },
         }
     }
 
@@ -137,31 +256,39 @@ impl GpuContext {
         )
     }
 
-    /// Runs `f`, turning any wgpu validation or out-of-memory error it raises into
-    /// [`Error::Gpu`] instead of wgpu's default panic; [`Error::DeviceLost`] when the device
-    /// has been reported lost (before or while `f` runs).
+    /// Runs `f`, turning any wgpu validation, internal or out-of-memory error it raises
+    /// into [`Error::Gpu`] or [`Error::OutOfMemory`] instead of wgpu's default panic;
+    /// [`Error::DeviceLost`] when the device has been reported lost (before or while `f`
+    /// runs). An error wgpu raised outside any scope since the last check is returned first.
     pub fn checked<T>(&self, context: &str, f: impl FnOnce() -> T) -> Result<T> {
         self.check_lost(context)?;
+        self.check_uncaptured(context)?;
         let oom = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let internal = self.device.push_error_scope(wgpu::ErrorFilter::Internal);
         let validation = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let fault = self.fault.lock().unwrap_or_else(|e| e.into_inner()).take();
+        if let Some(fault) = fault {
+            fault.raise(&self.device);
+        }
         let value = f();
         let errors = [
             pollster::block_on(validation.pop()),
+            pollster::block_on(internal.pop()),
             pollster::block_on(oom.pop()),
         ];
         self.check_lost(context)?;
         match errors.into_iter().flatten().next() {
-            Some(e) => Err(Error::Gpu {
-                context: context.to_string(),
-                message: e.to_string(),
-            }),
+            Some(e) => Err(self.gpu_error(context, &e)),
             None => Ok(value),
         }
     }
 
-    /// Waits for the queue to finish; [`Error::DeviceLost`] when the device was lost.
+    /// Waits for the queue to finish; [`Error::DeviceLost`] when the device was lost, and
+    /// the error wgpu raised outside any scope since the last check ([`Error::Gpu`],
+    /// [`Error::OutOfMemory`]).
     pub fn wait(&self, context: &str) -> Result<()> {
         self.check_lost(context)?;
+        self.check_uncaptured(context)?;
         let polled = self
             .device
             .poll(wgpu::PollType::wait_indefinitely())
@@ -171,8 +298,21 @@ impl GpuContext {
                 message: e.to_string(),
             });
         self.check_lost(context)?;
+        self.check_uncaptured(context)?;
         polled
     }
+}
+
+/// wgpu's multi-line report (`Validation Error`, `Caused by:`, the operation with its label,
+/// the cause) as one line: its other lines trimmed and joined by `: `.
+fn one_line(report: &str) -> String {
+    report
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty() && *l != "Caused by:" && *l != "Validation Error")
+        .map(|l| l.trim_end_matches(':'))
+        .collect::<Vec<_>>()
+        .join(": ")
 }
 
 /// `create_buffer_init` that does not panic on a lost device: the drop-in replacement for

@@ -67,14 +67,14 @@ impl EnvironmentMap {
         let meta = match header {
             Ok(Ok(meta)) => meta,
             Ok(Err(e)) => {
-                return Err(Error::Invalid {
-                    context: path.display().to_string(),
+                return Err(Error::Image {
+                    path: path.to_path_buf(),
                     message: format!("not a valid OpenEXR file: {e}"),
                 });
             }
             Err(_) => {
-                return Err(Error::Invalid {
-                    context: path.display().to_string(),
+                return Err(Error::Image {
+                    path: path.to_path_buf(),
                     message: "malformed OpenEXR header (the decoder failed)".into(),
                 });
             }

@@ -154,9 +154,8 @@ pub(crate) fn upload_layers(
         .iter()
         .any(|l| (l.0, l.1) != (*width, *height) || l.2.len() != l.0 * l.1)
     {
-        return Err(Error::Invalid {
-            context: label.into(),
-            message: "layers of differing sizes".into(),
+        return Err(Error::LayerSizes {
+            label: label.into(),
         });
     }
     let limit = ctx.device.limits();

@@ -13,10 +13,10 @@ pub const MAX_DIMENSION: u32 = 8192;
 /// panic.
 ///
 /// # Errors
-/// [`Error::Invalid`] naming `path`: not a picture of those formats, malformed, or too large.
+/// [`Error::Image`] or [`Error::ImageSize`] naming `path`: not a picture of those formats, malformed, or too large.
 pub(crate) fn decode_picture(path: &Path, what: &str, bytes: &[u8]) -> Result<image::DynamicImage> {
-    let invalid = |message: String| Error::Invalid {
-        context: path.display().to_string(),
+    let invalid = |message: String| Error::Image {
+        path: path.to_path_buf(),
         message,
     };
     let reader = || {
@@ -92,11 +92,12 @@ pub(crate) fn mip_chain<const C: usize>(
 pub(crate) fn check_image_size(path: &Path, what: &str, width: usize, height: usize) -> Result<()> {
     let max = MAX_DIMENSION as usize;
     if width == 0 || height == 0 || width > max || height > max {
-        return Err(Error::Invalid {
-            context: path.display().to_string(),
-            message: format!(
-                "{what} of {width}x{height} texels (expected 1 to {max} texels on each side)"
-            ),
+        return Err(Error::ImageSize {
+            path: path.to_path_buf(),
+            what: what.to_string(),
+            width: width as u64,
+            height: height as u64,
+            max: max as u64,
         });
     }
     Ok(())
@@ -122,8 +123,8 @@ impl RenderedImage {
     /// one picture outside the table atlases that is not: the `image` crate's PNG encoder
     /// cannot write the sRGB chunk that tells viewers how the bytes are encoded.
     pub fn encode_png(&self) -> Result<Vec<u8>> {
-        let err = |e: png::EncodingError| Error::Invalid {
-            context: "encoding the PNG".into(),
+        let err = |e: png::EncodingError| Error::Image {
+            path: "encoding the PNG".into(),
             message: e.to_string(),
         };
         let rgb: Vec<u8> = self

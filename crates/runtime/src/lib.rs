@@ -30,7 +30,7 @@ pub mod tables;
 pub mod thickness_map;
 
 pub use bindings::{TechniqueBinding, TechniqueOptions};
-pub use context::{BufferInitExt, GpuContext};
+pub use context::{BufferInitExt, Fault, GpuContext};
 /// Layout "integrated" of the `diffraction` technique ([`diffraction::integrated`]).
 pub use diffraction::integrated as diffraction_integrated;
 pub use error::{Error, Result};

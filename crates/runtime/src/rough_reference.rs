@@ -183,26 +183,34 @@ struct Integrator<'a> {
 
 impl<'a> Integrator<'a> {
     fn new(scene: &'a ReferenceScene<'a>, samples_per_pixel: usize) -> Result<Self> {
-        if !(scene.alpha > 0.0 && scene.alpha <= 1.0) || samples_per_pixel == 0 {
-            return Err(Error::Invalid {
-                context: "Monte Carlo reference".into(),
-                message: format!(
-                    "α {} and {samples_per_pixel} samples per pixel (expected 0 < α ≤ 1, at least 1 sample)",
-                    scene.alpha
-                ),
-            });
+        let out_of_range = |what: &str, value: f64, expected: &str| {
+            Err(Error::OutOfRange {
+                what: format!("Monte Carlo reference: {what}"),
+                value,
+                unit: "",
+                expected: expected.into(),
+            })
+        };
+        if !(scene.alpha > 0.0 && scene.alpha <= 1.0) {
+            return out_of_range("GGX roughness α", scene.alpha, "0 < α ≤ 1");
+        }
+        if samples_per_pixel == 0 {
+            return out_of_range("samples per pixel", 0.0, "at least 1");
         }
         if scene.width == 0 || scene.height == 0 {
-            return Err(Error::Invalid {
-                context: "Monte Carlo reference".into(),
-                message: "an empty image".into(),
-            });
+            return out_of_range(
+                "image pixels",
+                (scene.width * scene.height) as f64,
+                "at least 1",
+            );
         }
         let env = scene.environment;
         if env.width == 0 || env.height == 0 || env.rgb.len() != env.width * env.height {
-            return Err(Error::Invalid {
-                context: "Monte Carlo reference".into(),
-                message: "an empty or inconsistent environment".into(),
+            return Err(Error::TexelCount {
+                what: "Monte Carlo reference environment",
+                texels: env.rgb.len(),
+                width: env.width,
+                height: env.height,
             });
         }
         let level0: Level<4> = (
@@ -217,9 +225,9 @@ impl<'a> Integrator<'a> {
                 .collect(),
         );
         let light_dir =
-            normalize(scene.light.direction.map(f64::from)).ok_or_else(|| Error::Invalid {
-                context: "light".into(),
-                message: "zero direction".into(),
+            normalize(scene.light.direction.map(f64::from)).ok_or_else(|| Error::Light {
+                index: None,
+                problem: "zero direction".into(),
             })?;
         let e_l = std::array::from_fn(|k| {
             f64::from(scene.light.colour[k]) * f64::from(scene.light.intensity)
@@ -588,12 +596,22 @@ pub fn render_rough_row(
         || options.alphas.iter().any(|a| !(*a > 0.0 && *a <= 1.0))
         || !(8..=1024).contains(&options.tile)
     {
-        return Err(Error::Invalid {
-            context: "rough-sphere row".into(),
-            message: format!(
-                "roughnesses {:?} and tile {} (expected 0 < α ≤ 1, at least one; 8 to 1024 pixels)",
-                options.alphas, options.tile
-            ),
+        let (what, value, unit, expected) =
+            match options.alphas.iter().find(|a| !(**a > 0.0 && **a <= 1.0)) {
+                Some(&a) => ("roughness α", f64::from(a), "", "0 < α ≤ 1"),
+                None if options.alphas.is_empty() => ("roughnesses", 0.0, "", "at least one"),
+                None => (
+                    "tile",
+                    options.tile as f64,
+                    " pixels",
+                    "8 to 1024 pixels a side",
+                ),
+            };
+        return Err(Error::OutOfRange {
+            what: format!("rough-sphere row: {what}"),
+            value,
+            unit,
+            expected: expected.into(),
         });
     }
     let environment = match &options.environment {

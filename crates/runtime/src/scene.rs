@@ -81,9 +81,10 @@ impl FromStr for Scene {
         Scene::ALL
             .into_iter()
             .find(|k| k.name().eq_ignore_ascii_case(s.trim()))
-            .ok_or_else(|| Error::Invalid {
-                context: format!("scene `{s}`"),
-                message: format!("expected one of {}", Scene::ALL.map(Scene::name).join(", ")),
+            .ok_or_else(|| Error::UnknownName {
+                what: "scene",
+                name: s.to_string(),
+                expected: format!("one of {}", Scene::ALL.map(Scene::name).join(", ")),
             })
     }
 }

@@ -180,9 +180,10 @@ impl TableSet {
                 found = Some((m, p));
             }
         }
-        let (m, p) = found.ok_or_else(|| Error::Invalid {
-            context: "table set".into(),
-            message: "no table loaded".into(),
+        let (m, p) = found.ok_or_else(|| Error::MissingTable {
+            needed_by: "the table set's colorimeter".into(),
+            kind: "any",
+            example: None,
         })?;
         Ok(m.colorimeter(p)?)
     }

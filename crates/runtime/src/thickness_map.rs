@@ -4,7 +4,7 @@
 //! channels G and B, which `film_stack`'s lower films may follow one channel per film (the
 //! thesis's SVT with one map per layer, Sussenbach 2013 §4.2): uploaded as (g, g², g_G, g_B).
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, ThicknessMapProblem};
 use crate::image_io::{Level, decode_picture, mip_chain};
 use std::path::Path;
 
@@ -91,13 +91,9 @@ impl ThicknessMap {
                 ));
             }
             other => {
-                return Err(Error::Invalid {
-                    context: path.display().to_string(),
-                    message: format!(
-                        "a {:?} picture; a thickness map must be greyscale or RGB(A), 8 or \
-                         16 bits",
-                        other.color()
-                    ),
+                return Err(Error::ThicknessMap {
+                    path: path.to_path_buf(),
+                    problem: ThicknessMapProblem::ColourType(format!("{:?}", other.color())),
                 });
             }
         };
@@ -113,18 +109,14 @@ impl ThicknessMap {
     /// per film) is for [`Technique::Stack`](crate::shaders::Technique::Stack) only.
     ///
     /// # Errors
-    /// Those of [`ThicknessMap::load`]; [`Error::Invalid`] for a colour map with another
+    /// Those of [`ThicknessMap::load`]; [`Error::ThicknessMap`] for a colour map with another
     /// technique, which would read its R channel as if it were grey.
     pub fn load_for(path: &Path, technique: crate::shaders::Technique) -> Result<ThicknessMap> {
         let map = ThicknessMap::load(path)?;
         if map.green_blue.is_some() && technique != crate::shaders::Technique::Stack {
-            return Err(Error::Invalid {
-                context: path.display().to_string(),
-                message: format!(
-                    "a colour thickness map (channels R, G, B for a stack's films) is read by \
-                     technique `stack`; technique `{}` reads a greyscale map",
-                    technique.name()
-                ),
+            return Err(Error::ThicknessMap {
+                path: path.to_path_buf(),
+                problem: ThicknessMapProblem::ColourForTechnique(technique.name().to_string()),
             });
         }
         Ok(map)

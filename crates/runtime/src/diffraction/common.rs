@@ -172,12 +172,15 @@ pub(super) fn dispatch_probe(
     if cases == 0 {
         return Ok(Vec::new());
     }
+    let limit = ctx.device.limits().max_compute_workgroups_per_dimension;
     let groups = u32::try_from(cases.div_ceil(64))
         .ok()
-        .filter(|g| *g <= ctx.device.limits().max_compute_workgroups_per_dimension)
-        .ok_or_else(|| Error::Invalid {
-            context: format!("diffraction probe `{entry}`"),
-            message: format!("{cases} cases are too many for one dispatch"),
+        .filter(|g| *g <= limit)
+        .ok_or_else(|| Error::Limit {
+            what: format!("diffraction probe `{entry}` of {cases} cases (64 a workgroup)"),
+            needed: cases.div_ceil(64) as u64,
+            limit: u64::from(limit),
+            adapter: ctx.info.name.clone(),
         })?;
     let out_bytes = (cases * 2 * 16) as u64;
     let device = &ctx.device;

@@ -147,9 +147,8 @@ pub fn fresnel_parameters(fresnel: FresnelTerm) -> Result<(u32, [f32; 2])> {
         FresnelTerm::Unity => Ok((0, [1.0, 0.0])),
         FresnelTerm::Index(n) => {
             if !(n.re.is_finite() && n.im.is_finite() && n.re > 0.0 && n.im >= 0.0) {
-                return Err(Error::Invalid {
-                    context: "diffraction Fresnel index".into(),
-                    message: format!("{n} (expected n > 0, κ ≥ 0, finite)"),
+                return Err(Error::FresnelIndex {
+                    index: n.to_string(),
                 });
             }
             Ok((1, [n.re as f32, n.im as f32]))

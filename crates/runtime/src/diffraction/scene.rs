@@ -116,9 +116,10 @@ impl FromStr for DiffractionScene {
         DiffractionScene::ALL
             .into_iter()
             .find(|k| k.name().eq_ignore_ascii_case(s.trim()))
-            .ok_or_else(|| Error::Invalid {
-                context: format!("diffraction scene `{s}`"),
-                message: "expected cd-disc or snake-skin".into(),
+            .ok_or_else(|| Error::UnknownName {
+                what: "diffraction scene",
+                name: s.to_string(),
+                expected: "cd-disc or snake-skin".into(),
             })
     }
 }
@@ -176,35 +177,48 @@ impl DiffractionSceneOptions {
     /// Checks the settings.
     ///
     /// # Errors
-    /// [`Error::Invalid`] naming the setting.
+    /// [`Error::OutOfRange`] or [`Error::Light`] naming the setting.
     pub fn validate(&self) -> Result<()> {
-        let bad = |context: &str, message: String| {
-            Err(Error::Invalid {
-                context: context.into(),
-                message,
+        let bad = |what: &str, value: f64, unit: &'static str, expected: String| {
+            Err(Error::OutOfRange {
+                what: what.into(),
+                value,
+                unit,
+                expected,
             })
         };
         for (what, n) in [("width", self.width), ("height", self.height)] {
             if n == 0 || n > MAX_DIMENSION {
-                return bad(what, format!("{n} (expected 1 to {MAX_DIMENSION} pixels)"));
+                return bad(
+                    what,
+                    f64::from(n),
+                    " pixels",
+                    format!("1 to {MAX_DIMENSION}"),
+                );
             }
         }
         if !self.exposure_ev.is_finite() || self.exposure_ev.abs() > 64.0 {
             return bad(
                 "exposure",
-                format!("{} (expected −64 to 64 EV)", self.exposure_ev),
+                f64::from(self.exposure_ev),
+                " EV",
+                "−64 to 64".into(),
             );
         }
         if !(self.env_intensity.is_finite() && self.env_intensity >= 0.0) {
             return bad(
                 "environment intensity",
-                format!("{} (expected ≥ 0)", self.env_intensity),
+                f64::from(self.env_intensity),
+                "",
+                "≥ 0".into(),
             );
         }
         if self.env_samples > MAX_ENV_SAMPLES {
             return bad(
                 "environment samples",
-                format!("{} (expected 0 to {MAX_ENV_SAMPLES})", self.env_samples),
+                self.env_samples as f64,
+                "",
+                format!("0 to {MAX_ENV_SAMPLES}"),
             );
         }
         let l = &self.light;
@@ -213,7 +227,10 @@ impl DiffractionSceneOptions {
             && l.intensity >= 0.0
             && l.direction.iter().any(|x| *x != 0.0))
         {
-            return bad("light", format!("{l:?} (finite, non-zero direction)"));
+            return Err(Error::Light {
+                index: None,
+                problem: format!("{l:?} (finite, non-zero direction)"),
+            });
         }
         self.camera
             .inverse_view_projection(f64::from(self.width) / f64::from(self.height))?;
@@ -380,12 +397,9 @@ impl ScenePass {
             DiffractionTables::Integrated(t) => {
                 let wanted = integrated::fresnel_parameters(technique.fresnel)?;
                 if wanted != (t.uniform.fresnel_kind, t.uniform.fresnel_ior) {
-                    return Err(Error::Invalid {
-                        context: format!("integrated diffraction `{}`", t.name),
-                        message: format!(
-                            "the table was loaded with another Fresnel factor than the pass's {:?} (load it with that one)",
-                            technique.fresnel
-                        ),
+                    return Err(Error::FresnelMismatch {
+                        table: t.name.clone(),
+                        fresnel: format!("{:?}", technique.fresnel),
                     });
                 }
                 (

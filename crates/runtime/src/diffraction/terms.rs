@@ -149,9 +149,11 @@ impl DiffractionTable {
     /// [`MAX_RADIUS`] bins.
     pub fn radius(&self, tolerance: f64) -> Result<[i32; 2]> {
         if !(tolerance > 0.0 && tolerance < 1.0) {
-            return Err(Error::Invalid {
-                context: "diffraction window tolerance".into(),
-                message: format!("{tolerance} (expected between 0 and 1)"),
+            return Err(Error::OutOfRange {
+                what: "diffraction window tolerance".into(),
+                value: tolerance,
+                unit: "",
+                expected: "between 0 and 1".into(),
             });
         }
         let r = &self.record;
@@ -165,11 +167,10 @@ impl DiffractionTable {
                 .ceil()
                 .max(1.0);
             if need.is_nan() || need > f64::from(MAX_RADIUS) {
-                return Err(Error::Invalid {
-                    context: format!("diffraction `{}`", self.name),
-                    message: format!(
-                        "the coherence window spans {need} bins on each side (at most {MAX_RADIUS}): the patch is too large for σ_s"
-                    ),
+                return Err(Error::CoherenceWindow {
+                    table: self.name.clone(),
+                    bins: need,
+                    max: MAX_RADIUS,
                 });
             }
             Ok((need as i32).min((n / 2) as i32))
@@ -231,12 +232,10 @@ pub fn wavelength_grid(record: &DiffractionRecord, step_nm: Option<f64>) -> Resu
     let span = record.wavelength_max_nm - record.wavelength_min_nm;
     let count = (span / step + 1e-9).floor() + 1.0;
     if !(step > 0.0 && step.is_finite() && (2.0..=MAX_WAVELENGTHS as f64).contains(&count)) {
-        return Err(Error::Invalid {
-            context: "diffraction wavelength step".into(),
-            message: format!(
-                "{step} nm over {}–{} nm (expected 2 to {MAX_WAVELENGTHS} wavelengths)",
-                record.wavelength_min_nm, record.wavelength_max_nm
-            ),
+        return Err(Error::WavelengthStep {
+            step_nm: step,
+            range_nm: [record.wavelength_min_nm, record.wavelength_max_nm],
+            max_count: MAX_WAVELENGTHS,
         });
     }
     Ok((0..count as usize)
@@ -337,18 +336,14 @@ impl DiffractionBinding {
         let radius = table.radius(options.window_tolerance)?;
         let colorimeter = table.colorimeter()?;
         let wavelengths = wavelength_grid(r, options.wavelength_step_nm)?;
-        let grid = SpectralGrid::new(&colorimeter, &wavelengths).map_err(|e| Error::Invalid {
-            context: "diffraction wavelength grid".into(),
-            message: e.to_string(),
-        })?;
+        let grid = SpectralGrid::new(&colorimeter, &wavelengths)?;
         let spectrum = spectrum_weights(&grid, &colorimeter);
         let (fresnel_kind, fresnel_ior) = match options.fresnel {
             FresnelTerm::Unity => (0, [1.0, 0.0]),
             FresnelTerm::Index(n) => {
                 if !(n.re.is_finite() && n.im.is_finite() && n.re > 0.0 && n.im >= 0.0) {
-                    return Err(Error::Invalid {
-                        context: "diffraction Fresnel index".into(),
-                        message: format!("{n} (expected n > 0, κ ≥ 0, finite)"),
+                    return Err(Error::FresnelIndex {
+                        index: n.to_string(),
                     });
                 }
                 (1, [n.re as f32, n.im as f32])

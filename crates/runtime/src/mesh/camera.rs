@@ -87,9 +87,9 @@ pub fn orbit_camera(
     aspect: f64,
     orbit: &Orbit,
 ) -> Result<FittedCamera> {
-    let bad = |message: String| Error::Invalid {
-        context: "camera".into(),
-        message,
+    let bad = |problem: String| Error::Camera {
+        name: None,
+        problem,
     };
     if !lo.iter().chain(&hi).all(|x| x.is_finite()) || (0..3).any(|k| lo[k] > hi[k]) {
         return Err(bad(format!("scene bounds {lo:?} – {hi:?}")));
@@ -217,9 +217,9 @@ pub fn file_camera(
     hi: [f32; 3],
     aspect: f64,
 ) -> Result<FittedCamera> {
-    let bad = |message: String| Error::Invalid {
-        context: format!("camera `{}`", camera.name),
-        message,
+    let bad = |problem: String| Error::Camera {
+        name: Some(camera.name.clone()),
+        problem,
     };
     if !(aspect > 0.0 && aspect.is_finite()) {
         return Err(bad(format!("aspect ratio {aspect}")));

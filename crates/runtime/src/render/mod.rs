@@ -45,7 +45,7 @@
 
 use crate::bindings::{TechniqueBinding, TechniqueOptions};
 use crate::context::GpuContext;
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, TableMismatch};
 use crate::gpu::{
     begin_pass, cleared_attachment, fullscreen_pipeline, group_layout, read_texture, render_target,
     uniform_texture_group, upload_mips,
@@ -186,9 +186,9 @@ impl Renderer {
         thickness: &ThicknessMap,
     ) -> Result<RenderedImage> {
         if self.output != RenderOutput::Display {
-            return Err(Error::Invalid {
-                context: "render".into(),
-                message: "this renderer writes linear radiance: use render_linear_with".into(),
+            return Err(Error::WrongOutput {
+                writes: "linear radiance",
+                call: "render_linear_with",
             });
         }
         let (target, gpu_seconds) = self.draw(ctx, tables, options, environment, thickness)?;
@@ -216,9 +216,9 @@ impl Renderer {
         thickness: &ThicknessMap,
     ) -> Result<LinearImage> {
         if self.output != RenderOutput::Linear {
-            return Err(Error::Invalid {
-                context: "render".into(),
-                message: "this renderer writes display pixels: use render_with".into(),
+            return Err(Error::WrongOutput {
+                writes: "display pixels",
+                call: "render_with",
             });
         }
         let (target, gpu_seconds) = self.draw(ctx, tables, options, environment, thickness)?;
@@ -259,9 +259,11 @@ impl Renderer {
         ] {
             check_image_size(Path::new(what), what, w, h)?;
             if n != w * h {
-                return Err(Error::Invalid {
-                    context: what.into(),
-                    message: format!("{n} texels for {w}x{h}"),
+                return Err(Error::TexelCount {
+                    what,
+                    texels: n,
+                    width: w,
+                    height: h,
                 });
             }
         }
@@ -363,10 +365,10 @@ pub(crate) fn check_film_eval(tables: &TableSet, options: &SceneOptions) -> Resu
         return Ok(());
     }
     let Some(lut) = &tables.rough_film_lut else {
-        return Err(Error::Invalid {
-            context: "film evaluation `exact`".into(),
-            message: "needs a `rough-film-lut` table in the table set (e.g. rough-film-dielectric)"
-                .into(),
+        return Err(Error::MissingTable {
+            needed_by: "film evaluation `exact`".into(),
+            kind: "rough-film-lut",
+            example: Some("rough-film-dielectric"),
         });
     };
     let a = &lut.axes;
@@ -391,29 +393,31 @@ fn check_material_in_table(
     thickness_max_nm: f64,
 ) -> Result<()> {
     let tol = 1e-4;
-    let invalid = |message: String| {
-        Err(Error::Invalid {
-            context: context.to_string(),
-            message,
+    let invalid = |mismatch: TableMismatch| {
+        Err(Error::TableRange {
+            table: context.to_string(),
+            mismatch,
         })
     };
     if (f64::from(material.ambient_ior) - ambient_index).abs() > tol {
-        return invalid(format!(
-            "the table was baked for ambient index {ambient_index}, the material has {}",
-            material.ambient_ior
-        ));
+        return invalid(TableMismatch::Ambient {
+            table: ambient_index,
+            material: f64::from(material.ambient_ior),
+        });
     }
     let n = f64::from(material.film_ior);
     if n < ior_min - tol || n > ior_max + tol {
-        return invalid(format!(
-            "film index {n} lies outside the table's {ior_min}–{ior_max}"
-        ));
+        return invalid(TableMismatch::FilmIndex {
+            index: n,
+            range: [ior_min, ior_max],
+        });
     }
     let d = f64::from(material.max_thickness_nm());
     if d > thickness_max_nm * (1.0 + tol) {
-        return invalid(format!(
-            "the material reaches {d} nm, beyond the table's {thickness_max_nm} nm"
-        ));
+        return invalid(TableMismatch::Thickness {
+            thickness_nm: d,
+            max_nm: thickness_max_nm,
+        });
     }
     Ok(())
 }
@@ -423,9 +427,10 @@ fn check_material_in_table(
 /// transmitting material has a table with a transmittance.
 pub(crate) fn check_film_lut(tables: &TableSet, material: &MaterialOptions) -> Result<()> {
     let Some(lut) = &tables.film_lut else {
-        return Err(Error::Invalid {
-            context: "technique `lut`".into(),
-            message: "needs a `film-lut` table in the table set".into(),
+        return Err(Error::MissingTable {
+            needed_by: "technique `lut`".into(),
+            kind: "film-lut",
+            example: None,
         });
     };
     let a = &lut.axes;
@@ -438,9 +443,9 @@ pub(crate) fn check_film_lut(tables: &TableSet, material: &MaterialOptions) -> R
         a.thickness_max_nm,
     )?;
     if material.transmission && !lut.has_transmittance {
-        return Err(Error::Invalid {
-            context,
-            message: "a transmitting material (the bubble) needs a table with a transmittance (e.g. soap-film)".into(),
+        return Err(Error::TableRange {
+            table: context,
+            mismatch: TableMismatch::NoTransmittance,
         });
     }
     Ok(())

@@ -57,9 +57,10 @@ impl FromStr for SceneKind {
         SceneKind::ALL
             .into_iter()
             .find(|k| k.name().eq_ignore_ascii_case(s.trim()))
-            .ok_or_else(|| Error::Invalid {
-                context: format!("scene `{s}`"),
-                message: "expected sphere, bubble or plane".into(),
+            .ok_or_else(|| Error::UnknownName {
+                what: "scene",
+                name: s.to_string(),
+                expected: "sphere, bubble or plane".into(),
             })
     }
 }
@@ -118,9 +119,10 @@ impl FromStr for FilmEval {
         FilmEval::ALL
             .into_iter()
             .find(|k| k.name().eq_ignore_ascii_case(s.trim()))
-            .ok_or_else(|| Error::Invalid {
-                context: format!("film evaluation `{s}`"),
-                message: "expected classic, nv or exact".into(),
+            .ok_or_else(|| Error::UnknownName {
+                what: "film evaluation",
+                name: s.to_string(),
+                expected: "classic, nv or exact".into(),
             })
     }
 }
@@ -161,9 +163,9 @@ impl Camera {
     /// height), as WGSL columns: clip space (x, y ∈ [−1, 1], z ∈ [0, 1] from near to far) →
     /// world.
     pub fn inverse_view_projection(&self, aspect: f64) -> Result<[[f32; 4]; 4]> {
-        let bad = |message: String| Error::Invalid {
-            context: "camera".into(),
-            message,
+        let bad = |problem: String| Error::Camera {
+            name: None,
+            problem,
         };
         let v = |a: [f32; 3]| a.map(f64::from);
         let (eye, target, up) = (v(self.eye), v(self.target), v(self.up));
@@ -480,27 +482,28 @@ impl MaterialOptions {
         thin_film_thickness_um: f32,
         thin_film_ior: f32,
     ) -> Result<()> {
-        let bad = |message: String| {
-            Err(Error::Invalid {
-                context: "OpenPBR thin film".into(),
-                message,
+        let bad = |what: &str, value: f32, unit: &'static str, expected: &str| {
+            Err(Error::OutOfRange {
+                what: format!("OpenPBR thin film: {what}"),
+                value: f64::from(value),
+                unit,
+                expected: expected.into(),
             })
         };
         if !thin_film_weight.is_finite() {
-            return bad(format!(
-                "thin_film_weight {thin_film_weight} (expected 0 to 1)"
-            ));
+            return bad("thin_film_weight", thin_film_weight, "", "0 to 1");
         }
         if !(thin_film_thickness_um.is_finite() && (0.0..=1000.0).contains(&thin_film_thickness_um))
         {
-            return bad(format!(
-                "thin_film_thickness {thin_film_thickness_um} µm (expected 0 to 1000)"
-            ));
+            return bad(
+                "thin_film_thickness",
+                thin_film_thickness_um,
+                " µm",
+                "0 to 1000",
+            );
         }
         if !(thin_film_ior.is_finite() && thin_film_ior > 0.0) {
-            return bad(format!(
-                "thin_film_ior {thin_film_ior} (expected a positive number)"
-            ));
+            return bad("thin_film_ior", thin_film_ior, "", "a positive number");
         }
         let d_nm = thin_film_thickness_um * 1000.0;
         self.film_weight = thin_film_weight.clamp(0.0, 1.0);
@@ -525,10 +528,12 @@ impl MaterialOptions {
 
     /// Checks indices, thicknesses, roughness, weight and colour ranges.
     pub fn validate(&self) -> Result<()> {
-        let bad = |message: String| {
-            Err(Error::Invalid {
-                context: "material".into(),
-                message,
+        let bad = |what: &str, value: f32, expected: &str| {
+            Err(Error::OutOfRange {
+                what: format!("material: {what}"),
+                value: f64::from(value),
+                unit: "",
+                expected: expected.into(),
             })
         };
         let positive = [
@@ -537,7 +542,7 @@ impl MaterialOptions {
         ];
         for (name, v) in positive {
             if !(v > 0.0 && v.is_finite()) {
-                return bad(format!("{name} {v} (expected a positive number)"));
+                return bad(name, v, "a positive number");
             }
         }
         let (a, b) = match self.thickness {
@@ -556,29 +561,25 @@ impl MaterialOptions {
         ];
         for (name, v) in finite {
             if !(v.is_finite() && v.abs() <= 1e6) {
-                return bad(format!("{name} {v} (expected a finite number within ±1e6)"));
+                return bad(name, v, "a finite number within ±1e6");
             }
         }
-        if !(self.thickness_roughness_nm >= 0.0 && self.drain_nm >= 0.0) {
-            return bad("thickness roughness and drainage must be non-negative".into());
+        for (name, v) in [
+            ("thickness roughness", self.thickness_roughness_nm),
+            ("drainage", self.drain_nm),
+        ] {
+            if v < 0.0 {
+                return bad(name, v, "a non-negative number");
+            }
         }
         if !(self.film_weight >= 0.0 && self.film_weight <= 1.0) {
-            return bad(format!(
-                "film weight {} (expected 0 to 1)",
-                self.film_weight
-            ));
+            return bad("film weight", self.film_weight, "0 to 1");
         }
         if !(self.roughness_alpha >= 0.0 && self.roughness_alpha <= 1.0) {
-            return bad(format!(
-                "GGX roughness α {} (expected 0 to 1)",
-                self.roughness_alpha
-            ));
+            return bad("GGX roughness α", self.roughness_alpha, "0 to 1");
         }
-        if !self.base_colour.iter().all(|c| (0.0..=1.0).contains(c)) {
-            return bad(format!(
-                "base colour {:?} (expected 0 to 1 per channel)",
-                self.base_colour
-            ));
+        if let Some(&c) = self.base_colour.iter().find(|c| !(0.0..=1.0).contains(*c)) {
+            return bad("base colour channel", c, "0 to 1 per channel");
         }
         Ok(())
     }
@@ -683,9 +684,11 @@ impl SceneOptions {
     pub fn validate(&self) -> Result<()> {
         for (name, v) in [("width", self.width), ("height", self.height)] {
             if !(1..=MAX_DIMENSION).contains(&v) {
-                return Err(Error::Invalid {
-                    context: format!("image {name}"),
-                    message: format!("{v} pixels (expected 1 to {MAX_DIMENSION})"),
+                return Err(Error::OutOfRange {
+                    what: format!("image {name}"),
+                    value: f64::from(v),
+                    unit: " pixels",
+                    expected: format!("1 to {MAX_DIMENSION}"),
                 });
             }
         }
@@ -695,22 +698,33 @@ impl SceneOptions {
             ("light intensity", self.light.intensity),
         ] {
             if !(v.is_finite() && v.abs() <= 1e4) {
-                return Err(Error::Invalid {
-                    context: name.into(),
-                    message: format!("{v} (expected a finite number within ±1e4)"),
+                return Err(Error::OutOfRange {
+                    what: name.into(),
+                    value: f64::from(v),
+                    unit: "",
+                    expected: "a finite number within ±1e4".into(),
                 });
             }
         }
-        if self.env_intensity < 0.0 || self.light.intensity < 0.0 {
-            return Err(Error::Invalid {
-                context: "lighting".into(),
-                message: "intensities must be non-negative".into(),
-            });
+        for (name, v) in [
+            ("environment intensity", self.env_intensity),
+            ("light intensity", self.light.intensity),
+        ] {
+            if v < 0.0 {
+                return Err(Error::OutOfRange {
+                    what: name.into(),
+                    value: f64::from(v),
+                    unit: "",
+                    expected: "a non-negative number".into(),
+                });
+            }
         }
         if self.exposure_ev.abs() > 64.0 {
-            return Err(Error::Invalid {
-                context: "exposure".into(),
-                message: format!("{} EV (expected −64 to 64)", self.exposure_ev),
+            return Err(Error::OutOfRange {
+                what: "exposure".into(),
+                value: f64::from(self.exposure_ev),
+                unit: " EV",
+                expected: "−64 to 64".into(),
             });
         }
         if !self
@@ -721,21 +735,18 @@ impl SceneOptions {
             .all(|x| x.is_finite())
             || self.light.colour.iter().any(|&c| c < 0.0)
         {
-            return Err(Error::Invalid {
-                context: "light".into(),
-                message: format!(
+            return Err(Error::Light {
+                index: None,
+                problem: format!(
                     "{:?} (expected finite values, a non-negative colour)",
                     self.light
                 ),
             });
         }
         if self.punctual_lights.len() > MAX_PUNCTUAL_LIGHTS {
-            return Err(Error::Invalid {
-                context: "punctual lights".into(),
-                message: format!(
-                    "{} lights (at most {MAX_PUNCTUAL_LIGHTS} are drawn)",
-                    self.punctual_lights.len()
-                ),
+            return Err(Error::TooManyLights {
+                count: self.punctual_lights.len(),
+                max: MAX_PUNCTUAL_LIGHTS,
             });
         }
         for (k, light) in self.punctual_lights.iter().enumerate() {
@@ -762,9 +773,9 @@ impl SceneOptions {
                 || !cone_ok
                 || !aimed
             {
-                return Err(Error::Invalid {
-                    context: format!("punctual light {k}"),
-                    message: format!(
+                return Err(Error::Light {
+                    index: Some(k),
+                    problem: format!(
                         "{light:?} (expected finite values, a non-negative colour and intensity, a positive range, a direction, 0 ≤ inner < outer ≤ π/2)"
                     ),
                 });

@@ -124,9 +124,9 @@ impl ViewUniform {
     pub fn new(options: &SceneOptions, env_levels: usize) -> Result<ViewUniform> {
         let aspect = f64::from(options.width) / f64::from(options.height);
         let light =
-            normalize(options.light.direction.map(f64::from)).ok_or_else(|| Error::Invalid {
-                context: "light".into(),
-                message: "zero direction".into(),
+            normalize(options.light.direction.map(f64::from)).ok_or_else(|| Error::Light {
+                index: None,
+                problem: "zero direction".into(),
             })?;
         Ok(ViewUniform {
             inv_view_proj: options.camera.inverse_view_projection(aspect)?,
