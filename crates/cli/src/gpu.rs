@@ -17,6 +17,25 @@ written); 3 no usable GPU (no adapter, or the adapter refused to create a device
 /// test hook: `broken-shader` or `impossible-texture`).
 pub const FAULT_VAR: &str = "NACRE_TEST_GPU_FAULT";
 
+/// Mesa's switch for the extensions a GL driver lists.
+const MESA_EXTENSION_OVERRIDE: &str = "MESA_EXTENSION_OVERRIDE";
+
+/// Lets wgpu's GL backend render into 32-bit float targets on Mesa (the linear output and the
+/// probes). RGBA32F is colour-renderable in every desktop OpenGL from 3.0 (one of the
+/// specification's required framebuffer formats), but wgpu 30 believes it only when the driver
+/// lists `GL_ARB_color_buffer_float` or `GL_EXT_color_buffer_float`, and Mesa's core
+/// profile (llvmpipe) lists neither: the extension is listed with Mesa's own switch, unless
+/// the user set it. Other drivers ignore the variable; where a float target is refused,
+/// the render fails with the runtime's error naming the format.
+///
+/// Called first thing in `main`, before any other thread exists.
+pub fn list_float_targets_on_mesa_gl() {
+    if std::env::var_os(MESA_EXTENSION_OVERRIDE).is_none() {
+        // SAFETY: called first thing in `main`, before any other thread exists.
+        unsafe { std::env::set_var(MESA_EXTENSION_OVERRIDE, "+GL_ARB_color_buffer_float") };
+    }
+}
+
 /// A headless context on wgpu's adapter (`WGPU_BACKEND`, `WGPU_ADAPTER_NAME` apply), with
 /// the fault of [`FAULT_VAR`] armed when it is set.
 pub fn context() -> Result<GpuContext> {

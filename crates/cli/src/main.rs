@@ -1264,6 +1264,7 @@ fn quiet_vulkan_device_select() {
 
 fn main() -> ExitCode {
     quiet_vulkan_device_select();
+    gpu::list_float_targets_on_mesa_gl();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => e.exit(), // usage errors exit with status 2, --help/--version with 0
