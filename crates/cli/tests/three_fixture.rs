@@ -1,6 +1,8 @@
 //! The CPU colours the three.js package's browser tests compare against
 //! (`integrations/three/test/expected.json`, written by `node test/gen-expected.mjs`) are
-//! still what `nacre color` gives: each case stores its command; this runs it again.
+//! still what `nacre color` gives: each case stores its command; this runs it again. And the
+//! raw export the browser tests load (`test/export/`, served with the KTX2 file's level-0
+//! bytes as the `.raw`) is what `nacre export` writes.
 
 use std::path::Path;
 use std::process::Command;
@@ -54,4 +56,49 @@ fn three_fixture_matches_nacre_color() {
             }
         }
     }
+}
+
+#[test]
+fn three_export_fixture_matches_nacre_export() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("three_export_fixture");
+    std::fs::create_dir_all(&dir).expect("temporary folder");
+    let raw = dir.join("soap-film.reflectance.raw");
+    let out = Command::new(env!("CARGO_BIN_EXE_nacre"))
+        .args([
+            "export",
+            "--table",
+            "soap-film",
+            "--quantity",
+            "reflectance",
+            "--out",
+        ])
+        .arg(&raw)
+        .current_dir(&root)
+        .output()
+        .expect("run nacre");
+    assert!(
+        out.status.success(),
+        "nacre export: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let read_json = |p: &Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(p).expect("read sidecar")).expect("json")
+    };
+    let fixture = root.join("integrations/three/test/export/soap-film.reflectance.json");
+    assert_eq!(
+        read_json(&dir.join("soap-film.reflectance.json")),
+        read_json(&fixture),
+        "{} is stale: copy the sidecar of `nacre export --table soap-film --quantity reflectance`",
+        fixture.display()
+    );
+    // The KTX2 level index: level 0's byte offset and length at bytes 80 and 88.
+    let ktx2 = std::fs::read(root.join("tables/baked/soap-film.reflectance.ktx2")).expect("ktx2");
+    let word = |at: usize| u64::from_le_bytes(ktx2[at..at + 8].try_into().unwrap()) as usize;
+    let (offset, length) = (word(80), word(88));
+    let bytes = std::fs::read(&raw).expect("raw");
+    assert!(
+        bytes == ktx2[offset..offset + length],
+        "the raw export differs from the KTX2 file's level 0 (the browser tests serve the latter)"
+    );
 }

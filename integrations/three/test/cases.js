@@ -1,11 +1,16 @@
 // Browser side of the tests (loaded into /page/THREE.html by run.mjs): renders
 // NacreFilmMaterial into float render targets and reads the floats back.
 import * as THREE from 'three';
-import { NacreDebugView, NacreFilmMaterial, loadNacreTable, nacreGLTFPlugin } from '@nacre/three';
+import { NacreDebugView, NacreFilmMaterial, loadNacreRawTable, loadNacreTable, nacreGLTFPlugin } from '@nacre/three';
 
 const tables = {};
+// `NAME` loads tables/baked/NAME.json (KTX2); `export:NAME.QUANTITY` the raw export and its sidecar.
 async function table(name) {
-  tables[name] ??= await loadNacreTable(`/tables/${name}.json`);
+  if (!tables[name]) {
+    tables[name] = name.startsWith('export:')
+      ? await loadNacreRawTable(`/export/${name.slice('export:'.length)}.raw`)
+      : await loadNacreTable(`/tables/${name}.json`);
+  }
   return tables[name];
 }
 

@@ -14,6 +14,7 @@ const ANGLES = '0:80:10';
 // Each case: the stack air | film n@d | base (three's `ior`), and the table the GPU samples.
 const CASES = [
   { name: 'lut soap-film 1.33@400 | air', table: 'soap-film', technique: 'lut', filmIor: 1.33, thicknessNm: 400, baseIor: 1.0, method: 'lut:soap-film' },
+  { name: 'lut soap-film from nacre export (raw + sidecar) 1.33@400 | air', table: 'export:soap-film.reflectance', technique: 'lut', filmIor: 1.33, thicknessNm: 400, baseIor: 1.0, method: 'lut:soap-film' },
   { name: 'lut film-dielectric 1.6@300 | 1.5', table: 'film-dielectric', technique: 'lut', filmIor: 1.6, thicknessNm: 300, baseIor: 1.5, method: 'lut:film-dielectric' },
   { name: 'fourier 1.33@400 | air', table: 'fourier-srgb', technique: 'fourier', filmIor: 1.33, thicknessNm: 400, baseIor: 1.0, method: 'fourier' },
   { name: 'fourier 1.6@300 | 1.5', table: 'fourier-srgb', technique: 'fourier', filmIor: 1.6, thicknessNm: 300, baseIor: 1.5, method: 'fourier' },

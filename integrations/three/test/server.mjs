@@ -7,6 +7,10 @@
 //   /tables/...         tables/baked (the default table set)
 //   /samples/...        ../shared/gltf-samples (Khronos glTF samples; not in the repository)
 //   /page/NAME.html     an empty page whose import map points `three` at node_modules/NAME
+//   /export/NAME.QUANTITY.json  the sidecar `nacre export` wrote (test/export/, committed)
+//   /export/NAME.QUANTITY.raw   the raw texture: the level-0 bytes of tables/baked/NAME.QUANTITY.ktx2,
+//                       which are the bytes `nacre export` writes (crates/cli/tests/three_fixture.rs
+//                       checks both), so the 1.3 MB file need not be committed
 import { createServer } from 'node:http';
 import { readFile, stat } from 'node:fs/promises';
 import { extname, join, normalize, sep } from 'node:path';
@@ -24,6 +28,7 @@ const roots = {
   test: join(packageRoot, 'test'),
   three: join(packageRoot, 'node_modules'),
   tables: join(repoRoot, 'tables', 'baked'),
+  export: join(packageRoot, 'test', 'export'),
   samples: samplesRoot,
 };
 
@@ -66,6 +71,16 @@ export function startServer() {
       if (pageMatch) {
         res.writeHead(200, { 'content-type': 'text/html' });
         res.end(page(pageMatch[1]));
+        return;
+      }
+      const rawMatch = /^\/export\/([\w-]+\.(?:reflectance|transmittance))\.raw$/.exec(path);
+      if (rawMatch) {
+        const ktx2 = await readFile(join(roots.tables, `${rawMatch[1]}.ktx2`));
+        const view = new DataView(ktx2.buffer, ktx2.byteOffset, ktx2.byteLength);
+        const offset = Number(view.getBigUint64(80, true));
+        const length = Number(view.getBigUint64(88, true));
+        res.writeHead(200, { 'content-type': 'application/octet-stream' });
+        res.end(ktx2.subarray(offset, offset + length));
         return;
       }
       const [, root, ...rest] = path.split('/');
