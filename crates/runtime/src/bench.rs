@@ -142,18 +142,19 @@ pub fn run_bench_with_diffraction(
     let limit = ctx.device.limits().max_texture_dimension_2d;
     if options.width == 0 || options.height == 0 || options.width > limit || options.height > limit
     {
-        return Err(Error::Invalid {
-            context: "bench-gpu".into(),
-            message: format!(
-                "a {}×{} target (each side 1 to {limit} on this device)",
-                options.width, options.height
-            ),
+        return Err(Error::TargetSize {
+            what: "bench-gpu",
+            width: options.width,
+            height: options.height,
+            max: limit,
         });
     }
     if options.frames == 0 {
-        return Err(Error::Invalid {
-            context: "bench-gpu".into(),
-            message: "0 frames (expected at least 1)".into(),
+        return Err(Error::OutOfRange {
+            what: "bench-gpu: frames".into(),
+            value: 0.0,
+            unit: "",
+            expected: "at least 1".into(),
         });
     }
     let colorimeter = tables.colorimeter()?;
@@ -218,9 +219,10 @@ pub fn run_bench_with_diffraction(
     let mut results = Vec::new();
     for &pass in passes {
         if pass == BenchPass::Diffraction {
-            let (table, technique) = diffraction.ok_or_else(|| Error::Invalid {
-                context: "bench-gpu".into(),
-                message: "the diffraction pass needs a diffraction table".into(),
+            let (table, technique) = diffraction.ok_or_else(|| Error::MissingTable {
+                needed_by: "bench-gpu: the diffraction pass".into(),
+                kind: "diffraction",
+                example: Some("cd-tracks"),
             })?;
             let scene = ScenePass::bench(
                 ctx,

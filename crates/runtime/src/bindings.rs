@@ -102,9 +102,11 @@ pub fn spectral_samples(
     setup: &SpectralSetup,
 ) -> Result<Vec<params::SpectralSample>> {
     if !(1..=4096).contains(&setup.samples) {
-        return Err(Error::Invalid {
-            context: "spectral technique".into(),
-            message: format!("{} wavelengths (expected 1 to 4096)", setup.samples),
+        return Err(Error::OutOfRange {
+            what: "spectral technique: wavelengths".into(),
+            value: setup.samples as f64,
+            unit: "",
+            expected: "1 to 4096".into(),
         });
     }
     let (wavelengths, weights) = nacre_optics::spectral::sample_weights(colorimeter, setup.samples);
@@ -175,12 +177,14 @@ impl StackSetup {
     /// stacks `nacre bench-gpu` times.
     ///
     /// # Errors
-    /// [`Error::Invalid`] for a film count outside 1 to 8.
+    /// [`Error::OutOfRange`] for a film count outside 1 to 8.
     pub fn alternating(films: usize) -> Result<StackSetup> {
         if !(1..=nacre_optics::few_wavelengths::MAX_STACK_FILMS).contains(&films) {
-            return Err(Error::Invalid {
-                context: "film_stack".into(),
-                message: format!("{films} films (expected 1 to 8)"),
+            return Err(Error::OutOfRange {
+                what: "film_stack: films".into(),
+                value: films as f64,
+                unit: "",
+                expected: format!("1 to {}", nacre_optics::few_wavelengths::MAX_STACK_FILMS),
             });
         }
         let constant = |n: f64| {
@@ -308,9 +312,10 @@ impl TechniqueBinding {
     ) -> Result<Self> {
         let device = &ctx.device;
         let layout = table_layout(device, technique);
-        let missing = |kind: &str| Error::Invalid {
-            context: format!("technique `{}`", technique.name()),
-            message: format!("needs a `{kind}` table in the table set"),
+        let missing = |kind: &'static str| Error::MissingTable {
+            needed_by: format!("technique `{}`", technique.name()),
+            kind,
+            example: None,
         };
         let bind_group = ctx.checked(
             "creating a table bind group",

@@ -237,6 +237,18 @@ pub enum Error {
         /// The pass's Fresnel factor.
         fresnel: String,
     },
+    /// A render target outside the device's texture size.
+    #[error("{what}: a {width}×{height} target (each side 1 to {max} on this device)")]
+    TargetSize {
+        /// What renders into it.
+        what: &'static str,
+        /// Its width.
+        width: u32,
+        /// Its height.
+        height: u32,
+        /// The device's largest side.
+        max: u32,
+    },
     /// Array layers of differing sizes given for one array texture.
     #[error("{label}: layers of differing sizes")]
     LayerSizes {
