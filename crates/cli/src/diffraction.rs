@@ -3,7 +3,7 @@
 //! (file or synthetic spec) or a baked `diffraction` table. The evaluation is
 //! [`nacre_bake::commands::diffraction`]; this module holds the flags.
 
-use crate::ColourArgs;
+use crate::args::ColourArgs;
 use clap::Args;
 use nacre_bake::commands::diffraction::{
     self as lib, MapRequest, Source, SurfaceSpec, ViewsRequest,

@@ -2,7 +2,7 @@
 //! extension. The figures and their colour conventions live in [`nacre_bake::commands::plot`]; this
 //! module parses the flags, computes the data and hands it over.
 
-use super::{StackArgs, load_stack};
+use crate::args::{StackArgs, load_stack};
 use clap::{Args, Subcommand};
 use nacre_bake::commands::color::{self, LoadedLut, Method, Point, Quantity};
 use nacre_bake::commands::grid::{parse_range, parse_thickness_nm};
