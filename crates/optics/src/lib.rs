@@ -21,6 +21,7 @@
 // `!(x > 0.0)` is how this crate rejects NaN together with out-of-range values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub(crate) mod airy;
 pub mod colour;
 pub mod csv_rows;
 pub mod diffraction;
@@ -33,6 +34,7 @@ pub mod fresnel;
 pub mod material;
 pub mod microfacet;
 pub(crate) mod multilayer;
+pub(crate) mod power;
 pub mod quadrature;
 pub(crate) mod simd;
 pub mod spectral;

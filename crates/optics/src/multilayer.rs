@@ -84,10 +84,8 @@
 //! absorbing films and substrates, evanescent substrates, normal and grazing incidence).
 
 use crate::fresnel::BRANCH_TOLERANCE;
-use crate::simd::{
-    ARCH, PowerSlot, exp_neg_with, lane, lane_mut, madd, nmadd, sin_cos_bounded_with,
-};
-use crate::stack::{Power, wavenumber};
+use crate::power::{Power, PowerSlot, wavenumber};
+use crate::simd::{ARCH, exp_neg_with, lane, lane_mut, madd, nmadd, sin_cos_bounded_with};
 use num_complex::Complex64 as C64;
 use pulp::{Simd, WithSimd};
 use std::cell::RefCell;

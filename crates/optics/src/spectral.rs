@@ -51,10 +51,10 @@
 //! every bundled material and on constant indices n 1.0–3.0, κ 0–5), the worst case found is
 //! ΔE2000 0.0013.
 
+use crate::airy::{ColourSums, airy_accumulate};
 use crate::colour::{Colorimeter, SPECTRAL_MAX_NM, SPECTRAL_MIN_NM};
 use crate::elementary;
 use crate::error::{Error, Result};
-use crate::simd::{ColourSums, airy_accumulate};
 use crate::stack::{Prepared, Stack, ThicknessSweep, uniform_step};
 use std::f64::consts::PI;
 

@@ -49,16 +49,17 @@
 //! (angle, wavelength); over the top film it runs the Airy closed form through the
 //! vectorised kernel of the `simd` module.
 
+pub(crate) use crate::airy::uniform_step;
+use crate::airy::{AiryRow, airy_powers};
 use crate::elementary;
 use crate::error::{Error, Result};
 use crate::fresnel::{Interface, normal_component, power_factor_p, power_factor_s};
 use crate::material::Material;
 use crate::multilayer::{Media, stack_powers};
-pub(crate) use crate::simd::uniform_step;
-use crate::simd::{AiryRow, PowerSlot, airy_powers};
+use crate::power::PowerSlot;
+pub use crate::power::{Power, wavenumber};
 use num_complex::Complex64 as C64;
 use rayon::prelude::*;
-use std::f64::consts::PI;
 
 /// One film of a stack.
 #[derive(Clone, Debug, PartialEq)]
@@ -82,42 +83,6 @@ pub struct Amplitudes {
     pub t_p: C64,
 }
 
-/// Power reflectance and transmittance of a stack, per polarisation.
-///
-/// `#[repr(C)]`: four `f64` in field order (R_s, R_p, T_s, T_p), so that a slice of powers
-/// is an (n, 4) array of `f64` for bindings (the Python package hands a sweep to numpy
-/// without copying it).
-#[allow(non_snake_case)]
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-#[repr(C)]
-pub struct Power {
-    /// Reflectance, s polarisation.
-    pub R_s: f64,
-    /// Reflectance, p polarisation.
-    pub R_p: f64,
-    /// Transmittance into the substrate, s polarisation.
-    pub T_s: f64,
-    /// Transmittance into the substrate, p polarisation.
-    pub T_p: f64,
-}
-
-#[allow(non_snake_case)]
-impl Power {
-    /// Unpolarised reflectance (R_s + R_p) / 2.
-    pub fn R(&self) -> f64 {
-        0.5 * (self.R_s + self.R_p)
-    }
-    /// Unpolarised transmittance (T_s + T_p) / 2.
-    pub fn T(&self) -> f64 {
-        0.5 * (self.T_s + self.T_p)
-    }
-    /// Unpolarised absorptance A = 1 − R − T, never below 0: for a lossless stack R + T is 1
-    /// up to rounding, and the difference can come out as −10⁻¹⁶.
-    pub fn A(&self) -> f64 {
-        (1.0 - self.R() - self.T()).max(0.0)
-    }
-}
-
 /// Amplitudes and powers at one angle and wavelength.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Response {
@@ -125,12 +90,6 @@ pub struct Response {
     pub amplitudes: Amplitudes,
     /// Power coefficients.
     pub power: Power,
-}
-
-/// Vacuum wavenumber k₀ = 2π/λ, in rad/nm.
-#[inline]
-pub fn wavenumber(wavelength_nm: f64) -> f64 {
-    2.0 * PI / wavelength_nm
 }
 
 /// `exp(i z)` for complex z, without the general complex `exp` when z is real (sin, cos
