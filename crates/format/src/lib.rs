@@ -17,6 +17,8 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod atomic;
+pub mod checksum;
+pub mod decode;
 pub mod diffraction;
 pub mod error;
 pub mod export;

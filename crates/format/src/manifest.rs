@@ -383,14 +383,8 @@ impl Manifest {
     }
 }
 
-/// SHA-256 of a text, as lower-case hex.
-pub fn sha256_text(text: &str) -> String {
-    use sha2::{Digest, Sha256};
-    Sha256::digest(text.as_bytes())
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect()
-}
+/// SHA-256 of a text, as lower-case hex ([`crate::checksum::sha256_text`]).
+pub use crate::checksum::sha256_text;
 
 /// Most texels of level 0 of a `fourier` table.
 pub const MAX_FOURIER_SAMPLES: usize = 1 << 20;
