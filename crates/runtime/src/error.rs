@@ -273,6 +273,16 @@ pub enum Error {
         /// What is wrong and the way out.
         message: Msg,
     },
+    /// A glTF file nacre cannot load: the file, and what is wrong in it (naming the
+    /// accessor, buffer, mesh, node, camera or light and the value).
+    #[error("glTF {}: {error}", path.display())]
+    Gltf {
+        /// The glTF / GLB file (or the buffer file beside it).
+        path: PathBuf,
+        /// What is wrong.
+        #[source]
+        error: crate::gltf_scene::GltfError,
+    },
     /// A file could not be read or written.
     #[error("{path}: {source}")]
     Io {

@@ -8,8 +8,8 @@
 //! * one golden image (the thickness sweep, lut) under the thresholds of `tests/render.rs`;
 //! * bad files (missing, truncated, non-triangle primitives, absurd sizes) are errors.
 
-use nacre_runtime::gltf_scene::GltfScene;
 use nacre_runtime::gltf_scene::assets::{SPHERE_SPACING, SWEEPS, sweep_glb};
+use nacre_runtime::gltf_scene::{GltfError, GltfScene};
 use nacre_runtime::mesh::{fit_camera, render_gltf};
 use nacre_runtime::render::{FilmEval, RenderedImage, SceneKind, SceneOptions};
 use nacre_runtime::shaders::{MATERIAL, MESH, compose};
@@ -325,7 +325,15 @@ fn bad_gltf_files_are_errors() {
     let expect_err = |path: &Path, what: &str| {
         let e = GltfScene::load(path).expect_err(what);
         eprintln!("{what}: {e}");
-        e.to_string()
+        e
+    };
+    // The typed glTF error of `path`: the file named, the index and value carried.
+    let gltf_err = |path: &Path, what: &str| match expect_err(path, what) {
+        nacre_runtime::Error::Gltf { path: p, error } => {
+            assert_eq!(p, path, "{what}");
+            error
+        }
+        other => panic!("{what}: expected Error::Gltf, got {other:?}"),
     };
     expect_err(&dir.path().join("missing.glb"), "missing file");
     let good = sweep_glb(&SWEEPS[0]);
@@ -367,21 +375,64 @@ fn bad_gltf_files_are_errors() {
         patch(&|d| d["accessors"][0]["count"] = 1_000_000_000u64.into()),
     )
     .unwrap();
-    expect_err(&huge, "absurd accessor count");
+    assert!(
+        matches!(
+            gltf_err(&huge, "absurd accessor count"),
+            GltfError::AccessorBeyondView { accessor: 0, .. }
+        ),
+        "absurd accessor count"
+    );
     let quantized = dir.path().join("quantized.glb");
     std::fs::write(
         &quantized,
         patch(&|d| d["accessors"][0]["componentType"] = 5123.into()),
     )
     .unwrap();
-    expect_err(&quantized, "non-float positions");
+    let e = gltf_err(&quantized, "non-float positions");
+    assert!(
+        matches!(&e, GltfError::AccessorType { semantic, accessor: 0, found, .. } if semantic == "POSITION" && found.contains("U16")),
+        "{e:?}"
+    );
     let bad_index = dir.path().join("bad-index.glb");
     std::fs::write(
         &bad_index,
         patch(&|d| d["meshes"][0]["primitives"][0]["indices"] = 7.into()),
     )
     .unwrap();
-    expect_err(&bad_index, "dangling accessor index");
+    let e = gltf_err(&bad_index, "dangling accessor index");
+    assert!(
+        matches!(
+            e,
+            GltfError::NotGltf { .. } | GltfError::MissingAccessor { accessor: 7, .. }
+        ),
+        "{e:?}"
+    );
+    let required = dir.path().join("required.glb");
+    std::fs::write(
+        &required,
+        patch(&|d| d["extensionsRequired"] = serde_json::json!(["EXT_nacre_unknown"])),
+    )
+    .unwrap();
+    let e = gltf_err(&required, "unsupported required extension");
+    assert!(
+        matches!(&e, GltfError::UnsupportedExtension { extension, .. } if extension == "EXT_nacre_unknown"),
+        "{e:?}"
+    );
+    assert!(e.to_string().contains("EXT_nacre_unknown"), "{e}");
+    let far = dir.path().join("far.glb");
+    std::fs::write(
+        &far,
+        patch(&|d| {
+            d["nodes"][0]["translation"] = serde_json::json!([3e38, 3e38, 3e38]);
+            d["nodes"][0]["scale"] = serde_json::json!([1e38, 1e38, 1e38]);
+        }),
+    )
+    .unwrap();
+    let e = gltf_err(&far, "overflowing position");
+    assert!(
+        matches!(e, GltfError::NonFinitePosition { value, .. } if value.iter().any(|x| !x.is_finite())),
+        "{e:?}"
+    );
     let nan = dir.path().join("nan.glb");
     std::fs::write(
         &nan,

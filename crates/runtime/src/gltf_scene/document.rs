@@ -1,7 +1,7 @@
 //! Opening a glTF 2.0 / GLB file: its version, its accessors' existence, `extensionsRequired`
 //! (glTF §3.12), and its buffers (the GLB chunk, base64 `data:` URIs or files beside it).
 
-use super::error::invalid;
+use super::error::GltfError;
 use super::limits::MAX_FILE_BYTES;
 use crate::error::{Error, Result};
 use std::path::Path;
@@ -24,15 +24,20 @@ pub const SUPPORTED_EXTENSIONS: [&str; 8] = [
 /// accessors exist and whose `extensionsRequired` nacre implements (then cleared, since the
 /// `gltf` crate knows only its own features' extensions), validated by the `gltf` crate.
 pub(super) fn open(bytes: &[u8], path: &Path) -> Result<gltf::Gltf> {
-    let not_valid = |e: gltf::Error| invalid(path, format!("not a valid glTF 2.0 / GLB file: {e}"));
+    let not_valid = |e: gltf::Error| {
+        GltfError::NotGltf {
+            reason: e.to_string(),
+        }
+        .at(path)
+    };
     let raw = gltf::Gltf::from_slice_without_validation(bytes).map_err(not_valid)?;
     let json = raw.document.as_json();
     let version = &json.asset.version;
     if !version.starts_with("2.") {
-        return Err(invalid(
-            path,
-            format!("asset version `{version}`: expected a glTF 2.x file"),
-        ));
+        return Err(GltfError::Version {
+            version: version.clone(),
+        }
+        .at(path));
     }
     // gltf-json 1.4 validates a primitive by indexing its POSITION accessor before
     // checking that it exists (a panic): check every attribute's accessor first.
@@ -43,14 +48,13 @@ pub(super) fn open(bytes: &[u8], path: &Path) -> Result<gltf::Gltf> {
                 .values()
                 .find(|i| i.value() >= json.accessors.len())
             {
-                return Err(invalid(
-                    path,
-                    format!(
-                        "meshes[{m}].primitives[{p}].attributes: accessor {} does not exist (the file has {})",
-                        index.value(),
-                        json.accessors.len()
-                    ),
-                ));
+                return Err(GltfError::MissingAccessor {
+                    mesh: m,
+                    primitive: p,
+                    accessor: index.value(),
+                    count: json.accessors.len(),
+                }
+                .at(path));
             }
         }
     }
@@ -61,13 +65,11 @@ pub(super) fn open(bytes: &[u8], path: &Path) -> Result<gltf::Gltf> {
         .iter()
         .find(|e| !SUPPORTED_EXTENSIONS.contains(&e.as_str()))
     {
-        return Err(invalid(
-            path,
-            format!(
-                "the file requires the extension `{ext}`, which nacre does not implement (it implements {})",
-                SUPPORTED_EXTENSIONS.join(", ")
-            ),
-        ));
+        return Err(GltfError::UnsupportedExtension {
+            extension: ext.clone(),
+            supported: SUPPORTED_EXTENSIONS.join(", "),
+        }
+        .at(path));
     }
     let mut root = raw.document.into_json();
     root.extensions_required.clear();
@@ -82,18 +84,18 @@ pub(super) fn read_buffers(gltf: &gltf::Gltf, path: &Path) -> Result<Vec<Vec<u8>
     let doc = &gltf.document;
     let mut buffers = Vec::new();
     for buffer in doc.buffers() {
+        let b = buffer.index();
         let data = match buffer.source() {
             gltf::buffer::Source::Bin => gltf
                 .blob
                 .clone()
-                .ok_or_else(|| invalid(path, "the GLB binary chunk is missing"))?,
+                .ok_or_else(|| GltfError::MissingGlbChunk { buffer: b }.at(path))?,
             gltf::buffer::Source::Uri(uri) => {
                 if let Some(rest) = uri.strip_prefix("data:") {
                     let (_, b64) = rest
                         .split_once(";base64,")
-                        .ok_or_else(|| invalid(path, "only base64 `data:` URIs are supported"))?;
-                    base64_decode(b64)
-                        .ok_or_else(|| invalid(path, "a buffer's base64 data is malformed"))?
+                        .ok_or_else(|| GltfError::DataUri { buffer: b }.at(path))?;
+                    base64_decode(b64).ok_or_else(|| GltfError::Base64 { buffer: b }.at(path))?
                 } else {
                     let file = path.parent().unwrap_or(Path::new(".")).join(uri);
                     let len = std::fs::metadata(&file)
@@ -103,7 +105,13 @@ pub(super) fn read_buffers(gltf: &gltf::Gltf, path: &Path) -> Result<Vec<Vec<u8>
                         })?
                         .len();
                     if len > MAX_FILE_BYTES {
-                        return Err(invalid(&file, format!("{len} bytes (too large)")));
+                        return Err(GltfError::BufferTooLarge {
+                            buffer: b,
+                            uri: uri.to_string(),
+                            bytes: len,
+                            max: MAX_FILE_BYTES,
+                        }
+                        .at(path));
                     }
                     std::fs::read(&file).map_err(|source| Error::Io {
                         path: file.clone(),
@@ -113,15 +121,12 @@ pub(super) fn read_buffers(gltf: &gltf::Gltf, path: &Path) -> Result<Vec<Vec<u8>
             }
         };
         if data.len() < buffer.length() {
-            return Err(invalid(
-                path,
-                format!(
-                    "buffer {} holds {} bytes, the file declares {} (truncated?)",
-                    buffer.index(),
-                    data.len(),
-                    buffer.length()
-                ),
-            ));
+            return Err(GltfError::BufferShort {
+                buffer: b,
+                bytes: data.len(),
+                declared: buffer.length(),
+            }
+            .at(path));
         }
         buffers.push(data);
     }

@@ -1,12 +1,278 @@
-//! The loader's errors.
+//! The loader's errors: what is wrong with a glTF file, naming the accessor, buffer, mesh,
+//! primitive, node, camera or light and the offending value. [`crate::Error::Gltf`] pairs
+//! one with the file's path.
 
 use crate::error::Error;
 use std::path::Path;
 
-/// An error about the glTF file at `path`.
-pub(crate) fn invalid(path: &Path, message: impl Into<String>) -> Error {
-    Error::Invalid {
-        context: format!("glTF {}", path.display()),
-        message: message.into(),
+/// What is wrong with a glTF / GLB file (glTF 2.0 specification section in brackets).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum GltfError {
+    /// The file is larger than the loader reads.
+    #[error("{bytes} bytes (at most {max})")]
+    TooLarge {
+        /// The file's size, bytes.
+        bytes: u64,
+        /// The largest size read, bytes.
+        max: u64,
+    },
+    /// The `gltf` crate could not parse or validate the document.
+    #[error("not a valid glTF 2.0 / GLB file: {reason}")]
+    NotGltf {
+        /// The parser's message.
+        reason: String,
+    },
+    /// `asset.version` is not 2.x (§3.2).
+    #[error("asset version `{version}`: expected a glTF 2.x file")]
+    Version {
+        /// The declared version.
+        version: String,
+    },
+    /// A primitive's attribute names an accessor the file does not have.
+    #[error(
+        "meshes[{mesh}].primitives[{primitive}].attributes: accessor {accessor} does not exist (the file has {count})"
+    )]
+    MissingAccessor {
+        /// Mesh index.
+        mesh: usize,
+        /// Primitive index within the mesh.
+        primitive: usize,
+        /// The accessor index named.
+        accessor: usize,
+        /// How many accessors the file has.
+        count: usize,
+    },
+    /// `extensionsRequired` lists an extension nacre does not implement (§3.12).
+    #[error(
+        "the file requires the extension `{extension}`, which nacre does not implement (it implements {supported})"
+    )]
+    UnsupportedExtension {
+        /// The extension.
+        extension: String,
+        /// The implemented extensions, comma-separated.
+        supported: String,
+    },
+    /// A GLB buffer without the binary chunk.
+    #[error("buffer {buffer}: the GLB binary chunk is missing")]
+    MissingGlbChunk {
+        /// Buffer index.
+        buffer: usize,
+    },
+    /// A `data:` URI that is not base64.
+    #[error("buffer {buffer}: only base64 `data:` URIs are supported")]
+    DataUri {
+        /// Buffer index.
+        buffer: usize,
+    },
+    /// Malformed base64 in a `data:` URI.
+    #[error("buffer {buffer}: its base64 data is malformed")]
+    Base64 {
+        /// Buffer index.
+        buffer: usize,
+    },
+    /// A buffer file beside the glTF larger than the loader reads.
+    #[error("buffer {buffer} (`{uri}`): {bytes} bytes (at most {max})")]
+    BufferTooLarge {
+        /// Buffer index.
+        buffer: usize,
+        /// The buffer's URI.
+        uri: String,
+        /// Its size, bytes.
+        bytes: u64,
+        /// The largest size read, bytes.
+        max: u64,
+    },
+    /// A buffer shorter than its declared `byteLength`.
+    #[error("buffer {buffer} holds {bytes} bytes, the file declares {declared} (truncated?)")]
+    BufferShort {
+        /// Buffer index.
+        buffer: usize,
+        /// Bytes present.
+        bytes: usize,
+        /// `byteLength`.
+        declared: usize,
+    },
+    /// No triangle primitive in the scene.
+    #[error("the scene has no triangles")]
+    NoTriangles,
+    /// A node tree deeper than the loader follows.
+    #[error("node {node}: node hierarchy deeper than {max_depth} levels")]
+    TooDeep {
+        /// The node found too deep.
+        node: usize,
+        /// The deepest level followed.
+        max_depth: usize,
+    },
+    /// A node whose world transform is not finite.
+    #[error("node {node} has a non-finite transform")]
+    NodeTransform {
+        /// Node index.
+        node: usize,
+    },
+    /// A `KHR_lights_punctual` light with values out of range.
+    #[error("node {node}: light `{name}` (light {light}): {what}")]
+    Light {
+        /// The node placing it.
+        node: usize,
+        /// Light index.
+        light: usize,
+        /// Its name (or `light N`).
+        name: String,
+        /// The offending values and what was expected.
+        what: String,
+    },
+    /// A camera with values out of range (§3.10).
+    #[error("camera `{name}` (camera {camera}): {what}")]
+    Camera {
+        /// Camera index.
+        camera: usize,
+        /// Its name (or `camera N`).
+        name: String,
+        /// The offending values and what was expected.
+        what: String,
+    },
+    /// A primitive without POSITION.
+    #[error("mesh {mesh} primitive {primitive} has no POSITION")]
+    NoPosition {
+        /// Mesh index.
+        mesh: usize,
+        /// Primitive index.
+        primitive: usize,
+    },
+    /// An attribute accessor of the wrong component type or dimensions.
+    #[error("{semantic} accessor {accessor} is {found} (expected {expected})")]
+    AccessorType {
+        /// `POSITION`, `NORMAL`, …
+        semantic: String,
+        /// Accessor index.
+        accessor: usize,
+        /// Its component type and dimensions.
+        found: String,
+        /// What the attribute needs.
+        expected: String,
+    },
+    /// An attribute whose count differs from POSITION's.
+    #[error(
+        "mesh {mesh} primitive {primitive}: {semantic} has {count} elements, POSITION {positions}"
+    )]
+    CountMismatch {
+        /// Mesh index.
+        mesh: usize,
+        /// Primitive index.
+        primitive: usize,
+        /// The attribute.
+        semantic: String,
+        /// Its element count.
+        count: usize,
+        /// POSITION's count.
+        positions: usize,
+    },
+    /// More vertices or triangle corners than the loader takes.
+    #[error(
+        "mesh {mesh} primitive {primitive}: {vertices} vertices and {corners} triangle corners so far (at most {max_vertices} and {max_corners})"
+    )]
+    TooManyVertices {
+        /// Mesh index.
+        mesh: usize,
+        /// Primitive index.
+        primitive: usize,
+        /// Vertices over the scene so far.
+        vertices: usize,
+        /// Corners over the scene so far.
+        corners: usize,
+        /// The vertex limit.
+        max_vertices: usize,
+        /// The corner limit.
+        max_corners: usize,
+    },
+    /// A triangle list whose corner count is not a multiple of 3.
+    #[error("mesh {mesh} primitive {primitive}: {corners} triangle corners is not a multiple of 3")]
+    NotTriangles {
+        /// Mesh index.
+        mesh: usize,
+        /// Primitive index.
+        primitive: usize,
+        /// The corner count.
+        corners: usize,
+    },
+    /// An attribute the reader could not read.
+    #[error("mesh {mesh} primitive {primitive}: {semantic} cannot be read")]
+    Unreadable {
+        /// Mesh index.
+        mesh: usize,
+        /// Primitive index.
+        primitive: usize,
+        /// The attribute.
+        semantic: String,
+    },
+    /// A vertex position that is not finite (after the node transform).
+    #[error(
+        "mesh {mesh} primitive {primitive}: non-finite vertex position {value:?} (vertex {vertex})"
+    )]
+    NonFinitePosition {
+        /// Mesh index.
+        mesh: usize,
+        /// Primitive index.
+        primitive: usize,
+        /// Vertex index.
+        vertex: usize,
+        /// The position.
+        value: [f32; 3],
+    },
+    /// A vertex index beyond the vertices.
+    #[error("mesh {mesh} primitive {primitive}: index {index} beyond {vertices} vertices")]
+    IndexOutOfRange {
+        /// Mesh index.
+        mesh: usize,
+        /// Primitive index.
+        primitive: usize,
+        /// The index.
+        index: u32,
+        /// The vertex count.
+        vertices: usize,
+    },
+    /// A sparse accessor (core glTF 2.0, §3.6.2.3; not read yet).
+    #[error("accessor {accessor} is sparse (not supported)")]
+    Sparse {
+        /// Accessor index.
+        accessor: usize,
+    },
+    /// An accessor without a buffer view.
+    #[error("accessor {accessor} has no buffer view")]
+    NoBufferView {
+        /// Accessor index.
+        accessor: usize,
+    },
+    /// A buffer view that ends beyond its buffer.
+    #[error(
+        "buffer view {view} ends at byte {end}, beyond its buffer's {buffer_bytes} bytes (truncated file?)"
+    )]
+    ViewBeyondBuffer {
+        /// Buffer view index.
+        view: usize,
+        /// Its end, bytes.
+        end: u64,
+        /// The buffer's length, bytes.
+        buffer_bytes: u64,
+    },
+    /// An accessor that runs beyond its buffer view.
+    #[error("accessor {accessor} needs {needed} bytes of its buffer view's {view_bytes}")]
+    AccessorBeyondView {
+        /// Accessor index.
+        accessor: usize,
+        /// Bytes it needs.
+        needed: u64,
+        /// The view's length, bytes.
+        view_bytes: u64,
+    },
+}
+
+impl GltfError {
+    /// This error about the file at `path`, as the runtime's [`Error`].
+    pub fn at(self, path: &Path) -> Error {
+        Error::Gltf {
+            path: path.to_path_buf(),
+            error: self,
+        }
     }
 }

@@ -70,12 +70,11 @@
 
 use crate::error::{Error, Result};
 use crate::thickness_map::ThicknessMap;
-use error::invalid;
 use std::path::{Path, PathBuf};
 
 pub mod assets;
 mod document;
-mod error;
+pub mod error;
 mod limits;
 mod materials;
 pub mod metal;
@@ -85,6 +84,7 @@ mod primitive;
 pub mod textures;
 
 pub use document::SUPPORTED_EXTENSIONS;
+pub use error::GltfError;
 pub use limits::{MAX_FILE_BYTES, MAX_INDICES, MAX_VERTICES};
 pub use metal::{GOLD_F0, MetalBands, is_gold_like, metal_index_gulbrandsen2014, rgb_metal_for};
 pub use model::{
@@ -130,10 +130,11 @@ impl GltfScene {
         };
         let size = std::fs::metadata(path).map_err(io)?.len();
         if size > MAX_FILE_BYTES {
-            return Err(invalid(
-                path,
-                format!("{size} bytes (at most {MAX_FILE_BYTES})"),
-            ));
+            return Err(GltfError::TooLarge {
+                bytes: size,
+                max: MAX_FILE_BYTES,
+            }
+            .at(path));
         }
         let bytes = std::fs::read(path).map_err(io)?;
         GltfScene::from_bytes(&bytes, path)
@@ -163,7 +164,7 @@ impl GltfScene {
             ));
         }
         if placed.primitives.iter().all(|p| p.indices.is_empty()) {
-            return Err(invalid(path, "the scene has no triangles"));
+            return Err(GltfError::NoTriangles.at(path));
         }
         Ok(GltfScene {
             path: path.to_path_buf(),

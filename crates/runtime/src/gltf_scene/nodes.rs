@@ -1,11 +1,14 @@
 //! The scene's node trees (glTF §3.5): the meshes, cameras and `KHR_lights_punctual`
 //! lights they place, in world space.
 
-use super::error::invalid;
+use super::error::GltfError;
 use super::model::{GltfCamera, GltfLight, GltfMaterial, GltfPrimitive, GltfProjection, LightKind};
 use super::primitive::{self, Totals};
 use crate::error::Result;
 use std::path::Path;
+
+/// The deepest node level followed (a deeper tree is refused).
+const MAX_DEPTH: usize = 64;
 
 /// What the default scene's node trees place.
 pub(super) struct Placed {
@@ -50,15 +53,16 @@ pub(super) fn place(
     let mut skipped: std::collections::BTreeMap<String, usize> = Default::default();
     let mut totals = Totals::default();
     while let Some((node, parent, depth)) = stack.pop() {
-        if depth > 64 {
-            return Err(invalid(path, "node hierarchy deeper than 64 levels"));
+        if depth > MAX_DEPTH {
+            return Err(GltfError::TooDeep {
+                node: node.index(),
+                max_depth: MAX_DEPTH,
+            }
+            .at(path));
         }
         let world = mat_mul(&parent, &node.transform().matrix());
         if !world.iter().flatten().all(|x| x.is_finite()) {
-            return Err(invalid(
-                path,
-                format!("node {} has a non-finite transform", node.index()),
-            ));
+            return Err(GltfError::NodeTransform { node: node.index() }.at(path));
         }
         for child in node.children() {
             stack.push((child, world, depth + 1));
@@ -112,10 +116,18 @@ fn node_light(path: &Path, node: &gltf::Node, world: [[f32; 4]; 4]) -> Result<Op
         return Ok(None);
     };
     let index = light.index();
-    let bad = |what: String| invalid(path, format!("node {}: {what}", node.index()));
     let name = light
         .name()
         .map_or_else(|| format!("light {index}"), str::to_string);
+    let bad = |what: String| {
+        GltfError::Light {
+            node: node.index(),
+            light: index,
+            name: name.clone(),
+            what,
+        }
+        .at(path)
+    };
     let (colour, intensity) = (light.color(), light.intensity());
     if !colour
         .iter()
@@ -123,13 +135,13 @@ fn node_light(path: &Path, node: &gltf::Node, world: [[f32; 4]; 4]) -> Result<Op
         .all(|x| x.is_finite() && *x >= 0.0)
     {
         return Err(bad(format!(
-            "light `{name}`: colour {colour:?}, intensity {intensity} (expected finite, ≥ 0)"
+            "colour {colour:?}, intensity {intensity} (expected finite, ≥ 0)"
         )));
     }
     let range = light.range();
     if range.is_some_and(|r| !(r > 0.0 && r.is_finite())) {
         return Err(bad(format!(
-            "light `{name}`: range {} (expected a positive number)",
+            "range {} (expected a positive number)",
             range.unwrap_or_default()
         )));
     }
@@ -145,7 +157,7 @@ fn node_light(path: &Path, node: &gltf::Node, world: [[f32; 4]; 4]) -> Result<Op
                 && outer_cone_angle <= std::f32::consts::FRAC_PI_2;
             if !ok {
                 return Err(bad(format!(
-                    "light `{name}`: cone angles {inner_cone_angle}, {outer_cone_angle} rad"
+                    "cone angles {inner_cone_angle}, {outer_cone_angle} rad (expected 0 ≤ inner < outer ≤ π/2)"
                 )));
             }
             LightKind::Spot {
@@ -157,7 +169,7 @@ fn node_light(path: &Path, node: &gltf::Node, world: [[f32; 4]; 4]) -> Result<Op
     let z = [world[2][0], world[2][1], world[2][2]];
     let len = (z[0] * z[0] + z[1] * z[1] + z[2] * z[2]).sqrt();
     if !(len > 1e-12 && len.is_finite()) {
-        return Err(bad(format!("light `{name}`: its node's z axis is zero")));
+        return Err(bad("its node's z axis is zero".to_string()));
     }
     Ok(Some(GltfLight {
         name,
@@ -176,7 +188,14 @@ fn gltf_camera(path: &Path, camera: &gltf::Camera, world: [[f32; 4]; 4]) -> Resu
         .name()
         .map_or_else(|| format!("camera {}", camera.index()), str::to_string);
     let positive = |x: f32| x.is_finite() && x > 0.0;
-    let bad = |what: String| invalid(path, format!("camera `{name}`: {what}"));
+    let bad = |what: String| {
+        GltfError::Camera {
+            camera: camera.index(),
+            name: name.clone(),
+            what,
+        }
+        .at(path)
+    };
     let projection = match camera.projection() {
         gltf::camera::Projection::Perspective(p) => {
             let (yfov_rad, znear, zfar) = (p.yfov(), p.znear(), p.zfar());

@@ -1,7 +1,7 @@
 //! One triangle primitive (glTF §3.7.2): its accessors checked, its attributes read and
 //! placed in world space, flat normals and MikkTSpace tangents where the file has none.
 
-use super::error::invalid;
+use super::error::GltfError;
 use super::limits::{MAX_INDICES, MAX_VERTICES};
 use super::model::{GltfMaterial, GltfPrimitive};
 use crate::error::Result;
@@ -26,15 +26,23 @@ pub(super) fn read(
     materials: &[GltfMaterial],
     totals: &mut Totals,
 ) -> Result<GltfPrimitive> {
+    let (m, p) = (mesh.index(), prim.index());
     let Some(pos_acc) = prim.get(&gltf::Semantic::Positions) else {
-        return Err(invalid(
-            path,
-            format!(
-                "mesh {} primitive {} has no POSITION",
-                mesh.index(),
-                prim.index()
-            ),
-        ));
+        return Err(GltfError::NoPosition {
+            mesh: m,
+            primitive: p,
+        }
+        .at(path));
+    };
+    let counts_differ = |semantic: &str, count: usize, positions: usize| {
+        GltfError::CountMismatch {
+            mesh: m,
+            primitive: p,
+            semantic: semantic.to_string(),
+            count,
+            positions,
+        }
+        .at(path)
     };
     check_accessor(path, &pos_acc, buffers)?;
     let float3 = |a: &gltf::Accessor, what: &str| {
@@ -43,15 +51,13 @@ pub(super) fn read(
         {
             Ok(())
         } else {
-            Err(invalid(
-                path,
-                format!(
-                    "{what} accessor {} is {:?} {:?} (expected float VEC3)",
-                    a.index(),
-                    a.data_type(),
-                    a.dimensions()
-                ),
-            ))
+            Err(GltfError::AccessorType {
+                semantic: what.to_string(),
+                accessor: a.index(),
+                found: format!("{:?} {:?}", a.data_type(), a.dimensions()),
+                expected: "float VEC3".to_string(),
+            }
+            .at(path))
         }
     };
     float3(&pos_acc, "POSITION")?;
@@ -60,7 +66,7 @@ pub(super) fn read(
         check_accessor(path, a, buffers)?;
         float3(a, "NORMAL")?;
         if a.count() != pos_acc.count() {
-            return Err(invalid(path, "NORMAL and POSITION counts differ"));
+            return Err(counts_differ("NORMAL", a.count(), pos_acc.count()));
         }
     }
     if let Some(a) = prim.indices() {
@@ -71,35 +77,61 @@ pub(super) fn read(
     totals.vertices = totals.vertices.saturating_add(n_vertices);
     totals.corners = totals.corners.saturating_add(n_corners);
     if totals.vertices > MAX_VERTICES || totals.corners > MAX_INDICES {
-        return Err(invalid(
-            path,
-            format!("more than {MAX_VERTICES} vertices or {MAX_INDICES} triangle corners"),
-        ));
+        return Err(GltfError::TooManyVertices {
+            mesh: m,
+            primitive: p,
+            vertices: totals.vertices,
+            corners: totals.corners,
+            max_vertices: MAX_VERTICES,
+            max_corners: MAX_INDICES,
+        }
+        .at(path));
     }
     if !n_corners.is_multiple_of(3) {
-        return Err(invalid(
-            path,
-            format!("{n_corners} triangle corners is not a multiple of 3"),
-        ));
+        return Err(GltfError::NotTriangles {
+            mesh: m,
+            primitive: p,
+            corners: n_corners,
+        }
+        .at(path));
     }
     let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
     let positions: Vec<[f32; 3]> = reader
         .read_positions()
-        .ok_or_else(|| invalid(path, "POSITION cannot be read"))?
+        .ok_or_else(|| {
+            GltfError::Unreadable {
+                mesh: m,
+                primitive: p,
+                semantic: "POSITION".to_string(),
+            }
+            .at(path)
+        })?
         .map(|p| transform_point(world, p))
         .collect();
-    if !positions.iter().flatten().all(|x| x.is_finite()) {
-        return Err(invalid(path, "non-finite vertex positions"));
+    if let Some(vertex) = positions
+        .iter()
+        .position(|v| !v.iter().all(|x| x.is_finite()))
+    {
+        return Err(GltfError::NonFinitePosition {
+            mesh: m,
+            primitive: p,
+            vertex,
+            value: positions[vertex],
+        }
+        .at(path));
     }
     let mut indices: Vec<u32> = match reader.read_indices() {
         Some(ix) => ix.into_u32().collect(),
         None => (0..n_vertices as u32).collect(),
     };
     if let Some(&bad) = indices.iter().find(|&&i| i as usize >= positions.len()) {
-        return Err(invalid(
-            path,
-            format!("index {bad} beyond {} vertices", positions.len()),
-        ));
+        return Err(GltfError::IndexOutOfRange {
+            mesh: m,
+            primitive: p,
+            index: bad,
+            vertices: positions.len(),
+        }
+        .at(path));
     }
     if determinant3(world) < 0.0 {
         // A mirroring transform turns counter-clockwise triangles clockwise.
@@ -113,7 +145,11 @@ pub(super) fn read(
         if let Some(a) = prim.get(&gltf::Semantic::TexCoords(set as u32)) {
             check_accessor(path, &a, buffers)?;
             if a.count() != positions.len() {
-                return Err(invalid(path, "TEXCOORD and POSITION counts differ"));
+                return Err(counts_differ(
+                    &format!("TEXCOORD_{set}"),
+                    a.count(),
+                    positions.len(),
+                ));
             }
             *out = reader
                 .read_tex_coords(set as u32)
@@ -136,7 +172,7 @@ pub(super) fn read(
         Some(a) => {
             check_accessor(path, &a, buffers)?;
             if a.count() != positions.len() {
-                return Err(invalid(path, "COLOR_0 and POSITION counts differ"));
+                return Err(counts_differ("COLOR_0", a.count(), positions.len()));
             }
             reader
                 .read_colors(0)
@@ -154,7 +190,7 @@ pub(super) fn read(
         Some(a) => {
             check_accessor(path, &a, buffers)?;
             if a.count() != positions.len() {
-                return Err(invalid(path, "TANGENT and POSITION counts differ"));
+                return Err(counts_differ("TANGENT", a.count(), positions.len()));
             }
             reader
                 .read_tangents()
@@ -240,27 +276,26 @@ fn transform_tangent(m: &[[f32; 4]; 4], t: [f32; 4]) -> [f32; 4] {
 /// `gltf` crate's reader would panic otherwise).
 fn check_accessor(path: &Path, accessor: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<()> {
     if accessor.sparse().is_some() {
-        return Err(invalid(
-            path,
-            format!("accessor {} is sparse (not supported)", accessor.index()),
-        ));
+        return Err(GltfError::Sparse {
+            accessor: accessor.index(),
+        }
+        .at(path));
     }
     let Some(view) = accessor.view() else {
-        return Err(invalid(
-            path,
-            format!("accessor {} has no buffer view", accessor.index()),
-        ));
+        return Err(GltfError::NoBufferView {
+            accessor: accessor.index(),
+        }
+        .at(path));
     };
     let data_len = buffers.get(view.buffer().index()).map_or(0, Vec::len) as u64;
     let view_end = (view.offset() as u64).saturating_add(view.length() as u64);
     if view_end > data_len {
-        return Err(invalid(
-            path,
-            format!(
-                "buffer view {} ends at byte {view_end}, beyond its buffer's {data_len} bytes (truncated file?)",
-                view.index()
-            ),
-        ));
+        return Err(GltfError::ViewBeyondBuffer {
+            view: view.index(),
+            end: view_end,
+            buffer_bytes: data_len,
+        }
+        .at(path));
     }
     let elem = accessor.size() as u64;
     let stride = view.stride().map_or(elem, |s| s as u64);
@@ -273,14 +308,12 @@ fn check_accessor(path: &Path, accessor: &gltf::Accessor, buffers: &[Vec<u8>]) -
             .saturating_add(elem)
     };
     if end > view.length() as u64 {
-        return Err(invalid(
-            path,
-            format!(
-                "accessor {} needs {end} bytes of its buffer view's {}",
-                accessor.index(),
-                view.length()
-            ),
-        ));
+        return Err(GltfError::AccessorBeyondView {
+            accessor: accessor.index(),
+            needed: end,
+            view_bytes: view.length() as u64,
+        }
+        .at(path));
     }
     Ok(())
 }
