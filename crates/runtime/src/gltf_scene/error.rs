@@ -2,9 +2,6 @@
 //! primitive, node, camera or light and the offending value. [`crate::Error::Gltf`] pairs
 //! one with the file's path.
 
-use crate::error::Error;
-use std::path::Path;
-
 /// What is wrong with a glTF / GLB file (glTF 2.0 specification section in brackets).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum GltfError {
@@ -265,14 +262,4 @@ pub enum GltfError {
         /// The view's length, bytes.
         view_bytes: u64,
     },
-}
-
-impl GltfError {
-    /// This error about the file at `path`, as the runtime's [`Error`].
-    pub fn at(self, path: &Path) -> Error {
-        Error::Gltf {
-            path: path.to_path_buf(),
-            error: self,
-        }
-    }
 }

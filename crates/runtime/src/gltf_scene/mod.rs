@@ -120,6 +120,17 @@ pub struct GltfScene {
     pub cameras: Vec<GltfCamera>,
 }
 
+impl GltfError {
+    /// This error about the file at `path`, as the runtime's [`Error`] (defined here, not in
+    /// `error.rs`, which imports nothing of the crate).
+    pub fn at(self, path: &Path) -> Error {
+        Error::Gltf {
+            path: path.to_path_buf(),
+            error: self,
+        }
+    }
+}
+
 impl GltfScene {
     /// Reads a `.gltf` (JSON, buffers embedded as `data:` URIs or in files beside it) or a
     /// `.glb` file.
