@@ -163,6 +163,7 @@ pub struct RenderArgs {
 }
 
 pub fn run(args: &RenderArgs) -> Result<()> {
+    use nacre_runtime::mesh::{RenderInputs, TableFile, load_environment};
     use nacre_runtime::render::{FilmEval, SceneOptions, render_scene};
     use nacre_runtime::{Scene, TableSet, Technique};
     let film_eval = FilmEval::from(args.film_eval);
@@ -209,14 +210,25 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             samples: args.wavelengths,
         };
     }
-    // Check the settings and read every input before starting the GPU: bad input fails fast.
+    // Check the settings and read every input before starting the GPU: bad input fails fast;
+    // what the renderer needs is kept, so that nothing is read twice.
     options.validate()?;
+    let mut table_files = Vec::with_capacity(names.len());
     for name in &names {
-        Manifest::read(&set::resolve_table(name))?;
+        let path = set::resolve_table(name);
+        let manifest = Manifest::read(&path)?;
+        table_files.push(TableFile { path, manifest });
     }
-    if let Some(path) = &options.environment {
-        nacre_runtime::render::EnvironmentMap::load(path)?;
-    }
+    // The glTF renderer's environment (the default one without --env); the film scenes read
+    // theirs again in render_scene.
+    let environment = match (&args.gltf, &options.environment) {
+        (Some(_), _) => Some(load_environment(&options)?),
+        (None, Some(path)) => {
+            nacre_runtime::render::EnvironmentMap::load(path)?;
+            None
+        }
+        (None, None) => None,
+    };
     if let Some(path) = &options.thickness_map {
         nacre_runtime::render::ThicknessMap::load_for(path, technique)?;
     }
@@ -234,23 +246,30 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                     })
                 }
             };
-            let aspect = f64::from(options.width) / f64::from(options.height);
-            nacre_runtime::mesh::view_camera(&scene, view, aspect)?;
             Some((scene, view))
         }
         None => None,
     };
+    // The camera fitted, the lights and the settings of the frame: still before the GPU.
+    let inputs = match (&gltf, environment) {
+        (Some((scene, view)), Some(environment)) => Some(RenderInputs::with_environment(
+            scene,
+            &options,
+            *view,
+            environment,
+        )?),
+        _ => None,
+    };
     let ctx = crate::gpu::context()?;
     eprintln!("adapter: {}", ctx.describe());
     let mut tables = TableSet::default();
-    for name in &names {
-        tables.add(&ctx, &set::resolve_table(name))?;
+    for file in &table_files {
+        file.upload(&ctx, &mut tables)?;
     }
-    if let Some((scene, view)) = &gltf {
+    if let Some(inputs) = &inputs {
+        let scene = inputs.scene;
         let start = std::time::Instant::now();
-        let out = nacre_runtime::mesh::render_gltf_from(
-            &ctx, &tables, technique, scene, &options, *view,
-        )?;
+        let out = nacre_runtime::mesh::render(&ctx, &tables, technique, inputs)?;
         for note in &out.notes {
             eprintln!("note: {}", note.named(&error::Flags));
         }
