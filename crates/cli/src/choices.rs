@@ -40,23 +40,36 @@ impl ChannelArg {
     }
 }
 
-/// `nacre render --technique`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum TechniqueArg {
-    Lut,
-    Fourier,
-    Spectral,
-    Stack,
+/// `nacre render --technique`: one choice per entry of the runtime's technique registry
+/// (`nacre_runtime::technique::REGISTRY`), by its name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TechniqueArg(pub nacre_runtime::Technique);
+
+/// Every technique as a choice, in the registry's order.
+const TECHNIQUE_ARGS: [TechniqueArg; nacre_runtime::Technique::ALL.len()] = {
+    let all = nacre_runtime::Technique::ALL;
+    let mut args = [TechniqueArg(all[0]); nacre_runtime::Technique::ALL.len()];
+    let mut i = 0;
+    while i < all.len() {
+        args[i] = TechniqueArg(all[i]);
+        i += 1;
+    }
+    args
+};
+
+impl ValueEnum for TechniqueArg {
+    fn value_variants<'a>() -> &'a [Self] {
+        &TECHNIQUE_ARGS
+    }
+
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        Some(clap::builder::PossibleValue::new(self.0.name()))
+    }
 }
 
 impl From<TechniqueArg> for nacre_runtime::Technique {
     fn from(t: TechniqueArg) -> Self {
-        match t {
-            TechniqueArg::Lut => nacre_runtime::Technique::Lut,
-            TechniqueArg::Fourier => nacre_runtime::Technique::Fourier,
-            TechniqueArg::Spectral => nacre_runtime::Technique::Spectral,
-            TechniqueArg::Stack => nacre_runtime::Technique::Stack,
-        }
+        t.0
     }
 }
 
@@ -102,6 +115,38 @@ impl From<FilmEvalArg> for nacre_runtime::render::FilmEval {
             FilmEvalArg::Classic => FilmEval::Classic,
             FilmEvalArg::Nv => FilmEval::NormalView,
             FilmEvalArg::Exact => FilmEval::Exact,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nacre_runtime::technique::REGISTRY;
+
+    /// `--technique` offers every technique of the registry by its name, and each names a
+    /// CPU twin that `nacre color --method` accepts.
+    #[test]
+    fn techniques_come_from_the_registry() {
+        let names: Vec<String> = TechniqueArg::value_variants()
+            .iter()
+            .map(|t| t.to_possible_value().unwrap().get_name().to_string())
+            .collect();
+        let registry: Vec<&str> = REGISTRY.iter().map(|e| e.name).collect();
+        assert_eq!(names, registry);
+        for e in REGISTRY {
+            let t = TechniqueArg::from_str(e.name, false).unwrap();
+            assert_eq!(nacre_runtime::Technique::from(t), e.technique);
+            let twin = e
+                .cpu_twin
+                .replace('N', "30")
+                .replace("PATH", "tables/baked/film-dielectric.json");
+            assert!(
+                nacre_bake::commands::color::Method::parse(&twin).is_ok(),
+                "{}: CPU twin `{}`",
+                e.name,
+                e.cpu_twin
+            );
         }
     }
 }

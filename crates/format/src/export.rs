@@ -19,11 +19,13 @@
 //! The sidecar (`.json` beside the `.raw`) holds `width`, `height`, `depth`, `format`
 //! (`"rgba16f-le"`), `texel_order`, the table's kind, name, quantity and axes record as the
 //! manifest stores them, the mappings as text, and `shader_params`: the fields of the
-//! libraries' parameter struct (`NacreFilmLutParams` / `NacreRoughLutParams`).
+//! libraries' parameter struct (`NacreFilmLutParams` / `NacreRoughLutParams`), from the one
+//! field list of [`crate::gpu_params`].
 
 use crate::TableKind;
 use crate::atomic::write_files_atomic;
 use crate::error::{Error, Result};
+use crate::gpu_params::{FilmLutParams, RoughLutParams};
 use crate::load::LoadedRoughLut;
 use crate::manifest::Manifest;
 use crate::table_io::Table3;
@@ -97,17 +99,7 @@ pub fn export_raw(manifest_path: &Path, quantity: &str) -> Result<RawTexture3d> 
             let has_t = manifest
                 .load_table(manifest_path, "transmittance")?
                 .is_some();
-            let params = json!({
-                "cos_theta_count": axes.cos_theta_count,
-                "opd_count": axes.opd_count,
-                "ior_count": axes.ior_count,
-                "thickness_min_nm": axes.thickness_min_nm,
-                "thickness_max_nm": axes.thickness_max_nm,
-                "ior_min": axes.ior_min,
-                "ior_max": axes.ior_max,
-                "ambient_index": axes.ambient_index,
-                "has_transmittance": u32::from(has_t),
-            });
+            let params = FilmLutParams::shader_params(&axes, has_t);
             let mapping = json!({
                 "x": "t_x = sqrt(cos θ)",
                 "y": "t_y = Δ/Δ_max, Δ = 2 d sqrt(n² − n₀² sin²θ), Δ_max = 2 thickness_max_nm ior_max",
@@ -124,19 +116,7 @@ pub fn export_raw(manifest_path: &Path, quantity: &str) -> Result<RawTexture3d> 
                 "reflectance" => loaded.lut.reflectance,
                 _ => loaded.lut.transmittance.ok_or_else(missing)?,
             };
-            let params = json!({
-                "cos_theta_count": axes.cos_theta_count,
-                "opd_count": axes.opd_count,
-                "ior_count": axes.ior_count,
-                "alpha_count": axes.alpha_count,
-                "thickness_max_nm": axes.thickness_max_nm,
-                "ior_min": axes.ior_min,
-                "ior_max": axes.ior_max,
-                "alpha_min": axes.alpha_min,
-                "alpha_max": axes.alpha_max,
-                "ambient_index": axes.ambient_index,
-                "has_transmittance": u32::from(has_t),
-            });
+            let params = RoughLutParams::shader_params(&axes, has_t);
             let mapping = json!({
                 "x": "t_x = sqrt(cos θ_o)",
                 "y": "t_y = Δ/Δ_max, Δ = 2 d q(n_f, c_ref), c_ref = cos θ_o + (2α − α²)(0.7 − 0.8 cos θ_o), per α block",

@@ -24,6 +24,7 @@ pub mod error;
 pub mod export;
 pub mod film_lut;
 pub mod fourier;
+pub mod gpu_params;
 pub mod kind;
 pub mod ktx2;
 pub mod load;

@@ -46,12 +46,9 @@ impl BenchPass {
     pub fn name(self) -> &'static str {
         match self {
             BenchPass::Plain => "plain GGX + Schlick",
-            BenchPass::Film(Technique::Lut) => "film_lut",
-            BenchPass::Film(Technique::Fourier) => "film_fourier",
+            BenchPass::Film(t) => t.entry().bench_label,
             BenchPass::FourierFixed(3) => "film_fourier, M = 3",
             BenchPass::FourierFixed(_) => "film_fourier, fixed M",
-            BenchPass::Film(Technique::Spectral) => "film_spectral",
-            BenchPass::Film(Technique::Stack) => "film_stack",
             BenchPass::Diffraction => "diffraction",
             BenchPass::Stack(2) => "film_stack, 2 films",
             BenchPass::Stack(4) => "film_stack, 4 films",

@@ -27,6 +27,7 @@ pub mod rough_reference;
 pub mod scene;
 pub mod shaders;
 pub mod tables;
+pub mod technique;
 pub mod thickness_map;
 
 pub use bindings::{TechniqueBinding, TechniqueOptions};
@@ -39,5 +40,5 @@ pub use gltf_scene::{assets as gltf_assets, metal as gltf_metal, textures as glt
 pub use params::{FilmInput, FilmOutput};
 pub use render::{RenderedImage, Renderer, SceneKind, SceneOptions, render_scene};
 pub use scene::Scene;
-pub use shaders::Technique;
 pub use tables::TableSet;
+pub use technique::Technique;

@@ -229,129 +229,210 @@ pub fn run_spirv_probe(
     if count == 0 {
         return Ok(Vec::new());
     }
-    let device = &ctx.device;
-    let stage = wgpu::ShaderStages::COMPUTE;
-    let buffer_entry = |binding, ty| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: stage,
-        ty: wgpu::BindingType::Buffer {
-            ty,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    };
-    let output_size = u64::from(count) * 32;
-    let (output, readback) = ctx.checked(
-        "running the SPIR-V probe",
-        || -> Result<(wgpu::Buffer, wgpu::Buffer)> {
-            // naga's SPIR-V front end panics on some valid modules (e.g. naga 30 on an
-            // `OpImageFetch` of a 2-D array image when no 2-component integer vector type was
-            // declared): a panic there is reported as an error, not passed on.
-            let module = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                device.create_shader_module(wgpu::ShaderModuleDescriptor {
+    // naga's SPIR-V front end panics on some valid modules (e.g. naga 30 on an
+    // `OpImageFetch` of a 2-D array image when no 2-component integer vector type was
+    // declared): a panic there is reported as an error, not passed on.
+    let module = ctx.checked("compiling the SPIR-V probe", || {
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            ctx.device
+                .create_shader_module(wgpu::ShaderModuleDescriptor {
                     label: Some("SPIR-V probe"),
                     source: wgpu::ShaderSource::SpirV(words.as_slice().into()),
                 })
-            }))
-            .map_err(|panic| {
-                let message = panic
-                    .downcast_ref::<&str>()
-                    .map(|s| s.to_string())
-                    .or_else(|| panic.downcast_ref::<String>().cloned())
-                    .unwrap_or_else(|| "a panic without a message".into());
-                Error::Gpu {
-                    context: "SPIR-V probe: naga's SPIR-V front end".into(),
-                    message,
-                }
-            });
-            let module = module?;
-            let empty = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("SPIR-V probe (empty group 0)"),
-                entries: &[],
-            });
-            let io_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("SPIR-V probe inputs and outputs"),
-                entries: &[
-                    buffer_entry(0, wgpu::BufferBindingType::Storage { read_only: true }),
-                    buffer_entry(1, wgpu::BufferBindingType::Uniform),
-                    buffer_entry(2, wgpu::BufferBindingType::Storage { read_only: false }),
-                ],
-            });
-            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("SPIR-V probe"),
-                bind_group_layouts: &[Some(&empty), Some(probe.tables.0), Some(&io_layout)],
-                immediate_size: 0,
-            });
-            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("SPIR-V probe"),
-                layout: Some(&layout),
-                module: &module,
-                entry_point: Some(probe.entry_point),
-                compilation_options: Default::default(),
-                cache: None,
-            });
-            let inputs = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("SPIR-V probe inputs"),
-                contents: input_bytes,
-                usage: wgpu::BufferUsages::STORAGE,
-            });
-            let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("SPIR-V probe count"),
-                contents: bytemuck::bytes_of(&[count, 0, 0, 0]),
-                usage: wgpu::BufferUsages::UNIFORM,
-            });
-            let output = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("SPIR-V probe outputs"),
-                size: output_size,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            });
-            let readback = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("SPIR-V probe readback"),
-                size: output_size,
-                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
-            let empty_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("SPIR-V probe (empty group 0)"),
-                layout: &empty,
-                entries: &[],
-            });
-            let io_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("SPIR-V probe inputs and outputs"),
-                layout: &io_layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: inputs.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: uniform.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: output.as_entire_binding(),
-                    },
-                ],
-            });
-            let mut encoder = device.create_command_encoder(&Default::default());
-            {
-                let mut pass = encoder.begin_compute_pass(&Default::default());
-                pass.set_pipeline(&pipeline);
-                pass.set_bind_group(0, &empty_group, &[]);
-                pass.set_bind_group(1, probe.tables.1, &[]);
-                pass.set_bind_group(2, &io_group, &[]);
-                pass.dispatch_workgroups(count.div_ceil(SPIRV_PROBE_WORKGROUP), 1, 1);
+        }))
+        .map_err(|panic| {
+            let message = panic
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| panic.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "a panic without a message".into());
+            Error::Gpu {
+                context: "SPIR-V probe: naga's SPIR-V front end".into(),
+                message,
             }
-            encoder.copy_buffer_to_buffer(&output, 0, &readback, 0, output_size);
-            ctx.queue.submit([encoder.finish()]);
-            Ok((output, readback))
+        })
+    })??;
+    let floats = dispatch_compute(
+        ctx,
+        &ComputeProbe {
+            label: "SPIR-V probe",
+            module: &module,
+            entry_point: probe.entry_point,
+            tables: probe.tables,
+            io_group: 2,
+            inputs: input_bytes,
+            uniform: Some(bytemuck::bytes_of(&[count, 0, 0, 0])),
+            cases: count as usize,
         },
-    )??;
-    let bytes = gpu::read_buffer(ctx, &readback, "reading the SPIR-V probe's outputs")?;
-    drop(output);
-    let floats: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&bytes);
+    )?;
     Ok(floats.chunks_exact(2).map(|p| [p[0], p[1]]).collect())
+}
+
+/// One compute dispatch of a GPU = CPU probe: the one dispatcher of [`run_spirv_probe`] and
+/// the diffraction probes (`crate::diffraction`).
+pub(crate) struct ComputeProbe<'a> {
+    /// What errors and wgpu labels call it.
+    pub label: &'a str,
+    /// The compiled module.
+    pub module: &'a wgpu::ShaderModule,
+    /// Its compute entry point, [`SPIRV_PROBE_WORKGROUP`] invocations per workgroup, one per
+    /// case.
+    pub entry_point: &'a str,
+    /// Group 1: the technique's tables (layout and bind group).
+    pub tables: (&'a wgpu::BindGroupLayout, &'a wgpu::BindGroup),
+    /// The group of the inputs and outputs; the groups other than 1 below it are empty.
+    pub io_group: u32,
+    /// Binding 0 of the io group, `storage, read`.
+    pub inputs: &'a [u8],
+    /// Binding 1 of the io group when present, `uniform`.
+    pub uniform: Option<&'a [u8]>,
+    /// Cases: the outputs, the io group's last binding (`storage, read_write`), hold two
+    /// `vec4<f32>` per case.
+    pub cases: usize,
+}
+
+/// Runs `probe` and returns its outputs: two `vec4<f32>` per case, in order.
+///
+/// # Errors
+/// [`Error::Limit`] for more cases than one dispatch takes; [`Error::Gpu`] or
+/// [`Error::DeviceLost`] from the device.
+pub(crate) fn dispatch_compute(
+    ctx: &GpuContext,
+    probe: &ComputeProbe<'_>,
+) -> Result<Vec<[f32; 4]>> {
+    if probe.cases == 0 {
+        return Ok(Vec::new());
+    }
+    let label = probe.label;
+    let limit = ctx.device.limits().max_compute_workgroups_per_dimension;
+    let needed = probe.cases.div_ceil(SPIRV_PROBE_WORKGROUP as usize);
+    let groups = u32::try_from(needed)
+        .ok()
+        .filter(|g| *g <= limit)
+        .ok_or_else(|| Error::Limit {
+            what: format!(
+                "{label} of {} cases ({SPIRV_PROBE_WORKGROUP} a workgroup)",
+                probe.cases
+            ),
+            needed: needed as u64,
+            limit: u64::from(limit),
+            adapter: ctx.info.name.clone(),
+        })?;
+    let out_bytes = probe.cases as u64 * 32;
+    let device = &ctx.device;
+    let readback = ctx.checked(&format!("running the {label}"), || {
+        let buffer_entry = |binding, ty| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let mut io_entries = vec![buffer_entry(
+            0,
+            wgpu::BufferBindingType::Storage { read_only: true },
+        )];
+        if probe.uniform.is_some() {
+            io_entries.push(buffer_entry(1, wgpu::BufferBindingType::Uniform));
+        }
+        io_entries.push(buffer_entry(
+            io_entries.len() as u32,
+            wgpu::BufferBindingType::Storage { read_only: false },
+        ));
+        let io_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(label),
+            entries: &io_entries,
+        });
+        let empty = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(label),
+            entries: &[],
+        });
+        let layouts: Vec<Option<&wgpu::BindGroupLayout>> = (0..=probe.io_group)
+            .map(|g| match g {
+                1 => Some(probe.tables.0),
+                g if g == probe.io_group => Some(&io_layout),
+                _ => Some(&empty),
+            })
+            .collect();
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(label),
+            bind_group_layouts: &layouts,
+            immediate_size: 0,
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(probe.entry_point),
+            layout: Some(&layout),
+            module: probe.module,
+            entry_point: Some(probe.entry_point),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        let inputs = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: probe.inputs,
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let uniform = probe.uniform.map(|contents| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage: wgpu::BufferUsages::UNIFORM,
+            })
+        });
+        let outputs = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: out_bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: out_bytes,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let empty_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(label),
+            layout: &empty,
+            entries: &[],
+        });
+        let mut resources = vec![inputs.as_entire_binding()];
+        resources.extend(uniform.as_ref().map(|u| u.as_entire_binding()));
+        resources.push(outputs.as_entire_binding());
+        let io_entries: Vec<wgpu::BindGroupEntry<'_>> = resources
+            .into_iter()
+            .enumerate()
+            .map(|(i, resource)| wgpu::BindGroupEntry {
+                binding: i as u32,
+                resource,
+            })
+            .collect();
+        let io_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(label),
+            layout: &io_layout,
+            entries: &io_entries,
+        });
+        let mut encoder = device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&pipeline);
+            for g in 0..=probe.io_group {
+                let group = match g {
+                    1 => probe.tables.1,
+                    g if g == probe.io_group => &io_group,
+                    _ => &empty_group,
+                };
+                pass.set_bind_group(g, group, &[]);
+            }
+            pass.dispatch_workgroups(groups, 1, 1);
+        }
+        encoder.copy_buffer_to_buffer(&outputs, 0, &readback, 0, out_bytes);
+        ctx.queue.submit([encoder.finish()]);
+        readback
+    })?;
+    let bytes = gpu::read_buffer(ctx, &readback, &format!("reading the {label}'s outputs"))?;
+    Ok(bytemuck::pod_collect_to_vec(&bytes))
 }

@@ -20,10 +20,12 @@
 //!
 //! [`flatten`] gives a host engine one self-contained file per technique (or per consumer with
 //! [`flatten_with`]); [`compose`] keeps the runtime's historical order for the film pipelines:
-//! [`COMMON`], [`LUT_MAPPING`], one technique module ([`Technique::source`]), then the
+//! [`COMMON`], [`LUT_MAPPING`], one technique module ([`Technique::source`], from
+//! [`crate::technique::REGISTRY`]), then the
 //! consumers with whatever they import. See `shaders/README.md` for the bind-group contract
 //! each module follows.
 
+use crate::technique::REGISTRY;
 use std::fmt;
 use std::ops::Range;
 
@@ -31,16 +33,6 @@ use std::ops::Range;
 pub const COMMON: &str = include_str!("../../../shaders/common.wgsl");
 /// The film-lut coordinate mappings (mirror of `nacre_format::film_lut::FilmLutAxes`).
 pub const LUT_MAPPING: &str = include_str!("../../../shaders/lut_mapping.wgsl");
-/// Technique: trilinear lookup in a baked `film-lut` table.
-pub const FILM_LUT: &str = include_str!("../../../shaders/film_lut.wgsl");
-/// Technique: Belcour & Barla 2017 Eq. 10 with a baked `fourier` table.
-pub const FILM_FOURIER: &str = include_str!("../../../shaders/film_fourier.wgsl");
-/// Technique: brute-force loop over N wavelengths.
-pub const FILM_SPECTRAL: &str = include_str!("../../../shaders/film_spectral.wgsl");
-/// Technique: real-time multilayer stacks at a few wavelengths chosen well
-/// (`nacre_optics::few_wavelengths`).
-pub const FILM_STACK: &str = include_str!("../../../shaders/film_stack.wgsl");
-
 /// Baseline "technique" without a film (Schlick Fresnel) for `nacre bench-gpu`.
 pub const PLAIN: &str = include_str!("../../../shaders/plain.wgsl");
 /// Consumer: the full-screen GGX pass of `nacre bench-gpu`.
@@ -102,14 +94,27 @@ macro_rules! modules {
     };
 }
 
-/// Every module of `shaders/` (a test checks that the list matches the directory).
-pub const MODULES: &[Module] = modules![
+/// The [`Module`] of `shaders/NAME.wgsl`, for a technique's entry.
+#[macro_export]
+#[doc(hidden)]
+macro_rules! wgsl_module {
+    ($name:literal) => {
+        $crate::shaders::Module {
+            name: $name,
+            source: include_str!(concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/../../shaders/",
+                $name,
+                ".wgsl"
+            )),
+        }
+    };
+}
+
+/// The modules of `shaders/` that are no technique of [`crate::technique::REGISTRY`].
+const SHARED_MODULES: &[Module] = modules![
     "common",
     "lut_mapping",
-    "film_lut",
-    "film_fourier",
-    "film_spectral",
-    "film_stack",
     "plain",
     "rough_lut_mapping",
     "output",
@@ -128,16 +133,44 @@ pub const MODULES: &[Module] = modules![
     "diffraction_integrated_probe",
 ];
 
-/// The technique modules a host can flatten on their own ([`flatten`]): one file each.
-pub const TECHNIQUE_MODULES: &[&str] = &[
-    "film_lut",
-    "film_fourier",
-    "film_spectral",
-    "film_stack",
-    "plain",
-    "diffraction",
-    "diffraction_integrated",
-];
+const MODULE_COUNT: usize = SHARED_MODULES.len() + REGISTRY.len();
+
+/// Every module of `shaders/`: the shared ones, then each technique's (its entry in
+/// [`crate::technique::REGISTRY`] names it; a test checks that the list matches the
+/// directory).
+pub const MODULES: &[Module] = &{
+    let mut all = [SHARED_MODULES[0]; MODULE_COUNT];
+    let mut i = 0;
+    while i < MODULE_COUNT {
+        all[i] = if i < SHARED_MODULES.len() {
+            SHARED_MODULES[i]
+        } else {
+            REGISTRY[i - SHARED_MODULES.len()].module
+        };
+        i += 1;
+    }
+    all
+};
+
+/// The host-side techniques that are no film technique of the registry.
+const OTHER_TECHNIQUES: [&str; 3] = ["plain", "diffraction", "diffraction_integrated"];
+
+/// The technique modules a host can flatten on their own ([`flatten`]): one file each —
+/// every film technique of [`crate::technique::REGISTRY`], then `plain` and the two
+/// diffraction techniques.
+pub const TECHNIQUE_MODULES: &[&str] = &{
+    let mut all = [""; REGISTRY.len() + OTHER_TECHNIQUES.len()];
+    let mut i = 0;
+    while i < all.len() {
+        all[i] = if i < REGISTRY.len() {
+            REGISTRY[i].module.name
+        } else {
+            OTHER_TECHNIQUES[i - REGISTRY.len()]
+        };
+        i += 1;
+    }
+    all
+};
 
 /// The module of [`MODULES`] called `name`.
 pub fn module(name: &str) -> Option<&'static Module> {
@@ -546,58 +579,7 @@ pub fn film_pipeline(technique: &str, consumers: &[&str]) -> Result<Composed, Co
     resolve(&roots, Some(technique))
 }
 
-/// How the film colour is computed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Technique {
-    /// `film_lut.wgsl`.
-    Lut,
-    /// `film_fourier.wgsl`.
-    Fourier,
-    /// `film_spectral.wgsl`.
-    Spectral,
-    /// `film_stack.wgsl`.
-    Stack,
-}
-
-impl Technique {
-    /// Every technique.
-    pub const ALL: [Technique; 4] = [
-        Technique::Lut,
-        Technique::Fourier,
-        Technique::Spectral,
-        Technique::Stack,
-    ];
-
-    /// The technique module's WGSL source.
-    pub fn source(self) -> &'static str {
-        match self {
-            Technique::Lut => FILM_LUT,
-            Technique::Fourier => FILM_FOURIER,
-            Technique::Spectral => FILM_SPECTRAL,
-            Technique::Stack => FILM_STACK,
-        }
-    }
-
-    /// The technique module's name in [`MODULES`] (`film_lut`, …).
-    pub fn module(self) -> &'static str {
-        match self {
-            Technique::Lut => "film_lut",
-            Technique::Fourier => "film_fourier",
-            Technique::Spectral => "film_spectral",
-            Technique::Stack => "film_stack",
-        }
-    }
-
-    /// The name used on the command line and in file names.
-    pub fn name(self) -> &'static str {
-        match self {
-            Technique::Lut => "lut",
-            Technique::Fourier => "fourier",
-            Technique::Spectral => "spectral",
-            Technique::Stack => "stack",
-        }
-    }
-}
+pub use crate::technique::Technique;
 
 /// The full source of a pipeline: common + mapping + `technique` + `consumer`, each consumer
 /// after its imports (e.g. [`MATERIAL`] brings [`ROUGH_LUT_MAPPING`]). A consumer whose text is
@@ -758,7 +740,24 @@ mod tests {
             ),
             ("diffraction_integrated_probe", &["diffraction_integrated"]),
         ];
-        assert_eq!(expected.len(), MODULES.len());
+        // Every module is listed here but a new technique of the registry, which imports
+        // only shared modules.
+        for m in MODULES {
+            if expected.iter().all(|(name, _)| *name != m.name) {
+                assert!(
+                    REGISTRY.iter().any(|e| e.module == *m),
+                    "{}: not listed",
+                    m.name
+                );
+                for import in m.imports().unwrap() {
+                    assert!(
+                        matches!(import, Import::Module(d) if SHARED_MODULES.iter().any(|s| s.name == d)),
+                        "{}: imports {import}",
+                        m.name
+                    );
+                }
+            }
+        }
         for (name, deps) in expected {
             let m = module(name).unwrap_or_else(|| panic!("no module {name}"));
             let header_lines = m
@@ -927,9 +926,11 @@ mod tests {
         let host = "fn host() {}";
         assert_eq!(
             compose(Technique::Lut, &[host]),
-            cat(&[COMMON, LUT_MAPPING, FILM_LUT, host])
+            cat(&[COMMON, LUT_MAPPING, Technique::Lut.source(), host])
         );
-        let m = try_compose(FILM_LUT, &[MATERIAL, host]).unwrap().map;
+        let m = try_compose(Technique::Lut.source(), &[MATERIAL, host])
+            .unwrap()
+            .map;
         let files: Vec<&str> = m.spans.iter().map(|s| s.file.as_str()).collect();
         assert_eq!(
             files,
@@ -961,8 +962,16 @@ mod tests {
                 &["diffraction_common", "diffraction_integrated"],
             ),
         ];
-        let names: Vec<&str> = expected.iter().map(|e| e.0).collect();
-        assert_eq!(names, TECHNIQUE_MODULES);
+        // Listed here: every technique module but a new technique of the registry, which
+        // flattens to `common`, the shared modules it imports, then itself.
+        for name in TECHNIQUE_MODULES {
+            if expected.iter().all(|e| e.0 != *name) {
+                let files = flatten(name).unwrap().map.spans;
+                assert_eq!(files[0].file, "common.wgsl", "{name}");
+                assert_eq!(files.last().unwrap().file, format!("{name}.wgsl"));
+            }
+        }
+        assert!(expected.iter().all(|e| TECHNIQUE_MODULES.contains(&e.0)));
         for (name, modules) in expected {
             let composed = flatten(name).unwrap();
             let files: Vec<String> = composed.map.spans.iter().map(|s| s.file.clone()).collect();

@@ -125,7 +125,9 @@ impl TableSet {
             TableKind::RoughFilmLut => {
                 self.rough_film_lut = Some(upload_rough_film_lut(ctx, manifest, manifest_path)?)
             }
-            other @ TableKind::Diffraction => {
+            // Kinds the GPU does not sample (`diffraction` has its own loaders in
+            // `crate::diffraction`; a CPU-only kind needs no line here).
+            other => {
                 return Err(Error::Manifest {
                     path: manifest_path.to_path_buf(),
                     message: format!(

@@ -285,12 +285,77 @@ fn uniform_layouts_match_the_documented_ones() {
         assert_eq!(actual, members, "{struct_name}: member offsets");
         assert_eq!(actual_span, span, "{struct_name}: size");
     }
-    // The host mirrors of film_stack's structs.
-    assert_eq!(std::mem::size_of::<nacre_runtime::params::StackNode>(), 32);
-    assert_eq!(
-        std::mem::size_of::<nacre_runtime::params::StackParams>(),
-        288
+    // The host mirrors (`nacre_runtime::params`, the table kinds' uniforms of
+    // `nacre_format::gpu_params`) have the same sizes.
+    use nacre_runtime::params;
+    use std::mem::size_of;
+    let host: [(&str, usize); 7] = [
+        ("FilmInput", size_of::<params::FilmInput>()),
+        ("FilmLutParams", size_of::<params::FilmLutParams>()),
+        ("FourierParams", size_of::<params::FourierParams>()),
+        ("SpectralSample", size_of::<params::SpectralSample>()),
+        ("SpectralParams", size_of::<params::SpectralParams>()),
+        ("StackNode", size_of::<params::StackNode>()),
+        ("StackParams", size_of::<params::StackParams>()),
+    ];
+    for ((name, size), (struct_name, span, _)) in host.iter().zip(&expected) {
+        assert_eq!((*name, *size), (*struct_name, *span as usize));
+    }
+}
+
+/// `nacre_runtime::mesh::MeshUniform` (464 bytes) mirrors `MeshParams` (`shaders/mesh.wgsl`)
+/// member by member: naga's offsets are Rust's.
+#[test]
+fn mesh_uniform_matches_mesh_params() {
+    use nacre_runtime::mesh::MeshUniform;
+    use nacre_runtime::shaders::{MATERIAL, MESH};
+    let (source, map) = composition(
+        Technique::Lut,
+        &[("material.wgsl", MATERIAL), ("mesh.wgsl", MESH)],
     );
+    let (module, _) = validate("mesh.wgsl", &source, &map);
+    let found = module
+        .types
+        .iter()
+        .find(|(_, ty)| ty.name.as_deref() == Some("MeshParams"))
+        .expect("MeshParams declared");
+    let naga::TypeInner::Struct { ref members, span } = found.1.inner else {
+        panic!("MeshParams is not a struct");
+    };
+    let actual: Vec<(&str, u32)> = members
+        .iter()
+        .map(|m| (m.name.as_deref().unwrap_or(""), m.offset))
+        .collect();
+    macro_rules! offsets {
+        ($($field:ident),* $(,)?) => {
+            vec![$((stringify!($field), std::mem::offset_of!(MeshUniform, $field) as u32)),*]
+        };
+    }
+    let host = offsets![
+        view_proj,
+        base_colour,
+        emissive,
+        metallic,
+        specular_colour,
+        roughness,
+        specular,
+        normal_scale,
+        occlusion_strength,
+        alpha_cutoff,
+        dielectric_ior,
+        iridescence,
+        alpha_mode,
+        flags,
+        transmission,
+        lobes,
+        volume_thickness,
+        attenuation_distance,
+        attenuation_colour,
+        transforms,
+    ];
+    assert_eq!(actual, host, "MeshParams member offsets");
+    assert_eq!(span, 464);
+    assert_eq!(std::mem::size_of::<MeshUniform>(), span as usize);
 }
 
 #[test]

@@ -3,7 +3,7 @@
 //! record, the upload of a table's `Rgba32Float` array texture and the compute dispatch of
 //! the GPU = CPU probes.
 
-use crate::context::{BufferInitExt, GpuContext};
+use crate::context::GpuContext;
 use crate::error::{Error, Result};
 use crate::shaders;
 use crate::tables::check_limit;
@@ -153,13 +153,13 @@ pub(super) fn upload_rgba32f_array(
 }
 
 /// One compute dispatch of `entry` in `source` (64 invocations per workgroup, one per
-/// case) for the probes of both layouts: group 0 empty, group 1 the technique's
-/// (`technique`: layout and bind group), group 2 empty (the scenes' lights), group 3 binding 0
-/// the `input` (read-only storage), binding 1 two vec4<f32> outputs per case; returns the
-/// outputs.
+/// case) for the probes of both layouts, through [`crate::probe::dispatch_compute`]: group 0
+/// empty, group 1 the technique's (`technique`: layout and bind group), group 2 empty (the
+/// scenes' lights), group 3 binding 0 the `input` (read-only storage), binding 1 two
+/// vec4<f32> outputs per case; returns the outputs.
 ///
 /// # Errors
-/// [`Error::Invalid`] for more cases than one dispatch takes; [`Error::Gpu`] or
+/// [`Error::Limit`] for more cases than one dispatch takes; [`Error::Gpu`] or
 /// [`Error::DeviceLost`] from the device.
 pub(super) fn dispatch_probe(
     ctx: &GpuContext,
@@ -172,106 +172,18 @@ pub(super) fn dispatch_probe(
     if cases == 0 {
         return Ok(Vec::new());
     }
-    let limit = ctx.device.limits().max_compute_workgroups_per_dimension;
-    let groups = u32::try_from(cases.div_ceil(64))
-        .ok()
-        .filter(|g| *g <= limit)
-        .ok_or_else(|| Error::Limit {
-            what: format!("diffraction probe `{entry}` of {cases} cases (64 a workgroup)"),
-            needed: cases.div_ceil(64) as u64,
-            limit: u64::from(limit),
-            adapter: ctx.info.name.clone(),
-        })?;
-    let out_bytes = (cases * 2 * 16) as u64;
-    let device = &ctx.device;
     let module = shaders::create_module(ctx, entry, source)?;
-    let readback = ctx.checked(&format!("running the diffraction probe `{entry}`"), || {
-        let storage = |binding, read_only| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only },
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
-        let io_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("diffraction probe io"),
-            entries: &[storage(0, true), storage(1, false)],
-        });
-        let empty = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("diffraction probe (no view, no lights)"),
-            entries: &[],
-        });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("diffraction probe"),
-            bind_group_layouts: &[
-                Some(&empty),
-                Some(technique.0),
-                Some(&empty),
-                Some(&io_layout),
-            ],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some(entry),
-            layout: Some(&layout),
+    crate::probe::dispatch_compute(
+        ctx,
+        &crate::probe::ComputeProbe {
+            label: &format!("diffraction probe `{entry}`"),
             module: &module,
-            entry_point: Some(entry),
-            compilation_options: Default::default(),
-            cache: None,
-        });
-        let inputs = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("diffraction probe inputs"),
-            contents: bytemuck::cast_slice(input),
-            usage: wgpu::BufferUsages::STORAGE,
-        });
-        let outputs = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("diffraction probe outputs"),
-            size: out_bytes,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        let readback = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("diffraction probe readback"),
-            size: out_bytes,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let empty_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("diffraction probe (no view)"),
-            layout: &empty,
-            entries: &[],
-        });
-        let io = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("diffraction probe io"),
-            layout: &io_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: inputs.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: outputs.as_entire_binding(),
-                },
-            ],
-        });
-        let mut encoder = device.create_command_encoder(&Default::default());
-        {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&pipeline);
-            pass.set_bind_group(0, &empty_group, &[]);
-            pass.set_bind_group(1, technique.1, &[]);
-            pass.set_bind_group(2, &empty_group, &[]);
-            pass.set_bind_group(3, &io, &[]);
-            pass.dispatch_workgroups(groups, 1, 1);
-        }
-        encoder.copy_buffer_to_buffer(&outputs, 0, &readback, 0, out_bytes);
-        ctx.queue.submit([encoder.finish()]);
-        readback
-    })?;
-    let bytes = crate::gpu::read_buffer(ctx, &readback, "reading the diffraction probe back")?;
-    Ok(bytemuck::pod_collect_to_vec(&bytes))
+            entry_point: entry,
+            tables: technique,
+            io_group: 3,
+            inputs: bytemuck::cast_slice(input),
+            uniform: None,
+            cases,
+        },
+    )
 }

@@ -184,56 +184,9 @@ pub fn view_group_layout(device: &wgpu::Device, label: &str) -> wgpu::BindGroupL
 }
 
 /// Mirror of `RoughLutParams` (`shaders/rough_lut_mapping.wgsl`; the axes of
-/// `nacre_format::rough_film_lut::RoughLutAxes`): 48 bytes.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct RoughLutUniform {
-    /// Texels along cos θ_o.
-    pub cos_theta_count: u32,
-    /// Texels along Δ.
-    pub opd_count: u32,
-    /// Texels along the film index per α block.
-    pub ior_count: u32,
-    /// α blocks.
-    pub alpha_count: u32,
-    /// d_max, nm.
-    pub thickness_max_nm: f32,
-    /// Smallest film index.
-    pub ior_min: f32,
-    /// Largest film index.
-    pub ior_max: f32,
-    /// Smallest α.
-    pub alpha_min: f32,
-    /// Largest α.
-    pub alpha_max: f32,
-    /// Ambient index n₀.
-    pub ambient_index: f32,
-    /// 1 when the table has a transmittance.
-    pub has_transmittance: u32,
-    /// Padding to 48 bytes.
-    pub _pad0: u32,
-}
-
-impl RoughLutUniform {
-    /// The uniform of a loaded table.
-    pub fn new(lut: &RoughFilmLutTextures) -> RoughLutUniform {
-        let a = &lut.axes;
-        RoughLutUniform {
-            cos_theta_count: a.cos_theta_count as u32,
-            opd_count: a.opd_count as u32,
-            ior_count: a.ior_count as u32,
-            alpha_count: a.alpha_count as u32,
-            thickness_max_nm: a.thickness_max_nm as f32,
-            ior_min: a.ior_min as f32,
-            ior_max: a.ior_max as f32,
-            alpha_min: a.alpha_min as f32,
-            alpha_max: a.alpha_max as f32,
-            ambient_index: a.ambient_index as f32,
-            has_transmittance: u32::from(lut.has_transmittance),
-            _pad0: 0,
-        }
-    }
-}
+/// `nacre_format::rough_film_lut::RoughLutAxes`): 48 bytes, defined once in
+/// [`nacre_format::gpu_params`].
+pub use nacre_format::gpu_params::RoughLutParams as RoughLutUniform;
 
 /// The textures of group 0 besides the view uniform: the environment's box mip chain, its
 /// GGX-prefiltered levels ([`crate::ibl::PrefilteredEnvironment`]) and the E₁ table
@@ -264,7 +217,7 @@ impl EnvironmentTextures {
         let (rough_lut, rough_lut_uniform) = match (rough_lut, film_eval) {
             (Some(lut), FilmEval::Exact) => (
                 lut.reflectance.create_view(&Default::default()),
-                RoughLutUniform::new(lut),
+                RoughLutUniform::new(&lut.axes, lut.has_transmittance),
             ),
             _ => {
                 let placeholder = ctx.checked("a rough-film-lut placeholder", || {
