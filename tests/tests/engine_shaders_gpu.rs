@@ -494,7 +494,7 @@ fn rough_binding(tables: &TableSet) -> (wgpu::BindGroupLayout, wgpu::BindGroup) 
     });
     let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("RoughLutParams"),
-        contents: bytemuck::bytes_of(&RoughLutUniform::new(lut)),
+        contents: bytemuck::bytes_of(&RoughLutUniform::new(&lut.axes, lut.has_transmittance)),
         usage: wgpu::BufferUsages::UNIFORM,
     });
     let r = lut.reflectance.create_view(&Default::default());
