@@ -7,10 +7,11 @@ use crate::context::GpuContext;
 use crate::error::Result;
 use crate::tables::TableSet;
 use crate::technique::{BindInputs, Slot, Technique};
-use nacre_optics::Material;
 use nacre_optics::colour::Colorimeter;
 
-pub use crate::technique::{SpectralSetup, StackSetup, spectral_samples, stack_buffers};
+pub use crate::technique::{
+    SpectralSetup, StackSetup, TechniqueOptions, spectral_samples, stack_buffers,
+};
 
 const STAGES: wgpu::ShaderStages = wgpu::ShaderStages::FRAGMENT.union(wgpu::ShaderStages::COMPUTE);
 
@@ -56,34 +57,6 @@ pub fn table_layout(device: &wgpu::Device, technique: Technique) -> wgpu::BindGr
     })
 }
 
-/// Options of a technique's group-1 bind group.
-#[derive(Clone, Debug)]
-pub struct TechniqueOptions {
-    /// Harmonics M of `film_fourier`: 0 (the default) = automatic, as `nacre color --method
-    /// fourier` (`fourier:auto`): per pixel, as many as the series' decay and the
-    /// sensitivities' need for ΔE2000 p95 ≤ 0.1 (`nacre_optics::fourier` module docs, "How
-    /// many harmonics"); a fixed M otherwise.
-    pub harmonics: u32,
-    /// Setup of `film_spectral`.
-    pub spectral: SpectralSetup,
-    /// Setup of `film_stack`.
-    pub stack: StackSetup,
-}
-
-impl Default for TechniqueOptions {
-    fn default() -> Self {
-        TechniqueOptions {
-            harmonics: 0,
-            spectral: SpectralSetup {
-                samples: 30,
-                base: Material::constant("1.5", nacre_optics::C64::new(1.5, 0.0))
-                    .expect("a real index above zero is a valid material"),
-            },
-            stack: StackSetup::default(),
-        }
-    }
-}
-
 /// A technique ready to bind as group 1: its layout, bind group and the buffers they own.
 pub struct TechniqueBinding {
     /// The technique.
@@ -111,7 +84,7 @@ impl TechniqueBinding {
             tables,
             options,
             colorimeter,
-            technique,
+            name: technique.name(),
         };
         let bind_group = ctx.checked("creating a table bind group", || {
             (technique.entry().bind)(&inputs)

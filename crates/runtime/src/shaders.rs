@@ -94,23 +94,6 @@ macro_rules! modules {
     };
 }
 
-/// The [`Module`] of `shaders/NAME.wgsl`, for a technique's entry.
-#[macro_export]
-#[doc(hidden)]
-macro_rules! wgsl_module {
-    ($name:literal) => {
-        $crate::shaders::Module {
-            name: $name,
-            source: include_str!(concat!(
-                env!("CARGO_MANIFEST_DIR"),
-                "/../../shaders/",
-                $name,
-                ".wgsl"
-            )),
-        }
-    };
-}
-
 /// The modules of `shaders/` that are no technique of [`crate::technique::REGISTRY`].
 const SHARED_MODULES: &[Module] = modules![
     "common",
@@ -145,7 +128,10 @@ pub const MODULES: &[Module] = &{
         all[i] = if i < SHARED_MODULES.len() {
             SHARED_MODULES[i]
         } else {
-            REGISTRY[i - SHARED_MODULES.len()].module
+            Module {
+                name: REGISTRY[i - SHARED_MODULES.len()].module,
+                source: REGISTRY[i - SHARED_MODULES.len()].source,
+            }
         };
         i += 1;
     }
@@ -163,7 +149,7 @@ pub const TECHNIQUE_MODULES: &[&str] = &{
     let mut i = 0;
     while i < all.len() {
         all[i] = if i < REGISTRY.len() {
-            REGISTRY[i].module.name
+            REGISTRY[i].module
         } else {
             OTHER_TECHNIQUES[i - REGISTRY.len()]
         };
@@ -745,7 +731,7 @@ mod tests {
         for m in MODULES {
             if expected.iter().all(|(name, _)| *name != m.name) {
                 assert!(
-                    REGISTRY.iter().any(|e| e.module == *m),
+                    REGISTRY.iter().any(|e| e.module == m.name),
                     "{}: not listed",
                     m.name
                 );

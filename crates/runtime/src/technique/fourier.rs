@@ -4,16 +4,16 @@
 //! Group 1: 0 `texture_2d_array<f32>` (unfilterable), 1 `uniform FourierParams` (the table's
 //! axes and the harmonics, [`nacre_format::gpu_params::FourierParams`]).
 
-use super::{BindInputs, Slot, Technique, TechniqueEntry};
+use super::entry::{BindInputs, Slot, TechniqueEntry};
 use crate::context::BufferInitExt;
 use crate::error::Result;
 use nacre_format::gpu_params::FourierParams;
 
 /// The technique's entry.
 pub const ENTRY: TechniqueEntry = TechniqueEntry {
-    technique: Technique::Fourier,
     name: "fourier",
-    module: crate::wgsl_module!("film_fourier"),
+    module: "film_fourier",
+    source: include_str!("../../../../shaders/film_fourier.wgsl"),
     bench_label: "film_fourier",
     cpu_twin: "fourier",
     layout: &[

@@ -4,7 +4,7 @@
 //! sampler, 3 `uniform FilmLutParams` (the table's axes,
 //! [`nacre_format::gpu_params::FilmLutParams`]).
 
-use super::{BindInputs, Slot, Technique, TechniqueEntry};
+use super::entry::{BindInputs, Slot, TechniqueEntry};
 use crate::context::BufferInitExt;
 use crate::error::Result;
 use nacre_format::gpu_params::FilmLutParams;
@@ -12,9 +12,9 @@ use wgpu::TextureViewDimension::D3;
 
 /// The technique's entry.
 pub const ENTRY: TechniqueEntry = TechniqueEntry {
-    technique: Technique::Lut,
     name: "lut",
-    module: crate::wgsl_module!("film_lut"),
+    module: "film_lut",
+    source: include_str!("../../../../shaders/film_lut.wgsl"),
     bench_label: "film_lut",
     cpu_twin: "lut:PATH",
     layout: &[

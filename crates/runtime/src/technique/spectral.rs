@@ -3,18 +3,18 @@
 //!
 //! Group 1: 0 `storage, read array<SpectralSample>`, 1 `uniform SpectralParams`.
 
-use super::{BindInputs, Slot, Technique, TechniqueEntry};
+use super::entry::{BindInputs, Slot, TechniqueEntry};
+use super::options::SpectralSetup;
 use crate::context::BufferInitExt;
 use crate::error::{Error, Result};
 use bytemuck::{Pod, Zeroable};
-use nacre_optics::Material;
 use nacre_optics::colour::Colorimeter;
 
 /// The technique's entry.
 pub const ENTRY: TechniqueEntry = TechniqueEntry {
-    technique: Technique::Spectral,
     name: "spectral",
-    module: crate::wgsl_module!("film_spectral"),
+    module: "film_spectral",
+    source: include_str!("../../../../shaders/film_spectral.wgsl"),
     bench_label: "film_spectral",
     cpu_twin: "samples:N",
     layout: &[Slot::Storage, Slot::Uniform],
@@ -38,16 +38,6 @@ fn bind(inputs: &BindInputs<'_>) -> Result<wgpu::BindGroup> {
         "spectral tables",
         &[storage.as_entire_binding(), uniform.as_entire_binding()],
     ))
-}
-
-/// What the spectral technique integrates over: N wavelengths with their weights and the
-/// base's index at each (the `samples:N` method of `nacre color`).
-#[derive(Clone, Debug)]
-pub struct SpectralSetup {
-    /// Wavelength count N.
-    pub samples: usize,
-    /// The base material (its index is sampled at each wavelength).
-    pub base: Material,
 }
 
 /// The samples of `film_spectral` for `setup`: the wavelengths and weights of `nacre color
