@@ -4,7 +4,7 @@
 // Real-time multilayer films: ambient | up to 8 films | base, every medium with a complex
 // index that may vary with wavelength, evaluated per pixel by the exact per-polarisation
 // recurrence of crates/optics/src/stack.rs at a few wavelengths chosen by the rule of
-// crates/optics/src/few_wavelengths.rs. The GPU twin of `nacre color --method stack`
+// crates/optics/src/few_wavelengths/mod.rs. The GPU twin of `nacre color --method stack`
 // (`nacre_optics::few_wavelengths::StackEvaluation`); the capability of Sussenbach 2013 §4.2–4.3
 // (Algorithms 3 and 4) without its limits (dielectric films only, 5 uniform wavelengths).
 //
@@ -18,7 +18,7 @@
 //   c_j             StackParams.layers[j].w       film j's thickness-map channel: 0 R, 1 G, 2 B
 //   s_c             FilmInput.variation(_g, _b)   spatial variation 2g_c − 1 ∈ [−1, 1] of channel c
 //   k_j             StackParams.layers[j].z       2 max_λ |ñ_j|: film j's OPD per nm
-//   h               StackParams.finesse           the stack's finesse factor (few_wavelengths.rs)
+//   h               StackParams.finesse           the stack's finesse factor (few_wavelengths/mod.rs)
 //   λ_k, W_k        StackNode                     node wavelength, per-channel weight
 //   q_m             q[m]                          ñ_m cos θ_m = √(ñ_m² − (n₀ sin θ₀)²), forward branch
 //   r, t            FresnelInterface              interface m → m+1 amplitudes (common.wgsl)
