@@ -11,6 +11,7 @@ pub mod diffraction_integrated;
 pub mod diffraction_recipe;
 pub mod film_lut;
 pub mod fourier;
+pub mod height_field;
 pub mod rough_film_lut;
 
 use crate::error::{Error, Result};
