@@ -57,7 +57,7 @@
 
 use crate::error::{Error, Origin, Result};
 pub use crate::kinds::diffraction_recipe::DiffractionRecipe;
-pub use crate::kinds::height_field::read_height_field;
+pub use crate::kinds::height_field::{MAX_AXIS, read_height_field};
 use crate::kinds::{KindEntry, TableRecipe};
 use crate::recipe::{RawColour, line_of, parse_colour, table_name, toml_error};
 use nacre_format::diffraction::{DiffractionRecord, SIGN_CONVENTION};
@@ -78,9 +78,6 @@ use toml::Spanned;
 /// Largest pitch the automatic sampling of synthetic specs uses, µm: the Nyquist limit of
 /// 380 nm light at |u| = 2 is 0.095 µm.
 pub const AUTO_PITCH_UM: f64 = 0.09;
-
-/// Most samples per axis of a synthetic field or height-field file.
-pub const MAX_AXIS: usize = 4096;
 
 /// A synthetic height field.
 #[derive(Clone, Debug, PartialEq)]

@@ -6,10 +6,12 @@
 //! error naming the file.
 
 use crate::error::{Error, Result};
-use crate::kinds::diffraction::MAX_AXIS;
 use nacre_format::decode::guarded;
 use nacre_optics::diffraction::HeightField;
 use std::path::Path;
+
+/// Most samples per axis of a synthetic field or height-field file.
+pub const MAX_AXIS: usize = 4096;
 
 /// Reads a height-field file (PNG, JPEG, OpenEXR or CSV by extension; module docs) with
 /// `pitch_um` µm per sample and heights scaled by `height_scale_um`.
