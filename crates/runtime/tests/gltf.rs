@@ -688,3 +688,204 @@ fn every_punctual_light_is_drawn() {
     let lit = render(vec![toward]);
     assert!(lit.0 > 40.0, "spot aimed at the sphere: {lit:?}");
 }
+
+/// Little-endian bytes of `values`, each written by `le`.
+fn bytes_of<T: Copy, const N: usize>(values: &[T], le: impl Fn(T) -> [u8; N]) -> Vec<u8> {
+    values.iter().flat_map(|&v| le(v)).collect()
+}
+
+/// A GLB of one mesh with two primitives made of sparse accessors (glTF 2.0 §3.6.2.3):
+/// primitive 0, a quad whose POSITION accessor (4 vertices in a buffer view) has vertex 2
+/// replaced by (2, 2, 0); primitive 1, a triangle whose POSITION accessor has no buffer view
+/// (zeros) and vertices 1 and 2 replaced by (1, 0, 0) and (0, 1, 0). `sparse_u8` is the
+/// quad's sparse index, `sparse_u16` the triangle's two.
+fn sparse_glb(sparse_u8: u8, sparse_u16: [u16; 2], quad_sparse_count: u32) -> Vec<u8> {
+    let mut bin = bytes_of(
+        &[
+            0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0, 0.0,
+        ],
+        f32::to_le_bytes,
+    ); // 0..48
+    bin.extend(bytes_of(&[0u16, 1, 2, 0, 2, 3], u16::to_le_bytes)); // 48..60
+    bin.extend([sparse_u8, 0, 0, 0]); // 60..61 (padded to 64)
+    bin.extend(bytes_of(&[2.0f32, 2.0, 0.0], f32::to_le_bytes)); // 64..76
+    bin.extend(bytes_of(&sparse_u16, u16::to_le_bytes)); // 76..80
+    bin.extend(bytes_of(
+        &[1.0f32, 0.0, 0.0, 0.0, 1.0, 0.0],
+        f32::to_le_bytes,
+    )); // 80..104
+    let doc = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [
+            {"attributes": {"POSITION": 0}, "indices": 1},
+            {"attributes": {"POSITION": 2}}
+        ]}],
+        "buffers": [{"byteLength": bin.len()}],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": 48},
+            {"buffer": 0, "byteOffset": 48, "byteLength": 12},
+            {"buffer": 0, "byteOffset": 60, "byteLength": 1},
+            {"buffer": 0, "byteOffset": 64, "byteLength": 12},
+            {"buffer": 0, "byteOffset": 76, "byteLength": 4},
+            {"buffer": 0, "byteOffset": 80, "byteLength": 24}
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
+             "min": [0.0, 0.0, 0.0], "max": [2.0, 2.0, 0.0],
+             "sparse": {"count": quad_sparse_count,
+                        "indices": {"bufferView": 2, "componentType": 5121},
+                        "values": {"bufferView": 3}}},
+            {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"},
+            {"componentType": 5126, "count": 3, "type": "VEC3",
+             "min": [0.0, 0.0, 0.0], "max": [1.0, 1.0, 0.0],
+             "sparse": {"count": 2,
+                        "indices": {"bufferView": 4, "componentType": 5123},
+                        "values": {"bufferView": 5}}}
+        ]
+    });
+    nacre_runtime::gltf_scene::assets::glb(&doc, &bin)
+}
+
+#[test]
+fn sparse_accessors_replace_elements_of_the_view_or_of_zeros() {
+    let path = Path::new("sparse.glb");
+    let scene = GltfScene::from_bytes(&sparse_glb(2, [1, 2], 1), path).unwrap();
+    assert_eq!(scene.primitives.len(), 2);
+    // No normals: flat shading unwelds the triangles, so positions follow the indices.
+    let quad = &scene.primitives[0].positions;
+    let quad_vertices = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [2.0, 2.0, 0.0],
+        [0.0, 1.0, 0.0],
+    ];
+    let expected: Vec<[f32; 3]> = [0, 1, 2, 0, 2, 3].map(|i| quad_vertices[i]).to_vec();
+    assert_eq!(quad, &expected);
+    let triangle = &scene.primitives[1].positions;
+    assert_eq!(
+        triangle,
+        &vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
+    );
+    assert_eq!(scene.primitives[1].normals[0], [0.0, 0.0, 1.0]);
+
+    let err = |bytes: Vec<u8>| match GltfScene::from_bytes(&bytes, path) {
+        Err(nacre_runtime::Error::Gltf { error, .. }) => error,
+        other => panic!("expected a glTF error, got {other:?}"),
+    };
+    assert_eq!(
+        err(sparse_glb(9, [1, 2], 1)),
+        GltfError::SparseIndexOutOfRange {
+            accessor: 0,
+            position: 0,
+            index: 9,
+            count: 4
+        }
+    );
+    assert_eq!(
+        err(sparse_glb(2, [2, 1], 1)),
+        GltfError::SparseIndicesNotIncreasing {
+            accessor: 2,
+            position: 1,
+            previous: 2,
+            index: 1
+        }
+    );
+    assert_eq!(
+        err(sparse_glb(2, [1, 1], 1)),
+        GltfError::SparseIndicesNotIncreasing {
+            accessor: 2,
+            position: 1,
+            previous: 1,
+            index: 1
+        }
+    );
+    // Five sparse entries need 5 index bytes of a 1-byte view.
+    assert_eq!(
+        err(sparse_glb(2, [1, 2], 5)),
+        GltfError::SparseBeyondView {
+            accessor: 0,
+            part: "indices".to_string(),
+            needed: 5,
+            view_bytes: 1
+        }
+    );
+}
+
+/// A GLB of one triangle with `KHR_mesh_quantization` attributes (declared when `declared`):
+/// POSITION as normalised SHORT (0, 0, 0), (1, 0, 0), (0, 1, 0) (stride 8), NORMAL as
+/// normalised BYTE (0, 0, 1) (stride 4), TEXCOORD_0 as unnormalised UNSIGNED_BYTE (0, 0),
+/// (3, 0), (0, 5) (stride 4), under a node scaling by 2 and translating by (0, 0, 1).
+fn quantized_glb(declared: bool) -> Vec<u8> {
+    let mut bin = Vec::new();
+    for p in [[0i16, 0, 0], [32767, 0, 0], [0, 32767, 0]] {
+        bin.extend(bytes_of(&p, i16::to_le_bytes));
+        bin.extend([0, 0]);
+    } // 0..24
+    for _ in 0..3 {
+        bin.extend([0u8, 0, 127, 0]);
+    } // 24..36
+    for uv in [[0u8, 0], [3, 0], [0, 5]] {
+        bin.extend([uv[0], uv[1], 0, 0]);
+    } // 36..48
+    let mut doc = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0, "scale": [2.0, 2.0, 2.0], "translation": [0.0, 0.0, 1.0]}],
+        "meshes": [{"primitives": [
+            {"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}}
+        ]}],
+        "buffers": [{"byteLength": bin.len()}],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": 24, "byteStride": 8},
+            {"buffer": 0, "byteOffset": 24, "byteLength": 12, "byteStride": 4},
+            {"buffer": 0, "byteOffset": 36, "byteLength": 12, "byteStride": 4}
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5122, "normalized": true, "count": 3,
+             "type": "VEC3", "min": [0, 0, 0], "max": [32767, 32767, 0]},
+            {"bufferView": 1, "componentType": 5120, "normalized": true, "count": 3,
+             "type": "VEC3"},
+            {"bufferView": 2, "componentType": 5121, "count": 3, "type": "VEC2"}
+        ]
+    });
+    if declared {
+        doc["extensionsUsed"] = serde_json::json!(["KHR_mesh_quantization"]);
+        doc["extensionsRequired"] = serde_json::json!(["KHR_mesh_quantization"]);
+    }
+    nacre_runtime::gltf_scene::assets::glb(&doc, &bin)
+}
+
+#[test]
+fn quantized_attributes_are_dequantised_under_the_node_transform() {
+    let path = Path::new("quantized.glb");
+    let scene = GltfScene::from_bytes(&quantized_glb(true), path).unwrap();
+    let p = &scene.primitives[0];
+    assert_eq!(
+        p.positions,
+        vec![[0.0, 0.0, 1.0], [2.0, 0.0, 1.0], [0.0, 2.0, 1.0]]
+    );
+    assert_eq!(p.normals, vec![[0.0, 0.0, 1.0]; 3]);
+    assert_eq!(p.uvs, vec![[0.0, 0.0], [3.0, 0.0], [0.0, 5.0]]);
+    assert_eq!(p.indices, vec![0, 1, 2]);
+    // Without the extension declared, integer positions are not glTF.
+    match GltfScene::from_bytes(&quantized_glb(false), path) {
+        Err(nacre_runtime::Error::Gltf {
+            error:
+                GltfError::AccessorType {
+                    semantic,
+                    accessor: 0,
+                    found,
+                    ..
+                },
+            ..
+        }) => assert_eq!(
+            (semantic.as_str(), found.as_str()),
+            ("POSITION", "I16 normalized Vec3")
+        ),
+        other => panic!("expected an AccessorType error, got {other:?}"),
+    }
+}

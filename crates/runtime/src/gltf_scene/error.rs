@@ -192,16 +192,6 @@ pub enum GltfError {
         /// The corner count.
         corners: usize,
     },
-    /// An attribute the reader could not read.
-    #[error("mesh {mesh} primitive {primitive}: {semantic} cannot be read")]
-    Unreadable {
-        /// Mesh index.
-        mesh: usize,
-        /// Primitive index.
-        primitive: usize,
-        /// The attribute.
-        semantic: String,
-    },
     /// A vertex position that is not finite (after the node transform).
     #[error(
         "mesh {mesh} primitive {primitive}: non-finite vertex position {value:?} (vertex {vertex})"
@@ -228,17 +218,47 @@ pub enum GltfError {
         /// The vertex count.
         vertices: usize,
     },
-    /// A sparse accessor (core glTF 2.0, §3.6.2.3; not read yet).
-    #[error("accessor {accessor} is sparse (not supported)")]
-    Sparse {
+    /// A sparse index (§3.6.2.3) at or beyond the accessor's element count.
+    #[error(
+        "accessor {accessor}: sparse index {index} (entry {position}) beyond its {count} elements"
+    )]
+    SparseIndexOutOfRange {
         /// Accessor index.
         accessor: usize,
+        /// The entry among the sparse indices.
+        position: usize,
+        /// The index.
+        index: u32,
+        /// The accessor's element count.
+        count: usize,
     },
-    /// An accessor without a buffer view.
-    #[error("accessor {accessor} has no buffer view")]
-    NoBufferView {
+    /// Sparse indices that do not strictly increase (§3.6.2.3: "MUST strictly increase").
+    #[error(
+        "accessor {accessor}: sparse index {index} (entry {position}) after {previous}: the indices must strictly increase"
+    )]
+    SparseIndicesNotIncreasing {
         /// Accessor index.
         accessor: usize,
+        /// The entry among the sparse indices.
+        position: usize,
+        /// The index before it.
+        previous: u32,
+        /// The index.
+        index: u32,
+    },
+    /// A sparse accessor's indices or values running beyond their buffer view.
+    #[error(
+        "accessor {accessor}: sparse {part} need {needed} bytes of their buffer view's {view_bytes}"
+    )]
+    SparseBeyondView {
+        /// Accessor index.
+        accessor: usize,
+        /// `indices` or `values`.
+        part: String,
+        /// Bytes they need (offset included).
+        needed: u64,
+        /// The view's length, bytes.
+        view_bytes: u64,
     },
     /// A buffer view that ends beyond its buffer.
     #[error(

@@ -41,7 +41,12 @@
 //! | `specularFactor` × `specularColorFactor` (+ textures) | scale of the dielectric lobe's reflectance |
 //! | normal, occlusion, emissive (× `emissiveStrength`) | per fragment (`shaders/mesh.wgsl`) |
 //!
-//! Skins, morph targets, sparse accessors, quantised positions (`KHR_mesh_quantization`),
+//! Accessors (`accessor.rs`) may be sparse (§3.6.2.3: the listed elements replace those of
+//! the buffer view, or of zeros without one; indices out of range or not increasing are
+//! errors) and, with `KHR_mesh_quantization`, positions, normals, tangents and texture
+//! coordinates may be integers, normalised or not (the node transform dequantises them).
+//!
+//! Skins, morph targets,
 //! Draco, `transmissionTexture`, `thicknessTexture`, `KHR_materials_clearcoat`, `_sheen` and
 //! `_anisotropy` are not read. The default scene's cameras (perspective and orthographic, placed by their
 //! nodes: [`GltfScene::cameras`]) and `KHR_lights_punctual` lights ([`GltfScene::lights`])
@@ -72,6 +77,7 @@ use crate::error::{Error, Result};
 use crate::thickness_map::ThicknessMap;
 use std::path::{Path, PathBuf};
 
+mod accessor;
 pub mod assets;
 mod document;
 pub mod error;

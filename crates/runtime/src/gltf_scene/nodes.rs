@@ -3,7 +3,7 @@
 
 use super::error::GltfError;
 use super::model::{GltfCamera, GltfLight, GltfMaterial, GltfPrimitive, GltfProjection, LightKind};
-use super::primitive::{self, Totals};
+use super::primitive::Primitives;
 use crate::error::Result;
 use std::path::Path;
 
@@ -51,7 +51,8 @@ pub(super) fn place(
     let mut cameras = Vec::new();
     let mut lights = Vec::new();
     let mut skipped: std::collections::BTreeMap<String, usize> = Default::default();
-    let mut totals = Totals::default();
+    let quantized = doc.extensions_used().any(|e| e == "KHR_mesh_quantization");
+    let mut reader = Primitives::new(path, buffers, materials, quantized);
     while let Some((node, parent, depth)) = stack.pop() {
         if depth > MAX_DEPTH {
             return Err(GltfError::TooDeep {
@@ -81,15 +82,7 @@ pub(super) fn place(
                     .or_insert(0usize) += 1;
                 continue;
             }
-            primitives.push(primitive::read(
-                path,
-                &mesh,
-                &prim,
-                &world,
-                buffers,
-                materials,
-                &mut totals,
-            )?);
+            primitives.push(reader.read(&mesh, &prim, &world)?);
         }
     }
     cameras.sort_by_key(|(node, _)| *node);

@@ -1,232 +1,303 @@
 //! One triangle primitive (glTF §3.7.2): its accessors checked, its attributes read and
 //! placed in world space, flat normals and MikkTSpace tangents where the file has none.
 
+use super::accessor;
 use super::error::GltfError;
 use super::limits::{MAX_INDICES, MAX_VERTICES};
 use super::model::{GltfMaterial, GltfPrimitive};
 use crate::error::Result;
+use gltf::accessor::{DataType, Dimensions};
 use std::path::Path;
 
-/// Vertices and triangle corners read so far over the scene's primitives.
-#[derive(Default)]
-pub(super) struct Totals {
+/// What the primitives of one document are read from, and the vertices and triangle
+/// corners read so far over the scene's primitives.
+pub(super) struct Primitives<'a> {
+    /// The file, named in errors.
+    pub(super) path: &'a Path,
+    /// The document's buffers.
+    pub(super) buffers: &'a [Vec<u8>],
+    /// The document's materials, the default one last.
+    pub(super) materials: &'a [GltfMaterial],
+    /// The file uses `KHR_mesh_quantization`: attributes may be integers (normalised or not).
+    pub(super) quantized: bool,
     vertices: usize,
     corners: usize,
 }
 
-/// Primitive `prim` (mode TRIANGLES) of `mesh` under the node transform `world`, read from
-/// `buffers`; `materials` are the document's, the default one last. A mirroring transform
-/// (negative determinant) reverses the winding (§3.5.3).
-pub(super) fn read(
-    path: &Path,
-    mesh: &gltf::Mesh,
-    prim: &gltf::Primitive,
-    world: &[[f32; 4]; 4],
-    buffers: &[Vec<u8>],
-    materials: &[GltfMaterial],
-    totals: &mut Totals,
-) -> Result<GltfPrimitive> {
-    let (m, p) = (mesh.index(), prim.index());
-    let Some(pos_acc) = prim.get(&gltf::Semantic::Positions) else {
-        return Err(GltfError::NoPosition {
-            mesh: m,
-            primitive: p,
+/// The component types an attribute may have: `(type, normalized)`.
+type Allowed = &'static [(DataType, bool)];
+const FLOAT: Allowed = &[(DataType::F32, false)];
+/// `KHR_mesh_quantization`'s POSITION types (besides float).
+const QUANTIZED_POSITION: Allowed = &[
+    (DataType::F32, false),
+    (DataType::I8, false),
+    (DataType::I8, true),
+    (DataType::U8, false),
+    (DataType::U8, true),
+    (DataType::I16, false),
+    (DataType::I16, true),
+    (DataType::U16, false),
+    (DataType::U16, true),
+];
+/// `KHR_mesh_quantization`'s NORMAL and TANGENT types.
+const QUANTIZED_DIRECTION: Allowed = &[
+    (DataType::F32, false),
+    (DataType::I8, true),
+    (DataType::I16, true),
+];
+/// Core glTF's TEXCOORD and COLOR types.
+const CORE_TEXCOORD: Allowed = &[
+    (DataType::F32, false),
+    (DataType::U8, true),
+    (DataType::U16, true),
+];
+/// `KHR_mesh_quantization`'s TEXCOORD types.
+const QUANTIZED_TEXCOORD: Allowed = &[
+    (DataType::F32, false),
+    (DataType::I8, false),
+    (DataType::I8, true),
+    (DataType::U8, false),
+    (DataType::U8, true),
+    (DataType::I16, false),
+    (DataType::I16, true),
+    (DataType::U16, false),
+    (DataType::U16, true),
+];
+/// Triangle indices.
+const INDEX: Allowed = &[
+    (DataType::U8, false),
+    (DataType::U16, false),
+    (DataType::U32, false),
+];
+
+impl<'a> Primitives<'a> {
+    /// A reader of `path`'s primitives from `buffers`.
+    pub(super) fn new(
+        path: &'a Path,
+        buffers: &'a [Vec<u8>],
+        materials: &'a [GltfMaterial],
+        quantized: bool,
+    ) -> Self {
+        Primitives {
+            path,
+            buffers,
+            materials,
+            quantized,
+            vertices: 0,
+            corners: 0,
         }
-        .at(path));
-    };
-    let counts_differ = |semantic: &str, count: usize, positions: usize| {
-        GltfError::CountMismatch {
-            mesh: m,
-            primitive: p,
-            semantic: semantic.to_string(),
-            count,
-            positions,
-        }
-        .at(path)
-    };
-    check_accessor(path, &pos_acc, buffers)?;
-    let float3 = |a: &gltf::Accessor, what: &str| {
-        if a.data_type() == gltf::accessor::DataType::F32
-            && a.dimensions() == gltf::accessor::Dimensions::Vec3
+    }
+
+    /// Checks `a`'s component type and dimensions for `semantic` and its byte ranges.
+    fn check(
+        &self,
+        a: &gltf::Accessor,
+        semantic: &str,
+        allowed: Allowed,
+        dimensions: &[Dimensions],
+    ) -> Result<()> {
+        let normalized = a.normalized() && a.data_type() != DataType::F32;
+        if !allowed.contains(&(a.data_type(), normalized)) || !dimensions.contains(&a.dimensions())
         {
-            Ok(())
-        } else {
-            Err(GltfError::AccessorType {
-                semantic: what.to_string(),
+            let types: Vec<String> = allowed
+                .iter()
+                .map(|(t, n)| format!("{t:?}{}", if *n { " normalized" } else { "" }))
+                .collect();
+            let dims: Vec<String> = dimensions.iter().map(|d| format!("{d:?}")).collect();
+            return Err(GltfError::AccessorType {
+                semantic: semantic.to_string(),
                 accessor: a.index(),
-                found: format!("{:?} {:?}", a.data_type(), a.dimensions()),
-                expected: "float VEC3".to_string(),
+                found: format!(
+                    "{:?}{} {:?}",
+                    a.data_type(),
+                    if normalized { " normalized" } else { "" },
+                    a.dimensions()
+                ),
+                expected: format!("{} {}", types.join(" / "), dims.join(" / ")),
             }
-            .at(path))
+            .at(self.path));
         }
-    };
-    float3(&pos_acc, "POSITION")?;
-    let normal_acc = prim.get(&gltf::Semantic::Normals);
-    if let Some(a) = &normal_acc {
-        check_accessor(path, a, buffers)?;
-        float3(a, "NORMAL")?;
-        if a.count() != pos_acc.count() {
-            return Err(counts_differ("NORMAL", a.count(), pos_acc.count()));
-        }
+        accessor::check(self.path, a, self.buffers)
     }
-    if let Some(a) = prim.indices() {
-        check_accessor(path, &a, buffers)?;
-    }
-    let n_vertices = pos_acc.count();
-    let n_corners = prim.indices().map_or(n_vertices, |a| a.count());
-    totals.vertices = totals.vertices.saturating_add(n_vertices);
-    totals.corners = totals.corners.saturating_add(n_corners);
-    if totals.vertices > MAX_VERTICES || totals.corners > MAX_INDICES {
-        return Err(GltfError::TooManyVertices {
-            mesh: m,
-            primitive: p,
-            vertices: totals.vertices,
-            corners: totals.corners,
-            max_vertices: MAX_VERTICES,
-            max_corners: MAX_INDICES,
-        }
-        .at(path));
-    }
-    if !n_corners.is_multiple_of(3) {
-        return Err(GltfError::NotTriangles {
-            mesh: m,
-            primitive: p,
-            corners: n_corners,
-        }
-        .at(path));
-    }
-    let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
-    let positions: Vec<[f32; 3]> = reader
-        .read_positions()
-        .ok_or_else(|| {
-            GltfError::Unreadable {
+
+    /// Primitive `prim` (mode TRIANGLES) of `mesh` under the node transform `world`. A
+    /// mirroring transform (negative determinant) reverses the winding (§3.5.3); quantised
+    /// attributes are dequantised by the node transform (`KHR_mesh_quantization`), which
+    /// applies to every attribute as to float ones.
+    pub(super) fn read(
+        &mut self,
+        mesh: &gltf::Mesh,
+        prim: &gltf::Primitive,
+        world: &[[f32; 4]; 4],
+    ) -> Result<GltfPrimitive> {
+        let (path, buffers, materials) = (self.path, self.buffers, self.materials);
+        let q = self.quantized;
+        let (m, p) = (mesh.index(), prim.index());
+        let Some(pos_acc) = prim.get(&gltf::Semantic::Positions) else {
+            return Err(GltfError::NoPosition {
                 mesh: m,
                 primitive: p,
-                semantic: "POSITION".to_string(),
             }
-            .at(path)
-        })?
-        .map(|p| transform_point(world, p))
-        .collect();
-    if let Some(vertex) = positions
-        .iter()
-        .position(|v| !v.iter().all(|x| x.is_finite()))
-    {
-        return Err(GltfError::NonFinitePosition {
-            mesh: m,
-            primitive: p,
-            vertex,
-            value: positions[vertex],
-        }
-        .at(path));
-    }
-    let mut indices: Vec<u32> = match reader.read_indices() {
-        Some(ix) => ix.into_u32().collect(),
-        None => (0..n_vertices as u32).collect(),
-    };
-    if let Some(&bad) = indices.iter().find(|&&i| i as usize >= positions.len()) {
-        return Err(GltfError::IndexOutOfRange {
-            mesh: m,
-            primitive: p,
-            index: bad,
-            vertices: positions.len(),
-        }
-        .at(path));
-    }
-    if determinant3(world) < 0.0 {
-        // A mirroring transform turns counter-clockwise triangles clockwise.
-        for tri in indices.chunks_exact_mut(3) {
-            tri.swap(1, 2);
-        }
-    }
-    let material = prim.material().index().unwrap_or(materials.len() - 1);
-    let mut sets: [Vec<[f32; 2]>; 2] = [Vec::new(), Vec::new()];
-    for (set, out) in sets.iter_mut().enumerate() {
-        if let Some(a) = prim.get(&gltf::Semantic::TexCoords(set as u32)) {
-            check_accessor(path, &a, buffers)?;
-            if a.count() != positions.len() {
-                return Err(counts_differ(
-                    &format!("TEXCOORD_{set}"),
-                    a.count(),
-                    positions.len(),
-                ));
+            .at(path));
+        };
+        let n_vertices = pos_acc.count();
+        let counts_differ = |semantic: &str, a: &gltf::Accessor| {
+            if a.count() == n_vertices {
+                Ok(())
+            } else {
+                Err(GltfError::CountMismatch {
+                    mesh: m,
+                    primitive: p,
+                    semantic: semantic.to_string(),
+                    count: a.count(),
+                    positions: n_vertices,
+                }
+                .at(path))
             }
-            *out = reader
-                .read_tex_coords(set as u32)
-                .map(|t| t.into_f32().collect())
-                .unwrap_or_default();
+        };
+        let vec3 = &[Dimensions::Vec3][..];
+        self.check(
+            &pos_acc,
+            "POSITION",
+            if q { QUANTIZED_POSITION } else { FLOAT },
+            vec3,
+        )?;
+        let direction = if q { QUANTIZED_DIRECTION } else { FLOAT };
+        let normal_acc = prim.get(&gltf::Semantic::Normals);
+        if let Some(a) = &normal_acc {
+            self.check(a, "NORMAL", direction, vec3)?;
+            counts_differ("NORMAL", a)?;
         }
-    }
-    let [uv0, uv1] = sets;
-    let uvs = if uv0.len() == positions.len() {
-        uv0
-    } else {
-        vec![[0.0; 2]; positions.len()]
-    };
-    let uvs1 = if uv1.len() == positions.len() {
-        uv1
-    } else {
-        uvs.clone()
-    };
-    let colours: Vec<[f32; 4]> = match prim.get(&gltf::Semantic::Colors(0)) {
-        Some(a) => {
-            check_accessor(path, &a, buffers)?;
-            if a.count() != positions.len() {
-                return Err(counts_differ("COLOR_0", a.count(), positions.len()));
+        let tangent_acc = prim.get(&gltf::Semantic::Tangents);
+        if let Some(a) = &tangent_acc {
+            self.check(a, "TANGENT", direction, &[Dimensions::Vec4])?;
+            counts_differ("TANGENT", a)?;
+        }
+        let uv_accs = [0, 1].map(|set| prim.get(&gltf::Semantic::TexCoords(set)));
+        for (set, a) in uv_accs.iter().enumerate() {
+            if let Some(a) = a {
+                let name = format!("TEXCOORD_{set}");
+                let allowed = if q { QUANTIZED_TEXCOORD } else { CORE_TEXCOORD };
+                self.check(a, &name, allowed, &[Dimensions::Vec2])?;
+                counts_differ(&name, a)?;
             }
-            reader
-                .read_colors(0)
-                .map(|c| c.into_rgba_f32().collect())
-                .unwrap_or_default()
         }
-        None => Vec::new(),
-    };
-    let colours = if colours.len() == positions.len() {
-        colours
-    } else {
-        vec![[1.0; 4]; positions.len()]
-    };
-    let tangents: Vec<[f32; 4]> = match prim.get(&gltf::Semantic::Tangents) {
-        Some(a) => {
-            check_accessor(path, &a, buffers)?;
-            if a.count() != positions.len() {
-                return Err(counts_differ("TANGENT", a.count(), positions.len()));
+        let colour_acc = prim.get(&gltf::Semantic::Colors(0));
+        if let Some(a) = &colour_acc {
+            self.check(
+                a,
+                "COLOR_0",
+                CORE_TEXCOORD,
+                &[Dimensions::Vec3, Dimensions::Vec4],
+            )?;
+            counts_differ("COLOR_0", a)?;
+        }
+        if let Some(a) = prim.indices() {
+            self.check(&a, "indices", INDEX, &[Dimensions::Scalar])?;
+        }
+        let n_corners = prim.indices().map_or(n_vertices, |a| a.count());
+        self.vertices = self.vertices.saturating_add(n_vertices);
+        self.corners = self.corners.saturating_add(n_corners);
+        if self.vertices > MAX_VERTICES || self.corners > MAX_INDICES {
+            return Err(GltfError::TooManyVertices {
+                mesh: m,
+                primitive: p,
+                vertices: self.vertices,
+                corners: self.corners,
+                max_vertices: MAX_VERTICES,
+                max_corners: MAX_INDICES,
             }
-            reader
-                .read_tangents()
-                .map(|t| t.map(|t| transform_tangent(world, t)).collect())
-                .unwrap_or_default()
+            .at(path));
         }
-        None => Vec::new(),
-    };
-    let normals: Vec<[f32; 3]> = match prim.get(&gltf::Semantic::Normals) {
-        Some(_) => reader
-            .read_normals()
-            .map(|n| n.map(|n| transform_normal(world, n)).collect())
-            .unwrap_or_default(),
-        None => Vec::new(),
-    };
-    let mut out = GltfPrimitive {
-        tangents: if tangents.len() == positions.len() {
-            tangents
-        } else {
-            Vec::new()
-        },
-        positions,
-        normals,
-        uvs,
-        uvs1,
-        colours,
-        indices,
-        material,
-    };
-    if out.normals.len() != out.positions.len() {
-        out = flat_shaded(&out);
+        if !n_corners.is_multiple_of(3) {
+            return Err(GltfError::NotTriangles {
+                mesh: m,
+                primitive: p,
+                corners: n_corners,
+            }
+            .at(path));
+        }
+        let positions: Vec<[f32; 3]> = accessor::read_f32::<3>(path, &pos_acc, buffers)?
+            .into_iter()
+            .map(|p| transform_point(world, p))
+            .collect();
+        if let Some(vertex) = positions
+            .iter()
+            .position(|v| !v.iter().all(|x| x.is_finite()))
+        {
+            return Err(GltfError::NonFinitePosition {
+                mesh: m,
+                primitive: p,
+                vertex,
+                value: positions[vertex],
+            }
+            .at(path));
+        }
+        let mut indices: Vec<u32> = match prim.indices() {
+            Some(a) => accessor::read_u32(path, &a, buffers)?,
+            None => (0..n_vertices as u32).collect(),
+        };
+        if let Some(&bad) = indices.iter().find(|&&i| i as usize >= positions.len()) {
+            return Err(GltfError::IndexOutOfRange {
+                mesh: m,
+                primitive: p,
+                index: bad,
+                vertices: positions.len(),
+            }
+            .at(path));
+        }
+        if determinant3(world) < 0.0 {
+            // A mirroring transform turns counter-clockwise triangles clockwise.
+            for tri in indices.chunks_exact_mut(3) {
+                tri.swap(1, 2);
+            }
+        }
+        let material = prim.material().index().unwrap_or(materials.len() - 1);
+        let [uv0, uv1] = uv_accs.map(|a| a.map(|a| accessor::read_f32::<2>(path, &a, buffers)));
+        let uvs = match uv0.transpose()? {
+            Some(uv) => uv,
+            None => vec![[0.0; 2]; positions.len()],
+        };
+        let uvs1 = match uv1.transpose()? {
+            Some(uv) => uv,
+            None => uvs.clone(),
+        };
+        let colours = match &colour_acc {
+            Some(a) => accessor::read_f32::<4>(path, a, buffers)?,
+            None => vec![[1.0; 4]; positions.len()],
+        };
+        let tangents = match &tangent_acc {
+            Some(a) => accessor::read_f32::<4>(path, a, buffers)?
+                .into_iter()
+                .map(|t| transform_tangent(world, t))
+                .collect(),
+            None => Vec::new(),
+        };
+        let normals = match &normal_acc {
+            Some(a) => accessor::read_f32::<3>(path, a, buffers)?
+                .into_iter()
+                .map(|n| transform_normal(world, n))
+                .collect(),
+            None => Vec::new(),
+        };
+        let mut out = GltfPrimitive {
+            tangents,
+            positions,
+            normals,
+            uvs,
+            uvs1,
+            colours,
+            indices,
+            material,
+        };
+        if out.normals.len() != out.positions.len() {
+            out = flat_shaded(&out);
+        }
+        if materials[material].textures.normal.is_some() && out.tangents.is_empty() {
+            generate_tangents(&mut out);
+        }
+        Ok(out)
     }
-    if materials[material].textures.normal.is_some() && out.tangents.is_empty() {
-        generate_tangents(&mut out);
-    }
-    Ok(out)
 }
 
 /// A point under the column-major transform `m`.
@@ -270,52 +341,6 @@ fn transform_tangent(m: &[[f32; 4]; 4], t: [f32; 4]) -> [f32; 4] {
     } else {
         [1.0, 0.0, 0.0, 1.0]
     }
-}
-
-/// Checks that an accessor lies inside its buffer view and the view inside its buffer (the
-/// `gltf` crate's reader would panic otherwise).
-fn check_accessor(path: &Path, accessor: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<()> {
-    if accessor.sparse().is_some() {
-        return Err(GltfError::Sparse {
-            accessor: accessor.index(),
-        }
-        .at(path));
-    }
-    let Some(view) = accessor.view() else {
-        return Err(GltfError::NoBufferView {
-            accessor: accessor.index(),
-        }
-        .at(path));
-    };
-    let data_len = buffers.get(view.buffer().index()).map_or(0, Vec::len) as u64;
-    let view_end = (view.offset() as u64).saturating_add(view.length() as u64);
-    if view_end > data_len {
-        return Err(GltfError::ViewBeyondBuffer {
-            view: view.index(),
-            end: view_end,
-            buffer_bytes: data_len,
-        }
-        .at(path));
-    }
-    let elem = accessor.size() as u64;
-    let stride = view.stride().map_or(elem, |s| s as u64);
-    let count = accessor.count() as u64;
-    let end = if count == 0 {
-        0
-    } else {
-        (accessor.offset() as u64)
-            .saturating_add((count - 1).saturating_mul(stride))
-            .saturating_add(elem)
-    };
-    if end > view.length() as u64 {
-        return Err(GltfError::AccessorBeyondView {
-            accessor: accessor.index(),
-            needed: end,
-            view_bytes: view.length() as u64,
-        }
-        .at(path));
-    }
-    Ok(())
 }
 
 /// Every triangle corner its own vertex (all attributes copied).
