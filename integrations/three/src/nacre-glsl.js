@@ -971,7 +971,7 @@ NacreFilmOutput nacre_film_fourier_colour(NACRE_TEXTURE_2D_ARRAY(table), NacreFo
 //
 // The rough-film-lut axis mappings, forward (physical → t ∈ [0, 1]⁴) and inverse, and the
 // two-fetch lookup of the pre-integrated directional albedo, mirroring
-// \`nacre_format::rough_film_lut::{RoughLutAxes, RoughFilmLut::lookup}\` (crates/bake/src/kinds/rough_film_lut.rs,
+// \`nacre_format::rough_film_lut::{RoughLutAxes, RoughFilmLut::lookup}\` (crates/bake/src/kinds/rough_film_lut/mod.rs,
 // whose module docs derive them). Self-contained: needs no other module and defines no
 // bindings (the caller passes its texture, sampler and parameters).
 //
