@@ -52,12 +52,10 @@ step_rust() {
 # for it (wgpu-hal's CONTEXT_LOCK_TIMEOUT_SECS), which a long llvmpipe compile in another
 # test exceeds. MESA_EXTENSION_OVERRIDE lists GL_ARB_color_buffer_float, as the nacre binary
 # does (crates/cli/src/gpu.rs): RGBA32F targets are core in desktop GL 3.0, but wgpu believes
-# only the extension list. Not yet in the pass: crates/runtime/tests/diffraction.rs (on GL
-# the cd-tracks probe differs from the CPU, and the diffraction scenes outlast wgpu's GL
-# wait; issue 34).
+# only the extension list.
 GL_TESTS=(
     # crates/runtime/tests
-    diffraction_integrated gltf gltf_samples ktx2_load lost_device render rough
+    diffraction diffraction_integrated gltf gltf_samples ktx2_load lost_device render rough
     # tests/tests
     engine_shaders_gpu gpu_probe
     # crates/cli/tests that render (gltf_sweep: the 48 Khronos samples under ../shared, one

@@ -3,6 +3,11 @@
 use crate::error::{Error, Result};
 use std::sync::{Arc, Mutex};
 
+/// The longest [`GpuContext::wait`] waits for the queue before it reports the device as
+/// hung: 10 minutes, far above the slowest submission of the test suite on a software
+/// rasteriser (a diffraction scene on llvmpipe through GL).
+pub const WAIT_LIMIT: std::time::Duration = std::time::Duration::from_secs(600);
+
 /// A wgpu device and queue with the adapter they came from. A host engine that has its own
 /// device builds one with [`GpuContext::from_parts`].
 ///
@@ -286,17 +291,39 @@ impl GpuContext {
     /// Waits for the queue to finish; [`Error::DeviceLost`] when the device was lost, and
     /// the error wgpu raised outside any scope since the last check ([`Error::Gpu`],
     /// [`Error::OutOfMemory`]).
+    ///
+    /// An "indefinite" wait is not one on every backend: wgpu's GL backend waits on a GL
+    /// fence with `glClientWaitSync`, whose timeout is a signed 32-bit count of nanoseconds,
+    /// so each wait gives up after 2.1 s (wgpu-hal `gles::Fence::wait`) and the poll
+    /// reports [`wgpu::PollError::Timeout`] while the GPU is still working — a long
+    /// dispatch on llvmpipe (a diffraction scene) takes longer. The wait therefore polls
+    /// again after a timeout until the work is done, and reports [`Error::Gpu`] only when
+    /// the queue has not finished within [`WAIT_LIMIT`] in all (a hung device).
     pub fn wait(&self, context: &str) -> Result<()> {
         self.check_lost(context)?;
         self.check_uncaptured(context)?;
-        let polled = self
-            .device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map(|_| ())
-            .map_err(|e| Error::Gpu {
-                context: context.to_string(),
-                message: e.to_string(),
-            });
+        let start = std::time::Instant::now();
+        let polled = loop {
+            match self.device.poll(wgpu::PollType::wait_indefinitely()) {
+                Ok(_) => break Ok(()),
+                Err(wgpu::PollError::Timeout) if start.elapsed() < WAIT_LIMIT => {}
+                Err(wgpu::PollError::Timeout) => {
+                    break Err(Error::Gpu {
+                        context: context.to_string(),
+                        message: format!(
+                            "the queue did not finish within {} s (a hung device?)",
+                            WAIT_LIMIT.as_secs()
+                        ),
+                    });
+                }
+                Err(e) => {
+                    break Err(Error::Gpu {
+                        context: context.to_string(),
+                        message: e.to_string(),
+                    });
+                }
+            }
+        };
         self.check_lost(context)?;
         self.check_uncaptured(context)?;
         polled

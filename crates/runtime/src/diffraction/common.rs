@@ -101,16 +101,39 @@ pub(super) fn check_array_limits(ctx: &GpuContext, what: &str, size: [usize; 3])
     for (axis, n, limit) in [
         ("width", size[0], limits.max_texture_dimension_2d),
         ("height", size[1], limits.max_texture_dimension_2d),
-        ("layers", size[2], limits.max_texture_array_layers),
+        (
+            "layers",
+            allocated_layers(size),
+            limits.max_texture_array_layers,
+        ),
     ] {
         check_limit(ctx, &format!("{what} {axis}"), n as u64, limit)?;
     }
     Ok(())
 }
 
+/// The layers allocated for a 2-D array texture of `[width, height, layers]`: `layers`, or
+/// one more (left zero, never read) where wgpu's GL backend would not make the texture a
+/// 2-D array. wgpu-hal's GLES backend fixes a texture's GL target when it creates it, from
+/// its size alone (`gles::Texture::get_info_from_desc`): one layer gives `GL_TEXTURE_2D`,
+/// and a square one whose layer count is a multiple of 6 gives `GL_TEXTURE_CUBE_MAP(_ARRAY)`
+/// ("cube compatible"). A `D2Array` view of either reads nothing in a `sampler2DArray`
+/// (texelFetch returns 0): the 256 × 256 × 6 layers of `cd-tracks` made its every colour 0
+/// on GL. The extra layer keeps the target `GL_TEXTURE_2D_ARRAY` on every backend; the
+/// shaders read only the layers their uniform names.
+pub(super) fn allocated_layers([width, height, layers]: [usize; 3]) -> usize {
+    let cube_compatible = width == height && layers % 6 == 0;
+    if layers == 1 || cube_compatible {
+        layers + 1
+    } else {
+        layers
+    }
+}
+
 /// Uploads `texels` (RGBA, layer-major, rows of `width`) into a new `Rgba32Float` 2-D array
 /// texture of `[width, height, layers]` named `name`: the storage of both diffraction
-/// layouts, unfilterable and read with `textureLoad`.
+/// layouts, unfilterable and read with `textureLoad`. The texture has
+/// [`allocated_layers`] layers, the last one zero where that is one more.
 pub(super) fn upload_rgba32f_array(
     ctx: &GpuContext,
     name: &str,
@@ -125,7 +148,10 @@ pub(super) fn upload_rgba32f_array(
         };
         let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
             label: Some(name),
-            size,
+            size: wgpu::Extent3d {
+                depth_or_array_layers: allocated_layers([width, height, layers]) as u32,
+                ..size
+            },
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
@@ -186,4 +212,23 @@ pub(super) fn dispatch_probe(
             cases,
         },
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::allocated_layers;
+
+    #[test]
+    fn arrays_gl_would_take_for_a_2d_texture_or_a_cube_get_one_more_layer() {
+        // cd-tracks: 256 × 256, order 11 → 6 layers (a cube map to wgpu's GL backend).
+        assert_eq!(allocated_layers([256, 256, 6]), 7);
+        assert_eq!(allocated_layers([64, 64, 12]), 13);
+        // One layer (a GL_TEXTURE_2D) of any shape.
+        assert_eq!(allocated_layers([800, 1, 1]), 2);
+        assert_eq!(allocated_layers([16, 16, 1]), 2);
+        // Already 2-D arrays: unchanged.
+        assert_eq!(allocated_layers([800, 1, 6]), 6);
+        assert_eq!(allocated_layers([256, 256, 5]), 5);
+        assert_eq!(allocated_layers([256, 128, 6]), 6);
+    }
 }
