@@ -306,7 +306,10 @@ impl GpuContext {
         let polled = loop {
             match self.device.poll(wgpu::PollType::wait_indefinitely()) {
                 Ok(_) => break Ok(()),
-                Err(wgpu::PollError::Timeout) if start.elapsed() < WAIT_LIMIT => {}
+                // A device lost meanwhile ends the wait at once.
+                Err(wgpu::PollError::Timeout) if start.elapsed() < WAIT_LIMIT => {
+                    self.check_lost(context)?
+                }
                 Err(wgpu::PollError::Timeout) => {
                     break Err(Error::Gpu {
                         context: context.to_string(),
