@@ -54,7 +54,7 @@ step_rust() {
 # does (crates/cli/src/gpu.rs): RGBA32F targets are core in desktop GL 3.0, but wgpu believes
 # only the extension list.
 GL_TESTS=(
-    # crates/runtime/tests
+    # crates/runtime/tests (diffraction: 18 s on GL here)
     diffraction diffraction_integrated gltf gltf_samples ktx2_load lost_device render rough
     # tests/tests
     engine_shaders_gpu gpu_probe
