@@ -121,6 +121,8 @@ const MESH_FLAG_NORMAL_MAP: u32 = 1u;
 const MESH_FLAG_LINEAR_OUTPUT: u32 = 2u;
 // mesh_behind_tex holds the opaque scene's linear radiance (alpha 0 where nothing was drawn).
 const MESH_FLAG_BEHIND: u32 = 4u;
+// KHR_materials_unlit: the colour is base colour × texture × COLOR_0, unlit, without film.
+const MESH_FLAG_UNLIT: u32 = 8u;
 
 @group(3) @binding(0) var<uniform> mesh_params: MeshParams;
 @group(3) @binding(1) var mesh_base_tex: texture_2d<f32>;
@@ -342,6 +344,10 @@ fn mesh_fs(in: MeshVertexOut, @builtin(front_facing) front: bool) -> @location(0
         // glTF's specular BTDF is tinted by the base colour.
         radiance += shade.transmittance * base.rgb * mesh_behind(in.world, n, v, ior, roughness);
     }
+    let unlit = (q.flags & MESH_FLAG_UNLIT) != 0u;
+    if unlit {
+        radiance = base.rgb;
+    }
     // MASK: below the cutoff the fragment is discarded (after the shading: lavapipe's
     // LLVM back end of Mesa 22 crashed compiling the shading loop after an early discard).
     if q.alpha_mode == MESH_ALPHA_MASK && !(base.a >= q.alpha_cutoff) {
@@ -351,6 +357,7 @@ fn mesh_fs(in: MeshVertexOut, @builtin(front_facing) front: bool) -> @location(0
     if (q.flags & MESH_FLAG_LINEAR_OUTPUT) != 0u {
         return vec4<f32>(sanitize_radiance(radiance), alpha);
     }
-    let colour = material_display(radiance);
-    return vec4<f32>(colour.rgb, alpha);
+    // Unlit: the base colour itself on screen (sRGB-encoded, no exposure or tone mapping).
+    let colour = select(material_display(radiance).rgb, srgb_encode(base.rgb), unlit);
+    return vec4<f32>(colour, alpha);
 }

@@ -889,3 +889,66 @@ fn quantized_attributes_are_dequantised_under_the_node_transform() {
         other => panic!("expected an AccessorType error, got {other:?}"),
     }
 }
+
+#[test]
+fn unlit_materials_show_their_base_colour() {
+    // The sparse quad and triangle (`sparse_glb`) with one KHR_materials_unlit material.
+    let good = sparse_glb(2, [1, 2], 1);
+    let json_len = u32::from_le_bytes(good[12..16].try_into().unwrap()) as usize;
+    let mut doc: serde_json::Value = serde_json::from_slice(&good[20..20 + json_len]).unwrap();
+    let base = [0.2f32, 0.5, 0.8];
+    doc["materials"] = serde_json::json!([{
+        "pbrMetallicRoughness": {"baseColorFactor": [base[0], base[1], base[2], 1.0],
+                                 "metallicFactor": 0.0},
+        "extensions": {"KHR_materials_unlit": {}}
+    }]);
+    doc["extensionsUsed"] = serde_json::json!(["KHR_materials_unlit"]);
+    doc["extensionsRequired"] = serde_json::json!(["KHR_materials_unlit"]);
+    doc["meshes"][0]["primitives"][0]["material"] = 0.into();
+    doc["meshes"][0]["primitives"][1]["material"] = 0.into();
+    let bytes = nacre_runtime::gltf_scene::assets::glb(&doc, &good[20 + json_len + 8..]);
+    let scene = GltfScene::from_bytes(&bytes, Path::new("unlit.glb")).unwrap();
+    assert!(scene.materials[0].unlit);
+    let out = render_gltf(ctx(), &tables(), Technique::Lut, &scene, &options()).unwrap();
+    let image = &out.image;
+    let background = pixel(image, (0, 0));
+    // sRGB encoding (IEC 61966-2-1) of the linear base colour, 0–255.
+    let expected = base.map(|c| {
+        let c = f64::from(c);
+        255.0
+            * if c <= 0.003_130_8 {
+                12.92 * c
+            } else {
+                1.055 * c.powf(1.0 / 2.4) - 0.055
+            }
+    });
+    let mut covered = 0;
+    for y in 0..image.height {
+        for x in 0..image.width {
+            let p = pixel(image, (x, y));
+            if distance(p, background) > 0.0 {
+                covered += 1;
+                // Edge pixels mix with the background; inside, the colour is the base's.
+                if distance(p, expected) > 1.5 {
+                    let neighbours_covered =
+                        [(-1i64, 0i64), (1, 0), (0, -1), (0, 1)]
+                            .iter()
+                            .all(|&(dx, dy)| {
+                                let (nx, ny) = (x as i64 + dx, y as i64 + dy);
+                                nx >= 0
+                                    && ny >= 0
+                                    && (nx as u32) < image.width
+                                    && (ny as u32) < image.height
+                                    && distance(pixel(image, (nx as u32, ny as u32)), background)
+                                        > 0.0
+                            });
+                    assert!(
+                        !neighbours_covered,
+                        "({x}, {y}): {p:?}, expected {expected:?}"
+                    );
+                }
+            }
+        }
+    }
+    assert!(covered > 100, "{covered} pixels covered");
+}

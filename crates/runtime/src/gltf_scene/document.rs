@@ -9,13 +9,14 @@ use std::path::Path;
 /// The glTF extensions nacre implements: a file whose `extensionsRequired` lists only these
 /// loads (`KHR_materials_transmission` and `_volume` refract the opaque scene in screen
 /// space, as the glTF Sample Viewer does: `shaders/mesh.wgsl`).
-pub const SUPPORTED_EXTENSIONS: [&str; 9] = [
+pub const SUPPORTED_EXTENSIONS: [&str; 10] = [
     "KHR_lights_punctual",
     "KHR_mesh_quantization",
     "KHR_materials_iridescence",
     "KHR_materials_ior",
     "KHR_materials_specular",
     "KHR_materials_emissive_strength",
+    "KHR_materials_unlit",
     "KHR_materials_transmission",
     "KHR_materials_volume",
     "KHR_texture_transform",

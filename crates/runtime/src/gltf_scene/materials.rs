@@ -152,6 +152,7 @@ fn material(loader: &mut TextureLoader, m: &gltf::Material) -> GltfMaterial {
         },
         double_sided: m.double_sided(),
         emissive: m.emissive_factor().map(|e| e * strength),
+        unlit: m.unlit(),
         specular: specular.as_ref().map_or(1.0, |s| s.specular_factor()),
         specular_colour: specular
             .as_ref()

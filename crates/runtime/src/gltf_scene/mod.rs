@@ -2,7 +2,7 @@
 //! tangents, two texture-coordinate sets, vertex colours, indexed or not, node transforms
 //! applied) and their materials — the core metallic-roughness model with all its textures,
 //! `KHR_materials_iridescence`, `KHR_materials_ior`, `KHR_materials_specular`,
-//! `KHR_materials_emissive_strength`, `KHR_texture_transform`, `KHR_materials_transmission`
+//! `KHR_materials_emissive_strength`, `KHR_materials_unlit`, `KHR_texture_transform`, `KHR_materials_transmission`
 //! and `KHR_materials_volume` (thickness factor and attenuation) — mapped onto nacre's [`MaterialOptions`] (the uniform
 //! parameters) and [`GltfMaterial`]'s textures (read per fragment by `shaders/mesh.wgsl`).
 //!

@@ -115,6 +115,9 @@ pub struct GltfMaterial {
     pub double_sided: bool,
     /// `emissiveFactor` × `KHR_materials_emissive_strength` `emissiveStrength`.
     pub emissive: [f32; 3],
+    /// `KHR_materials_unlit`: the fragment's colour is base colour × texture × `COLOR_0`,
+    /// without light, film or emission.
+    pub unlit: bool,
     /// `KHR_materials_specular` `specularFactor` (default 1).
     pub specular: f32,
     /// `KHR_materials_specular` `specularColorFactor` (default 1).
@@ -142,6 +145,7 @@ impl Default for GltfMaterial {
             alpha_mode: AlphaMode::Opaque,
             double_sided: false,
             emissive: [0.0; 3],
+            unlit: false,
             specular: 1.0,
             specular_colour: [1.0; 3],
             normal_scale: 1.0,

@@ -82,7 +82,8 @@ pub struct MeshUniform {
     pub iridescence: f32,
     /// 0 OPAQUE, 1 MASK, 2 BLEND.
     pub alpha_mode: u32,
-    /// Bit 0: a normal texture is bound; [`FLAG_LINEAR_OUTPUT`], [`FLAG_BEHIND`].
+    /// Bit 0: a normal texture is bound; [`FLAG_LINEAR_OUTPUT`], [`FLAG_BEHIND`],
+    /// [`FLAG_UNLIT`].
     pub flags: u32,
     /// `transmissionFactor`.
     pub transmission: f32,
@@ -106,6 +107,10 @@ pub const FLAG_LINEAR_OUTPUT: u32 = 2;
 /// [`MeshUniform::flags`]: binding 17 holds the opaque scene's linear radiance
 /// (`shaders/mesh.wgsl` MESH_FLAG_BEHIND).
 pub const FLAG_BEHIND: u32 = 4;
+
+/// [`MeshUniform::flags`]: the material is `KHR_materials_unlit` (`shaders/mesh.wgsl`
+/// MESH_FLAG_UNLIT).
+pub const FLAG_UNLIT: u32 = 8;
 
 /// Format of the picture of the opaque scene that transmissive surfaces refract.
 pub const BEHIND_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
@@ -160,7 +165,7 @@ impl MeshUniform {
             dielectric_ior: m.dielectric_ior(),
             iridescence: m.iridescence.map_or(0.0, |i| i.factor),
             alpha_mode,
-            flags: u32::from(t.normal.is_some()),
+            flags: u32::from(t.normal.is_some()) | if m.unlit { FLAG_UNLIT } else { 0 },
             transmission: m.transmission,
             lobes: match m.metallic_range() {
                 (_, hi) if hi <= 0.0 => 0,
