@@ -29,6 +29,20 @@
 //   specular    = specularFactor × specularTexture.a, × specularColorFactor ×
 //                 specularColorTexture (sRGB) (KHR_materials_specular): the dielectric lobe's
 //                 reflectance scale (material.wgsl, SurfaceMaterial)
+//   clear coat  = KHR_materials_clearcoat: c = clearcoatFactor × clearcoatTexture.r,
+//                 r_c = clearcoatRoughnessFactor × clearcoatRoughnessTexture.g (α_c = r_c²),
+//                 n_c = the geometric normal, or clearcoatNormalTexture's (scaled) in the same
+//                 tangent frame; the whole material below it (film, lobes, emission,
+//                 transmission) is seen through it (the extension's "Layering"):
+//                   L = L_base (1 − c F_c) + c L_coat,  F_c = 0.04 + 0.96 (1 − n_c·v)⁵
+//                 (Schlick, coat index 1.5), L_coat the coat's GGX lobe of F0 = 0.04:
+//                 per light D V F_schlick(v·h) E n_c·l, and from the environment the
+//                 prefiltered radiance towards reflect(−v, n_c) at α_c times
+//                 0.04 E₁ + 0.96 E₅ (split-sum paths: E₁ the F = 1 albedo, E₅ its (1 − v·h)⁵-
+//                 weighted part, env_ggx_albedo .r and .g) or F_c (1 − 0.55 √α_c) (classic
+//                 path: the box mip chain at α_c's level); occlusion applies to the
+//                 environment's share. The coat's textures take slots the material leaves
+//                 empty (coat_slots: crates/runtime/src/mesh/textures.rs coat_slots).
 //   metal lobe  = the complex index whose normal-incidence reflectance is baseColor, per
 //                 channel, with edge tint = baseColor (Gulbrandsen 2014, Eq. 1–2; the same
 //                 inversion as crates/runtime/src/gltf_scene.rs metal_index_gulbrandsen2014)
@@ -50,7 +64,7 @@
 // Bind groups: 0 view, 1 technique, 2 material (material.wgsl), 3 the primitive's glTF
 // material (MeshParams, 8 textures and their samplers, and at binding 17 the scene behind):
 //
-// 464 bytes, uniform (mirrored by `MeshUniform` in crates/runtime/src/mesh.rs):
+// 480 bytes, uniform (mirrored by `MeshUniform` in crates/runtime/src/mesh.rs):
 //
 //   offset size field
 //        0   64 view_proj: mat4x4<f32>     world → clip (x, y ∈ [−1, 1], z ∈ [0, 1] near → far)
@@ -73,7 +87,14 @@
 //      152    4 volume_thickness: f32      thicknessFactor (KHR_materials_volume), world units
 //      156    4 attenuation_distance: f32  attenuationDistance (0: no attenuation)
 //      160   16 attenuation_colour: vec4   attenuationColor (rgb)
-//      176  288 transforms: array<TexTransform, 9>  per slot (MESH_TEX_*): rows (a, b, c, set),
+//      176    4 clearcoat: f32             clearcoatFactor (0: no coat)
+//      180    4 clearcoat_roughness: f32   clearcoatRoughnessFactor
+//      184    4 clearcoat_normal_scale: f32  clearcoatNormalTexture.scale
+//      188    4 coat_slots: u32            the slots of clearcoatTexture, …RoughnessTexture,
+//                                          …NormalTexture in bits 0–3, 4–7, 8–11 (15: none);
+//                                          bits 16–23: slots lent to the coat (their own role
+//                                          reads white)
+//      192  288 transforms: array<TexTransform, 9>  per slot (MESH_TEX_*): rows (a, b, c, set),
 //                                                     (d, e, f, 0)
 struct TexTransform {
     row0: vec4<f32>,
@@ -100,6 +121,10 @@ struct MeshParams {
     volume_thickness: f32,
     attenuation_distance: f32,
     attenuation_colour: vec4<f32>,
+    clearcoat: f32,
+    clearcoat_roughness: f32,
+    clearcoat_normal_scale: f32,
+    coat_slots: u32,
     transforms: array<TexTransform, 9>,
 }
 
@@ -123,6 +148,10 @@ const MESH_FLAG_LINEAR_OUTPUT: u32 = 2u;
 const MESH_FLAG_BEHIND: u32 = 4u;
 // KHR_materials_unlit: the colour is base colour × texture × COLOR_0, unlit, without film.
 const MESH_FLAG_UNLIT: u32 = 8u;
+// MeshParams.coat_slots: no texture.
+const MESH_COAT_SLOT_NONE: u32 = 15u;
+// The clear coat's index 1.5: F0 = ((1.5 − 1)/(1.5 + 1))² (KHR_materials_clearcoat).
+const MESH_COAT_F0: f32 = 0.04;
 
 @group(3) @binding(0) var<uniform> mesh_params: MeshParams;
 @group(3) @binding(1) var mesh_base_tex: texture_2d<f32>;
@@ -266,19 +295,87 @@ fn mesh_behind(world: vec3<f32>, n: vec3<f32>, v: vec3<f32>, ior: f32, roughness
     return behind;
 }
 
+// Slot k's sample among the eight (k ≥ 8: white).
+fn mesh_slot_sample(k: u32, s0: vec4<f32>, s1: vec4<f32>, s2: vec4<f32>, s3: vec4<f32>, s4: vec4<f32>, s5: vec4<f32>, s6: vec4<f32>, s7: vec4<f32>) -> vec4<f32> {
+    var out = vec4<f32>(1.0);
+    out = select(out, s0, k == 0u);
+    out = select(out, s1, k == 1u);
+    out = select(out, s2, k == 2u);
+    out = select(out, s3, k == 3u);
+    out = select(out, s4, k == 4u);
+    out = select(out, s5, k == 5u);
+    out = select(out, s6, k == 6u);
+    out = select(out, s7, k == 7u);
+    return out;
+}
+
+// What slot k's own role reads: its sample, or white where the slot is lent to the coat.
+fn mesh_own(k: u32, sample: vec4<f32>) -> vec4<f32> {
+    return select(sample, vec4<f32>(1.0), ((mesh_params.coat_slots >> (16u + k)) & 1u) != 0u);
+}
+
+// Normal n perturbed by a tangent-space normal texture's texel (rgb), scale s on x and y, in
+// the tangent frame (t, b) of the fragment (already turned towards the viewer).
+fn mesh_perturb(n: vec3<f32>, t: vec3<f32>, b: vec3<f32>, texel: vec3<f32>, s: f32) -> vec3<f32> {
+    let m = (texel * 2.0 - 1.0) * vec3<f32>(s, s, 1.0);
+    return safe_normalize(m.x * t + m.y * b + m.z * n, n);
+}
+
+// The clear coat's own radiance L_coat (header): its GGX lobe (F0 = 0.04, F90 = 1) of
+// normal n_c and roughness α_c under every light and the environment (× occlusion).
+fn mesh_coat_radiance(world: vec3<f32>, n_c: vec3<f32>, v: vec3<f32>, alpha_c: f32, occlusion: f32) -> vec3<f32> {
+    let alpha = clamp(finite_or(alpha_c, 0.0), MATERIAL_ALPHA_MIN, 1.0);
+    let n_dot_v = clamp(dot(n_c, v), MATERIAL_COS_MIN, 1.0);
+    let r = reflect(-v, n_c);
+    var env: vec3<f32>;
+    if material_params.film_eval == MATERIAL_FILM_EVAL_CLASSIC {
+        let fresnel = MESH_COAT_F0 + (1.0 - MESH_COAT_F0) * pow(1.0 - n_dot_v, 5.0);
+        env = env_radiance(r, env_specular_lod(alpha)) * fresnel * ggx_albedo_scale(alpha);
+    } else {
+        // Split sum: L̃(r, α_c) (F0 E₁ + (1 − F0) E₅).
+        let t = clamp(vec2<f32>(n_dot_v, alpha), vec2<f32>(0.0), vec2<f32>(1.0));
+        let uv = (t * (GGX_ALBEDO_SIZE - 1.0) + 0.5) / GGX_ALBEDO_SIZE;
+        let e = clamp(textureSampleLevel(env_ggx_albedo, env_lut_sampler, uv, 0.0).rg, vec2<f32>(0.0), vec2<f32>(1.0));
+        env = env_prefiltered_radiance(r, alpha) * (MESH_COAT_F0 * e.x + (1.0 - MESH_COAT_F0) * e.y);
+    }
+    var out = env * clamp(finite_or(occlusion, 1.0), 0.0, 1.0);
+    let light_slots = 1u + min(view.light_count, VIEW_MAX_LIGHTS);
+    for (var j = 0u; j < light_slots; j++) {
+        let light = material_light_sample(j, world);
+        let n_dot_l = dot(n_c, light.towards);
+        let h = safe_normalize(v + light.towards, n_c);
+        let fresnel = MESH_COAT_F0 + (1.0 - MESH_COAT_F0) * pow(1.0 - clamp(dot(v, h), 0.0, 1.0), 5.0);
+        let f = ggx_distribution(dot(n_c, h), alpha) * ggx_visibility(n_dot_v, max(n_dot_l, 0.0), alpha) * fresnel;
+        out += select(vec3<f32>(0.0), f * light.irradiance * n_dot_l, n_dot_l > 0.0);
+    }
+    return sanitize_radiance(out);
+}
+
 @fragment
 fn mesh_fs(in: MeshVertexOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
     let q = mesh_params;
     // Every texture is sampled first, in uniform control flow (implicit derivatives).
-    let base_tex = textureSample(mesh_base_tex, mesh_base_smp, mesh_uv(MESH_TEX_BASE, in.uv0, in.uv1));
-    let mr_tex = textureSample(mesh_mr_tex, mesh_mr_smp, mesh_uv(MESH_TEX_METAL_ROUGH, in.uv0, in.uv1));
-    let normal_uv = mesh_uv(MESH_TEX_NORMAL, in.uv0, in.uv1);
-    let normal_tex = textureSample(mesh_normal_tex, mesh_normal_smp, normal_uv);
-    let occlusion_tex = textureSample(mesh_occlusion_tex, mesh_occlusion_smp, mesh_uv(MESH_TEX_OCCLUSION, in.uv0, in.uv1));
-    let emissive_tex = textureSample(mesh_emissive_tex, mesh_emissive_smp, mesh_uv(MESH_TEX_EMISSIVE, in.uv0, in.uv1));
-    let iridescence_tex = textureSample(mesh_iridescence_tex, mesh_iridescence_smp, mesh_uv(MESH_TEX_IRIDESCENCE, in.uv0, in.uv1));
-    let specular_tex = textureSample(mesh_specular_tex, mesh_specular_smp, mesh_uv(MESH_TEX_SPECULAR, in.uv0, in.uv1));
-    let specular_colour_tex = textureSample(mesh_specular_colour_tex, mesh_specular_colour_smp, mesh_uv(MESH_TEX_SPECULAR_COLOUR, in.uv0, in.uv1));
+    let slot0 = textureSample(mesh_base_tex, mesh_base_smp, mesh_uv(MESH_TEX_BASE, in.uv0, in.uv1));
+    let slot1 = textureSample(mesh_mr_tex, mesh_mr_smp, mesh_uv(MESH_TEX_METAL_ROUGH, in.uv0, in.uv1));
+    let slot2 = textureSample(mesh_normal_tex, mesh_normal_smp, mesh_uv(MESH_TEX_NORMAL, in.uv0, in.uv1));
+    let slot3 = textureSample(mesh_occlusion_tex, mesh_occlusion_smp, mesh_uv(MESH_TEX_OCCLUSION, in.uv0, in.uv1));
+    let slot4 = textureSample(mesh_emissive_tex, mesh_emissive_smp, mesh_uv(MESH_TEX_EMISSIVE, in.uv0, in.uv1));
+    let slot5 = textureSample(mesh_iridescence_tex, mesh_iridescence_smp, mesh_uv(MESH_TEX_IRIDESCENCE, in.uv0, in.uv1));
+    let slot6 = textureSample(mesh_specular_tex, mesh_specular_smp, mesh_uv(MESH_TEX_SPECULAR, in.uv0, in.uv1));
+    let slot7 = textureSample(mesh_specular_colour_tex, mesh_specular_colour_smp, mesh_uv(MESH_TEX_SPECULAR_COLOUR, in.uv0, in.uv1));
+    let base_tex = mesh_own(MESH_TEX_BASE, slot0);
+    let mr_tex = mesh_own(MESH_TEX_METAL_ROUGH, slot1);
+    let normal_tex = mesh_own(MESH_TEX_NORMAL, slot2);
+    let occlusion_tex = mesh_own(MESH_TEX_OCCLUSION, slot3);
+    let emissive_tex = mesh_own(MESH_TEX_EMISSIVE, slot4);
+    let iridescence_tex = mesh_own(MESH_TEX_IRIDESCENCE, slot5);
+    let specular_tex = mesh_own(MESH_TEX_SPECULAR, slot6);
+    let specular_colour_tex = mesh_own(MESH_TEX_SPECULAR_COLOUR, slot7);
+    // The clear coat's textures, from the slots lent to them (white without).
+    let coat_tex = mesh_slot_sample(q.coat_slots & 15u, slot0, slot1, slot2, slot3, slot4, slot5, slot6, slot7);
+    let coat_rough_tex = mesh_slot_sample((q.coat_slots >> 4u) & 15u, slot0, slot1, slot2, slot3, slot4, slot5, slot6, slot7);
+    let coat_normal_slot = (q.coat_slots >> 8u) & 15u;
+    let coat_normal_tex = mesh_slot_sample(coat_normal_slot, slot0, slot1, slot2, slot3, slot4, slot5, slot6, slot7);
     // The thickness texture's (E[g], E[g²]) for the pixel's footprint, then d and σ_d.
     let thickness_uv = mesh_uv(MESH_TEX_THICKNESS, in.uv0, in.uv1);
     let moments = material_sample_thickness_map(thickness_uv, dpdx(thickness_uv), dpdy(thickness_uv));
@@ -293,16 +390,19 @@ fn mesh_fs(in: MeshVertexOut, @builtin(front_facing) front: bool) -> @location(0
     let n_raw = safe_normalize(in.normal, v);
     // Double-sided: the shading normal faces the viewer; the tangent frame turns with it.
     let facing = select(1.0, -1.0, dot(n_raw, v) < 0.0);
-    var n = n_raw * facing;
-    if (q.flags & MESH_FLAG_NORMAL_MAP) != 0u {
-        let t_raw = in.tangent.xyz - n * dot(n, in.tangent.xyz);
-        let t = safe_normalize(t_raw * facing, vec3<f32>(0.0));
-        if dot(t, t) > 0.5 {
-            let b = cross(n_raw, t_raw) * select(1.0, -1.0, in.tangent.w < 0.0);
-            let tb = safe_normalize(b * facing, vec3<f32>(0.0));
-            let s = finite_or(q.normal_scale, 1.0);
-            let m = (normal_tex.rgb * 2.0 - 1.0) * vec3<f32>(s, s, 1.0);
-            n = safe_normalize(m.x * t + m.y * tb + m.z * n, n);
+    let n_geo = n_raw * facing;
+    var n = n_geo;
+    var n_coat = n_geo;
+    let t_raw = in.tangent.xyz - n_geo * dot(n_geo, in.tangent.xyz);
+    let t = safe_normalize(t_raw * facing, vec3<f32>(0.0));
+    let b = cross(n_raw, t_raw) * select(1.0, -1.0, in.tangent.w < 0.0);
+    let tb = safe_normalize(b * facing, vec3<f32>(0.0));
+    if dot(t, t) > 0.5 {
+        if (q.flags & MESH_FLAG_NORMAL_MAP) != 0u {
+            n = mesh_perturb(n_geo, t, tb, normal_tex.rgb, finite_or(q.normal_scale, 1.0));
+        }
+        if coat_normal_slot != MESH_COAT_SLOT_NONE {
+            n_coat = mesh_perturb(n_geo, t, tb, coat_normal_tex.rgb, finite_or(q.clearcoat_normal_scale, 1.0));
         }
     }
 
@@ -345,6 +445,14 @@ fn mesh_fs(in: MeshVertexOut, @builtin(front_facing) front: bool) -> @location(0
         radiance += shade.transmittance * base.rgb * mesh_behind(in.world, n, v, ior, roughness);
     }
     let unlit = (q.flags & MESH_FLAG_UNLIT) != 0u;
+    // The clear coat over everything below it (header).
+    let coat = clamp(finite_or(q.clearcoat * coat_tex.r, 0.0), 0.0, 1.0);
+    if coat > 0.0 {
+        let coat_roughness = clamp(finite_or(q.clearcoat_roughness * coat_rough_tex.g, 0.0), 0.0, 1.0);
+        let n_dot_v = clamp(dot(n_coat, v), 0.0, 1.0);
+        let fresnel = MESH_COAT_F0 + (1.0 - MESH_COAT_F0) * pow(1.0 - n_dot_v, 5.0);
+        radiance = radiance * (1.0 - coat * fresnel) + coat * mesh_coat_radiance(in.world, n_coat, v, coat_roughness * coat_roughness, mat.occlusion);
+    }
     if unlit {
         radiance = base.rgb;
     }

@@ -303,11 +303,19 @@ pub fn ggx_albedo_alpha(j: usize) -> f64 {
 /// `nacre_optics::microfacet` (weight G₂/G₁) on the midpoints of a
 /// [`GGX_ALBEDO_STRATA`]² grid of (u₁, u₂): deterministic, stratified.
 pub fn ggx_albedo(cos_theta_o: f64, alpha: f64) -> f64 {
+    ggx_albedo_terms(cos_theta_o, alpha)[0]
+}
+
+/// (E₁, E₅)(μ_o, α): E₁ as [`ggx_albedo`], and E₅ = ∫ (1 − v·h)⁵ D G₂ / (4 μ_o μ_i) μ_i dω_i,
+/// its share weighted by Schlick's Fresnel term, by the same estimator: the albedo of a GGX
+/// lobe with Schlick's F = F0 + (1 − F0)(1 − v·h)⁵ is F0 E₁ + (1 − F0) E₅ (Karis 2013, "Real
+/// Shading in Unreal Engine 4", the split sum's scale and bias: A = E₁ − E₅, B = E₅).
+pub fn ggx_albedo_terms(cos_theta_o: f64, alpha: f64) -> [f64; 2] {
     let mu = cos_theta_o.clamp(1e-4, 1.0);
     let wo = [(1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu];
     let g1 = smith_g1(wo, alpha);
     let m = GGX_ALBEDO_STRATA;
-    let mut sum = 0.0;
+    let mut sum = [0.0; 2];
     for a in 0..m {
         for b in 0..m {
             let h = sample_ggx_vndf(
@@ -323,15 +331,17 @@ pub fn ggx_albedo(cos_theta_o: f64, alpha: f64) -> f64 {
                 2.0 * d * h[2] - wo[2],
             ];
             if wi[2] > 0.0 && d > 0.0 {
-                sum += smith_g2(wo, wi, alpha) / g1;
+                let w = smith_g2(wo, wi, alpha) / g1;
+                sum[0] += w;
+                sum[1] += w * (1.0 - d).powi(5);
             }
         }
     }
-    sum / (m * m) as f64
+    sum.map(|s| s / (m * m) as f64)
 }
 
 /// The E₁ table: [`GGX_ALBEDO_SIZE`]² texels, x = μ_o ([`ggx_albedo_cos`]), y = α
-/// ([`ggx_albedo_alpha`]), (E₁, 0) per texel (`Rg16Float` on the GPU). Computed once per
+/// ([`ggx_albedo_alpha`]), (E₁, E₅) per texel ([`ggx_albedo_terms`]; `Rg16Float` on the GPU). Computed once per
 /// process (≈ 4 M visible-normal samples) and cached.
 pub fn ggx_albedo_table() -> &'static Level<2> {
     static TABLE: OnceLock<Level<2>> = OnceLock::new();
@@ -340,10 +350,7 @@ pub fn ggx_albedo_table() -> &'static Level<2> {
         let texels = (0..n * n)
             .into_par_iter()
             .map(|t| {
-                [
-                    ggx_albedo(ggx_albedo_cos(t % n), ggx_albedo_alpha(t / n)) as f32,
-                    0.0,
-                ]
+                ggx_albedo_terms(ggx_albedo_cos(t % n), ggx_albedo_alpha(t / n)).map(|e| e as f32)
             })
             .collect();
         (n, n, texels)

@@ -303,7 +303,7 @@ fn uniform_layouts_match_the_documented_ones() {
     }
 }
 
-/// `nacre_runtime::mesh::MeshUniform` (464 bytes) mirrors `MeshParams` (`shaders/mesh.wgsl`)
+/// `nacre_runtime::mesh::MeshUniform` (480 bytes) mirrors `MeshParams` (`shaders/mesh.wgsl`)
 /// member by member: naga's offsets are Rust's.
 #[test]
 fn mesh_uniform_matches_mesh_params() {
@@ -351,10 +351,14 @@ fn mesh_uniform_matches_mesh_params() {
         volume_thickness,
         attenuation_distance,
         attenuation_colour,
+        clearcoat,
+        clearcoat_roughness,
+        clearcoat_normal_scale,
+        coat_slots,
         transforms,
     ];
     assert_eq!(actual, host, "MeshParams member offsets");
-    assert_eq!(span, 464);
+    assert_eq!(span, 480);
     assert_eq!(std::mem::size_of::<MeshUniform>(), span as usize);
 }
 

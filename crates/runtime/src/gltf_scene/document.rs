@@ -9,9 +9,10 @@ use std::path::Path;
 /// The glTF extensions nacre implements: a file whose `extensionsRequired` lists only these
 /// loads (`KHR_materials_transmission` and `_volume` refract the opaque scene in screen
 /// space, as the glTF Sample Viewer does: `shaders/mesh.wgsl`).
-pub const SUPPORTED_EXTENSIONS: [&str; 10] = [
+pub const SUPPORTED_EXTENSIONS: [&str; 11] = [
     "KHR_lights_punctual",
     "KHR_mesh_quantization",
+    "KHR_materials_clearcoat",
     "KHR_materials_iridescence",
     "KHR_materials_ior",
     "KHR_materials_specular",

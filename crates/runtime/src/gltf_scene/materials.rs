@@ -1,7 +1,7 @@
 //! The document's materials (glTF §3.9 and the extensions nacre implements) with the
 //! textures they read, and the `iridescenceThicknessTexture` of each as a thickness map.
 
-use super::model::{AlphaMode, GltfMaterial, Iridescence, MaterialTextures, Volume};
+use super::model::{AlphaMode, Clearcoat, GltfMaterial, Iridescence, MaterialTextures, Volume};
 use super::textures::{
     GltfTexture, TextureLoader, TextureRef, thickness_texture, transform_from_json,
 };
@@ -62,6 +62,8 @@ fn material(loader: &mut TextureLoader, m: &gltf::Material) -> GltfMaterial {
     let iridescence = read_iridescence(m);
     let iri_ext = m.extension_value("KHR_materials_iridescence");
     let specular = m.specular();
+    let coat_ext = m.extension_value("KHR_materials_clearcoat");
+    let coat_info = |key: &str| coat_ext.and_then(|e| e.get(key));
     let normal = m.normal_texture();
     let occlusion = m.occlusion_texture();
     let textures = MaterialTextures {
@@ -131,6 +133,24 @@ fn material(loader: &mut TextureLoader, m: &gltf::Material) -> GltfMaterial {
             specular.as_ref().and_then(|s| s.specular_color_texture()),
             true,
         ),
+        clearcoat: loader.json(
+            &name,
+            "clearcoatTexture",
+            coat_info("clearcoatTexture"),
+            false,
+        ),
+        clearcoat_roughness: loader.json(
+            &name,
+            "clearcoatRoughnessTexture",
+            coat_info("clearcoatRoughnessTexture"),
+            false,
+        ),
+        clearcoat_normal: loader.json(
+            &name,
+            "clearcoatNormalTexture",
+            coat_info("clearcoatNormalTexture"),
+            false,
+        ),
     };
     let strength = m.emissive_strength().unwrap_or(1.0);
     GltfMaterial {
@@ -145,6 +165,7 @@ fn material(loader: &mut TextureLoader, m: &gltf::Material) -> GltfMaterial {
             attenuation_colour: v.attenuation_color(),
         }),
         iridescence,
+        clearcoat: coat_ext.map(read_clearcoat),
         alpha_mode: match m.alpha_mode() {
             gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
             gltf::material::AlphaMode::Mask => AlphaMode::Mask(m.alpha_cutoff().unwrap_or(0.5)),
@@ -186,6 +207,25 @@ fn thickness_map(
             }
         },
         None => None,
+    }
+}
+
+/// `KHR_materials_clearcoat` from its JSON object `ext`, the extension's defaults where a
+/// value is missing or not a number.
+fn read_clearcoat(ext: &serde_json::Value) -> Clearcoat {
+    let num = |v: Option<&serde_json::Value>, default: f32| {
+        v.and_then(serde_json::Value::as_f64)
+            .map_or(default, |v| v as f32)
+    };
+    let d = Clearcoat::default();
+    Clearcoat {
+        factor: num(ext.get("clearcoatFactor"), d.factor),
+        roughness: num(ext.get("clearcoatRoughnessFactor"), d.roughness),
+        normal_scale: num(
+            ext.get("clearcoatNormalTexture")
+                .and_then(|t| t.get("scale")),
+            d.normal_scale,
+        ),
     }
 }
 

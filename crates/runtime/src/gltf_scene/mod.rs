@@ -94,8 +94,8 @@ pub use error::GltfError;
 pub use limits::{MAX_FILE_BYTES, MAX_INDICES, MAX_VERTICES};
 pub use metal::{GOLD_F0, MetalBands, is_gold_like, metal_index_gulbrandsen2014, rgb_metal_for};
 pub use model::{
-    AlphaMode, GltfCamera, GltfLight, GltfMaterial, GltfPrimitive, GltfProjection, Iridescence,
-    LightKind, MaterialTextures, Volume,
+    AlphaMode, Clearcoat, GltfCamera, GltfLight, GltfMaterial, GltfPrimitive, GltfProjection,
+    Iridescence, LightKind, MaterialTextures, Volume,
 };
 pub use textures::{
     GltfTexture, IDENTITY_TRANSFORM, MAX_TEXTURE_DIMENSION, SamplerSpec, TextureRef, Wrap,

@@ -27,6 +27,29 @@ pub struct Iridescence {
     pub has_texture: bool,
 }
 
+/// `KHR_materials_clearcoat` of one material (defaults from the extension): a clear
+/// dielectric coat of index 1.5 (F0 = 0.04) over the whole material, with its own GGX
+/// roughness and normal.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Clearcoat {
+    /// `clearcoatFactor` (default 0), the coat's intensity.
+    pub factor: f32,
+    /// `clearcoatRoughnessFactor` (default 0), perceptual: GGX α = roughness².
+    pub roughness: f32,
+    /// `clearcoatNormalTexture.scale` (default 1).
+    pub normal_scale: f32,
+}
+
+impl Default for Clearcoat {
+    fn default() -> Self {
+        Clearcoat {
+            factor: 0.0,
+            roughness: 0.0,
+            normal_scale: 1.0,
+        }
+    }
+}
+
 impl Default for Iridescence {
     fn default() -> Self {
         Iridescence {
@@ -75,6 +98,12 @@ pub struct MaterialTextures {
     pub specular: Option<TextureRef>,
     /// `specularColorTexture` (sRGB).
     pub specular_colour: Option<TextureRef>,
+    /// `clearcoatTexture` (R: × `clearcoatFactor`).
+    pub clearcoat: Option<TextureRef>,
+    /// `clearcoatRoughnessTexture` (G: × `clearcoatRoughnessFactor`).
+    pub clearcoat_roughness: Option<TextureRef>,
+    /// `clearcoatNormalTexture` (tangent space, the coat's own normal).
+    pub clearcoat_normal: Option<TextureRef>,
 }
 
 /// `KHR_materials_volume`: the volume under a transmissive surface.
@@ -109,6 +138,8 @@ pub struct GltfMaterial {
     pub volume: Option<Volume>,
     /// `KHR_materials_iridescence`, if present.
     pub iridescence: Option<Iridescence>,
+    /// `KHR_materials_clearcoat`, if present.
+    pub clearcoat: Option<Clearcoat>,
     /// `alphaMode` and `alphaCutoff` (default 0.5).
     pub alpha_mode: AlphaMode,
     /// `doubleSided`.
@@ -142,6 +173,7 @@ impl Default for GltfMaterial {
             transmission: 0.0,
             volume: None,
             iridescence: None,
+            clearcoat: None,
             alpha_mode: AlphaMode::Opaque,
             double_sided: false,
             emissive: [0.0; 3],

@@ -89,6 +89,12 @@ pub(super) fn choose(
         let (mut m, material_notes) = gm.material_options(colorimeter)?;
         if used.contains(&i) {
             notes.extend(material_notes.into_iter().map(Msg::from));
+            for name in super::textures::coat_slots(gm).dropped {
+                notes.push(Msg::from(format!(
+                    "{}: {name} not read (the material's textures fill every slot); its factor is used",
+                    gm.name
+                )));
+            }
         }
         let (lo, hi) = gm.metallic_range();
         let one_lobe = hi <= 0.0 || lo >= 1.0;

@@ -35,7 +35,7 @@ pub use camera::{
 };
 pub use inputs::{RenderInputs, TableFile, load_environment};
 pub use lights::scene_lights;
-pub use textures::rgba8_mip_chain;
+pub use textures::{COAT_SLOT_NONE, CoatSlots, coat_slots, rgba8_mip_chain};
 
 use crate::context::GpuContext;
 use crate::error::Result;
@@ -95,6 +95,14 @@ pub struct MeshUniform {
     pub attenuation_distance: f32,
     /// `attenuationColor` (rgb; w unused).
     pub attenuation_colour: [f32; 4],
+    /// `KHR_materials_clearcoat` `clearcoatFactor` (0: no coat).
+    pub clearcoat: f32,
+    /// `clearcoatRoughnessFactor`.
+    pub clearcoat_roughness: f32,
+    /// `clearcoatNormalTexture.scale`.
+    pub clearcoat_normal_scale: f32,
+    /// The slots of the coat's textures and the borrowed slots ([`CoatSlots::packed`]).
+    pub coat_slots: u32,
     /// Per texture slot ([`TEXTURE_SLOTS`] and the thickness texture): rows (a, b, c, set),
     /// (d, e, f, 0) of its `KHR_texture_transform`.
     pub transforms: [[[f32; 4]; 2]; 9],
@@ -131,7 +139,8 @@ impl MeshUniform {
     /// The uniform of glTF material `m` seen through `view_proj`.
     pub fn new(view_proj: [[f32; 4]; 4], m: &GltfMaterial) -> MeshUniform {
         let t = &m.textures;
-        let in_order = textures::slots_of(m);
+        let coat = textures::coat_slots(m);
+        let in_order = coat.slots;
         let slots: [Option<TextureRef>; 9] =
             std::array::from_fn(|k| in_order.get(k).copied().unwrap_or(t.thickness));
         let transforms = slots.map(|slot| {
@@ -184,6 +193,10 @@ impl MeshUniform {
                 let [r, g, b] = v.attenuation_colour;
                 [r, g, b, 1.0]
             }),
+            clearcoat: m.clearcoat.map_or(0.0, |c| c.factor),
+            clearcoat_roughness: m.clearcoat.map_or(0.0, |c| c.roughness),
+            clearcoat_normal_scale: m.clearcoat.map_or(1.0, |c| c.normal_scale),
+            coat_slots: coat.packed(),
             transforms,
         }
     }

@@ -7,10 +7,45 @@ use crate::error::Result;
 use crate::gltf_scene::{GltfMaterial, GltfScene, GltfTexture, SamplerSpec, TextureRef, Wrap};
 use crate::shaders;
 
-/// A material's textures in group 3's slot order ([`TEXTURE_SLOTS`]).
+/// A material's textures in group 3's slot order ([`TEXTURE_SLOTS`]), with its
+/// `KHR_materials_clearcoat` textures in slots it leaves empty ([`coat_slots`]).
 pub(super) fn slots_of(gm: &GltfMaterial) -> [Option<TextureRef>; 8] {
+    coat_slots(gm).slots
+}
+
+/// [`CoatSlots::slot`] of a coat texture that has no slot: the shader reads 1 (white).
+pub const COAT_SLOT_NONE: u32 = 15;
+
+/// Where a material's clearcoat textures are read from. Group 3 holds 8 material textures,
+/// and wgpu's GL backend allows 16 sampled textures per shader stage, all of which the mesh
+/// pipeline with the `lut` technique uses: instead of new bindings, the coat's textures take
+/// slots the material leaves empty (a clearcoat texture that another slot of the material
+/// already reads, with the same coordinates, shares that slot).
+#[derive(Clone, Debug, PartialEq)]
+pub struct CoatSlots {
+    /// The textures per slot.
+    pub slots: [Option<TextureRef>; 8],
+    /// The slot of `clearcoatTexture`, `clearcoatRoughnessTexture`, `clearcoatNormalTexture`
+    /// ([`COAT_SLOT_NONE`] where the material has none, or no slot was free).
+    pub slot: [u32; 3],
+    /// Bit k: slot k holds a coat texture in place of its own role (which reads white).
+    pub borrowed: u32,
+    /// The coat textures that found no free slot (their names), not read.
+    pub dropped: Vec<&'static str>,
+}
+
+impl CoatSlots {
+    /// `MeshUniform::coat_slots`: the three slots in bits 0–3, 4–7, 8–11, the borrowed
+    /// slots' mask in bits 16–23 (`shaders/mesh.wgsl` mesh_coat_slot).
+    pub fn packed(&self) -> u32 {
+        self.slot[0] | self.slot[1] << 4 | self.slot[2] << 8 | self.borrowed << 16
+    }
+}
+
+/// The slots of material `gm`'s own textures and of its clearcoat textures.
+pub fn coat_slots(gm: &GltfMaterial) -> CoatSlots {
     let t = &gm.textures;
-    [
+    let mut slots = [
         t.base_colour,
         t.metallic_roughness,
         t.normal,
@@ -19,7 +54,38 @@ pub(super) fn slots_of(gm: &GltfMaterial) -> [Option<TextureRef>; 8] {
         t.iridescence,
         t.specular,
         t.specular_colour,
-    ]
+    ];
+    let mut out = CoatSlots {
+        slots,
+        slot: [COAT_SLOT_NONE; 3],
+        borrowed: 0,
+        dropped: Vec::new(),
+    };
+    let coat = [
+        ("clearcoatTexture", t.clearcoat),
+        ("clearcoatRoughnessTexture", t.clearcoat_roughness),
+        ("clearcoatNormalTexture", t.clearcoat_normal),
+    ];
+    for (k, (name, texture)) in coat.into_iter().enumerate() {
+        let Some(texture) = texture else { continue };
+        // The same texture (decoded in the same colour space: `texture` is per decoding)
+        // with the same coordinates shares the slot.
+        let shared = (0..8).find(|&s| slots[s] == Some(texture));
+        // Otherwise the last empty slot (the specular and iridescence slots first).
+        let free = || (0..8).rev().find(|&s| slots[s].is_none());
+        match shared.or_else(free) {
+            Some(s) => {
+                if slots[s].is_none() {
+                    slots[s] = Some(texture);
+                    out.borrowed |= 1 << s;
+                }
+                out.slot[k] = s as u32;
+            }
+            None => out.dropped.push(name),
+        }
+    }
+    out.slots = slots;
+    out
 }
 
 /// A sampler's identity (wrap modes and filters).
