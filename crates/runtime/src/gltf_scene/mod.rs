@@ -11,7 +11,8 @@
 //! * `extensionsRequired`: accepted when every entry is in [`SUPPORTED_EXTENSIONS`], refused
 //!   otherwise with a message naming the file and the extension (§3.12: a client that does
 //!   not support a required extension must not load the file);
-//! * primitives of mode TRIANGLES (4); points, lines, strips and fans are skipped with one
+//! * primitives of mode TRIANGLES (4), TRIANGLE_STRIP (5) and TRIANGLE_FAN (6) (strips and fans
+//!   made lists, §3.7.2.1); points and lines are skipped with one
 //!   note counting them; missing normals become flat normals, missing tangents of a
 //!   normal-mapped primitive MikkTSpace tangents (`bevy_mikktspace`, as §3.7.2.1 prescribes),
 //!   computed after the node transform; a mirroring node transform (negative determinant)
@@ -176,7 +177,7 @@ impl GltfScene {
                 .map(|(k, n)| format!("{n} {k}"))
                 .collect();
             notes.push(format!(
-                "skipped {total} primitive(s) nacre does not draw ({}); only triangle lists are drawn",
+                "skipped {total} primitive(s) nacre does not draw ({}); only triangles (lists, strips, fans) are drawn",
                 kinds.join(", ")
             ));
         }

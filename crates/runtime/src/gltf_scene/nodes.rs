@@ -76,7 +76,11 @@ pub(super) fn place(
         }
         let Some(mesh) = node.mesh() else { continue };
         for prim in mesh.primitives() {
-            if prim.mode() != gltf::mesh::Mode::Triangles {
+            use gltf::mesh::Mode;
+            if !matches!(
+                prim.mode(),
+                Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+            ) {
                 *skipped
                     .entry(format!("{:?}", prim.mode()))
                     .or_insert(0usize) += 1;

@@ -63,6 +63,23 @@ const QUANTIZED_TEXCOORD: Allowed = &[
     (DataType::U16, false),
     (DataType::U16, true),
 ];
+/// The triangle list of a TRIANGLE_STRIP or TRIANGLE_FAN's vertices `v` (glTF 2.0
+/// §3.7.2.1, "Topology Types"): strip triangle i = (v_i, v_{i+1+i%2}, v_{i+2−i%2}), fan
+/// triangle i = (v_{i+1}, v_{i+2}, v_0); fewer than three vertices make none.
+fn triangle_list(mode: gltf::mesh::Mode, v: &[u32]) -> Vec<u32> {
+    let n = v.len().saturating_sub(2);
+    let mut out = Vec::with_capacity(3 * n);
+    for i in 0..n {
+        let tri = if mode == gltf::mesh::Mode::TriangleFan {
+            [v[i + 1], v[i + 2], v[0]]
+        } else {
+            [v[i], v[i + 1 + i % 2], v[i + 2 - i % 2]]
+        };
+        out.extend_from_slice(&tri);
+    }
+    out
+}
+
 /// Triangle indices.
 const INDEX: Allowed = &[
     (DataType::U8, false),
@@ -195,7 +212,15 @@ impl<'a> Primitives<'a> {
         if let Some(a) = prim.indices() {
             self.check(&a, "indices", INDEX, &[Dimensions::Scalar])?;
         }
-        let n_corners = prim.indices().map_or(n_vertices, |a| a.count());
+        let listed = prim.indices().map_or(n_vertices, |a| a.count());
+        let mode = prim.mode();
+        let list = mode == gltf::mesh::Mode::Triangles;
+        // Strips and fans become lists of listed − 2 triangles.
+        let n_corners = if list {
+            listed
+        } else {
+            3 * listed.saturating_sub(2)
+        };
         self.vertices = self.vertices.saturating_add(n_vertices);
         self.corners = self.corners.saturating_add(n_corners);
         if self.vertices > MAX_VERTICES || self.corners > MAX_INDICES {
@@ -237,6 +262,9 @@ impl<'a> Primitives<'a> {
             Some(a) => accessor::read_u32(path, &a, buffers)?,
             None => (0..n_vertices as u32).collect(),
         };
+        if !list {
+            indices = triangle_list(mode, &indices);
+        }
         if let Some(&bad) = indices.iter().find(|&&i| i as usize >= positions.len()) {
             return Err(GltfError::IndexOutOfRange {
                 mesh: m,
@@ -447,4 +475,25 @@ fn determinant3(m: &[[f32; 4]; 4]) -> f64 {
     a(0, 0) * (a(1, 1) * a(2, 2) - a(1, 2) * a(2, 1))
         - a(0, 1) * (a(1, 0) * a(2, 2) - a(1, 2) * a(2, 0))
         + a(0, 2) * (a(1, 0) * a(2, 1) - a(1, 1) * a(2, 0))
+}
+
+#[cfg(test)]
+mod topology_tests {
+    use super::triangle_list;
+    use gltf::mesh::Mode;
+
+    /// Strips alternate their winding back to counter-clockwise; fans turn about vertex 0
+    /// (glTF 2.0 §3.7.2.1); fewer than three vertices make no triangle.
+    #[test]
+    fn strips_and_fans_become_lists() {
+        assert_eq!(
+            triangle_list(Mode::TriangleStrip, &[0, 1, 2, 3, 4]),
+            [0, 1, 2, 1, 3, 2, 2, 3, 4]
+        );
+        assert_eq!(
+            triangle_list(Mode::TriangleFan, &[0, 1, 2, 3]),
+            [1, 2, 0, 2, 3, 0]
+        );
+        assert!(triangle_list(Mode::TriangleStrip, &[0, 1]).is_empty());
+    }
 }
