@@ -146,7 +146,7 @@ fn packed(path: &Path, accessor: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result
 /// One component at the start of `b`: a float as it is; an integer as its value or, when
 /// `normalized`, by glTF §3.11: f = c / 255 (u8), c / 65535 (u16), max(c / 127, −1) (i8),
 /// max(c / 32767, −1) (i16).
-fn decode(t: DataType, normalized: bool, b: &[u8]) -> f32 {
+pub(super) fn decode(t: DataType, normalized: bool, b: &[u8]) -> f32 {
     match t {
         DataType::F32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
         DataType::U32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f32,

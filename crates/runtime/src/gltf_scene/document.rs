@@ -9,7 +9,8 @@ use std::path::Path;
 /// The glTF extensions nacre implements: a file whose `extensionsRequired` lists only these
 /// loads (`KHR_materials_transmission` and `_volume` refract the opaque scene in screen
 /// space, as the glTF Sample Viewer does: `shaders/mesh.wgsl`).
-pub const SUPPORTED_EXTENSIONS: [&str; 11] = [
+pub const SUPPORTED_EXTENSIONS: [&str; 12] = [
+    "KHR_draco_mesh_compression",
     "KHR_lights_punctual",
     "KHR_mesh_quantization",
     "KHR_materials_clearcoat",
@@ -25,8 +26,9 @@ pub const SUPPORTED_EXTENSIONS: [&str; 11] = [
 
 /// The document of glTF or GLB `bytes`: a glTF 2.x asset whose primitives' attribute
 /// accessors exist and whose `extensionsRequired` nacre implements (then cleared, since the
-/// `gltf` crate knows only its own features' extensions), validated by the `gltf` crate.
-pub(super) fn open(bytes: &[u8], path: &Path) -> Result<gltf::Gltf> {
+/// `gltf` crate knows only its own features' extensions), validated by the `gltf` crate, and
+/// the `extensionsRequired` it listed.
+pub(super) fn open(bytes: &[u8], path: &Path) -> Result<(gltf::Gltf, Vec<String>)> {
     let not_valid = |e: gltf::Error| {
         GltfError::NotGltf {
             reason: e.to_string(),
@@ -75,11 +77,50 @@ pub(super) fn open(bytes: &[u8], path: &Path) -> Result<gltf::Gltf> {
         .at(path));
     }
     let mut root = raw.document.into_json();
-    root.extensions_required.clear();
-    Ok(gltf::Gltf {
-        document: gltf::Document::from_json(root).map_err(not_valid)?,
-        blob: raw.blob,
-    })
+    let required = std::mem::take(&mut root.extensions_required);
+    validate(&root).map_err(not_valid)?;
+    Ok((
+        gltf::Gltf {
+            document: gltf::Document::from_json_without_validation(root),
+            blob: raw.blob,
+        },
+        required,
+    ))
+}
+
+/// The `gltf` crate's validation of `root` (what `gltf::Document::from_json` does), except
+/// that an accessor of a `KHR_draco_mesh_compression` primitive may lack a buffer view: its
+/// data is in the Draco stream (the extension's accessors have none), where gltf-json 1.4
+/// wants every accessor to have a buffer view or sparse values.
+fn validate(root: &gltf::json::Root) -> std::result::Result<(), gltf::Error> {
+    use gltf::json::validation::{Error as Invalid, Validate};
+    let mut compressed = std::collections::BTreeSet::new();
+    for primitive in root.meshes.iter().flat_map(|m| &m.primitives) {
+        let draco = primitive
+            .extensions
+            .as_ref()
+            .is_some_and(|e| e.others.contains_key(super::draco::EXTENSION));
+        if draco {
+            compressed.extend(primitive.attributes.values().map(|a| a.value()));
+            compressed.extend(primitive.indices.map(|a| a.value()));
+        }
+    }
+    let mut errors = Vec::new();
+    root.validate(root, gltf::json::Path::new, &mut |path, error| {
+        let path = path();
+        let draco_data = matches!(error, Invalid::Missing)
+            && compressed
+                .iter()
+                .any(|a| path.as_str() == format!("accessors[{a}].bufferView"));
+        if !draco_data {
+            errors.push((path, error));
+        }
+    });
+    if errors.is_empty() {
+        Ok(())
+    } else {
+        Err(gltf::Error::Validation(errors))
+    }
 }
 
 /// The bytes of every buffer of `gltf`, each at least as long as the file declares.

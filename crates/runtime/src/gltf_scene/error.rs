@@ -282,4 +282,29 @@ pub enum GltfError {
         /// The view's length, bytes.
         view_bytes: u64,
     },
+    /// A `KHR_draco_mesh_compression` primitive whose extension object, Draco stream or
+    /// decoded attributes do not fit together (the extension's rules: `draco.rs`).
+    #[error(
+        "mesh {mesh} primitive {primitive}: KHR_draco_mesh_compression (buffer view {view}): {what}"
+    )]
+    Draco {
+        /// Mesh index.
+        mesh: usize,
+        /// Primitive index.
+        primitive: usize,
+        /// The buffer view holding the Draco stream.
+        view: usize,
+        /// What is wrong, with the offending values (or the decoder's reason).
+        what: String,
+    },
+    /// A malformed `KHR_draco_mesh_compression` object on a primitive.
+    #[error("mesh {mesh} primitive {primitive}: KHR_draco_mesh_compression: {what}")]
+    DracoExtension {
+        /// Mesh index.
+        mesh: usize,
+        /// Primitive index.
+        primitive: usize,
+        /// The offending member and value.
+        what: String,
+    },
 }

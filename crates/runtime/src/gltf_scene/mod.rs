@@ -46,9 +46,13 @@
 //! the buffer view, or of zeros without one; indices out of range or not increasing are
 //! errors) and, with `KHR_mesh_quantization`, positions, normals, tangents and texture
 //! coordinates may be integers, normalised or not (the node transform dequantises them).
+//! `KHR_draco_mesh_compression` primitives (`draco.rs`) are decoded by `draco-oxide-decoder`:
+//! the extension's map of unique ids picks the attributes, the decoder dequantises them, and
+//! an optional extension falls back to the uncompressed accessors when the stream does not
+//! decode.
 //!
 //! Skins, morph targets,
-//! Draco, `transmissionTexture`, `thicknessTexture`, `KHR_materials_clearcoat`, `_sheen` and
+//! `transmissionTexture`, `thicknessTexture`, `KHR_materials_clearcoat`, `_sheen` and
 //! `_anisotropy` are not read. The default scene's cameras (perspective and orthographic, placed by their
 //! nodes: [`GltfScene::cameras`]) and `KHR_lights_punctual` lights ([`GltfScene::lights`])
 //! are read; see `mesh/lights.rs` for how the renderer lights the scene with them.
@@ -81,6 +85,7 @@ use std::path::{Path, PathBuf};
 mod accessor;
 pub mod assets;
 mod document;
+mod draco;
 pub mod error;
 mod limits;
 mod materials;
@@ -160,7 +165,7 @@ impl GltfScene {
 
     /// Parses glTF or GLB bytes; `path` names the file in errors and locates external buffers.
     pub fn from_bytes(bytes: &[u8], path: &Path) -> Result<GltfScene> {
-        let gltf = document::open(bytes, path)?;
+        let (gltf, required) = document::open(bytes, path)?;
         let buffers = document::read_buffers(&gltf, path)?;
         let materials::Materials {
             materials,
@@ -168,7 +173,9 @@ impl GltfScene {
             textures,
             mut notes,
         } = materials::read(&gltf.document, &buffers, path);
-        let placed = nodes::place(&gltf.document, &buffers, path, &materials)?;
+        let draco_required = required.iter().any(|e| e == draco::EXTENSION);
+        let placed = nodes::place(&gltf.document, &buffers, path, &materials, draco_required)?;
+        notes.extend(placed.notes);
         if !placed.skipped.is_empty() {
             let total: usize = placed.skipped.values().sum();
             let kinds: Vec<String> = placed

@@ -20,16 +20,21 @@ pub(super) struct Placed {
     pub(super) lights: Vec<GltfLight>,
     /// Primitives of other modes than TRIANGLES, counted by mode (not drawn).
     pub(super) skipped: std::collections::BTreeMap<String, usize>,
+    /// What the primitives' reader noted (a Draco stream that fell back to its uncompressed
+    /// accessors), one line each.
+    pub(super) notes: Vec<String>,
 }
 
 /// Walks the default scene's (or the first scene's) node trees, or every root node when the
 /// file has no scene, reading each mesh's primitives from `buffers` (`materials` are the
-/// document's, the default one last).
+/// document's, the default one last); `draco_required`: the file lists
+/// `KHR_draco_mesh_compression` in `extensionsRequired` (no uncompressed fallback).
 pub(super) fn place(
     doc: &gltf::Document,
     buffers: &[Vec<u8>],
     path: &Path,
     materials: &[GltfMaterial],
+    draco_required: bool,
 ) -> Result<Placed> {
     let roots: Vec<gltf::Node> = match doc.default_scene().or_else(|| doc.scenes().next()) {
         Some(scene) => scene.nodes().collect(),
@@ -52,7 +57,7 @@ pub(super) fn place(
     let mut lights = Vec::new();
     let mut skipped: std::collections::BTreeMap<String, usize> = Default::default();
     let quantized = doc.extensions_used().any(|e| e == "KHR_mesh_quantization");
-    let mut reader = Primitives::new(path, buffers, materials, quantized);
+    let mut reader = Primitives::new(doc, path, buffers, materials, quantized, draco_required);
     while let Some((node, parent, depth)) = stack.pop() {
         if depth > MAX_DEPTH {
             return Err(GltfError::TooDeep {
@@ -96,6 +101,7 @@ pub(super) fn place(
         cameras: cameras.into_iter().map(|(_, c)| c).collect(),
         lights: lights.into_iter().map(|(_, l)| l).collect(),
         skipped,
+        notes: reader.notes,
     })
 }
 

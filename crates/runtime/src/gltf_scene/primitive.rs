@@ -2,16 +2,21 @@
 //! placed in world space, flat normals and MikkTSpace tangents where the file has none.
 
 use super::accessor;
+use super::draco::{self, DracoPrimitive};
 use super::error::GltfError;
 use super::limits::{MAX_INDICES, MAX_VERTICES};
 use super::model::{GltfMaterial, GltfPrimitive};
 use crate::error::Result;
 use gltf::accessor::{DataType, Dimensions};
+use std::collections::HashMap;
 use std::path::Path;
+use std::rc::Rc;
 
 /// What the primitives of one document are read from, and the vertices and triangle
 /// corners read so far over the scene's primitives.
 pub(super) struct Primitives<'a> {
+    /// The document (its buffer views hold `KHR_draco_mesh_compression` streams).
+    doc: &'a gltf::Document,
     /// The file, named in errors.
     pub(super) path: &'a Path,
     /// The document's buffers.
@@ -20,6 +25,14 @@ pub(super) struct Primitives<'a> {
     pub(super) materials: &'a [GltfMaterial],
     /// The file uses `KHR_mesh_quantization`: attributes may be integers (normalised or not).
     pub(super) quantized: bool,
+    /// The file lists `KHR_draco_mesh_compression` in `extensionsRequired`: a Draco stream
+    /// that does not decode is an error (else the uncompressed accessors are read, if any).
+    draco_required: bool,
+    /// Decoded Draco primitives by (mesh, primitive), decoded once however many nodes place
+    /// the mesh (`None`: the stream fell back to the uncompressed accessors).
+    draco: HashMap<(usize, usize), Option<Rc<DracoPrimitive>>>,
+    /// What the reader noted (a Draco fallback), one line each.
+    pub(super) notes: Vec<String>,
     vertices: usize,
     corners: usize,
 }
@@ -88,18 +101,24 @@ const INDEX: Allowed = &[
 ];
 
 impl<'a> Primitives<'a> {
-    /// A reader of `path`'s primitives from `buffers`.
+    /// A reader of `path`'s primitives (of `doc`) from `buffers`.
     pub(super) fn new(
+        doc: &'a gltf::Document,
         path: &'a Path,
         buffers: &'a [Vec<u8>],
         materials: &'a [GltfMaterial],
         quantized: bool,
+        draco_required: bool,
     ) -> Self {
         Primitives {
+            doc,
             path,
             buffers,
             materials,
             quantized,
+            draco_required,
+            draco: HashMap::new(),
+            notes: Vec::new(),
             vertices: 0,
             corners: 0,
         }
@@ -137,6 +156,80 @@ impl<'a> Primitives<'a> {
         accessor::check(self.path, a, self.buffers)
     }
 
+    /// The decoded `KHR_draco_mesh_compression` stream of `prim`, if it has one (decoded on
+    /// the first call, then kept): `None` without the extension, or when the stream does not
+    /// decode, the extension is optional and every accessor of the primitive has its
+    /// uncompressed data (a buffer view or sparse values) — then with a note.
+    fn draco(
+        &mut self,
+        mesh: &gltf::Mesh,
+        prim: &gltf::Primitive,
+    ) -> Result<Option<Rc<DracoPrimitive>>> {
+        let (m, p) = (mesh.index(), prim.index());
+        let path = self.path;
+        let Some((view, unique_ids)) = draco::extension(prim).map_err(|what| {
+            GltfError::DracoExtension {
+                mesh: m,
+                primitive: p,
+                what,
+            }
+            .at(path)
+        })?
+        else {
+            return Ok(None);
+        };
+        if let Some(decoded) = self.draco.get(&(m, p)) {
+            return Ok(decoded.clone());
+        }
+        let fail = |what: String| {
+            GltfError::Draco {
+                mesh: m,
+                primitive: p,
+                view,
+                what,
+            }
+            .at(path)
+        };
+        let Some(v) = self.doc.views().nth(view) else {
+            return Err(fail(format!(
+                "the file has {} buffer views",
+                self.doc.views().len()
+            )));
+        };
+        let data = self
+            .buffers
+            .get(v.buffer().index())
+            .map_or(&[][..], Vec::as_slice);
+        let end = v.offset().saturating_add(v.length());
+        let Some(stream) = data.get(v.offset()..end) else {
+            return Err(GltfError::ViewBeyondBuffer {
+                view,
+                end: end as u64,
+                buffer_bytes: data.len() as u64,
+            }
+            .at(path));
+        };
+        let decoded = match draco::decode(stream, view, &unique_ids) {
+            Ok(d) => Some(Rc::new(d)),
+            Err(why) => {
+                let uncompressed = prim
+                    .attributes()
+                    .map(|(_, a)| a)
+                    .chain(prim.indices())
+                    .all(|a| a.view().is_some() || a.sparse().is_some());
+                if self.draco_required || !uncompressed {
+                    return Err(fail(why));
+                }
+                self.notes.push(format!(
+                    "mesh {m} primitive {p}: its KHR_draco_mesh_compression stream (buffer view {view}) does not decode ({why}); its uncompressed accessors are read instead"
+                ));
+                None
+            }
+        };
+        self.draco.insert((m, p), decoded.clone());
+        Ok(decoded)
+    }
+
     /// Primitive `prim` (mode TRIANGLES) of `mesh` under the node transform `world`. A
     /// mirroring transform (negative determinant) reverses the winding (§3.5.3); quantised
     /// attributes are dequantised by the node transform (`KHR_mesh_quantization`), which
@@ -147,9 +240,26 @@ impl<'a> Primitives<'a> {
         prim: &gltf::Primitive,
         world: &[[f32; 4]; 4],
     ) -> Result<GltfPrimitive> {
+        let draco = self.draco(mesh, prim)?;
         let (path, buffers, materials) = (self.path, self.buffers, self.materials);
         let q = self.quantized;
         let (m, p) = (mesh.index(), prim.index());
+        // An attribute's values: from the Draco stream when it holds the semantic, else from
+        // the accessor.
+        let draco = draco.as_deref();
+        fn values<const N: usize>(
+            draco: Option<&DracoPrimitive>,
+            (path, buffers): (&Path, &[Vec<u8>]),
+            (m, p): (usize, usize),
+            semantic: &str,
+            a: &gltf::Accessor,
+        ) -> Result<Vec<[f32; N]>> {
+            match draco {
+                Some(d) if d.has(semantic) => d.read_f32::<N>(path, m, p, semantic, a),
+                _ => accessor::read_f32::<N>(path, a, buffers),
+            }
+        }
+        let at = (path, buffers);
         let Some(pos_acc) = prim.get(&gltf::Semantic::Positions) else {
             return Err(GltfError::NoPosition {
                 mesh: m,
@@ -212,7 +322,24 @@ impl<'a> Primitives<'a> {
         if let Some(a) = prim.indices() {
             self.check(&a, "indices", INDEX, &[Dimensions::Scalar])?;
         }
-        let listed = prim.indices().map_or(n_vertices, |a| a.count());
+        let listed = match (draco, prim.indices()) {
+            (Some(d), Some(a)) if a.count() != d.indices.len() => {
+                return Err(GltfError::Draco {
+                    mesh: m,
+                    primitive: p,
+                    view: d.view,
+                    what: format!(
+                        "indices (accessor {}): the accessor declares {} corners, the stream decodes {}",
+                        a.index(),
+                        a.count(),
+                        d.indices.len()
+                    ),
+                }
+                .at(path));
+            }
+            (Some(d), _) => d.indices.len(),
+            (None, a) => a.map_or(n_vertices, |a| a.count()),
+        };
         let mode = prim.mode();
         let list = mode == gltf::mesh::Mode::Triangles;
         // Strips and fans become lists of listed − 2 triangles.
@@ -242,7 +369,7 @@ impl<'a> Primitives<'a> {
             }
             .at(path));
         }
-        let positions: Vec<[f32; 3]> = accessor::read_f32::<3>(path, &pos_acc, buffers)?
+        let positions: Vec<[f32; 3]> = values::<3>(draco, at, (m, p), "POSITION", &pos_acc)?
             .into_iter()
             .map(|p| transform_point(world, p))
             .collect();
@@ -258,9 +385,10 @@ impl<'a> Primitives<'a> {
             }
             .at(path));
         }
-        let mut indices: Vec<u32> = match prim.indices() {
-            Some(a) => accessor::read_u32(path, &a, buffers)?,
-            None => (0..n_vertices as u32).collect(),
+        let mut indices: Vec<u32> = match (draco, prim.indices()) {
+            (Some(d), _) => d.indices.clone(),
+            (None, Some(a)) => accessor::read_u32(path, &a, buffers)?,
+            (None, None) => (0..n_vertices as u32).collect(),
         };
         if !list {
             indices = triangle_list(mode, &indices);
@@ -281,7 +409,11 @@ impl<'a> Primitives<'a> {
             }
         }
         let material = prim.material().index().unwrap_or(materials.len() - 1);
-        let [uv0, uv1] = uv_accs.map(|a| a.map(|a| accessor::read_f32::<2>(path, &a, buffers)));
+        let [uv0, uv1] = [0, 1].map(|set| {
+            uv_accs[set]
+                .as_ref()
+                .map(|a| values::<2>(draco, at, (m, p), &format!("TEXCOORD_{set}"), a))
+        });
         let uvs = match uv0.transpose()? {
             Some(uv) => uv,
             None => vec![[0.0; 2]; positions.len()],
@@ -291,18 +423,18 @@ impl<'a> Primitives<'a> {
             None => uvs.clone(),
         };
         let colours = match &colour_acc {
-            Some(a) => accessor::read_f32::<4>(path, a, buffers)?,
+            Some(a) => values::<4>(draco, at, (m, p), "COLOR_0", a)?,
             None => vec![[1.0; 4]; positions.len()],
         };
         let tangents = match &tangent_acc {
-            Some(a) => accessor::read_f32::<4>(path, a, buffers)?
+            Some(a) => values::<4>(draco, at, (m, p), "TANGENT", a)?
                 .into_iter()
                 .map(|t| transform_tangent(world, t))
                 .collect(),
             None => Vec::new(),
         };
         let normals = match &normal_acc {
-            Some(a) => accessor::read_f32::<3>(path, a, buffers)?
+            Some(a) => values::<3>(draco, at, (m, p), "NORMAL", a)?
                 .into_iter()
                 .map(|n| transform_normal(world, n))
                 .collect(),
