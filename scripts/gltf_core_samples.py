@@ -12,8 +12,7 @@ Per model: its `glTF/` file rendered at the size of its reference screenshot
 assets', CC BY 4.0 / CC0, see each LICENSE.md) from the view in VIEWS (the fitted orbit
 camera by default), written as OUT/NAME.png. Every other variant (`glTF-Binary`,
 `glTF-Draco`, `glTF-Quantized`) is rendered too, and the script prints one line per file:
-rendered, or refused with nacre's message (Draco files render once nacre decodes them; the
-script needs no change). With --compare DIR it also writes DIR/NAME.png: nacre's render beside
+rendered, or refused with nacre's message. With --compare DIR it also writes DIR/NAME.png: nacre's render beside
 the reference screenshot, for looking at them (not for the repository: the screenshots are
 not ours).
 """
