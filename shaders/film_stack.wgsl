@@ -30,7 +30,7 @@
 //
 // Rule: OPD = h Σ_j k_j d_j; N = ⌈base_count + count_per_opd_nm · OPD⌉ rounded up to the
 // ladder (StackParams.rule_size, increasing); the rule's nodes are stack_nodes[offset …
-// offset + N). With `fixed` = 1 rule 0 is always used (`stack:N`).
+// offset + N). With `fixed_rule` = 1 rule 0 is always used (`stack:N`).
 //
 // Recurrence at each node (stack.rs, Heavens 1955 §4): Γ_F = r_{F,F+1}, τ_F = t_{F,F+1}; for
 // m = F−1 … 0, with e = e^{iδ_{m+1}}, δ = 2π d q / λ,
@@ -68,7 +68,7 @@ struct StackNode {
 //        0    4 films: u32              F (1 … 8)
 //        4    4 dispersive: u32         1 when some index varies with λ
 //        8    4 rule_count: u32         rules in the ladder (≤ 16)
-//       12    4 fixed: u32              1: always rule 0
+//       12    4 fixed_rule: u32         1: always rule 0
 //       16    4 base_count: f32         N at OPD 0
 //       20    4 count_per_opd_nm: f32   samples per nm of OPD
 //       24    4 finesse: f32            h
@@ -80,7 +80,7 @@ struct StackParams {
     films: u32,
     dispersive: u32,
     rule_count: u32,
-    fixed: u32,
+    fixed_rule: u32,
     base_count: f32,
     count_per_opd_nm: f32,
     finesse: f32,
@@ -104,7 +104,7 @@ fn stack_rule(i: u32) -> vec2<u32> {
 // The rule for the pixel's OPD: the first whose count reaches ⌈base + slope · OPD⌉, else the last.
 fn stack_rule_for(opd_nm: f32) -> u32 {
     let rules = clamp(stack_params.rule_count, 1u, 16u);
-    if stack_params.fixed == 1u {
+    if stack_params.fixed_rule == 1u {
         return 0u;
     }
     let needed = ceil(stack_params.base_count + stack_params.count_per_opd_nm * max(opd_nm, 0.0));

@@ -10,6 +10,11 @@
 //!   nacre-optics), ≤ 10⁻⁴ per channel (full-float table), M = 1, 2, 3 (the runtime's
 //!   default), auto, and M = 3 prefiltered with σ_d = 40 nm;
 //! * rough-film-lut: `RoughFilmLut::lookup` (nacre-format), ≤ 2×10⁻³ (half-float table);
+//! * film_stack: `StackEvaluation::colour` (nacre-optics), ≤ 10⁻⁴ per channel, over the
+//!   stacks of `probe_support::stack_cases` (1 to 8 films, metal films and bases, dispersive
+//!   materials, total internal reflection; the rule ladder and a fixed rule) and the
+//!   alternating stacks of 1 to 8 films, read from the stack table (`StackGpu::texels`, an
+//!   RGBA32F texture) and `NacreStackParams` as an engine uploads them from `nacre export`;
 //! * every library output finite for NaN, ±∞, negative, zero and huge inputs.
 //!
 //! Neither a missing adapter nor a missing `glslangValidator` skips: both fail, the latter
@@ -17,7 +22,9 @@
 
 use nacre_bake::commands::color::{Method, Quantity};
 use nacre_format::Manifest;
+use nacre_format::export::{read_stack_json, stack_json};
 use nacre_format::film_lut::FilmLut;
+use nacre_format::gpu_params::{STACK_TEXTURE_WIDTH, StackGpu};
 use nacre_format::load::LoadedRoughLut;
 use nacre_format::rough_film_lut::RoughFilmLut;
 use nacre_optics::fourier::Harmonics;
@@ -35,7 +42,7 @@ mod support;
 use support::ctx;
 
 mod probe_support;
-use probe_support::{Lcg, cpu_colours, input, manifest, max_diff, random_points};
+use probe_support::{Lcg, cpu_colours, input, manifest, max_diff, random_points, stack_cases};
 
 /// The two libraries.
 #[derive(Clone, Copy, Debug)]
@@ -614,6 +621,232 @@ fn rough_lut_libraries_match_the_cpu_lookup() {
                 "{lang:?} rough-film-lut: {o:?} for {:?}",
                 hostile[i]
             );
+        }
+    }
+}
+
+/// The film_stack probe: group 1 = the stack table (RGBA32F, read with texelFetch / Load)
+/// and `NacreStackParams`.
+fn stack_probe(lang: Lang) -> Vec<u8> {
+    let group1 = match lang {
+        Lang::Glsl => {
+            "layout(set = 1, binding = 0) uniform texture2D stack_table;\n\
+             layout(set = 1, binding = 1, std140) uniform Stack { NacreStackParams stack_params; };"
+        }
+        Lang::Hlsl => {
+            "[[vk::binding(0, 1)]] Texture2D<float4> stack_table;\n\
+             [[vk::binding(1, 1)]] cbuffer Stack { NacreStackParams stack_params; };"
+        }
+    };
+    let body = "    NacreFilmOutput o = nacre_film_stack_colour(stack_table, stack_params, x);";
+    glslang(
+        lang,
+        "stack",
+        &probe_source(lang, group1, "NacreFilmInput", body, true),
+    )
+}
+
+/// Group 1 of the stack probe for `gpu`: its texels as an RGBA32F texture and its uniform.
+fn stack_binding(gpu: &StackGpu) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
+    let ctx = ctx();
+    let device = &ctx.device;
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("stack probe"),
+        entries: &[
+            wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 1,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+        ],
+    });
+    let texels = gpu.texels();
+    let size = wgpu::Extent3d {
+        width: STACK_TEXTURE_WIDTH as u32,
+        height: gpu.nodes.len() as u32,
+        depth_or_array_layers: 1,
+    };
+    let texture = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("stack table"),
+        size,
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba32Float,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    ctx.queue.write_texture(
+        wgpu::TexelCopyTextureInfo {
+            texture: &texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
+        bytemuck::cast_slice(&texels),
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(STACK_TEXTURE_WIDTH as u32 * 16),
+            rows_per_image: Some(size.height),
+        },
+        size,
+    );
+    let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("NacreStackParams"),
+        contents: bytemuck::bytes_of(&gpu.params),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let view = texture.create_view(&Default::default());
+    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("stack probe"),
+        layout: &layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::TextureView(&view),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: uniform.as_entire_binding(),
+            },
+        ],
+    });
+    (layout, group)
+}
+
+#[test]
+fn stack_libraries_match_the_cpu_twin() {
+    use nacre_optics::few_wavelengths::StackEvaluation;
+    use nacre_runtime::bindings::StackSetup;
+    let colorimeter = TableSet::load(ctx(), &manifest("fourier-srgb"))
+        .unwrap()
+        .colorimeter()
+        .unwrap();
+    let spirv: Vec<(Lang, Vec<u8>)> = LANGS.iter().map(|&l| (l, stack_probe(l))).collect();
+    let mut cases: Vec<(String, StackSetup)> = stack_cases()
+        .into_iter()
+        .map(|(name, stack, samples)| {
+            let films = stack.layers().len();
+            let setup = StackSetup {
+                stack,
+                relative_nm: (0..films).map(|j| 15.0 * j as f64).collect(),
+                // One thickness-map channel per film (R, G, B in turn).
+                channels: (0..films).map(|j| j % 3).collect(),
+                samples,
+            };
+            (name.to_string(), setup)
+        })
+        .collect();
+    for films in 1..=8 {
+        cases.push((
+            format!("{films} alternating films"),
+            StackSetup::alternating(films).unwrap(),
+        ));
+    }
+    // The hostile set, with hostile variations too.
+    let hostile: Vec<FilmInput> = hostile_inputs()
+        .into_iter()
+        .enumerate()
+        .map(|(i, x)| {
+            let v = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 1e30, -3.0, 0.5][i % 6];
+            FilmInput {
+                variation: v,
+                variation_g: -v,
+                variation_b: v,
+                ..x
+            }
+        })
+        .collect();
+    for (name, setup) in &cases {
+        let mut eval = StackEvaluation::new(
+            &colorimeter,
+            &setup.stack,
+            &setup.relative_nm,
+            setup.samples,
+        )
+        .unwrap();
+        if !setup.channels.is_empty() {
+            eval = eval.with_channels(&setup.channels).unwrap();
+        }
+        let gpu = StackGpu::new(&eval);
+        // The numbers as an engine reads them: through the exported JSON's text.
+        let text = serde_json::to_string(&stack_json(&gpu, serde_json::json!({}))).unwrap();
+        let read = read_stack_json(&serde_json::from_str(&text).unwrap(), "probe").unwrap();
+        assert_eq!(read, gpu, "{name}: the JSON round trip");
+        let (layout, group) = stack_binding(&read);
+        let mut rng = Lcg(43);
+        let inputs: Vec<FilmInput> = (0..400)
+            .map(|_| {
+                let (c, d) = (rng.next(), 500.0 * rng.next());
+                let s = [(); 3].map(|_| (2.0 * rng.next() - 1.0) as f32);
+                FilmInput {
+                    variation: s[0],
+                    variation_g: s[1],
+                    variation_b: s[2],
+                    ..input(c, d, 1.5, 0.0, 1.0, C64::new(1.5, 0.0))
+                }
+            })
+            .collect();
+        // The CPU twin at the f32 inputs the GPU saw.
+        let cpu: Vec<([f64; 3], [f64; 3])> = inputs
+            .iter()
+            .map(|i| {
+                eval.colour(
+                    f64::from(i.cos_theta_i),
+                    f64::from(i.thickness_nm),
+                    [i.variation, i.variation_g, i.variation_b].map(f64::from),
+                )
+            })
+            .collect();
+        for (lang, spirv) in &spirv {
+            let probe = SpirvProbe {
+                spirv,
+                entry_point: "main",
+                tables: (&layout, &group),
+            };
+            let run = |inputs: &[FilmInput]| -> Vec<[[f32; 3]; 2]> {
+                run_spirv_probe(
+                    ctx(),
+                    &probe,
+                    bytemuck::cast_slice(inputs),
+                    inputs.len() as u32,
+                )
+                .unwrap()
+                .into_iter()
+                .map(|[r, t]| [[r[0], r[1], r[2]], [t[0], t[1], t[2]]])
+                .collect()
+            };
+            let out = run(&inputs);
+            for (k, quantity) in ["R", "T"].iter().enumerate() {
+                let c: Vec<[f64; 3]> = cpu.iter().map(|x| if k == 0 { x.0 } else { x.1 }).collect();
+                let g: Vec<[f32; 3]> = out.iter().map(|o| o[k]).collect();
+                let (worst, at) = max_diff(&c, &g);
+                eprintln!("{lang:?} stack {name}: {quantity} max |GPU − CPU| = {worst:.2e}");
+                assert!(
+                    worst <= 1e-4,
+                    "{lang:?} stack {name} {quantity}: {worst:e} at {:?}: CPU {:?} GPU {:?}",
+                    inputs[at],
+                    c[at],
+                    g[at]
+                );
+            }
+            let out = run(&hostile);
+            assert_finite(&format!("{lang:?} stack {name}"), &out, &hostile);
         }
     }
 }

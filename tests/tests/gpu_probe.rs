@@ -226,81 +226,11 @@ fn film_spectral_matches_samples_n() {
 #[test]
 fn film_stack_matches_its_cpu_twin() {
     use nacre_optics::few_wavelengths::StackEvaluation;
-    use nacre_optics::{Layer, Stack};
     use nacre_runtime::bindings::StackSetup;
     let ctx = ctx();
     let tables = TableSet::load(ctx, &manifest("fourier-srgb")).unwrap();
     let colorimeter = tables.colorimeter().unwrap();
-    let constant = |n: f64| Material::constant(format!("{n}"), C64::new(n, 0.0)).unwrap();
-    let bundled = |name: &str| materials::resolve(name, "test", None).unwrap();
-    let layer = |material: Material, thickness_nm: f64| Layer {
-        material,
-        thickness_nm,
-    };
-    let cases: Vec<(&str, Stack, Option<usize>)> = vec![
-        (
-            "one film on gold",
-            Stack::new(
-                constant(1.0),
-                vec![layer(constant(1.45), 300.0)],
-                bundled("au"),
-            )
-            .unwrap(),
-            None,
-        ),
-        (
-            "metal-dielectric-metal",
-            Stack::new(
-                constant(1.0),
-                vec![layer(bundled("ag"), 10.0), layer(constant(1.38), 150.0)],
-                bundled("ag"),
-            )
-            .unwrap(),
-            None,
-        ),
-        (
-            "dispersive four films on silicon",
-            Stack::new(
-                bundled("air"),
-                vec![
-                    layer(bundled("mgf2"), 90.0),
-                    layer(bundled("tio2"), 50.0),
-                    layer(bundled("cr"), 8.0),
-                    layer(bundled("water"), 200.0),
-                ],
-                bundled("si"),
-            )
-            .unwrap(),
-            None,
-        ),
-        (
-            "eight films, fixed 16 nodes",
-            Stack::new(
-                constant(1.0),
-                (0..8)
-                    .map(|j| {
-                        layer(
-                            constant(if j % 2 == 0 { 1.38 } else { 2.3 }),
-                            40.0 + 10.0 * j as f64,
-                        )
-                    })
-                    .collect(),
-                constant(1.52),
-            )
-            .unwrap(),
-            Some(16),
-        ),
-        (
-            "dense ambient, total internal reflection",
-            Stack::new(
-                constant(1.6),
-                vec![layer(constant(1.0), 120.0), layer(constant(1.33), 200.0)],
-                constant(1.2),
-            )
-            .unwrap(),
-            None,
-        ),
-    ];
+    let cases = probe_support::stack_cases();
     for (name, stack, samples) in cases {
         let films = stack.layers().len();
         let relative_nm: Vec<f64> = (0..films).map(|j| 15.0 * j as f64).collect();

@@ -21,7 +21,8 @@ impl From<QuantityArg> for Quantity {
     }
 }
 
-/// `nacre render --layer-channel`: the thickness-map channel a stack's film follows.
+/// `nacre render --layer-channel`, `nacre export --layer-channel`: the thickness-map channel
+/// a stack's film follows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum ChannelArg {
     R,

@@ -40,6 +40,8 @@ pub fn flag(param: Param) -> &'static str {
         Param::Table => "--table",
         Param::Tables => "--tables",
         Param::Out => "--out",
+        Param::Relative => "--relative",
+        Param::LayerChannel => "--layer-channel",
         Param::Layout => "--layout",
         Param::IntegratedSamples => "--integrated-samples",
         Param::Pitch => "--pitch",

@@ -75,7 +75,8 @@ enum Command {
     Conformance(conformance::ConformanceArgs),
     /// Write one quantity of a film-lut or rough-film-lut table as a raw 3-D texture for a
     /// game engine (RGBA half floats, little-endian, x fastest, then y, then z) with a JSON
-    /// sidecar (dimensions, format, axes, mappings, shader parameters); docs/engines/.
+    /// sidecar (dimensions, format, axes, mappings, shader parameters), or a multilayer
+    /// stack (--layer …) as the JSON the engine libraries' film_stack reads; docs/engines/.
     #[command(after_help = export::EXAMPLES)]
     Export(export::ExportArgs),
     /// Print a baked table's manifest as JSON.

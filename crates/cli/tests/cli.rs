@@ -1091,6 +1091,160 @@ fn export_writes_a_raw_texture_and_sidecar() {
     }
 }
 
+/// `nacre export --layer …` writes the stack JSON of the engine libraries' `film_stack`:
+/// the numbers `StackGpu` prepares from the same stack (read back exactly), the stack
+/// described under `about`; bad input exits 2 naming the flag and writes nothing.
+#[test]
+fn export_writes_a_stack_json() {
+    use nacre_optics::few_wavelengths::StackEvaluation;
+    let dir = tempfile::tempdir().unwrap();
+    let o = nacre(
+        &[
+            "export",
+            "--layer",
+            "1.38@100",
+            "--layer",
+            "2.3@60",
+            "--substrate",
+            "1.5",
+            "--relative",
+            "0",
+            "--relative",
+            "20",
+            "--layer-channel",
+            "r",
+            "--layer-channel",
+            "g",
+            "--out",
+            "stack.json",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("2 films"), "{}", stderr(&o));
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("stack.json")).unwrap()).unwrap();
+    let read = nacre_format::export::read_stack_json(&json, "stack.json").unwrap();
+    let constant = |n: f64| {
+        nacre_optics::Material::constant(format!("{n}"), nacre_optics::C64::new(n, 0.0)).unwrap()
+    };
+    let layer = |n: f64, d: f64| nacre_optics::Layer {
+        material: constant(n),
+        thickness_nm: d,
+    };
+    let stack = nacre_optics::Stack::new(
+        constant(1.0),
+        vec![layer(1.38, 100.0), layer(2.3, 60.0)],
+        constant(1.5),
+    )
+    .unwrap();
+    let colorimeter = nacre_optics::colour::Colorimeter::new(
+        "1931".parse().unwrap(),
+        "d65".parse().unwrap(),
+        "srgb".parse().unwrap(),
+    );
+    let eval = StackEvaluation::new(&colorimeter, &stack, &[0.0, 20.0], None)
+        .unwrap()
+        .with_channels(&[0, 1])
+        .unwrap();
+    assert_eq!(read, nacre_format::gpu_params::StackGpu::new(&eval));
+    assert_eq!(json["about"]["films"][1]["channel"], "g");
+    assert_eq!(json["about"]["films"][1]["relative_nm"], 20.0);
+    assert_eq!(json["texture"]["width"], 6);
+    assert_eq!(json["texture"]["height"], json["node_count"]);
+    let wrong = |args: &[&str], names: &[&str]| {
+        let o = nacre(args, dir.path());
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        for name in names {
+            assert!(stderr(&o).contains(name), "{args:?}: {}", stderr(&o));
+        }
+        assert!(!dir.path().join("x.json").exists());
+    };
+    wrong(
+        &[
+            "export",
+            "--layer",
+            "1.38@100",
+            "--relative",
+            "1",
+            "--relative",
+            "2",
+            "--out",
+            "x.json",
+        ],
+        &["--relative", "one per film"],
+    );
+    wrong(
+        &[
+            "export",
+            "--layer",
+            "1.38@100",
+            "--relative",
+            "-5",
+            "--out",
+            "x.json",
+        ],
+        &["--relative"],
+    );
+    wrong(
+        &[
+            "export",
+            "--layer",
+            "1.38@100",
+            "--layer",
+            "1.5@10",
+            "--layer-channel",
+            "g",
+            "--layer-channel",
+            "r",
+            "--out",
+            "x.json",
+        ],
+        &["--layer-channel", "top film"],
+    );
+    wrong(
+        &[
+            "export",
+            "--layer",
+            "1.38@100",
+            "--wavelengths",
+            "0",
+            "--out",
+            "x.json",
+        ],
+        &["--wavelengths"],
+    );
+    let nine: Vec<&str> = std::iter::once("export")
+        .chain((0..9).flat_map(|_| ["--layer", "1.4@50"]))
+        .chain(["--out", "x.json"])
+        .collect();
+    wrong(&nine, &["--layer", "1 to 8"]);
+    wrong(
+        &["export", "--layer", "nosuchmaterial@100", "--out", "x.json"],
+        &["nosuchmaterial"],
+    );
+    wrong(
+        &[
+            "export", "--layer", "1.38@100", "--space", "cmyk", "--out", "x.json",
+        ],
+        &["--space"],
+    );
+    // --table and a stack, or neither: usage errors.
+    wrong(
+        &[
+            "export",
+            "--table",
+            "soap-film",
+            "--layer",
+            "1.38@100",
+            "--out",
+            "x.json",
+        ],
+        &["--table"],
+    );
+    wrong(&["export", "--out", "x.json"], &["--table"]);
+}
+
 /// `nacre spectrum | head`: a reader that closes the pipe early ends the command quietly
 /// (status 0, nothing on stderr), as Unix tools do.
 #[test]

@@ -21,11 +21,19 @@
 //! manifest stores them, the mappings as text, and `shader_params`: the fields of the
 //! libraries' parameter struct (`NacreFilmLutParams` / `NacreRoughLutParams`), from the one
 //! field list of [`crate::gpu_params`].
+//!
+//! A multilayer stack (`film_stack`) reads no table but its own prepared numbers:
+//! [`stack_json`] lays out a [`StackGpu`] as the JSON an engine uploads (`nacre export
+//! --layer …`; schema `nacre-film-stack` version [`STACK_JSON_VERSION`], documented in
+//! docs/engines/README.md) and [`read_stack_json`] reads it back.
 
 use crate::TableKind;
 use crate::atomic::write_files_atomic;
 use crate::error::{Error, Result};
-use crate::gpu_params::{FilmLutParams, RoughLutParams};
+use crate::gpu_params::{
+    FilmLutParams, RoughLutParams, STACK_MAX_FILMS, STACK_MAX_RULES, STACK_TEXTURE_WIDTH, StackGpu,
+    StackNode, StackParams,
+};
 use crate::load::LoadedRoughLut;
 use crate::manifest::Manifest;
 use crate::table_io::Table3;
@@ -209,6 +217,225 @@ pub fn write_raw(raw_path: &Path, texture: &RawTexture3d) -> Result<PathBuf> {
     Ok(sidecar)
 }
 
+/// Version of the stack JSON's schema (`"format": "nacre-film-stack"`).
+pub const STACK_JSON_VERSION: u32 = 1;
+
+/// The stack JSON of `gpu` (schema in docs/engines/README.md): `format`, `version`,
+/// `technique`, `about` (what the caller says the numbers are: the stack, the colour
+/// settings), `media`, `node_count`, `shader_params` (the fields of `StackParams` /
+/// `NacreStackParams`, arrays in full), `nodes` (`wavelength_nm`, `weight` rgb), `indices`
+/// ((n, κ) per node and medium, node-major) and `texture` (the engine libraries' RGBA32F
+/// stack table: `width`, `height`, `format`, `texel_order`, `data` row-major, 4 floats a
+/// texel). Every number is the f32 the GPU reads, printed so that it parses back exactly.
+pub fn stack_json(gpu: &StackGpu, about: serde_json::Value) -> serde_json::Value {
+    let p = &gpu.params;
+    let texels = gpu.texels();
+    json!({
+        "format": "nacre-film-stack",
+        "version": STACK_JSON_VERSION,
+        "technique": "film_stack",
+        "about": about,
+        "media": gpu.media(),
+        "node_count": gpu.nodes.len(),
+        "shader_params": {
+            "films": p.films,
+            "dispersive": p.dispersive,
+            "rule_count": p.rule_count,
+            "fixed_rule": p.fixed_rule,
+            "base_count": p.base_count,
+            "count_per_opd_nm": p.count_per_opd_nm,
+            "finesse": p.finesse,
+            "rule_offset": p.rule_offset,
+            "rule_size": p.rule_size,
+            "layers": p.layers,
+        },
+        "nodes": gpu.nodes.iter().map(|n| json!({
+            "wavelength_nm": n.wavelength_nm,
+            "weight": [n.weight[0], n.weight[1], n.weight[2]],
+        })).collect::<Vec<_>>(),
+        "indices": gpu.indices,
+        "texture": {
+            "width": STACK_TEXTURE_WIDTH,
+            "height": gpu.nodes.len(),
+            "format": "rgba32f",
+            "texel_order": "row k = node k, x fastest: texel (0, k) = (wavelength_nm, weight r, g, b); texel (1 + i, k) = (n, κ) of medium 2i, (n, κ) of medium 2i + 1; medium 0 ambient, 1 … films top first, films + 1 base",
+            "data": texels.iter().flatten().copied().collect::<Vec<f32>>(),
+        },
+    })
+}
+
+/// Reads a stack JSON written by [`stack_json`] back into the GPU's numbers (`nodes`,
+/// `indices` and `shader_params`; `texture` is derived from them and not read).
+///
+/// Errors ([`Error::Invalid`] naming `origin`, e.g. the file): another format or version, a
+/// missing or mistyped field, a film count outside 1 to 8, rules outside the nodes, or an
+/// index count other than nodes × media.
+pub fn read_stack_json(value: &serde_json::Value, origin: &str) -> Result<StackGpu> {
+    let bad = |message: String| Error::Invalid {
+        context: origin.to_string().into(),
+        message: message.into(),
+    };
+    if value["format"] != "nacre-film-stack" {
+        return Err(bad(format!(
+            "`format` is {}, expected \"nacre-film-stack\" (written by nacre export --layer …)",
+            value["format"]
+        )));
+    }
+    if value["version"] != STACK_JSON_VERSION {
+        return Err(bad(format!(
+            "`version` is {}, this nacre reads version {STACK_JSON_VERSION}",
+            value["version"]
+        )));
+    }
+    let field = |path: &str| -> Result<&serde_json::Value> {
+        let mut v = value;
+        for key in path.split('.') {
+            v = v.get(key).ok_or_else(|| bad(format!("no `{path}`")))?;
+        }
+        Ok(v)
+    };
+    let float = |v: &serde_json::Value, what: &str| -> Result<f32> {
+        v.as_f64()
+            .map(|x| x as f32)
+            .ok_or_else(|| bad(format!("`{what}` is {v}, expected a number")))
+    };
+    let uint = |path: &str| -> Result<u32> {
+        let v = field(path)?;
+        v.as_u64()
+            .and_then(|x| u32::try_from(x).ok())
+            .ok_or_else(|| bad(format!("`{path}` is {v}, expected an unsigned integer")))
+    };
+    let array = |path: &str| -> Result<&Vec<serde_json::Value>> {
+        let v = field(path)?;
+        v.as_array()
+            .ok_or_else(|| bad(format!("`{path}` is not an array")))
+    };
+    let mut params = StackParams {
+        films: uint("shader_params.films")?,
+        dispersive: uint("shader_params.dispersive")?,
+        rule_count: uint("shader_params.rule_count")?,
+        fixed_rule: uint("shader_params.fixed_rule")?,
+        base_count: float(
+            field("shader_params.base_count")?,
+            "shader_params.base_count",
+        )?,
+        count_per_opd_nm: float(
+            field("shader_params.count_per_opd_nm")?,
+            "shader_params.count_per_opd_nm",
+        )?,
+        finesse: float(field("shader_params.finesse")?, "shader_params.finesse")?,
+        ..StackParams::default()
+    };
+    if !(1..=STACK_MAX_FILMS as u32).contains(&params.films) {
+        return Err(bad(format!(
+            "`shader_params.films` is {}, expected 1 to {STACK_MAX_FILMS}",
+            params.films
+        )));
+    }
+    if !(1..=STACK_MAX_RULES as u32).contains(&params.rule_count) {
+        return Err(bad(format!(
+            "`shader_params.rule_count` is {}, expected 1 to {STACK_MAX_RULES}",
+            params.rule_count
+        )));
+    }
+    for (key, out) in [
+        ("shader_params.rule_offset", &mut params.rule_offset),
+        ("shader_params.rule_size", &mut params.rule_size),
+    ] {
+        let values = array(key)?;
+        if values.len() != STACK_MAX_RULES {
+            return Err(bad(format!(
+                "`{key}` holds {} values, expected {STACK_MAX_RULES}",
+                values.len()
+            )));
+        }
+        for (o, v) in out.iter_mut().zip(values) {
+            *o = v
+                .as_u64()
+                .and_then(|x| u32::try_from(x).ok())
+                .ok_or_else(|| bad(format!("`{key}` holds {v}, expected unsigned integers")))?;
+        }
+    }
+    let layers = array("shader_params.layers")?;
+    if layers.len() != STACK_MAX_FILMS {
+        return Err(bad(format!(
+            "`shader_params.layers` holds {} films, expected {STACK_MAX_FILMS}",
+            layers.len()
+        )));
+    }
+    for (j, layer) in layers.iter().enumerate() {
+        let values = layer.as_array().filter(|a| a.len() == 4).ok_or_else(|| {
+            bad(format!(
+                "`shader_params.layers[{j}]` is {layer}, expected 4 numbers"
+            ))
+        })?;
+        for (c, v) in values.iter().enumerate() {
+            params.layers[j][c] = float(v, &format!("shader_params.layers[{j}][{c}]"))?;
+        }
+    }
+    let nodes = array("nodes")?
+        .iter()
+        .enumerate()
+        .map(|(k, n)| -> Result<StackNode> {
+            let weight = n["weight"]
+                .as_array()
+                .filter(|a| a.len() == 3)
+                .ok_or_else(|| bad(format!("`nodes[{k}].weight` is not 3 numbers")))?;
+            let w = |c: usize| float(&weight[c], &format!("nodes[{k}].weight[{c}]"));
+            Ok(StackNode {
+                wavelength_nm: float(&n["wavelength_nm"], &format!("nodes[{k}].wavelength_nm"))?,
+                _pad: [0.0; 3],
+                weight: [w(0)?, w(1)?, w(2)?, 0.0],
+            })
+        })
+        .collect::<Result<Vec<_>>>()?;
+    for i in 0..params.rule_count as usize {
+        let end = u64::from(params.rule_offset[i]) + u64::from(params.rule_size[i]);
+        if params.rule_size[i] == 0 || end > nodes.len() as u64 {
+            return Err(bad(format!(
+                "rule {i} (nodes {} + {}) lies outside the {} nodes",
+                params.rule_offset[i],
+                params.rule_size[i],
+                nodes.len()
+            )));
+        }
+    }
+    let indices = array("indices")?
+        .iter()
+        .enumerate()
+        .map(|(i, n)| -> Result<[f32; 2]> {
+            let pair = n
+                .as_array()
+                .filter(|a| a.len() == 2)
+                .ok_or_else(|| bad(format!("`indices[{i}]` is {n}, expected [n, κ]")))?;
+            Ok([
+                float(&pair[0], &format!("indices[{i}][0]"))?,
+                float(&pair[1], &format!("indices[{i}][1]"))?,
+            ])
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let media = params.films as usize + 2;
+    if indices.len() != nodes.len() * media {
+        return Err(bad(format!(
+            "`indices` holds {} values, expected nodes × media = {} × {media}",
+            indices.len(),
+            nodes.len()
+        )));
+    }
+    Ok(StackGpu {
+        nodes,
+        indices,
+        params,
+    })
+}
+
+/// Writes `value` as pretty JSON to `path` atomically (no partial file on failure).
+pub fn write_json(path: &Path, value: &serde_json::Value) -> Result<()> {
+    let mut json = serde_json::to_vec_pretty(value).expect("JSON values serialise");
+    json.push(b'\n');
+    crate::atomic::write_atomic(path, |w| w.write_all(&json))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -272,5 +499,75 @@ mod tests {
         let raw = export_raw(&dir.join("soap-film.json"), "reflectance").unwrap();
         let e = write_raw(Path::new("out.json"), &raw).unwrap_err();
         assert!(e.to_string().starts_with("out: "), "{e}");
+    }
+
+    #[test]
+    fn a_stack_round_trips_through_its_json() {
+        use nacre_optics::colour::Colorimeter;
+        use nacre_optics::few_wavelengths::StackEvaluation;
+        use nacre_optics::{C64, Layer, Material, Stack};
+        let constant = |n: f64, k: f64| Material::constant("m", C64::new(n, k)).unwrap();
+        let stack = Stack::new(
+            constant(1.0, 0.0),
+            vec![
+                Layer {
+                    material: constant(1.38, 0.0),
+                    thickness_nm: 100.0,
+                },
+                Layer {
+                    material: constant(0.2, 3.0),
+                    thickness_nm: 12.0,
+                },
+            ],
+            constant(1.5, 0.0),
+        )
+        .unwrap();
+        let colorimeter = Colorimeter::new(
+            "1931".parse().unwrap(),
+            "d65".parse().unwrap(),
+            "srgb".parse().unwrap(),
+        );
+        let eval = StackEvaluation::new(&colorimeter, &stack, &[0.0, 4.0], None)
+            .unwrap()
+            .with_channels(&[0, 2])
+            .unwrap();
+        let gpu = StackGpu::new(&eval);
+        let value = stack_json(&gpu, json!({"note": "test"}));
+        // Through text, as an engine reads it.
+        let text = serde_json::to_string(&value).unwrap();
+        let back = read_stack_json(&serde_json::from_str(&text).unwrap(), "test").unwrap();
+        assert_eq!(back, gpu);
+        assert_eq!(
+            gpu.params.layers[1],
+            [12.0, 4.0, gpu.params.layers[1][2], 2.0]
+        );
+        let texels = gpu.texels();
+        assert_eq!(
+            value["texture"]["data"].as_array().unwrap().len(),
+            4 * texels.len()
+        );
+        // Node 3, medium 2 (the metal film) is texel (1 + 2/2, 3) = (2, 3), components x, y.
+        let media = gpu.media();
+        assert_eq!(
+            texels[3 * STACK_TEXTURE_WIDTH + 2][0],
+            gpu.indices[3 * media + 2][0]
+        );
+        assert_eq!(texels[3 * STACK_TEXTURE_WIDTH + 2][1], 3.0);
+        assert_eq!(
+            texels[3 * STACK_TEXTURE_WIDTH][0],
+            gpu.nodes[3].wavelength_nm
+        );
+        // Tampered copies are errors naming the field.
+        let mut broken = value.clone();
+        broken["shader_params"]["films"] = json!(9);
+        let e = read_stack_json(&broken, "x.json").unwrap_err();
+        assert!(e.to_string().contains("shader_params.films"), "{e}");
+        let mut broken = value.clone();
+        broken["indices"].as_array_mut().unwrap().pop();
+        let e = read_stack_json(&broken, "x.json").unwrap_err();
+        assert!(e.to_string().contains("nodes × media"), "{e}");
+        let mut broken = value;
+        broken["format"] = json!("rgba16f-le");
+        assert!(read_stack_json(&broken, "x.json").is_err());
     }
 }

@@ -7,6 +7,10 @@
 //! makes both the struct (f32/u32, what the GPU reads) and `shader_params` (the same fields
 //! with the manifest's own numbers, f64 and integers, without padding: what a sidecar
 //! records), so the two cannot drift apart.
+//!
+//! `film_stack` reads no table: [`StackGpu`] holds what it reads instead (nodes, indices
+//! and [`StackParams`], prepared from a [`nacre_optics::few_wavelengths::StackEvaluation`]),
+//! for the runtime, the engine libraries' stack table and `nacre export`'s stack JSON.
 
 use crate::film_lut::FilmLutAxes;
 use crate::fourier::FourierAxes;
@@ -165,6 +169,154 @@ uniform! {
     padding { _pad0: u32 = 0, }
 }
 
+/// Most films of a `film_stack` stack (`STACK_MAX_FILMS` of `shaders/film_stack.wgsl`).
+pub const STACK_MAX_FILMS: usize = nacre_optics::few_wavelengths::MAX_STACK_FILMS;
+
+/// Most rules of a `film_stack` ladder (the 16 slots of `StackParams::rule_offset`).
+pub const STACK_MAX_RULES: usize = 16;
+
+/// Texels per row of the engine libraries' stack table ([`StackGpu::texels`]): the node,
+/// then the (n, κ) of two media per texel for up to [`STACK_MAX_FILMS`] + 2 media.
+pub const STACK_TEXTURE_WIDTH: usize = 1 + (STACK_MAX_FILMS + 2).div_ceil(2);
+
+/// Mirror of `StackNode` (`shaders/film_stack.wgsl`): 32 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct StackNode {
+    /// Node wavelength λ_k, nm.
+    pub wavelength_nm: f32,
+    /// Padding.
+    pub _pad: [f32; 3],
+    /// Per-channel weight W_k (rgb), 0.
+    pub weight: [f32; 4],
+}
+
+/// Mirror of `StackParams` (`shaders/film_stack.wgsl`): 288 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct StackParams {
+    /// Films F.
+    pub films: u32,
+    /// 1 when some index varies with wavelength.
+    pub dispersive: u32,
+    /// Rules in the ladder.
+    pub rule_count: u32,
+    /// 1: always rule 0 (`stack:N`).
+    pub fixed_rule: u32,
+    /// N at OPD 0.
+    pub base_count: f32,
+    /// Samples per nm of OPD.
+    pub count_per_opd_nm: f32,
+    /// The stack's finesse factor h.
+    pub finesse: f32,
+    /// Padding.
+    pub _pad0: f32,
+    /// First node of rule i.
+    pub rule_offset: [u32; 16],
+    /// Nodes of rule i.
+    pub rule_size: [u32; 16],
+    /// Film j: (d_j⁰, r_j, k_j, c_j).
+    pub layers: [[f32; 4]; 8],
+}
+
+/// Everything `film_stack` reads, in the GPU's numbers: the nodes of every rule (rules
+/// concatenated), every medium's index at every node (node-major: node k, medium m at
+/// `k · media + m`, medium 0 the ambient, 1 … F the films top first, F + 1 the base) and the
+/// uniform. One preparation for the runtime's storage buffers, the engine libraries' stack
+/// table ([`StackGpu::texels`]), the Bevy plugin and `nacre export`'s stack JSON
+/// ([`crate::export::stack_json`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StackGpu {
+    /// The nodes (`array<StackNode>`).
+    pub nodes: Vec<StackNode>,
+    /// Every medium's index (n, κ) at every node (`array<vec2<f32>>`).
+    pub indices: Vec<[f32; 2]>,
+    /// The uniform.
+    pub params: StackParams,
+}
+
+impl StackGpu {
+    /// The GPU's numbers of `eval` (f64 rounded to nearest f32).
+    pub fn new(eval: &nacre_optics::few_wavelengths::StackEvaluation) -> Self {
+        use nacre_optics::few_wavelengths::{BASE_COUNT, COUNT_PER_OPD_NM};
+        let mut nodes = Vec::new();
+        let mut params = StackParams {
+            films: eval.thickness_nm().len() as u32,
+            dispersive: u32::from(eval.dispersive()),
+            rule_count: eval.rules().len() as u32,
+            fixed_rule: u32::from(eval.fixed()),
+            base_count: BASE_COUNT as f32,
+            count_per_opd_nm: COUNT_PER_OPD_NM as f32,
+            finesse: eval.finesse() as f32,
+            ..StackParams::default()
+        };
+        for (i, rule) in eval.rules().iter().enumerate().take(STACK_MAX_RULES) {
+            params.rule_offset[i] = nodes.len() as u32;
+            params.rule_size[i] = rule.wavelengths_nm().len() as u32;
+            for (&l, w) in rule.wavelengths_nm().iter().zip(rule.weights()) {
+                nodes.push(StackNode {
+                    wavelength_nm: l as f32,
+                    _pad: [0.0; 3],
+                    weight: [w[0] as f32, w[1] as f32, w[2] as f32, 0.0],
+                });
+            }
+        }
+        for (j, (((d, r), k), c)) in eval
+            .thickness_nm()
+            .iter()
+            .zip(eval.relative_nm())
+            .zip(eval.opd_factors())
+            .zip(eval.channels())
+            .enumerate()
+            .take(STACK_MAX_FILMS)
+        {
+            params.layers[j] = [*d as f32, *r as f32, *k as f32, *c as f32];
+        }
+        let indices = eval
+            .indices()
+            .iter()
+            .flatten()
+            .map(|n| [n.re as f32, n.im as f32])
+            .collect();
+        StackGpu {
+            nodes,
+            indices,
+            params,
+        }
+    }
+
+    /// Media M = F + 2 (ambient, films, base).
+    pub fn media(&self) -> usize {
+        self.params.films as usize + 2
+    }
+
+    /// The stack table of the engine libraries (`nacre_film_stack_colour` in
+    /// `shaders/glsl/nacre.glsl` and `shaders/hlsl/nacre.hlsl`): an RGBA32F 2-D texture of
+    /// [`STACK_TEXTURE_WIDTH`] × (node count) texels, row-major (x fastest), row k node k:
+    /// texel (0, k) = (λ_k nm, W_k,r, W_k,g, W_k,b); texel (1 + i, k) = (n, κ) of medium 2i
+    /// and (n, κ) of medium 2i + 1 (zeros past the last medium).
+    pub fn texels(&self) -> Vec<[f32; 4]> {
+        let media = self.media();
+        let mut texels = vec![[0.0f32; 4]; STACK_TEXTURE_WIDTH * self.nodes.len()];
+        for (k, node) in self.nodes.iter().enumerate() {
+            let row = &mut texels[k * STACK_TEXTURE_WIDTH..(k + 1) * STACK_TEXTURE_WIDTH];
+            row[0] = [
+                node.wavelength_nm,
+                node.weight[0],
+                node.weight[1],
+                node.weight[2],
+            ];
+            for m in 0..media.min(2 * (STACK_TEXTURE_WIDTH - 1)) {
+                let n = self.indices.get(k * media + m).copied().unwrap_or([0.0; 2]);
+                let texel = &mut row[1 + m / 2];
+                texel[2 * (m % 2)] = n[0];
+                texel[2 * (m % 2) + 1] = n[1];
+            }
+        }
+        texels
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -176,5 +328,9 @@ mod tests {
         assert_eq!(std::mem::size_of::<RoughLutParams>(), 48);
         assert_eq!(std::mem::offset_of!(RoughLutParams, has_transmittance), 40);
         assert_eq!(std::mem::offset_of!(FourierParams, white), 32);
+        assert_eq!(std::mem::size_of::<StackNode>(), 32);
+        assert_eq!(std::mem::size_of::<StackParams>(), 288);
+        assert_eq!(std::mem::offset_of!(StackParams, layers), 160);
+        assert_eq!(STACK_TEXTURE_WIDTH, 6);
     }
 }

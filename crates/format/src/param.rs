@@ -138,6 +138,10 @@ params! {
     BenchBaseIor => "bench_base_ior",
     /// The file an export writes.
     Out => "out",
+    /// Relative thicknesses of a stack's films, nm.
+    Relative => "relative",
+    /// The thickness-map channel of each film of a stack.
+    LayerChannel => "layer_channel",
     /// The glTF file's camera to render from.
     Camera => "camera",
     /// Orbit camera: rotation about the vertical, degrees.

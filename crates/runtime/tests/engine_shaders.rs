@@ -3,7 +3,8 @@
 //! with the WGSL modules they translate, and compile — no GPU needed
 //! (`tests/tests/engine_shaders_gpu.rs` proves they compute what nacre computes):
 //!
-//! * every function of common, lut_mapping, film_lut, film_fourier and rough_lut_mapping has
+//! * every function of common, lut_mapping, film_lut, film_fourier, rough_lut_mapping and
+//!   film_stack has
 //!   its counterpart `nacre_<name>` (a technique's `film_colour`: `nacre_<module>_colour`);
 //! * every constant `NAME` is `NACRE_NAME` with the same value, every struct `S` is
 //!   `NacreS` with the same fields in the same order;
@@ -24,12 +25,13 @@ use std::process::Command;
 mod support;
 use support::repo_root;
 
-const MODULES: [&str; 5] = [
+const MODULES: [&str; 6] = [
     "common",
     "lut_mapping",
     "film_lut",
     "film_fourier",
     "rough_lut_mapping",
+    "film_stack",
 ];
 
 fn read(path: &str) -> String {
@@ -114,11 +116,9 @@ fn struct_fields(source: &str, name: &str, wgsl: bool) -> Option<Vec<String>> {
                 if wgsl {
                     l.split(':').next().unwrap().trim().to_string()
                 } else {
-                    l.trim_end_matches(';')
-                        .split_whitespace()
-                        .last()
-                        .unwrap()
-                        .to_string()
+                    // `uvec4 rule_offset[4];` declares `rule_offset`.
+                    let name = l.trim_end_matches(';').split_whitespace().last().unwrap();
+                    name.split('[').next().unwrap().to_string()
                 }
             })
             .collect(),
@@ -244,7 +244,8 @@ void nacre_test(inout vec4 o) {
     NacreFilmOutput a = nacre_film_lut_colour(LUT_ARGS, lut_params, i);
     NacreFilmOutput b = nacre_film_fourier_colour(fourier_table, fourier_params, i);
     vec3 e = nacre_rough_lut_sample(ROUGH_ARGS, rough_params, 0.5, 0.2, 300.0, 1.4);
-    o = vec4(a.reflectance + a.transmittance + b.reflectance + b.transmittance + e, 1.0);
+    NacreFilmOutput s = nacre_film_stack_colour(stack_table, stack_params, i);
+    o = vec4(a.reflectance + a.transmittance + b.reflectance + b.transmittance + e + s.reflectance + s.transmittance, 1.0);
 }
 "#;
 
@@ -254,8 +255,9 @@ fn the_glsl_library_compiles_for_webgl_opengl_and_vulkan() {
     // GLSL ES 3.00 (three.js: precision statements first, combined samplers, plain uniforms).
     let es = format!(
         "#version 300 es\nprecision highp float;\nprecision highp int;\n\
-         precision highp sampler3D;\nprecision highp sampler2DArray;\n{lib}\n\
+         precision highp sampler3D;\nprecision highp sampler2DArray;\nprecision highp sampler2D;\n{lib}\n\
          uniform sampler3D lut_r;\nuniform sampler3D lut_t;\nuniform sampler2DArray fourier_table;\n\
+         uniform sampler2D stack_table;\nuniform NacreStackParams stack_params;\n\
          uniform NacreFilmLutParams lut_params;\nuniform NacreFourierParams fourier_params;\n\
          uniform NacreRoughLutParams rough_params;\nout vec4 colour;\n\
          #define LUT_ARGS lut_r, lut_t\n#define ROUGH_ARGS lut_r\n{GLSL_CONSUMER}\n\
@@ -267,8 +269,10 @@ fn the_glsl_library_compiles_for_webgl_opengl_and_vulkan() {
         "#version 450\n{lib}\n\
          layout(binding = 0) uniform sampler3D lut_r;\nlayout(binding = 1) uniform sampler3D lut_t;\n\
          layout(binding = 2) uniform sampler2DArray fourier_table;\n\
+         layout(binding = 4) uniform sampler2D stack_table;\n\
          layout(std140, binding = 3) uniform Params {{ NacreFilmLutParams lut_params; \
-         NacreFourierParams fourier_params; NacreRoughLutParams rough_params; }};\n\
+         NacreFourierParams fourier_params; NacreRoughLutParams rough_params; \
+         NacreStackParams stack_params; }};\n\
          layout(location = 0) out vec4 colour;\n\
          #define LUT_ARGS lut_r, lut_t\n#define ROUGH_ARGS lut_r\n{GLSL_CONSUMER}\n\
          void main() {{ nacre_test(colour); }}\n"
@@ -282,8 +286,10 @@ fn the_glsl_library_compiles_for_webgl_opengl_and_vulkan() {
          layout(set = 0, binding = 1) uniform texture3D lut_t;\n\
          layout(set = 0, binding = 2) uniform sampler lut_s;\n\
          layout(set = 0, binding = 3) uniform texture2DArray fourier_table;\n\
+         layout(set = 0, binding = 5) uniform texture2D stack_table;\n\
          layout(std140, set = 0, binding = 4) uniform Params {{ NacreFilmLutParams lut_params; \
-         NacreFourierParams fourier_params; NacreRoughLutParams rough_params; }};\n\
+         NacreFourierParams fourier_params; NacreRoughLutParams rough_params; \
+         NacreStackParams stack_params; }};\n\
          layout(location = 0) out vec4 colour;\n\
          #define LUT_ARGS lut_r, lut_s, lut_t, lut_s\n#define ROUGH_ARGS lut_r, lut_s\n{GLSL_CONSUMER}\n\
          void main() {{ nacre_test(colour); }}\n"
@@ -298,15 +304,17 @@ fn the_hlsl_library_and_the_shader_graph_entry_points_compile() {
     let lib = read("shaders/hlsl/nacre.hlsl");
     let plain = format!(
         "{lib}\nTexture3D<float4> lut_r;\nTexture3D<float4> lut_t;\nSamplerState lut_s;\n\
-         Texture2DArray<float4> fourier_table;\n\
+         Texture2DArray<float4> fourier_table;\nTexture2D<float4> stack_table;\n\
          cbuffer Params {{ NacreFilmLutParams lut_params; NacreFourierParams fourier_params; \
-         NacreRoughLutParams rough_params; }};\n\
+         NacreRoughLutParams rough_params; NacreStackParams stack_params; }};\n\
          float4 main() : SV_Target {{\n\
          NacreFilmInput i = nacre_make_film_input(0.5, 300.0, 1.4, 10.0, 1.0, (float3)1.5, (float3)0.0);\n\
          NacreFilmOutput a = nacre_film_lut_colour(lut_r, lut_s, lut_t, lut_s, lut_params, i);\n\
          NacreFilmOutput b = nacre_film_fourier_colour(fourier_table, fourier_params, i);\n\
          float3 e = nacre_rough_lut_sample(lut_r, lut_s, rough_params, 0.5, 0.2, 300.0, 1.4);\n\
-         return float4(a.reflectance + a.transmittance + b.reflectance + b.transmittance + e, 1.0);\n}}\n"
+         NacreFilmOutput s = nacre_film_stack_colour(stack_table, stack_params, i);\n\
+         return float4(a.reflectance + a.transmittance + b.reflectance + b.transmittance + e \
+         + s.reflectance + s.transmittance, 1.0);\n}}\n"
     );
     glslang(
         "plain.hlsl",

@@ -247,7 +247,7 @@ fn uniform_layouts_match_the_documented_ones() {
                 ("films", 0),
                 ("dispersive", 4),
                 ("rule_count", 8),
-                ("fixed", 12),
+                ("fixed_rule", 12),
                 ("base_count", 16),
                 ("count_per_opd_nm", 20),
                 ("finesse", 24),

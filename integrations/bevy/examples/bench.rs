@@ -1,6 +1,8 @@
 //! Frame time of the film material against `StandardMaterial` in the same Bevy scene: a grid
 //! of spheres filling a headless 1280 × 720 target, rendered with `StandardMaterial`, with
-//! `NacreMaterial` on `film_lut` and on `film_fourier`; each frame waits for the GPU. Prints
+//! `NacreMaterial` on `film_lut`, on `film_fourier` and on `film_stack` (the default
+//! two-film stack, `bevy_nacre::material::default_stack`, its top film d across the grid);
+//! each frame waits for the GPU. Prints
 //! milliseconds per frame (median of the timed frames) and the ratios. A benchmark, not a
 //! test: the figures go to BENCHMARKS.md.
 //!
@@ -150,7 +152,11 @@ fn main() {
     println!(
         "StandardMaterial: {standard:.2} ms/frame ({GRID}×{GRID} spheres, {WIDTH}×{HEIGHT}, median of {frames})"
     );
-    for technique in [FilmTechnique::Lut, FilmTechnique::Fourier] {
+    for technique in [
+        FilmTechnique::Lut,
+        FilmTechnique::Fourier,
+        FilmTechnique::Stack,
+    ] {
         let film = time_scene(Kind::Film(technique), frames);
         println!(
             "NacreMaterial ({technique:?}): {film:.2} ms/frame, {:.2}× StandardMaterial",

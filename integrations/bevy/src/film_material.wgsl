@@ -7,10 +7,13 @@
 // film's Airy reflectance replaces Fresnel in the microfacet BRDF, evaluated at the
 // microfacet angle cos θ = v·h). nacre's functions come from the repository's shaders,
 // registered as naga_oil modules (src/shaders.rs): `film_lut::film_colour` (a baked
-// film-lut table, bindings 100–103) and `film_fourier::film_colour` (any film on any base,
-// metals included, bindings 104–105). The technique is a shader def from the material's
-// pipeline key (`NACRE_FILM_LUT` or `NACRE_FILM_FOURIER`, src/material.rs), so a pipeline
-// compiles one of them. Bevy's functions are imported, never copied.
+// film-lut table, bindings 100–103), `film_fourier::film_colour` (any film on any base,
+// metals included, bindings 104–105) and `film_stack::film_colour` (a multilayer stack,
+// bindings 111–113: its nodes, indices and StackParams; the thickness texture's R, G, B give
+// its lower films' variations s_c = 2c − 1). The technique is a shader def from the material's
+// pipeline key (`NACRE_FILM_LUT`, `NACRE_FILM_FOURIER` or `NACRE_FILM_STACK`,
+// src/material.rs), so a pipeline compiles one of them. Bevy's functions are imported, never
+// copied.
 //
 // Symbols
 //
@@ -76,6 +79,7 @@
 #import nacre::common::{FilmInput, FilmOutput}
 #import nacre::film_lut
 #import nacre::film_fourier
+#import nacre::film_stack
 
 #ifdef PREPASS_PIPELINE
 #import bevy_pbr::{
@@ -101,7 +105,8 @@
 
 // Mirror of `NacreFilmUniform` (src/material.rs, 64 bytes).
 struct NacreFilmUniform {
-    // 0: film_lut, 1: film_fourier (the shader compiles one, chosen by shader def).
+    // 0: film_lut, 1: film_fourier, 2: film_stack (the shader compiles one, chosen by shader
+    // def).
     technique: u32,
     // 0: glTF d = mix(a, b, g); 1: SVT d = a + b (2g − 1).
     thickness_mode: u32,
@@ -128,10 +133,14 @@ struct NacreFilmUniform {
 
 // The film's colour through the material's technique.
 fn nacre_film_colour(input: FilmInput) -> FilmOutput {
+#ifdef NACRE_FILM_STACK
+    return film_stack::film_colour(input);
+#else
 #ifdef NACRE_FILM_FOURIER
     return film_fourier::film_colour(input);
 #else
     return film_lut::film_colour(input);
+#endif
 #endif
 }
 
@@ -306,12 +315,15 @@ fn fragment(
     // Thickness and weight textures (glTF: iridescenceThicknessTexture.g,
     // iridescenceTexture.r), sampled in uniform control flow.
     var thickness_g = 1.0;
+    // film_stack: the thickness texture's R, G, B (1 without one) vary its lower films.
+    var thickness_rgb = vec3<f32>(1.0);
     var weight = nacre_film.weight;
 #ifdef VERTEX_UVS_A
-    let g = textureSample(nacre_thickness_texture, nacre_thickness_sampler, in.uv).g;
+    let rgb = textureSample(nacre_thickness_texture, nacre_thickness_sampler, in.uv).rgb;
     let w = textureSample(nacre_weight_texture, nacre_weight_sampler, in.uv).r;
     if (nacre_film.flags & 1u) != 0u {
-        thickness_g = g;
+        thickness_g = rgb.g;
+        thickness_rgb = rgb;
     }
     if (nacre_film.flags & 2u) != 0u {
         weight *= w;
@@ -327,6 +339,9 @@ fn fragment(
     input.ambient_ior = nacre_film.ambient_ior;
     input.base_ior = nacre_film.base_ior;
     input.base_kappa = nacre_film.base_kappa;
+    input.variation = 2.0 * thickness_rgb.r - 1.0;
+    input.variation_g = 2.0 * thickness_rgb.g - 1.0;
+    input.variation_b = 2.0 * thickness_rgb.b - 1.0;
     let m = pbr_input.material.metallic;
     let base = pbr_input.material.base_color.rgb;
     let alpha = pbr_input.material.base_color.a;

@@ -7,8 +7,8 @@
 //!   ([`shaders`]), the table asset and its loader ([`tables`]; the default set is built
 //!   in), the film material [`NacreMaterial`] ([`material`]) and the glTF hook ([`gltf`]).
 //! * [`NacreMaterial`] = `ExtendedMaterial<StandardMaterial, NacreFilm>`: Bevy's PBR
-//!   lighting with nacre's film colour (`film_lut` or `film_fourier`) in place of the
-//!   specular Fresnel term.
+//!   lighting with nacre's film colour (`film_lut`, `film_fourier` or a multilayer
+//!   `film_stack`, [`NacreFilm::set_stack`]) in place of the specular Fresnel term.
 //!
 //! ```no_run
 //! use bevy::prelude::*;
@@ -39,7 +39,10 @@ pub mod material;
 pub mod shaders;
 pub mod tables;
 
-pub use material::{FilmTechnique, FilmThickness, NacreFilm, NacreFilmKey, NacreMaterial};
+pub use material::{
+    DEFAULT_STACK_INDICES, DEFAULT_STACK_NODES, FilmTechnique, FilmThickness, NacreFilm,
+    NacreFilmKey, NacreMaterial, StackUniform,
+};
 pub use tables::{DEFAULT_FILM_LUT, DEFAULT_FOURIER, NacreTable, NacreTableLoader};
 
 use bevy::app::{App, Plugin, PostUpdate};
@@ -65,6 +68,7 @@ impl Plugin for NacrePlugin {
             );
         shaders::register(&mut app.world_mut().resource_mut::<Assets<Shader>>());
         add_default_tables(app);
+        add_default_stack(app);
         if let Some(handlers) = app
             .world_mut()
             .get_resource_mut::<bevy::gltf::extensions::GltfExtensionHandlers>()
@@ -75,6 +79,18 @@ impl Plugin for NacrePlugin {
                 .push(Box::new(gltf::NacreGltfHandler::default()));
         }
     }
+}
+
+/// Uploads the default stack ([`material::default_stack`]) under [`DEFAULT_STACK_NODES`] and
+/// [`DEFAULT_STACK_INDICES`], which every [`NacreFilm`] binds until given its own.
+fn add_default_stack(app: &mut App) {
+    let (nodes, indices) = material::stack_buffers(&material::DEFAULT_STACK);
+    let mut buffers = app
+        .world_mut()
+        .resource_mut::<Assets<bevy::render::storage::ShaderBuffer>>();
+    // UUID handles never fail to insert.
+    let _ = buffers.insert(DEFAULT_STACK_NODES.id(), nodes);
+    let _ = buffers.insert(DEFAULT_STACK_INDICES.id(), indices);
 }
 
 /// Builds the compiled-in default set into [`DEFAULT_FILM_LUT`] and [`DEFAULT_FOURIER`].

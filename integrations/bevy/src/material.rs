@@ -9,7 +9,7 @@ use crate::tables::{
 use bevy::asset::{AssetEvent, Assets, Handle};
 use bevy::ecs::message::MessageReader;
 use bevy::image::Image;
-use bevy::math::Vec3;
+use bevy::math::{UVec4, Vec3, Vec4};
 use bevy::mesh::MeshVertexBufferLayoutRef;
 use bevy::pbr::{
     ExtendedMaterial, MaterialExtension, MaterialExtensionKey, MaterialExtensionPipeline,
@@ -22,8 +22,10 @@ use bevy::render::render_resource::{
     AsBindGroup, AsBindGroupShaderType, RenderPipelineDescriptor, ShaderType,
     SpecializedMeshPipelineError,
 };
+use bevy::render::storage::ShaderBuffer;
 use bevy::render::texture::GpuImage;
 use bevy::shader::ShaderRef;
+use nacre_format::gpu_params::{StackGpu, StackParams};
 
 /// `StandardMaterial` with a nacre thin film on top.
 pub type NacreMaterial = ExtendedMaterial<StandardMaterial, NacreFilm>;
@@ -40,6 +42,60 @@ pub enum FilmTechnique {
     /// The Fourier-series method (`film_fourier.wgsl`): any film index on any base, metals
     /// included, from [`NacreFilm::base_ior`] and [`NacreFilm::base_kappa`].
     Fourier,
+    /// A multilayer stack (`film_stack.wgsl`): ambient, 1 to 8 films, base, absorbing and
+    /// dispersive media, from [`NacreFilm::set_stack`] (a [`StackGpu`] prepared by
+    /// nacre, e.g. read from `nacre export --layer …`'s JSON with [`NacreFilm::stack_from_json`]).
+    /// The top film's thickness is the material's ([`NacreFilm::thickness`]); film j ≥ 2 is
+    /// d_j + r_j (2c − 1), c its channel (R, G or B) of the thickness texture (1 without one).
+    /// `film_ior`, `base_ior`, `base_kappa` and `ambient_ior` are ignored: the stack has them.
+    Stack,
+}
+
+/// Mirror of `StackParams` (`shaders/film_stack.wgsl`, 288 bytes; [`StackParams`] with
+/// Bevy's shader types).
+#[derive(Clone, Copy, Debug, Default, PartialEq, ShaderType, Reflect)]
+pub struct StackUniform {
+    /// Films F.
+    pub films: u32,
+    /// 1 when some index varies with wavelength.
+    pub dispersive: u32,
+    /// Rules in the ladder.
+    pub rule_count: u32,
+    /// 1: always rule 0.
+    pub fixed_rule: u32,
+    /// N at OPD 0.
+    pub base_count: f32,
+    /// Samples per nm of OPD.
+    pub count_per_opd_nm: f32,
+    /// The stack's finesse factor h.
+    pub finesse: f32,
+    /// Padding.
+    pub _pad0: f32,
+    /// First node of rule i (component i % 4 of element i / 4).
+    pub rule_offset: [UVec4; 4],
+    /// Nodes of rule i.
+    pub rule_size: [UVec4; 4],
+    /// Film j: (d_j⁰, r_j, k_j, c_j).
+    pub layers: [Vec4; 8],
+}
+
+impl From<&StackParams> for StackUniform {
+    fn from(p: &StackParams) -> Self {
+        let quad = |v: &[u32; 16], i: usize| UVec4::from_slice(&v[4 * i..4 * i + 4]);
+        StackUniform {
+            films: p.films,
+            dispersive: p.dispersive,
+            rule_count: p.rule_count,
+            fixed_rule: p.fixed_rule,
+            base_count: p.base_count,
+            count_per_opd_nm: p.count_per_opd_nm,
+            finesse: p.finesse,
+            _pad0: 0.0,
+            rule_offset: std::array::from_fn(|i| quad(&p.rule_offset, i)),
+            rule_size: std::array::from_fn(|i| quad(&p.rule_size, i)),
+            layers: p.layers.map(Vec4::from_array),
+        }
+    }
 }
 
 /// How the thickness texture's green channel g maps to the film thickness d.
@@ -76,7 +132,7 @@ impl Default for FilmThickness {
 /// Mirror of `NacreFilmUniform` (`film_material.wgsl`, 64 bytes).
 #[derive(Clone, Copy, Debug, Default, PartialEq, ShaderType)]
 pub struct NacreFilmUniform {
-    /// 0 film_lut, 1 film_fourier.
+    /// 0 film_lut, 1 film_fourier, 2 film_stack.
     pub technique: u32,
     /// 0 glTF, 1 SVT.
     pub thickness_mode: u32,
@@ -153,6 +209,72 @@ pub struct NacreFilm {
     /// fourier axes (from [`NacreFilm::fourier_table`]).
     #[uniform(105)]
     pub fourier_axes: FourierUniform,
+    /// The stack's nodes, `array<StackNode>` ([`NacreFilm::set_stack`]; by default
+    /// [`DEFAULT_STACK_NODES`]).
+    #[storage(111, read_only)]
+    pub stack_nodes: Handle<ShaderBuffer>,
+    /// Every medium's index at every node, `array<vec2<f32>>` ([`NacreFilm::set_stack`]).
+    #[storage(112, read_only)]
+    pub stack_indices: Handle<ShaderBuffer>,
+    /// The stack's uniform ([`NacreFilm::set_stack`]).
+    #[uniform(113)]
+    pub stack_params: StackUniform,
+}
+
+/// The nodes of the default stack (the runtime's `StackSetup::default()`: 100 nm of n 1.38
+/// over 60 nm of n 2.3 on glass n 1.5, the lower film varying by ±30 nm), built by
+/// [`crate::NacrePlugin`].
+pub const DEFAULT_STACK_NODES: Handle<ShaderBuffer> =
+    bevy::asset::uuid_handle!("6f0e35a4-3c1e-4b47-9d0e-4c5b1d6b0a21");
+/// The indices of the default stack.
+pub const DEFAULT_STACK_INDICES: Handle<ShaderBuffer> =
+    bevy::asset::uuid_handle!("6f0e35a4-3c1e-4b47-9d0e-4c5b1d6b0a22");
+
+/// The default stack's numbers ([`default_stack`]), prepared once.
+pub static DEFAULT_STACK: std::sync::LazyLock<StackGpu> = std::sync::LazyLock::new(default_stack);
+
+/// The default stack's numbers ([`DEFAULT_STACK_NODES`]): 1.38 @ 100 nm (r 0) over
+/// 2.3 @ 60 nm (r 30 nm) in air on n 1.5, 1931/D65/sRGB, the rule ladder.
+pub fn default_stack() -> StackGpu {
+    use nacre_optics::few_wavelengths::StackEvaluation;
+    use nacre_optics::{C64, Layer, Material, Stack};
+    let constant = |n: f64| {
+        Material::constant(format!("{n}"), C64::new(n, 0.0))
+            .expect("a real index above zero is a valid material")
+    };
+    let layer = |n: f64, d: f64| Layer {
+        material: constant(n),
+        thickness_nm: d,
+    };
+    let stack = Stack::new(
+        constant(1.0),
+        vec![layer(1.38, 100.0), layer(2.3, 60.0)],
+        constant(1.5),
+    )
+    .expect("finite thicknesses and a clear ambient");
+    let colorimeter = nacre_optics::colour::Colorimeter::new(
+        nacre_optics::colour::Observer::Cie1931_2Deg,
+        nacre_optics::colour::Illuminant::D65,
+        nacre_optics::colour::OutputSpace::Rgb(nacre_optics::colour::RgbSpace::Srgb),
+    );
+    let eval = StackEvaluation::new(&colorimeter, &stack, &[0.0, 30.0], None)
+        .expect("two films, valid relative thicknesses, the ladder");
+    StackGpu::new(&eval)
+}
+
+/// The storage buffers of `stack`'s nodes and indices.
+pub fn stack_buffers(stack: &StackGpu) -> (ShaderBuffer, ShaderBuffer) {
+    use bevy::asset::RenderAssetUsages;
+    (
+        ShaderBuffer::new(
+            bytemuck::cast_slice(&stack.nodes),
+            RenderAssetUsages::RENDER_WORLD,
+        ),
+        ShaderBuffer::new(
+            bytemuck::cast_slice(&stack.indices),
+            RenderAssetUsages::RENDER_WORLD,
+        ),
+    )
 }
 
 /// The film's part of the material's pipeline key (see [`FilmTechnique`]).
@@ -160,6 +282,36 @@ pub struct NacreFilm {
 pub struct NacreFilmKey {
     /// The technique the pipeline's fragment shader compiles.
     pub technique: FilmTechnique,
+}
+
+impl NacreFilm {
+    /// Draws `stack` ([`FilmTechnique::Stack`]): its buffers are added to `buffers`, its
+    /// uniform set, and the thickness set to the top film's SVT form (d⁰, r) from the stack.
+    pub fn set_stack(&mut self, stack: &StackGpu, buffers: &mut bevy::asset::Assets<ShaderBuffer>) {
+        let (nodes, indices) = stack_buffers(stack);
+        self.stack_nodes = buffers.add(nodes);
+        self.stack_indices = buffers.add(indices);
+        self.stack_params = StackUniform::from(&stack.params);
+        self.technique = FilmTechnique::Stack;
+        self.thickness = FilmThickness::Svt {
+            average_nm: stack.params.layers[0][0],
+            relative_nm: stack.params.layers[0][1],
+        };
+    }
+
+    /// The stack of the JSON `nacre export --layer … --out stack.json` writes (schema in
+    /// docs/engines/README.md), ready for [`NacreFilm::set_stack`].
+    ///
+    /// # Errors
+    /// Text that is not JSON, or JSON that is not a valid stack (naming `origin` and the field).
+    pub fn stack_from_json(text: &str, origin: &str) -> Result<StackGpu, nacre_format::Error> {
+        let value: serde_json::Value =
+            serde_json::from_str(text).map_err(|e| nacre_format::Error::Invalid {
+                context: origin.to_string().into(),
+                message: format!("not JSON: {e}").into(),
+            })?;
+        nacre_format::export::read_stack_json(&value, origin)
+    }
 }
 
 impl From<&NacreFilm> for NacreFilmKey {
@@ -176,6 +328,7 @@ impl FilmTechnique {
         match self {
             FilmTechnique::Lut => "NACRE_FILM_LUT",
             FilmTechnique::Fourier => "NACRE_FILM_FOURIER",
+            FilmTechnique::Stack => "NACRE_FILM_STACK",
         }
     }
 }
@@ -201,6 +354,9 @@ impl Default for NacreFilm {
             lut_axes: FilmLutUniform::default(),
             fourier_coefficients: None,
             fourier_axes: FourierUniform::default(),
+            stack_nodes: DEFAULT_STACK_NODES,
+            stack_indices: DEFAULT_STACK_INDICES,
+            stack_params: StackUniform::from(&DEFAULT_STACK.params),
         }
     }
 }
@@ -251,6 +407,7 @@ impl AsBindGroupShaderType<NacreFilmUniform> for NacreFilm {
             technique: match self.technique {
                 FilmTechnique::Lut => 0,
                 FilmTechnique::Fourier => 1,
+                FilmTechnique::Stack => 2,
             },
             thickness_mode,
             flags: u32::from(self.thickness_texture.is_some())

@@ -4,13 +4,14 @@
 //! (`include_str!`) and turns each into a naga_oil module that Bevy's composer imports:
 //!
 //! * `#define_import_path nacre::<module>` is prepended (`nacre::common`,
-//!   `nacre::lut_mapping`, `nacre::film_lut`, `nacre::film_fourier`);
+//!   `nacre::lut_mapping`, `nacre::film_lut`, `nacre::film_fourier`, `nacre::film_stack`);
 //! * the module's `// import: a, b` header line (shaders/README.md) becomes one
 //!   `#import nacre::a::{…}` line per name, listing every top-level `fn`, `struct` and
 //!   `const` of module `a` (naga_oil imports items, not whole namespaces);
 //! * a technique's bind group 1 (`@group(1) @binding(k)`) moves into Bevy's material bind
 //!   group at `@group(#{MATERIAL_BIND_GROUP}) @binding(base + k)` ([`FILM_LUT_BINDING`],
-//!   [`FILM_FOURIER_BINDING`]), where [`crate::NacreFilm`]'s `AsBindGroup` puts the tables.
+//!   [`FILM_FOURIER_BINDING`], [`FILM_STACK_BINDING`]), where [`crate::NacreFilm`]'s
+//!   `AsBindGroup` puts the tables and the stack's buffers.
 //!
 //! * struct members whose names naga's WGSL writer would change (a name ending in a digit or
 //!   `_`, or holding `__`: `_pad3`, `c0`, …), which naga_oil refuses in a composable module,
@@ -29,10 +30,13 @@ pub const FILM_LUT_BINDING: u32 = 100;
 /// First binding of `film_fourier.wgsl`'s group 1 in the material bind group (bindings
 /// 104–105: the coefficient texture, `FourierParams`).
 pub const FILM_FOURIER_BINDING: u32 = 104;
+/// First binding of `film_stack.wgsl`'s group 1 in the material bind group (bindings
+/// 111–113: the nodes, the indices, `StackParams`).
+pub const FILM_STACK_BINDING: u32 = 111;
 
 /// nacre's modules registered with Bevy, in dependency order: (name, source, first binding
 /// of its group 1).
-pub const MODULES: [(&str, &str, Option<u32>); 4] = [
+pub const MODULES: [(&str, &str, Option<u32>); 5] = [
     ("common", include_str!("../../../shaders/common.wgsl"), None),
     (
         "lut_mapping",
@@ -49,15 +53,21 @@ pub const MODULES: [(&str, &str, Option<u32>); 4] = [
         include_str!("../../../shaders/film_fourier.wgsl"),
         Some(FILM_FOURIER_BINDING),
     ),
+    (
+        "film_stack",
+        include_str!("../../../shaders/film_stack.wgsl"),
+        Some(FILM_STACK_BINDING),
+    ),
 ];
 
 /// Handles under which [`crate::NacrePlugin`] registers the modules (same order as
 /// [`MODULES`]).
-pub const MODULE_HANDLES: [Handle<Shader>; 4] = [
+pub const MODULE_HANDLES: [Handle<Shader>; 5] = [
     uuid_handle!("6f0e35a4-3c1e-4b47-9d0e-4c5b1d6b0a01"),
     uuid_handle!("6f0e35a4-3c1e-4b47-9d0e-4c5b1d6b0a02"),
     uuid_handle!("6f0e35a4-3c1e-4b47-9d0e-4c5b1d6b0a03"),
     uuid_handle!("6f0e35a4-3c1e-4b47-9d0e-4c5b1d6b0a04"),
+    uuid_handle!("6f0e35a4-3c1e-4b47-9d0e-4c5b1d6b0a05"),
 ];
 
 /// The material's fragment shader (`src/film_material.wgsl`).
@@ -298,6 +308,10 @@ mod tests {
         let fourier = naga_oil_source("film_fourier").unwrap();
         assert!(fourier.contains("@binding(104) var fourier_table"));
         assert!(fourier.contains("@binding(105) var<uniform> fourier_params"));
+        let stack = naga_oil_source("film_stack").unwrap();
+        assert!(stack.contains("@binding(111) var<storage, read> stack_nodes"));
+        assert!(stack.contains("@binding(112) var<storage, read> stack_indices"));
+        assert!(stack.contains("@binding(113) var<uniform> stack_params"));
     }
 
     #[test]

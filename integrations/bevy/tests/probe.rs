@@ -5,7 +5,11 @@
 //! lookup `nacre_format::film_lut::FilmLut::lookup` on the same KTX2 texels) and
 //! `--method fourier:auto` (`nacre_optics::fourier::FilmOnBase::fourier_colour_with` on
 //! the same table), over a grid of (cos θ, thickness, film index, base): within 2×10⁻³ per
-//! channel. A missing adapter fails the test.
+//! channel; and `film_stack` (the stack's buffers as [`NacreFilm::set_stack`] uploads them)
+//! against its CPU twin `StackEvaluation::colour` (`nacre color --method stack`) for a
+//! dispersive, absorbing four-film stack on silicon with one map channel per film, over the
+//! same points with random variations: within 10⁻⁴ per channel. A missing adapter fails the
+//! test.
 
 use bevy::prelude::*;
 use bevy::render::render_asset::RenderAssets;
@@ -25,18 +29,22 @@ use bevy::render::texture::GpuImage;
 use bevy::render::{Render, RenderApp, RenderSystems};
 use bevy::shader::{Shader, ShaderDefVal};
 use bevy_nacre::tables::{FilmLutUniform, FourierUniform, NacreTableAxes};
-use bevy_nacre::{DEFAULT_FILM_LUT, DEFAULT_FOURIER, NacreTable};
+use bevy_nacre::{DEFAULT_FILM_LUT, DEFAULT_FOURIER, NacreTable, StackUniform};
 use nacre_format::Manifest;
 use nacre_format::film_lut::FilmLut;
+use nacre_format::gpu_params::StackGpu;
 use nacre_optics::C64;
+use nacre_optics::few_wavelengths::StackEvaluation;
 use nacre_optics::fourier::{FilmOnBase, Harmonics};
 use std::sync::{Arc, Mutex};
 
 mod support;
 use support::{headless_app, repo_root};
 
-/// Floats per `FilmInput` (64 bytes) and per `ProbeOutput` (64 bytes).
+/// Floats per `FilmInput` (64 bytes).
 const STRIDE: usize = 16;
+/// Floats per `ProbeOutput` (96 bytes).
+const OUT_STRIDE: usize = 24;
 
 type Slot = Arc<Mutex<Option<Result<Vec<f32>, String>>>>;
 
@@ -48,6 +56,7 @@ struct Probe {
     images: [Handle<Image>; 3],
     lut_axes: FilmLutUniform,
     fourier_axes: FourierUniform,
+    stack: StackGpu,
     result: Slot,
     done: bool,
 }
@@ -83,7 +92,7 @@ fn run_probe(
     };
     let floats_to_bytes = |v: &[f32]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
     let count = probe.inputs.len() / STRIDE;
-    let size = (count * STRIDE * 4) as u64;
+    let size = (count * OUT_STRIDE * 4) as u64;
     let input = device.create_buffer_with_data(&BufferInitDescriptor {
         label: Some("nacre probe inputs"),
         contents: &floats_to_bytes(&probe.inputs),
@@ -111,6 +120,21 @@ fn run_probe(
         contents: &uniform_bytes(&probe.fourier_axes),
         usage: BufferUsages::UNIFORM,
     });
+    let stack_nodes = device.create_buffer_with_data(&BufferInitDescriptor {
+        label: Some("StackNode[]"),
+        contents: bytemuck::cast_slice(&probe.stack.nodes),
+        usage: BufferUsages::STORAGE,
+    });
+    let stack_indices = device.create_buffer_with_data(&BufferInitDescriptor {
+        label: Some("stack indices"),
+        contents: bytemuck::cast_slice(&probe.stack.indices),
+        usage: BufferUsages::STORAGE,
+    });
+    let stack_params = device.create_buffer_with_data(&BufferInitDescriptor {
+        label: Some("StackParams"),
+        contents: &uniform_bytes(&StackUniform::from(&probe.stack.params)),
+        usage: BufferUsages::UNIFORM,
+    });
     let layout = cache.get_bind_group_layout(&probe.layout);
     let bind_group = device.create_bind_group(
         "nacre probe",
@@ -124,6 +148,9 @@ fn run_probe(
             (103, lut_params.as_entire_binding()),
             (104, &fourier.texture_view),
             (105, fourier_params.as_entire_binding()),
+            (111, stack_nodes.as_entire_binding()),
+            (112, stack_indices.as_entire_binding()),
+            (113, stack_params.as_entire_binding()),
         )),
     );
     let mut encoder = device.create_command_encoder(&CommandEncoderDescriptor::default());
@@ -154,9 +181,9 @@ fn run_probe(
     probe.done = true;
 }
 
-/// Runs the probe on `inputs` (STRIDE floats each, `FilmInput`'s layout); per input
-/// (lut R, lut T, fourier R, fourier T).
-fn gpu_probe(inputs: Vec<f32>) -> Vec<[[f32; 3]; 4]> {
+/// Runs the probe on `inputs` (STRIDE floats each, `FilmInput`'s layout) with `stack`; per
+/// input (lut R, lut T, fourier R, fourier T, stack R, stack T).
+fn gpu_probe(inputs: Vec<f32>, stack: StackGpu) -> Vec<[[f32; 3]; 6]> {
     let mut app = headless_app(&repo_root());
     let (lut, fourier) = {
         let tables = app.world().resource::<Assets<NacreTable>>();
@@ -199,6 +226,9 @@ fn gpu_probe(inputs: Vec<f32>) -> Vec<[[f32; 3]; 4]> {
                     texture_2d_array(TextureSampleType::Float { filterable: false }),
                 ),
                 (105, uniform_buffer_sized(false, None)),
+                (111, storage_buffer_read_only_sized(false, None)),
+                (112, storage_buffer_read_only_sized(false, None)),
+                (113, uniform_buffer_sized(false, None)),
             ),
         ),
     );
@@ -228,6 +258,7 @@ fn gpu_probe(inputs: Vec<f32>) -> Vec<[[f32; 3]; 4]> {
         ],
         lut_axes,
         fourier_axes,
+        stack,
         result: result.clone(),
         done: false,
     });
@@ -237,7 +268,7 @@ fn gpu_probe(inputs: Vec<f32>) -> Vec<[[f32; 3]; 4]> {
         if let Some(r) = result.lock().unwrap().take() {
             let floats = r.unwrap_or_else(|e| panic!("{e}"));
             return floats
-                .chunks_exact(STRIDE)
+                .chunks_exact(OUT_STRIDE)
                 .map(|o| std::array::from_fn(|k| [o[4 * k], o[4 * k + 1], o[4 * k + 2]]))
                 .collect();
         }
@@ -262,6 +293,7 @@ struct Point {
     thickness_nm: f64,
     film_ior: f64,
     base: C64,
+    variation: [f64; 3],
 }
 
 fn film_input(p: &Point) -> [f32; STRIDE] {
@@ -270,6 +302,9 @@ fn film_input(p: &Point) -> [f32; STRIDE] {
     v[1] = p.thickness_nm as f32;
     v[2] = p.film_ior as f32;
     v[4] = 1.0; // ambient
+    for c in 0..3 {
+        v[5 + c] = p.variation[c] as f32;
+    }
     v[8..11].fill(p.base.re as f32);
     v[12..15].fill(p.base.im as f32);
     v
@@ -318,6 +353,7 @@ fn the_plugins_shader_functions_match_nacre_color() {
                     thickness_nm: axes.thickness_max_nm * f64::from(j) / 24.0,
                     film_ior: axes.ior_min + (axes.ior_max - axes.ior_min) * f64::from(k) / 6.0,
                     base: C64::new(1.5, 0.0),
+                    variation: [f64::from(i) / 4.0 - 1.0, f64::from(k) / 3.0 - 1.0, 0.5],
                 });
             }
         }
@@ -336,6 +372,7 @@ fn the_plugins_shader_functions_match_nacre_color() {
                 thickness_nm: rng.next() * 2000.0,
                 film_ior: 1.2 + rng.next() * 1.2,
                 base,
+                variation: [(); 3].map(|_| 2.0 * rng.next() - 1.0),
             });
         }
     }
@@ -344,7 +381,29 @@ fn the_plugins_shader_functions_match_nacre_color() {
         .chain(&fourier_points)
         .flat_map(film_input)
         .collect();
-    let gpu = gpu_probe(inputs);
+    // A dispersive, absorbing stack: MgF₂, TiO₂, 8 nm of chromium and water on silicon, one
+    // map channel per film.
+    let bundled = |name: &str| nacre_format::materials::resolve(name, "test", None).unwrap();
+    let layer = |name: &str, thickness_nm: f64| nacre_optics::Layer {
+        material: bundled(name),
+        thickness_nm,
+    };
+    let stack = nacre_optics::Stack::new(
+        bundled("air"),
+        vec![
+            layer("mgf2", 90.0),
+            layer("tio2", 50.0),
+            layer("cr", 8.0),
+            layer("water", 200.0),
+        ],
+        bundled("si"),
+    )
+    .unwrap();
+    let eval = StackEvaluation::new(&colorimeter, &stack, &[0.0, 15.0, 3.0, 60.0], None)
+        .unwrap()
+        .with_channels(&[0, 1, 2, 0])
+        .unwrap();
+    let gpu = gpu_probe(inputs.clone(), StackGpu::new(&eval));
     assert_eq!(gpu.len(), lut_points.len() + fourier_points.len());
     let (gpu_lut, gpu_fourier) = gpu.split_at(lut_points.len());
 
@@ -399,5 +458,30 @@ fn the_plugins_shader_functions_match_nacre_color() {
             cpu.len()
         );
         assert!(worst <= 2e-3, "film_fourier {name}: {worst:e}");
+    }
+    // The stack's CPU twin at the f32 inputs the GPU saw.
+    let cpu: Vec<([f64; 3], [f64; 3])> = inputs
+        .chunks_exact(STRIDE)
+        .map(|v| {
+            eval.colour(
+                f64::from(v[0]),
+                f64::from(v[1]),
+                [v[5], v[6], v[7]].map(f64::from),
+            )
+        })
+        .collect();
+    for (k, name) in [(4, "reflectance"), (5, "transmittance")] {
+        let c: Vec<[f64; 3]> = cpu.iter().map(|x| if k == 4 { x.0 } else { x.1 }).collect();
+        let g: Vec<[f32; 3]> = gpu.iter().map(|o| o[k]).collect();
+        let (worst, at) = max_diff(&c, &g);
+        eprintln!(
+            "film_stack {name}: {} points, max |GPU − CPU| = {worst:.2e}",
+            c.len()
+        );
+        assert!(
+            worst <= 1e-4,
+            "film_stack {name}: {worst:e} at input {:?}",
+            &inputs[at * STRIDE..at * STRIDE + 8]
+        );
     }
 }

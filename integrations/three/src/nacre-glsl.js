@@ -38,12 +38,18 @@ export const nacreGlsl = `// nacre · shaders/glsl/nacre.glsl — the film-lut, 
 #define NACRE_TEXTURE_2D_ARRAY(name) texture2DArray name
 #define NACRE_FETCH_2D_ARRAY(name, texel, lod) texelFetch(name, texel, lod)
 #define NACRE_SIZE_2D_ARRAY(name) textureSize(name, 0)
+#define NACRE_TEXTURE_2D_FLOAT(name) texture2D name
+#define NACRE_FETCH_2D(name, texel) texelFetch(name, texel, 0)
+#define NACRE_SIZE_2D(name) textureSize(name, 0)
 #else
 #define NACRE_TEXTURE_3D(name) sampler3D name
 #define NACRE_SAMPLE_3D(name, uvw) textureLod(name, uvw, 0.0)
 #define NACRE_TEXTURE_2D_ARRAY(name) sampler2DArray name
 #define NACRE_FETCH_2D_ARRAY(name, texel, lod) texelFetch(name, texel, lod)
 #define NACRE_SIZE_2D_ARRAY(name) textureSize(name, 0)
+#define NACRE_TEXTURE_2D_FLOAT(name) sampler2D name
+#define NACRE_FETCH_2D(name, texel) texelFetch(name, texel, 0)
+#define NACRE_SIZE_2D(name) textureSize(name, 0)
 #endif
 
 // ═══ shaders/common.wgsl ═══
@@ -1167,6 +1173,246 @@ vec3 nacre_rough_lut_sample(NACRE_TEXTURE_3D(table), NacreRoughLutParams p, floa
     vec3 e0 = NACRE_SAMPLE_3D(table, k.uvw0).rgb;
     vec3 e1 = NACRE_SAMPLE_3D(table, k.uvw1).rgb;
     return mix(e0, e1, k.blend);
+}
+
+// ═══ shaders/film_stack.wgsl ═══
+//
+// Real-time multilayer films: ambient | up to 8 films | base, every medium with a complex
+// index that may vary with wavelength, evaluated per pixel by the exact per-polarisation
+// recurrence of crates/optics/src/stack.rs at a few wavelengths chosen by the rule of
+// crates/optics/src/few_wavelengths/mod.rs. The GPU twin of \`nacre color --method stack\`
+// (\`nacre_optics::few_wavelengths::StackEvaluation\`); the capability of Sussenbach 2013 §4.2–4.3
+// (Algorithms 3 and 4) without its limits (dielectric films only, 5 uniform wavelengths).
+//
+// Symbols
+//
+//   symbol          code                          meaning
+//   m = 0 … M−1     medium index                  0 ambient, 1 … F films (top first), F+1 base
+//   ñ_m(λ_k)        stack_indices[k M + m]        complex index (n, κ) of medium m at node k
+//   d_j             thickness[j]                  film j's thickness at the pixel, nm
+//   d_j⁰, r_j       StackParams.layers[j].xy      film j's thickness and relative thickness, nm
+//   c_j             StackParams.layers[j].w       film j's thickness-map channel: 0 R, 1 G, 2 B
+//   s_c             FilmInput.variation(_g, _b)   spatial variation 2g_c − 1 ∈ [−1, 1] of channel c
+//   k_j             StackParams.layers[j].z       2 max_λ |ñ_j|: film j's OPD per nm
+//   h               StackParams.finesse           the stack's finesse factor (few_wavelengths/mod.rs)
+//   λ_k, W_k        StackNode                     node wavelength, per-channel weight
+//   q_m             q[m]                          ñ_m cos θ_m = √(ñ_m² − (n₀ sin θ₀)²), forward branch
+//   r, t            FresnelInterface              interface m → m+1 amplitudes (common.wgsl)
+//   Γ_m, τ_m        gamma, tau                    composite amplitudes below interface m
+//
+// Films: d_1 = FilmInput.thickness_nm (the pixel's film thickness, as for every technique),
+// d_j = max(0, d_j⁰ + r_j s_{c_j}) for j ≥ 2 (Sussenbach 2013 Eq. 4.3, d = d_avg + d_rel Δ(x),
+// with one map for all layers — every c_j = 0 — or one channel per layer).
+//
+// Rule: OPD = h Σ_j k_j d_j; N = ⌈base_count + count_per_opd_nm · OPD⌉ rounded up to the
+// ladder (StackParams.rule_size, increasing); the rule's nodes are stack_nodes[offset …
+// offset + N). With \`fixed_rule\` = 1 rule 0 is always used (\`stack:N\`).
+//
+// Recurrence at each node (stack.rs, Heavens 1955 §4): Γ_F = r_{F,F+1}, τ_F = t_{F,F+1}; for
+// m = F−1 … 0, with e = e^{iδ_{m+1}}, δ = 2π d q / λ,
+//
+//   Γ_m = (r + Γ_{m+1} e²) / (1 + r Γ_{m+1} e²),   τ_m = t τ_{m+1} e / (1 + r Γ_{m+1} e²)
+//
+// R = (|Γ_0,s|² + |Γ_0,p|²)/2, T = (|τ_0,s|² f_s + |τ_0,p|² f_p)/2 (the power factors of
+// common.wgsl, Byrnes' tmm conventions); C = Σ_k W_k R(λ_k) and likewise for T. Only e^{+iδ}
+// with Im δ ≥ 0 appears: thick, absorbing and evanescent (beyond the critical angle) films
+// never overflow. When no medium is dispersive (StackParams.dispersive = 0) the q_m and the
+// interfaces do not depend on λ and are computed once per pixel, before the wavelength loop
+// (the thesis's precalculation of wavelength-invariant terms).
+//
+// FilmInput fields used: cos_theta_i, thickness_nm, variation, variation_g, variation_b. The ambient index comes from
+// the stack (its real part), so do the base and the films; film_ior, ambient_ior, base_*
+// and sigma_thickness_nm are ignored. Indices are sanitised like a base index.
+//
+// Engine libraries: the WGSL reads its nodes and indices from two storage buffers, which
+// GLSL ES 3.00 (WebGL 2) lacks; here both live in one RGBA32F 2-D texture, the stack table
+// (\`nacre_format::gpu_params::StackGpu::texels\`, the \`texture\` of the JSON that \`nacre
+// export --layer …\` writes), read with texelFetch (no filtering): 6 texels a row, row k = node k,
+//
+//   texel (0, k)      (λ_k nm, W_k,r, W_k,g, W_k,b)
+//   texel (1 + i, k)  (n, κ) of medium 2i, (n, κ) of medium 2i + 1 (zeros past the base)
+//
+// and the number of nodes, arrayLength(&stack_nodes), is the table's height. The uniform is
+// NacreStackParams (the JSON's \`shader_params\`; std140 has the WGSL uniform's bytes). The
+// texture is a combined \`sampler2D\` (GLSL ES: declare \`precision highp sampler2D;\`), or
+// with NACRE_VULKAN_SEPARATE_SAMPLERS a \`texture2D\` read without a sampler.
+
+// One node (32 bytes, array stride 32, storage):
+//
+//   offset size field
+//        0    4 wavelength_nm: f32
+//        4   12 _pad0, _pad1, _pad2: f32
+//       16   16 weight: vec4<f32>     rgb: per-channel weight W_k; a: unused (0)
+struct NacreStackNode {
+    float wavelength_nm;
+    float _pad0;
+    float _pad1;
+    float _pad2;
+    vec4 weight;
+};
+
+// (288 bytes, uniform; \`nacre_runtime::params::StackParams\` mirrors it)
+//
+//   offset size field
+//        0    4 films: u32              F (1 … 8)
+//        4    4 dispersive: u32         1 when some index varies with λ
+//        8    4 rule_count: u32         rules in the ladder (≤ 16)
+//       12    4 fixed_rule: u32         1: always rule 0
+//       16    4 base_count: f32         N at OPD 0
+//       20    4 count_per_opd_nm: f32   samples per nm of OPD
+//       24    4 finesse: f32            h
+//       28    4 _pad0: f32
+//       32   64 rule_offset: array<vec4<u32>, 4>   first node of rule i (component i % 4 of i / 4)
+//       96   64 rule_size: array<vec4<u32>, 4>     nodes of rule i
+//      160  128 layers: array<vec4<f32>, 8>        film j: (d_j⁰, r_j, k_j, c_j)
+struct NacreStackParams {
+    uint films;
+    uint dispersive;
+    uint rule_count;
+    uint fixed_rule;
+    float base_count;
+    float count_per_opd_nm;
+    float finesse;
+    float _pad0;
+    uvec4 rule_offset[4];
+    uvec4 rule_size[4];
+    vec4 layers[8];
+};
+
+const uint NACRE_STACK_MAX_FILMS = 8u;
+
+// Node k of the stack table (\`stack_nodes[k]\`).
+NacreStackNode nacre_stack_node(NACRE_TEXTURE_2D_FLOAT(table), uint k) {
+    vec4 texel = NACRE_FETCH_2D(table, ivec2(0, int(k)));
+    NacreStackNode n;
+    n.wavelength_nm = texel.x;
+    n._pad0 = 0.0;
+    n._pad1 = 0.0;
+    n._pad2 = 0.0;
+    n.weight = vec4(texel.yzw, 0.0);
+    return n;
+}
+
+// Nodes in the stack table (arrayLength(&stack_nodes)): its height.
+uint nacre_stack_node_count(NACRE_TEXTURE_2D_FLOAT(table)) {
+    return uint(max(NACRE_SIZE_2D(table).y, 0));
+}
+
+// Rule i's (first node, node count).
+uvec2 nacre_stack_rule(NacreStackParams p, uint i) {
+    return uvec2(p.rule_offset[i / 4u][i % 4u], p.rule_size[i / 4u][i % 4u]);
+}
+
+// The rule for the pixel's OPD: the first whose count reaches ⌈base + slope · OPD⌉, else the last.
+uint nacre_stack_rule_for(NacreStackParams p, float opd_nm) {
+    uint rules = clamp(p.rule_count, 1u, 16u);
+    if (p.fixed_rule == 1u) {
+        return 0u;
+    }
+    float needed = ceil(p.base_count + p.count_per_opd_nm * max(opd_nm, 0.0));
+    for (uint i = 0u; i < rules; i++) {
+        if (float(nacre_stack_rule(p, i).y) >= needed) {
+            return i;
+        }
+    }
+    return rules - 1u;
+}
+
+// Medium m's index at node k, sanitised.
+vec2 nacre_stack_index(NACRE_TEXTURE_2D_FLOAT(table), uint k, uint m, uint media) {
+    vec4 texel = NACRE_FETCH_2D(table, ivec2(int(1u + m / 2u), int(k)));
+    vec2 n = (m % 2u) == 0u ? texel.xy : texel.zw;
+    return nacre_sanitize_base_index(n.x, n.y);
+}
+
+// film_colour of film_stack.wgsl: \`table\` is the stack table, \`p\` its uniform.
+NacreFilmOutput nacre_film_stack_colour(NACRE_TEXTURE_2D_FLOAT(table), NacreStackParams p, NacreFilmInput raw) {
+    NacreFilmInput inp = nacre_sanitize_input(raw);
+    float c = max(inp.cos_theta_i, NACRE_COS_THETA_MIN);
+    uint films = clamp(p.films, 1u, NACRE_STACK_MAX_FILMS);
+    uint media = films + 2u;
+    // Films' thicknesses at the pixel and the rule's OPD.
+    float thickness[8];
+    float opd = 0.0;
+    vec3 variation = vec3(inp.variation, inp.variation_g, inp.variation_b);
+    for (uint j = 0u; j < films; j++) {
+        vec4 layer = p.layers[j];
+        float d = inp.thickness_nm;
+        if (j > 0u) {
+            float s = variation[int(min(uint(clamp(layer.w, 0.0, 2.0)), 2u))];
+            d = clamp(layer.x + layer.y * s, 0.0, NACRE_THICKNESS_MAX_NM);
+            d = nacre_f32_is_finite(d) ? d : 0.0;
+        }
+        thickness[j] = d;
+        opd += layer.z * d;
+    }
+    uvec2 rule = nacre_stack_rule(p, nacre_stack_rule_for(p, opd * p.finesse));
+    uint first = rule.x;
+    uint node_count = nacre_stack_node_count(table);
+    uint count = min(rule.y, node_count - min(first, node_count));
+    vec2 q[10];
+    vec2 r_s[9];
+    vec2 r_p[9];
+    vec2 t_s[9];
+    vec2 t_p[9];
+    float factor_s = 0.0;
+    float factor_p = 0.0;
+    vec3 r = vec3(0.0);
+    vec3 t = vec3(0.0);
+    for (uint i = 0u; i < count; i++) {
+        uint k = first + i;
+        NacreStackNode node = nacre_stack_node(table, k);
+        if (!nacre_f32_is_finite(node.wavelength_nm) || !(node.wavelength_nm > 0.0)) {
+            continue;
+        }
+        if (i == 0u || p.dispersive != 0u) {
+            // Normal components and interfaces (wavelength-invariant without dispersion).
+            float n0 = nacre_stack_index(table, k, 0u, media).x;
+            vec2 prev = nacre_c_real(n0);
+            q[0] = nacre_c_real(n0 * c);
+            for (uint m = 1u; m < media; m++) {
+                vec2 n = nacre_stack_index(table, k, m, media);
+                q[m] = nacre_normal_component_cos(n, n0, c);
+                NacreFresnelInterface f = nacre_fresnel_interface(prev, q[m - 1u], n, q[m]);
+                r_s[m - 1u] = f.r_s;
+                r_p[m - 1u] = f.r_p;
+                t_s[m - 1u] = f.t_s;
+                t_p[m - 1u] = f.t_p;
+                prev = n;
+            }
+            factor_s = nacre_power_factor_s(q[0], q[media - 1u]);
+            factor_p = nacre_power_factor_p(nacre_c_real(n0), q[0], prev, q[media - 1u]);
+        }
+        vec2 gamma_s = r_s[films];
+        vec2 gamma_p = r_p[films];
+        vec2 tau_s = t_s[films];
+        vec2 tau_p = t_p[films];
+        for (uint jj = 0u; jj < films; jj++) {
+            uint m = films - 1u - jj;
+            // Film m + 1 (medium m + 1): e^{iδ} (phase in cycles reduced first) and
+            // e^{2iδ} = (e^{iδ})², as stack.rs forms it.
+            vec2 qf = q[m + 1u];
+            float x = nacre_safe_div(thickness[m], node.wavelength_nm);
+            vec2 e1 = nacre_c_exp_i_cycles(x * qf.x) * exp(-NACRE_TWO_PI * x * qf.y);
+            vec2 e2 = nacre_c_mul(e1, e1);
+            vec2 gs = nacre_c_mul(gamma_s, e2);
+            vec2 gp = nacre_c_mul(gamma_p, e2);
+            vec2 den_s = nacre_c_inv(vec2(1.0, 0.0) + nacre_c_mul(r_s[m], gs));
+            vec2 den_p = nacre_c_inv(vec2(1.0, 0.0) + nacre_c_mul(r_p[m], gp));
+            gamma_s = nacre_c_mul(r_s[m] + gs, den_s);
+            gamma_p = nacre_c_mul(r_p[m] + gp, den_p);
+            tau_s = nacre_c_mul(nacre_c_mul(nacre_c_mul(t_s[m], tau_s), e1), den_s);
+            tau_p = nacre_c_mul(nacre_c_mul(nacre_c_mul(t_p[m], tau_p), e1), den_p);
+        }
+        float reflectance = 0.5 * (nacre_unit_power(nacre_c_abs2(gamma_s)) + nacre_unit_power(nacre_c_abs2(gamma_p)));
+        float transmittance = 0.5 * (nacre_unit_power(nacre_c_abs2(tau_s) * factor_s) + nacre_unit_power(nacre_c_abs2(tau_p) * factor_p));
+        r += reflectance * node.weight.rgb;
+        t += transmittance * node.weight.rgb;
+    }
+    NacreFilmOutput o;
+    o.reflectance = r;
+    o.transmittance = t;
+    return nacre_sanitize_output(o);
 }
 
 #endif

@@ -85,3 +85,83 @@ pub fn random_points(seed: u64, count: usize, d_max: f64) -> Vec<(f64, f64, f64)
         })
         .collect()
 }
+
+/// The stacks of the `film_stack` probes (`gpu_probe.rs` for the WGSL technique,
+/// `engine_shaders_gpu.rs` for the GLSL and HLSL libraries): 1 to 8 films, dielectric,
+/// absorbing metal films (10 nm silver, chromium) and bases, dispersive materials, an ambient
+/// denser than its films (total internal reflection, evanescent films), the rule ladder
+/// (`None`) and a fixed rule of 16 nodes.
+pub fn stack_cases() -> Vec<(&'static str, nacre_optics::Stack, Option<usize>)> {
+    use nacre_format::materials;
+    use nacre_optics::{Layer, Stack};
+    let constant = |n: f64| Material::constant(format!("{n}"), C64::new(n, 0.0)).unwrap();
+    let bundled = |name: &str| materials::resolve(name, "test", None).unwrap();
+    let layer = |material: Material, thickness_nm: f64| Layer {
+        material,
+        thickness_nm,
+    };
+    vec![
+        (
+            "one film on gold",
+            Stack::new(
+                constant(1.0),
+                vec![layer(constant(1.45), 300.0)],
+                bundled("au"),
+            )
+            .unwrap(),
+            None,
+        ),
+        (
+            "metal-dielectric-metal",
+            Stack::new(
+                constant(1.0),
+                vec![layer(bundled("ag"), 10.0), layer(constant(1.38), 150.0)],
+                bundled("ag"),
+            )
+            .unwrap(),
+            None,
+        ),
+        (
+            "dispersive four films on silicon",
+            Stack::new(
+                bundled("air"),
+                vec![
+                    layer(bundled("mgf2"), 90.0),
+                    layer(bundled("tio2"), 50.0),
+                    layer(bundled("cr"), 8.0),
+                    layer(bundled("water"), 200.0),
+                ],
+                bundled("si"),
+            )
+            .unwrap(),
+            None,
+        ),
+        (
+            "eight films, fixed 16 nodes",
+            Stack::new(
+                constant(1.0),
+                (0..8)
+                    .map(|j| {
+                        layer(
+                            constant(if j % 2 == 0 { 1.38 } else { 2.3 }),
+                            40.0 + 10.0 * j as f64,
+                        )
+                    })
+                    .collect(),
+                constant(1.52),
+            )
+            .unwrap(),
+            Some(16),
+        ),
+        (
+            "dense ambient, total internal reflection",
+            Stack::new(
+                constant(1.6),
+                vec![layer(constant(1.0), 120.0), layer(constant(1.33), 200.0)],
+                constant(1.2),
+            )
+            .unwrap(),
+            None,
+        ),
+    ]
+}

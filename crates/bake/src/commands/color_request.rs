@@ -36,6 +36,23 @@ pub struct ColourSettings<'a> {
     pub space: Option<&'a str>,
 }
 
+/// The colorimeter of `settings` (1931, d65 and srgb where `None`). Errors: an unknown
+/// observer, illuminant or space, naming its parameter.
+pub fn colorimeter(settings: &ColourSettings) -> Result<Colorimeter> {
+    fn flag_err(flag: Param, v: &str) -> impl FnOnce(nacre_optics::Error) -> Error {
+        let v = v.to_string();
+        move |e| Error::value(flag, v, e.to_string())
+    }
+    let o = settings.observer.unwrap_or("1931");
+    let i = settings.illuminant.unwrap_or("d65");
+    let s = settings.space.unwrap_or("srgb");
+    Ok(Colorimeter::new(
+        o.parse().map_err(flag_err(Param::Observer, o))?,
+        i.parse().map_err(flag_err(Param::Illuminant, i))?,
+        s.parse().map_err(flag_err(Param::Space, s))?,
+    ))
+}
+
 /// A `nacre color` method with everything it needs, as given on the command line.
 #[derive(Clone, Copy, Debug)]
 pub struct ColorRequest<'a> {
@@ -194,18 +211,8 @@ pub fn prepare(stack: &Stack, method: Method, req: &ColorRequest) -> Result<Prep
             (Some(lut), c)
         }
         _ => {
-            fn flag_err(flag: Param, v: &str) -> impl FnOnce(nacre_optics::Error) -> Error {
-                let v = v.to_string();
-                move |e| Error::value(flag, v, e.to_string())
-            }
-            let o = given[0].clone().unwrap_or_else(|| "1931".into());
-            let i = given[1].clone().unwrap_or_else(|| "d65".into());
-            let s = given[2].clone().unwrap_or_else(|| "srgb".into());
-            let c = Colorimeter::new(
-                o.parse().map_err(flag_err(Param::Observer, &o))?,
-                i.parse().map_err(flag_err(Param::Illuminant, &i))?,
-                s.parse().map_err(flag_err(Param::Space, &s))?,
-            );
+            let c = colorimeter(&req.colour)?;
+            let s = req.colour.space.unwrap_or("srgb");
             if method == Method::Rgb3 && s == "xyz" {
                 return Err(Error::value(
                     Param::Method,

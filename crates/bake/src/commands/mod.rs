@@ -1,6 +1,7 @@
 //! The commands behind the `nacre` tool that evaluate rather than bake: `color` (its methods,
 //! and [`color_request`]: a method prepared from the command line's values), `compare`,
-//! `conformance`, `diffraction`, `spectrum`, `plot`, with their inputs (stack flags and
+//! `conformance`, `diffraction`, `spectrum`, `plot`, the stack JSON of `export`
+//! ([`export_stack`]), with their inputs (stack flags and
 //! recipes, angle/wavelength grids).
 
 pub mod color;
@@ -8,6 +9,7 @@ pub mod color_request;
 pub mod compare;
 pub mod conformance;
 pub mod diffraction;
+pub mod export_stack;
 pub mod grid;
 pub mod plot;
 pub mod spectrum;

@@ -25,7 +25,7 @@ mod stack;
 pub use entry::{BindInputs, Slot, TechniqueEntry};
 pub use options::{SpectralSetup, StackSetup, TechniqueOptions};
 pub use spectral::{SpectralParams, SpectralSample, spectral_samples};
-pub use stack::{StackNode, StackParams, stack_buffers};
+pub use stack::{StackGpu, StackNode, StackParams, stack_buffers, stack_gpu};
 
 /// How the film colour is computed: one variant per technique file, its entry in
 /// [`Technique::entry`].
