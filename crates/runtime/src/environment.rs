@@ -45,10 +45,10 @@ impl EnvironmentMap {
     /// crate. Negative values become 0.
     ///
     /// # Errors
-    /// [`Error::Io`] or [`Error::Table`] when the file cannot be read or is not a valid flat
-    /// single-part RGB OpenEXR image with finite values; [`Error::Invalid`] for a picture
-    /// that is not a valid PNG, JPEG or Radiance HDR file, or when a side is 0 or larger than
-    /// [`crate::image_io::MAX_DIMENSION`] (checked before the pixels are decoded).
+    /// [`Error::Io`] when the file cannot be read; [`Error::Image`] or [`Error::Table`] when it
+    /// is not a valid flat single-part RGB OpenEXR image with finite values, or not a valid
+    /// PNG, JPEG or Radiance HDR picture; [`Error::ImageSize`] when a side is 0 or larger
+    /// than [`crate::image_io::MAX_DIMENSION`] (checked before the pixels are decoded).
     pub fn load(path: &Path) -> Result<EnvironmentMap> {
         let bytes = std::fs::read(path).map_err(|source| Error::Io {
             path: path.to_path_buf(),
@@ -61,28 +61,26 @@ impl EnvironmentMap {
         if !named_exr && !bytes.starts_with(&EXR_MAGIC) {
             return Self::from_picture(path, &bytes);
         }
-        let header = std::panic::catch_unwind(|| {
-            exr::meta::MetaData::read_from_buffered(Cursor::new(&bytes[..]), false)
-        });
-        let meta = match header {
-            Ok(Ok(meta)) => meta,
-            Ok(Err(e)) => {
-                return Err(Error::Image {
-                    path: path.to_path_buf(),
-                    message: format!("not a valid OpenEXR file: {e}"),
-                });
-            }
-            Err(_) => {
-                return Err(Error::Image {
-                    path: path.to_path_buf(),
-                    message: "malformed OpenEXR header (the decoder failed)".into(),
-                });
-            }
-        };
+        // The header alone first, so that a huge image is refused before its pixels are
+        // decoded; a panic in the decoder is an error naming the file.
+        let meta = nacre_format::decode::guarded(
+            || {
+                exr::meta::MetaData::read_from_buffered(Cursor::new(&bytes[..]), false).map_err(
+                    |e| Error::Image {
+                        path: path.to_path_buf(),
+                        message: format!("not a valid OpenEXR file: {e}"),
+                    },
+                )
+            },
+            || Error::Image {
+                path: path.to_path_buf(),
+                message: "malformed OpenEXR header (the decoder failed)".into(),
+            },
+        )?;
         if let Some(h) = meta.headers.first() {
             check_image_size(path, "an environment", h.layer_size.0, h.layer_size.1)?;
         }
-        let (atlas, _) = nacre_format::table_io::read_exr(path)?;
+        let (atlas, _) = nacre_format::table_io::decode_exr_bytes(path, &bytes)?;
         check_image_size(path, "an environment", atlas.width, atlas.height)?;
         Ok(EnvironmentMap {
             width: atlas.width,

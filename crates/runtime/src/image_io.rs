@@ -10,7 +10,8 @@ pub const MAX_DIMENSION: u32 = 8192;
 /// Decodes the picture `bytes` read from `path` (PNG, JPEG or Radiance HDR, told apart by
 /// their content): its size is checked against [`MAX_DIMENSION`] (`what` names the picture
 /// in the error) before the pixels are decoded, and a decoder failure is an error, not a
-/// panic.
+/// panic (the decoders run under [`nacre_format::decode::guarded`], as every decoder of an
+/// untrusted file does).
 ///
 /// # Errors
 /// [`Error::Image`] or [`Error::ImageSize`] naming `path`: not a picture of those formats, malformed, or too large.
@@ -39,10 +40,8 @@ pub(crate) fn decode_picture(path: &Path, what: &str, bytes: &[u8]) -> Result<im
         r.decode()
             .map_err(|e| invalid(format!("not a valid picture: {e}")))
     };
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(decode)).unwrap_or_else(|_| {
-        Err(invalid(
-            "malformed picture data (the decoder failed)".into(),
-        ))
+    nacre_format::decode::guarded(decode, || {
+        invalid("malformed picture data (the decoder failed)".into())
     })
 }
 

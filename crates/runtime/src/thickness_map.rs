@@ -33,9 +33,10 @@ impl ThicknessMap {
     /// colour picture's R is `values` and its G and B are `green_blue`.
     ///
     /// # Errors
-    /// [`Error::Io`] when the file cannot be read; [`Error::Invalid`] when it is not a valid
-    /// PNG or JPEG, not 8- or 16-bit, or a side is 0 or larger than
-    /// [`crate::image_io::MAX_DIMENSION`] (checked before the pixels are decoded).
+    /// [`Error::Io`] when the file cannot be read; [`Error::Image`] when it is not a valid
+    /// PNG or JPEG; [`Error::ThicknessMap`] when it is not 8- or 16-bit; [`Error::ImageSize`]
+    /// when a side is 0 or larger than [`crate::image_io::MAX_DIMENSION`] (checked before
+    /// the pixels are decoded).
     pub fn load(path: &Path) -> Result<ThicknessMap> {
         let bytes = std::fs::read(path).map_err(|source| Error::Io {
             path: path.to_path_buf(),
