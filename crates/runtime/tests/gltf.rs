@@ -18,7 +18,7 @@ use naga::valid::{Capabilities, ValidationFlags, Validator};
 use std::path::{Path, PathBuf};
 
 mod support;
-use support::{ctx, repo_root};
+use support::{ctx, film_tables, manifest, repo_root};
 
 fn asset_dir() -> PathBuf {
     repo_root().join("tests/golden/gltf")
@@ -26,14 +26,6 @@ fn asset_dir() -> PathBuf {
 
 fn updating() -> bool {
     std::env::var("NACRE_UPDATE_GOLDEN").is_ok_and(|v| v == "1")
-}
-
-/// The tables of `nacre render --gltf`: film-dielectric + fourier-srgb.
-fn tables() -> TableSet {
-    let baked = nacre_format::set::default_baked_dir();
-    let mut tables = TableSet::load(ctx(), &baked.join("film-dielectric.json")).unwrap();
-    tables.add(ctx(), &baked.join("fourier-srgb.json")).unwrap();
-    tables
 }
 
 /// Image size of the sweep renders: five spheres in a row.
@@ -136,7 +128,7 @@ fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
 #[test]
 fn sweeps_render_and_parameters_change_colours() {
     let ctx = ctx();
-    let tables = tables();
+    let tables = film_tables("film-dielectric");
     for technique in [Technique::Lut, Technique::Fourier] {
         for sweep in &SWEEPS {
             let name = format!("{} ({})", sweep.file, technique.name());
@@ -208,7 +200,7 @@ fn sweeps_render_and_parameters_change_colours() {
 #[test]
 fn gltf_meshes_render_with_the_rough_film_paths() {
     let ctx = ctx();
-    let mut tables = tables();
+    let mut tables = film_tables("film-dielectric");
     let scene = GltfScene::load(&asset_dir().join("sweep-thickness.glb")).unwrap();
     let render = |tables: &TableSet, film_eval: FilmEval| {
         let mut o = options();
@@ -219,10 +211,7 @@ fn gltf_meshes_render_with_the_rough_film_paths() {
         .err()
         .expect("exact without its table");
     assert!(err.to_string().contains("rough-film-lut"), "{err}");
-    let baked = nacre_format::set::default_baked_dir();
-    tables
-        .add(ctx, &baked.join("rough-film-dielectric.json"))
-        .unwrap();
+    tables.add(ctx, &manifest("rough-film-dielectric")).unwrap();
     let classic = render(&tables, FilmEval::Classic).unwrap().image;
     let background = |image: &RenderedImage| [image.pixels[0], image.pixels[1], image.pixels[2]];
     let covered = |image: &RenderedImage| {
@@ -275,7 +264,7 @@ fn read_png_rgb(path: &Path) -> Option<(u32, u32, Vec<u8>)> {
 #[test]
 fn golden_image_of_the_thickness_sweep() {
     let ctx = ctx();
-    let tables = tables();
+    let tables = film_tables("film-dielectric");
     let scene = GltfScene::load(&asset_dir().join("sweep-thickness.glb")).unwrap();
     let out = render_gltf(ctx, &tables, Technique::Lut, &scene, &options()).unwrap();
     let reference_path = asset_dir().join("sweep-thickness-lut.png");
@@ -464,11 +453,12 @@ fn bad_gltf_files_are_errors() {
 
     // Absurd image sizes are refused before any GPU work.
     let scene = GltfScene::load(&asset_dir().join(SWEEPS[0].file)).unwrap();
-    let mut o = options();
-    o.width = 0;
-    assert!(render_gltf(ctx(), &tables(), Technique::Fourier, &scene, &o).is_err());
-    o.width = 100_000;
-    assert!(render_gltf(ctx(), &tables(), Technique::Fourier, &scene, &o).is_err());
+    let tables = film_tables("film-dielectric");
+    for width in [0, 100_000] {
+        let mut o = options();
+        o.width = width;
+        assert!(render_gltf(ctx(), &tables, Technique::Fourier, &scene, &o).is_err());
+    }
 }
 
 /// The file's cameras and KHR_lights_punctual lights are read with their nodes' transforms;
@@ -641,7 +631,14 @@ fn every_punctual_light_is_drawn() {
         o.env_intensity = 0.0;
         let mut scene = plain.clone();
         scene.lights = lights;
-        let out = render_gltf(ctx(), &tables(), Technique::Fourier, &scene, &o).unwrap();
+        let out = render_gltf(
+            ctx(),
+            &film_tables("film-dielectric"),
+            Technique::Fourier,
+            &scene,
+            &o,
+        )
+        .unwrap();
         let grey = |k| sphere_colour(&scene, &out.image, k).iter().sum::<f64>() / 3.0;
         (grey(0), grey(4))
     };
@@ -909,7 +906,14 @@ fn unlit_materials_show_their_base_colour() {
     let bytes = nacre_runtime::gltf_scene::assets::glb(&doc, &good[20 + json_len + 8..]);
     let scene = GltfScene::from_bytes(&bytes, Path::new("unlit.glb")).unwrap();
     assert!(scene.materials[0].unlit);
-    let out = render_gltf(ctx(), &tables(), Technique::Lut, &scene, &options()).unwrap();
+    let out = render_gltf(
+        ctx(),
+        &film_tables("film-dielectric"),
+        Technique::Lut,
+        &scene,
+        &options(),
+    )
+    .unwrap();
     let image = &out.image;
     let background = pixel(image, (0, 0));
     // sRGB encoding (IEC 61966-2-1) of the linear base colour, 0–255.
@@ -1099,9 +1103,15 @@ fn clearcoat_layers_over_the_base_as_the_extension_says() {
         o.env_intensity = radiance_l as f32;
         o.film_eval = eval;
         let render = |scene: &GltfScene| {
-            render_gltf(ctx(), &tables(), Technique::Fourier, scene, &o)
-                .unwrap()
-                .image
+            render_gltf(
+                ctx(),
+                &film_tables("film-dielectric"),
+                Technique::Fourier,
+                scene,
+                &o,
+            )
+            .unwrap()
+            .image
         };
         let bare_image = render(&bare);
         assert!(

@@ -10,43 +10,13 @@
 //! the default view) from below. The directory missing is a failure when the `CI`
 //! environment variable is set, a skip (with a message) elsewhere.
 
+use nacre_runtime::Technique;
 use nacre_runtime::gltf_scene::GltfScene;
 use nacre_runtime::mesh::{Orbit, ViewPoint, render_gltf_from};
 use nacre_runtime::render::{RenderedImage, SceneKind, SceneOptions};
-use nacre_runtime::{TableSet, Technique};
-use std::path::PathBuf;
 
 mod support;
-use support::{ctx, repo_root};
-
-/// `../shared/gltf-samples` (or `$NACRE_GLTF_SAMPLES`, for a checkout elsewhere, such as a
-/// git worktree), or `None` (skip) outside CI; a panic in CI.
-fn samples() -> Option<PathBuf> {
-    let dir = std::env::var_os("NACRE_GLTF_SAMPLES")
-        .map_or_else(|| repo_root().join("../shared/gltf-samples"), PathBuf::from);
-    if dir.is_dir() {
-        return Some(dir);
-    }
-    if std::env::var_os("CI").is_some() {
-        panic!(
-            "{} is missing: CI must provide the Khronos glTF samples (../shared/DATA.md)",
-            dir.display()
-        );
-    }
-    eprintln!(
-        "skipped: {} not found (the Khronos glTF samples of ../shared/DATA.md)",
-        dir.display()
-    );
-    None
-}
-
-/// The default set's tables of a glTF render.
-fn tables() -> TableSet {
-    let baked = nacre_format::set::default_baked_dir();
-    let mut tables = TableSet::load(ctx(), &baked.join("film-dielectric.json")).unwrap();
-    tables.add(ctx(), &baked.join("fourier-srgb.json")).unwrap();
-    tables
-}
+use support::{ctx, film_tables, gltf_samples};
 
 fn options() -> SceneOptions {
     let mut o = SceneOptions::new(SceneKind::Sphere);
@@ -55,9 +25,16 @@ fn options() -> SceneOptions {
 }
 
 fn render(scene: &GltfScene, view: ViewPoint) -> RenderedImage {
-    render_gltf_from(ctx(), &tables(), Technique::Lut, scene, &options(), view)
-        .unwrap_or_else(|e| panic!("{}: {e}", scene.path.display()))
-        .image
+    render_gltf_from(
+        ctx(),
+        &film_tables("film-dielectric"),
+        Technique::Lut,
+        scene,
+        &options(),
+        view,
+    )
+    .unwrap_or_else(|e| panic!("{}: {e}", scene.path.display()))
+    .image
 }
 
 /// Per pixel, the sum over R, G, B of |a − b| (0 to 765 levels).
@@ -131,7 +108,7 @@ const BELOW: ViewPoint = ViewPoint::Orbit(Orbit {
 
 #[test]
 fn every_film_the_physics_makes_visible_shows() {
-    let Some(dir) = samples() else { return };
+    let Some(dir) = gltf_samples() else { return };
     let default = ("default view", ViewPoint::default());
     let cases = [
         Case {

@@ -5,14 +5,13 @@
 //! `extensionsRequired`) renders like its `.gltf`. The directory missing is a failure when
 //! the `CI` environment variable is set, a skip (with a message) elsewhere.
 
+use nacre_runtime::Technique;
 use nacre_runtime::gltf_scene::GltfScene;
 use nacre_runtime::mesh::{ViewPoint, render_gltf, render_gltf_from};
 use nacre_runtime::render::{RenderedImage, SceneKind, SceneOptions};
-use nacre_runtime::{TableSet, Technique};
-use std::path::PathBuf;
 
 mod support;
-use support::{ctx, repo_root};
+use support::{ctx, film_tables, gltf_samples};
 
 const ASSETS: [&str; 6] = [
     "IridescenceMetallicSpheres",
@@ -22,32 +21,6 @@ const ASSETS: [&str; 6] = [
     "IridescentDishWithOlives",
     "IridescenceAbalone",
 ];
-
-/// `../shared/gltf-samples`, or `None` (skip) outside CI; a panic in CI.
-fn samples() -> Option<PathBuf> {
-    let dir = repo_root().join("../shared/gltf-samples");
-    if dir.is_dir() {
-        return Some(dir);
-    }
-    if std::env::var_os("CI").is_some() {
-        panic!(
-            "{} is missing: CI must provide the Khronos glTF samples (../shared/DATA.md)",
-            dir.display()
-        );
-    }
-    eprintln!(
-        "skipped: {} not found (the Khronos glTF samples of ../shared/DATA.md)",
-        dir.display()
-    );
-    None
-}
-
-fn tables() -> TableSet {
-    let baked = nacre_format::set::default_baked_dir();
-    let mut tables = TableSet::load(ctx(), &baked.join("film-dielectric.json")).unwrap();
-    tables.add(ctx(), &baked.join("fourier-srgb.json")).unwrap();
-    tables
-}
 
 fn options() -> SceneOptions {
     let mut o = SceneOptions::new(SceneKind::Sphere);
@@ -72,8 +45,8 @@ fn colourfulness(image: &RenderedImage) -> f64 {
 
 #[test]
 fn khronos_iridescence_assets_load_and_render() {
-    let Some(dir) = samples() else { return };
-    let tables = tables();
+    let Some(dir) = gltf_samples() else { return };
+    let tables = film_tables("film-dielectric");
     for name in ASSETS {
         let path = dir.join(name).join("glTF").join(format!("{name}.gltf"));
         let scene = GltfScene::load(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -116,8 +89,8 @@ fn khronos_iridescence_assets_load_and_render() {
 
 #[test]
 fn suzanne_glb_requires_iridescence_and_renders_like_the_gltf() {
-    let Some(dir) = samples() else { return };
-    let tables = tables();
+    let Some(dir) = gltf_samples() else { return };
+    let tables = film_tables("film-dielectric");
     let base = dir.join("IridescenceSuzanne");
     let glb = GltfScene::load(&base.join("glTF-Binary/IridescenceSuzanne.glb"))
         .expect("a file that requires KHR_materials_iridescence loads");
@@ -145,8 +118,8 @@ fn suzanne_glb_requires_iridescence_and_renders_like_the_gltf() {
 /// against the same primitives with the film weight set to 0.
 #[test]
 fn the_films_colour_their_regions_of_the_artist_made_assets() {
-    let Some(dir) = samples() else { return };
-    let tables = tables();
+    let Some(dir) = gltf_samples() else { return };
+    let tables = film_tables("film-dielectric");
     // (asset, least chroma with the film, least gain over the same without it). Measured on
     // lavapipe, lit by the default environment alone: 33.0 / 13.0 / 12.0 with the film,
     // 13.8 / 5.6 / 9.4 without (the Abalone's textures are coloured already).

@@ -14,11 +14,7 @@ use nacre_runtime::{FilmInput, TableSet, Technique};
 use std::path::{Path, PathBuf};
 
 mod support;
-use support::ctx;
-
-fn manifest(name: &str) -> PathBuf {
-    default_baked_dir().join(format!("{name}.json"))
-}
+use support::{ctx, manifest};
 
 /// Copies table `name` into `dir` with only its KTX2 files listed (and copied); returns
 /// the new manifest's path.

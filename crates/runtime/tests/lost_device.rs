@@ -8,16 +8,14 @@ use nacre_runtime::params::FilmInput;
 use nacre_runtime::probe::run_probe;
 use nacre_runtime::render::{SceneKind, SceneOptions, render_scene};
 use nacre_runtime::{Error, GpuContext, TableSet, Technique};
-use std::path::PathBuf;
+
+mod support;
+use support::manifest;
 
 fn fresh_context() -> GpuContext {
     GpuContext::new_headless().unwrap_or_else(|e| {
         panic!("the lost-device tests need an adapter (CI installs mesa-vulkan-drivers): {e}")
     })
-}
-
-fn manifest(name: &str) -> PathBuf {
-    nacre_format::set::default_baked_dir().join(format!("{name}.json"))
 }
 
 fn small_sphere() -> SceneOptions {

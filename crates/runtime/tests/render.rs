@@ -22,7 +22,7 @@ use naga::valid::{Capabilities, ValidationFlags, Validator};
 use std::path::{Path, PathBuf};
 
 mod support;
-use support::{ctx, repo_root, translate};
+use support::{ctx, film_tables, repo_root, translate};
 
 fn golden_dir() -> PathBuf {
     repo_root().join("tests/golden/render")
@@ -43,10 +43,7 @@ fn tables_for(scene: SceneKind) -> TableSet {
         SceneKind::Bubble => "soap-film",
         SceneKind::Plane => "oil-slick",
     };
-    let baked = nacre_format::set::default_baked_dir();
-    let mut tables = TableSet::load(ctx(), &baked.join(format!("{lut}.json"))).unwrap();
-    tables.add(ctx(), &baked.join("fourier-srgb.json")).unwrap();
-    tables
+    film_tables(lut)
 }
 
 // ─── Shaders, no GPU ───────────────────────────────────────────────────────────────────────

@@ -2,7 +2,7 @@
 //! Each test binary uses only some of them.
 #![allow(dead_code)]
 
-use nacre_runtime::GpuContext;
+use nacre_runtime::{GpuContext, TableSet};
 use naga::back::{glsl, hlsl, msl, spv};
 use naga::valid::{Capabilities, ModuleInfo, ValidationFlags, Validator};
 use std::path::PathBuf;
@@ -24,6 +24,50 @@ pub fn ctx() -> &'static GpuContext {
 /// The repository root.
 pub fn repo_root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// The manifest of the default set's table `name` (`film-dielectric` →
+/// `tables/baked/film-dielectric.json`).
+pub fn manifest(name: &str) -> PathBuf {
+    nacre_format::set::default_baked_dir().join(format!("{name}.json"))
+}
+
+/// The default set's film-lut `lut` and `fourier-srgb` on `ctx`: the tables of `nacre
+/// render` (with `film-dielectric`, those of `nacre render --gltf`).
+pub fn film_tables_on(ctx: &GpuContext, lut: &str) -> TableSet {
+    let mut tables = TableSet::load(ctx, &manifest(lut))
+        .unwrap_or_else(|e| panic!("the default table {lut}: {e}"));
+    tables
+        .add(ctx, &manifest("fourier-srgb"))
+        .unwrap_or_else(|e| panic!("the default table fourier-srgb: {e}"));
+    tables
+}
+
+/// [`film_tables_on`] the test binary's context.
+pub fn film_tables(lut: &str) -> TableSet {
+    film_tables_on(ctx(), lut)
+}
+
+/// Khronos' glTF sample assets, `../shared/gltf-samples` (or `$NACRE_GLTF_SAMPLES`, for a
+/// checkout elsewhere), not part of this repository (`../shared/DATA.md`): `None` (the
+/// test skips, saying why) when missing outside CI; a panic when missing in CI (`CI` set).
+pub fn gltf_samples() -> Option<PathBuf> {
+    let dir = std::env::var_os("NACRE_GLTF_SAMPLES")
+        .map_or_else(|| repo_root().join("../shared/gltf-samples"), PathBuf::from);
+    if dir.is_dir() {
+        return Some(dir);
+    }
+    if std::env::var_os("CI").is_some() {
+        panic!(
+            "{} is missing: CI must provide the Khronos glTF samples (../shared/DATA.md)",
+            dir.display()
+        );
+    }
+    eprintln!(
+        "skipped: {} not found (the Khronos glTF samples of ../shared/DATA.md)",
+        dir.display()
+    );
+    None
 }
 
 /// Parses and validates WGSL `source`, panicking with naga's annotated report (line and
