@@ -37,11 +37,12 @@ pub(super) struct Primitives<'a> {
     corners: usize,
 }
 
-/// The component types an attribute may have: `(type, normalized)`.
+/// The component types an accessor may have: `(type, normalized)`.
 type Allowed = &'static [(DataType, bool)];
 const FLOAT: Allowed = &[(DataType::F32, false)];
-/// `KHR_mesh_quantization`'s POSITION types (besides float).
-const QUANTIZED_POSITION: Allowed = &[
+/// Float or any 8- or 16-bit integer, normalised or not (`KHR_mesh_quantization`'s POSITION
+/// and TEXCOORD types).
+const FLOAT_OR_SHORT: Allowed = &[
     (DataType::F32, false),
     (DataType::I8, false),
     (DataType::I8, true),
@@ -52,28 +53,18 @@ const QUANTIZED_POSITION: Allowed = &[
     (DataType::U16, false),
     (DataType::U16, true),
 ];
-/// `KHR_mesh_quantization`'s NORMAL and TANGENT types.
-const QUANTIZED_DIRECTION: Allowed = &[
+/// Float or a normalised signed 8- or 16-bit integer (`KHR_mesh_quantization`'s NORMAL and
+/// TANGENT types).
+const FLOAT_OR_SIGNED_NORMALIZED: Allowed = &[
     (DataType::F32, false),
     (DataType::I8, true),
     (DataType::I16, true),
 ];
-/// Core glTF's TEXCOORD and COLOR types.
-const CORE_TEXCOORD: Allowed = &[
+/// Float or a normalised unsigned 8- or 16-bit integer (core glTF's TEXCOORD and COLOR
+/// types).
+const FLOAT_OR_UNSIGNED_NORMALIZED: Allowed = &[
     (DataType::F32, false),
     (DataType::U8, true),
-    (DataType::U16, true),
-];
-/// `KHR_mesh_quantization`'s TEXCOORD types.
-const QUANTIZED_TEXCOORD: Allowed = &[
-    (DataType::F32, false),
-    (DataType::I8, false),
-    (DataType::I8, true),
-    (DataType::U8, false),
-    (DataType::U8, true),
-    (DataType::I16, false),
-    (DataType::I16, true),
-    (DataType::U16, false),
     (DataType::U16, true),
 ];
 /// The triangle list of a TRIANGLE_STRIP or TRIANGLE_FAN's vertices `v` (glTF 2.0
@@ -93,12 +84,54 @@ fn triangle_list(mode: gltf::mesh::Mode, v: &[u32]) -> Vec<u32> {
     out
 }
 
-/// Triangle indices.
-const INDEX: Allowed = &[
+/// What one accessor of a primitive may be (glTF §3.7.2.1 and `KHR_mesh_quantization`).
+struct Rule {
+    /// Its dimensions.
+    dimensions: &'static [Dimensions],
+    /// Its component types in core glTF.
+    core: Allowed,
+    /// Its component types in a file that uses `KHR_mesh_quantization`.
+    quantized: Allowed,
+}
+
+/// The rules of the accessors nacre reads, one line each.
+const POSITION: Rule = Rule {
+    dimensions: &[Dimensions::Vec3],
+    core: FLOAT,
+    quantized: FLOAT_OR_SHORT,
+};
+const NORMAL: Rule = Rule {
+    dimensions: &[Dimensions::Vec3],
+    core: FLOAT,
+    quantized: FLOAT_OR_SIGNED_NORMALIZED,
+};
+const TANGENT: Rule = Rule {
+    dimensions: &[Dimensions::Vec4],
+    core: FLOAT,
+    quantized: FLOAT_OR_SIGNED_NORMALIZED,
+};
+const TEXCOORD: Rule = Rule {
+    dimensions: &[Dimensions::Vec2],
+    core: FLOAT_OR_UNSIGNED_NORMALIZED,
+    quantized: FLOAT_OR_SHORT,
+};
+const COLOR: Rule = Rule {
+    dimensions: &[Dimensions::Vec3, Dimensions::Vec4],
+    core: FLOAT_OR_UNSIGNED_NORMALIZED,
+    quantized: FLOAT_OR_UNSIGNED_NORMALIZED,
+};
+/// Unsigned integers, the component types of triangle indices.
+const UNSIGNED: Allowed = &[
     (DataType::U8, false),
     (DataType::U16, false),
     (DataType::U32, false),
 ];
+/// Triangle indices.
+const INDICES: Rule = Rule {
+    dimensions: &[Dimensions::Scalar],
+    core: UNSIGNED,
+    quantized: UNSIGNED,
+};
 
 impl<'a> Primitives<'a> {
     /// A reader of `path`'s primitives (of `doc`) from `buffers`.
@@ -124,14 +157,17 @@ impl<'a> Primitives<'a> {
         }
     }
 
-    /// Checks `a`'s component type and dimensions for `semantic` and its byte ranges.
-    fn check(
-        &self,
-        a: &gltf::Accessor,
-        semantic: &str,
-        allowed: Allowed,
-        dimensions: &[Dimensions],
-    ) -> Result<()> {
+    /// Checks `a`'s component type and dimensions against `rule` (the accessor of
+    /// `semantic`) and its byte ranges.
+    fn check(&self, a: &gltf::Accessor, semantic: &str, rule: &Rule) -> Result<()> {
+        let (allowed, dimensions) = (
+            if self.quantized {
+                rule.quantized
+            } else {
+                rule.core
+            },
+            rule.dimensions,
+        );
         let normalized = a.normalized() && a.data_type() != DataType::F32;
         if !allowed.contains(&(a.data_type(), normalized)) || !dimensions.contains(&a.dimensions())
         {
@@ -242,7 +278,6 @@ impl<'a> Primitives<'a> {
     ) -> Result<GltfPrimitive> {
         let draco = self.draco(mesh, prim)?;
         let (path, buffers, materials) = (self.path, self.buffers, self.materials);
-        let q = self.quantized;
         let (m, p) = (mesh.index(), prim.index());
         // An attribute's values: from the Draco stream when it holds the semantic, else from
         // the accessor.
@@ -282,45 +317,32 @@ impl<'a> Primitives<'a> {
                 .at(path))
             }
         };
-        let vec3 = &[Dimensions::Vec3][..];
-        self.check(
-            &pos_acc,
-            "POSITION",
-            if q { QUANTIZED_POSITION } else { FLOAT },
-            vec3,
-        )?;
-        let direction = if q { QUANTIZED_DIRECTION } else { FLOAT };
+        self.check(&pos_acc, "POSITION", &POSITION)?;
         let normal_acc = prim.get(&gltf::Semantic::Normals);
         if let Some(a) = &normal_acc {
-            self.check(a, "NORMAL", direction, vec3)?;
+            self.check(a, "NORMAL", &NORMAL)?;
             counts_differ("NORMAL", a)?;
         }
         let tangent_acc = prim.get(&gltf::Semantic::Tangents);
         if let Some(a) = &tangent_acc {
-            self.check(a, "TANGENT", direction, &[Dimensions::Vec4])?;
+            self.check(a, "TANGENT", &TANGENT)?;
             counts_differ("TANGENT", a)?;
         }
         let uv_accs = [0, 1].map(|set| prim.get(&gltf::Semantic::TexCoords(set)));
         for (set, a) in uv_accs.iter().enumerate() {
             if let Some(a) = a {
                 let name = format!("TEXCOORD_{set}");
-                let allowed = if q { QUANTIZED_TEXCOORD } else { CORE_TEXCOORD };
-                self.check(a, &name, allowed, &[Dimensions::Vec2])?;
+                self.check(a, &name, &TEXCOORD)?;
                 counts_differ(&name, a)?;
             }
         }
         let colour_acc = prim.get(&gltf::Semantic::Colors(0));
         if let Some(a) = &colour_acc {
-            self.check(
-                a,
-                "COLOR_0",
-                CORE_TEXCOORD,
-                &[Dimensions::Vec3, Dimensions::Vec4],
-            )?;
+            self.check(a, "COLOR_0", &COLOR)?;
             counts_differ("COLOR_0", a)?;
         }
         if let Some(a) = prim.indices() {
-            self.check(&a, "indices", INDEX, &[Dimensions::Scalar])?;
+            self.check(&a, "indices", &INDICES)?;
         }
         let listed = match (draco, prim.indices()) {
             (Some(d), Some(a)) if a.count() != d.indices.len() => {
