@@ -15,29 +15,10 @@ use nacre_runtime::gltf_scene::{GltfError, GltfPrimitive, GltfScene};
 use std::path::{Path, PathBuf};
 
 mod support;
-use support::repo_root;
+use support::{gltf_core_samples, repo_root};
 
 fn fixture_dir() -> PathBuf {
     repo_root().join("tests/golden/gltf/draco")
-}
-
-/// `../shared/gltf-core-samples`, or `None` (skip) outside CI; a panic in CI.
-fn core_samples() -> Option<PathBuf> {
-    let dir = repo_root().join("../shared/gltf-core-samples");
-    if dir.is_dir() {
-        return Some(dir);
-    }
-    if std::env::var_os("CI").is_some() {
-        panic!(
-            "{} is missing: CI must provide the Khronos glTF samples (../shared/DATA.md)",
-            dir.display()
-        );
-    }
-    eprintln!(
-        "skipped: {} not found (the Khronos glTF samples of ../shared/DATA.md)",
-        dir.display()
-    );
-    None
 }
 
 /// A vertex: position, normal, first texture coordinates, colour.
@@ -127,7 +108,9 @@ fn extent(scene: &GltfScene) -> f32 {
 
 #[test]
 fn khronos_draco_box_and_duck_decode_to_their_plain_models() {
-    let Some(dir) = core_samples() else { return };
+    let Some(dir) = gltf_core_samples() else {
+        return;
+    };
     // Box: exact (its stream's quantisation reproduces the plain file's values); Duck:
     // gltf-pipeline's defaults, position 11 bits, normal 8 bits octahedral, texcoord 10 bits.
     for (model, position_bits, normal_tol, uv_tol) in [

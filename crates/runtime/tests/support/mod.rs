@@ -48,12 +48,24 @@ pub fn film_tables(lut: &str) -> TableSet {
     film_tables_on(ctx(), lut)
 }
 
-/// Khronos' glTF sample assets, `../shared/gltf-samples` (or `$NACRE_GLTF_SAMPLES`, for a
-/// checkout elsewhere), not part of this repository (`../shared/DATA.md`): `None` (the
-/// test skips, saying why) when missing outside CI; a panic when missing in CI (`CI` set).
+/// Khronos' glTF sample assets with films, `../shared/gltf-samples` (or
+/// `$NACRE_GLTF_SAMPLES`, for a checkout elsewhere): see [`shared_folder`].
 pub fn gltf_samples() -> Option<PathBuf> {
-    let dir = std::env::var_os("NACRE_GLTF_SAMPLES")
-        .map_or_else(|| repo_root().join("../shared/gltf-samples"), PathBuf::from);
+    shared_folder(
+        std::env::var_os("NACRE_GLTF_SAMPLES")
+            .map_or_else(|| repo_root().join("../shared/gltf-samples"), PathBuf::from),
+    )
+}
+
+/// Khronos' core glTF sample models, `../shared/gltf-core-samples`: see [`shared_folder`].
+pub fn gltf_core_samples() -> Option<PathBuf> {
+    shared_folder(repo_root().join("../shared/gltf-core-samples"))
+}
+
+/// `dir`, a folder of `../shared` (not part of this repository, `../shared/DATA.md`): `None`
+/// (the test skips, saying why) when missing outside CI; a panic when missing in CI (`CI`
+/// set).
+fn shared_folder(dir: PathBuf) -> Option<PathBuf> {
     if dir.is_dir() {
         return Some(dir);
     }
