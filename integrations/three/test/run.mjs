@@ -1,6 +1,8 @@
 // The browser tests of @nacre/three: Debian's Chromium driven by playwright-core, WebGL 2 on
 // SwiftShader, pages served from 127.0.0.1 (server.mjs), for the newest three.js the package
-// is tested with (node_modules/three) and the oldest (node_modules/three-r160).
+// is tested with (node_modules/three) and the oldest (node_modules/three-r160); and
+// WebGPURenderer (NacreFilmNodeMaterial, @nacre/three/webgpu) on Chromium's WebGPU over
+// SwiftShader, for r187 and the oldest release it supports (node_modules/three-r171).
 //
 //   node test/run.mjs            film colour vs nacre's CPU colours (test/expected.json),
 //                                the glTF screenshot, and the frame-time ratio
@@ -17,6 +19,7 @@ import { packageRoot, samplesRoot, startServer } from './server.mjs';
 
 const CHROMIUM = process.env.NACRE_CHROMIUM ?? '/usr/bin/chromium';
 const VERSIONS = ['three', 'three-r160'];
+const WEBGPU_VERSIONS = ['three', 'three-r171'];
 const TOLERANCE = { lut: 2e-3, fourier: 1e-4 };
 const benchOnly = process.argv.includes('--bench');
 const inCi = Boolean(process.env.CI);
@@ -49,6 +52,23 @@ const context = await chromium.launchPersistentContext(userDataDir, {
   ],
 });
 
+// WebGPU needs the GPU process (no --disable-gpu): Chromium's WebGPU on SwiftShader's Vulkan.
+const webgpuBrowser = await chromium.launch({
+  executablePath: CHROMIUM,
+  headless: true,
+  args: [
+    '--no-sandbox',
+    '--disable-background-networking',
+    '--disable-component-update',
+    '--disable-sync',
+    '--no-first-run',
+    '--disable-quic',
+    '--enable-unsafe-webgpu',
+    '--use-webgpu-adapter=swiftshader',
+  ],
+});
+const webgpuContext = await webgpuBrowser.newContext();
+
 let failures = 0;
 const fail = (message) => {
   failures++;
@@ -56,8 +76,8 @@ const fail = (message) => {
 };
 const report = { chromium: context.browser()?.version() ?? null, versions: {} };
 
-async function openPage(threeName) {
-  const page = await context.newPage();
+async function openPage(threeName, browserContext = context) {
+  const page = await browserContext.newPage();
   const errors = [];
   page.on('pageerror', (e) => errors.push(String(e)));
   page.on('console', (m) => {
@@ -78,12 +98,16 @@ function maxAbs(a, b) {
   return Math.max(...a.map((v, i) => Math.abs(v - b[i])));
 }
 
-async function filmTests(threeName) {
-  const { page, errors } = await openPage(threeName);
+// `webgpu`: NacreFilmNodeMaterial on WebGPURenderer (test/cases-webgpu.js), else
+// NacreFilmMaterial on WebGLRenderer (test/cases.js); labels carry the renderer.
+async function filmTests(threeName, webgpu = false) {
+  const label = webgpu ? `${threeName} WebGPU` : threeName;
+  const module = webgpu ? '/test/cases-webgpu.js' : '/test/cases.js';
+  const { page, errors } = await openPage(threeName, webgpu ? webgpuContext : context);
   const cases = expected.cases.map(({ expected: _, ...c }) => c);
-  const out = await page.evaluate(async (cases) => (await import('/test/cases.js')).filmCases(cases), cases);
-  if (errors.length) fail(`${threeName}: page errors: ${errors.join(' | ')}`);
-  console.log(`three r${out.info.revision} on ${out.info.unmasked ?? out.info.renderer} (${out.info.version})`);
+  const out = await page.evaluate(async ([module, cases]) => (await import(module)).filmCases(cases), [module, cases]);
+  if (errors.length) fail(`${label}: page errors: ${errors.join(' | ')}`);
+  console.log(`${label}: three r${out.info.revision} on ${out.info.unmasked ?? out.info.renderer} (${out.info.version})`);
   const summary = { revision: out.info.revision, renderer: out.info.unmasked ?? out.info.renderer, cases: {} };
   for (const [i, got] of out.cases.entries()) {
     const want = expected.cases[i];
@@ -97,7 +121,7 @@ async function filmTests(threeName) {
       for (const light of ['environment', 'directional', 'point']) {
         const { lit, unit } = row[light];
         if (!(unit[0] > 1e-3 && unit[1] > 1e-3 && unit[2] > 1e-3)) {
-          fail(`${threeName} ${want.name} ${row.deg}°: ${light} light gives no specular (unit film ${unit.slice(0, 3)})`);
+          fail(`${label} ${want.name} ${row.deg}°: ${light} light gives no specular (unit film ${unit.slice(0, 3)})`);
           continue;
         }
         const ratio = [0, 1, 2].map((k) => lit[k] / unit[k]);
@@ -109,16 +133,31 @@ async function filmTests(threeName) {
       }
     }
     summary.cases[want.name] = worst;
-    const line = `${threeName} ${want.name} (${want.technique}): max |GPU − CPU| film ${worst.film.toExponential(2)}, ` +
+    const line = `${label} ${want.name} (${want.technique}): max |GPU − CPU| film ${worst.film.toExponential(2)}, ` +
       `directional ${worst.directional.toExponential(2)}, point ${worst.point.toExponential(2)}, ` +
       `environment ${worst.environment.toExponential(2)} (tolerance ${tol}); |n·v − cos θ| ${worst.cosTheta.toExponential(2)}`;
     console.log(line);
-    if (lostOnDirect) fail(`${threeName} ${want.name}: the film is lost on direct light (highlight white)`);
-    if (!(worst.film <= tol)) fail(`${threeName} ${want.name}: film colour off by ${worst.film} > ${tol}`);
-    if (!(worst.directional <= tol)) fail(`${threeName} ${want.name}: directional light off by ${worst.directional} > ${tol}`);
-    if (!(worst.point <= tol)) fail(`${threeName} ${want.name}: point light off by ${worst.point} > ${tol}`);
-    if (!(worst.environment <= tol)) fail(`${threeName} ${want.name}: environment light off by ${worst.environment} > ${tol}`);
-    if (!(worst.cosTheta <= 1e-5)) fail(`${threeName} ${want.name}: n·v off by ${worst.cosTheta}`);
+    if (lostOnDirect) fail(`${label} ${want.name}: the film is lost on direct light (highlight white)`);
+    if (!(worst.film <= tol)) fail(`${label} ${want.name}: film colour off by ${worst.film} > ${tol}`);
+    if (!(worst.directional <= tol)) fail(`${label} ${want.name}: directional light off by ${worst.directional} > ${tol}`);
+    if (!(worst.point <= tol)) fail(`${label} ${want.name}: point light off by ${worst.point} > ${tol}`);
+    if (!(worst.environment <= tol)) fail(`${label} ${want.name}: environment light off by ${worst.environment} > ${tol}`);
+    if (!(worst.cosTheta <= 1e-5)) fail(`${label} ${want.name}: n·v off by ${worst.cosTheta}`);
+  }
+  if (webgpu) {
+    // The control on WebGPU: three's own film (Belcour & Barla's analytic approximation)
+    // on the directional light over nacre's unit film. The direct-light comparison above must
+    // reject it at most angles of every case it is run for, or it could never fail.
+    for (const c of expected.cases.filter((k) => !k.table.startsWith('export:'))) {
+      const rows = await page.evaluate(async (c) => (await import('/test/cases-webgpu.js')).threeFilmDirectional(c), c);
+      const tol = TOLERANCE[c.technique];
+      const rejected = rows.filter((row, j) => !(maxAbs([0, 1, 2].map((k) => row.lit[k] / row.unit[k]), c.expected[j]) <= tol)).length;
+      console.log(`${label} control, three's own film on the directional light (${c.name}): rejected at ${rejected} of ${rows.length} angles`);
+      summary.cases[c.name].threeFilmRejectedAngles = rejected;
+      if (!(rejected * 2 > rows.length)) fail(`${label} ${c.name}: the direct-light check accepts three's own film at ${rows.length - rejected} of ${rows.length} angles`);
+    }
+    await page.close();
+    return summary;
   }
   // The control: the earlier recipe of docs/engines/threejs.md. On r187 the detector must
   // see its film lost on the directional light (or the check above could never fail).
@@ -193,18 +232,21 @@ async function screenshotTest(threeName) {
   return { ...summary, ...stats };
 }
 
-async function bench(threeName, size, frames, rounds) {
-  const { page, errors } = await openPage(threeName);
+async function bench(threeName, size, frames, rounds, webgpu = false) {
+  const label = webgpu ? `${threeName} WebGPU` : threeName;
+  const module = webgpu ? '/test/cases-webgpu.js' : '/test/cases.js';
+  const { page, errors } = await openPage(threeName, webgpu ? webgpuContext : context);
   const t = await page.evaluate(
-    async ([size, frames, rounds]) => (await import('/test/cases.js')).frameTime(size, frames, rounds),
-    [size, frames, rounds],
+    async ([module, size, frames, rounds]) => (await import(module)).frameTime(size, frames, rounds),
+    [module, size, frames, rounds],
   );
   await page.close();
-  if (errors.length) fail(`${threeName} bench: page errors: ${errors.join(' | ')}`);
+  if (errors.length) fail(`${label} bench: page errors: ${errors.join(' | ')}`);
   const r = (a, b) => (t[a] / t[b]).toFixed(2);
-  const line = `${threeName} frame time ${size}×${size} (median of ${rounds} rounds × ${frames} frames): ` +
-    `plain MeshPhysicalMaterial ${t.plain.toFixed(2)} ms, three's iridescence ${t.threeIridescence.toFixed(2)} ms, ` +
-    `NacreFilmMaterial lut ${t.nacreLut.toFixed(2)} ms, fourier ${t.nacreFourier.toFixed(2)} ms; ` +
+  const node = webgpu ? 'Node' : '';
+  const line = `${label} frame time ${size}×${size} (median of ${rounds} rounds × ${frames} frames): ` +
+    `plain MeshPhysical${node}Material ${t.plain.toFixed(2)} ms, three's iridescence ${t.threeIridescence.toFixed(2)} ms, ` +
+    `NacreFilm${node}Material lut ${t.nacreLut.toFixed(2)} ms, fourier ${t.nacreFourier.toFixed(2)} ms; ` +
     `ratios to plain: three's iridescence ${r('threeIridescence', 'plain')}, nacre lut ${r('nacreLut', 'plain')}, nacre fourier ${r('nacreFourier', 'plain')}`;
   console.log(line);
   return { ...t, size, frames, rounds };
@@ -221,10 +263,21 @@ try {
       report.versions[threeName].bench = await bench(threeName, 512, 10, 7);
     }
   }
+  for (const threeName of WEBGPU_VERSIONS) {
+    const key = `${threeName} WebGPU`;
+    report.versions[key] = {};
+    if (!benchOnly) {
+      report.versions[key].film = await filmTests(threeName, true);
+      report.versions[key].bench = await bench(threeName, 256, 5, 3, true);
+    } else {
+      report.versions[key].bench = await bench(threeName, 512, 10, 7, true);
+    }
+  }
 } catch (e) {
   fail(`error: ${e.stack ?? e}`);
 } finally {
   await context.close();
+  await webgpuBrowser.close();
   await server.close();
   rmSync(userDataDir, { recursive: true, force: true });
 }

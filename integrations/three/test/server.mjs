@@ -3,7 +3,8 @@
 //
 //   /pkg/...            integrations/three/src (the package)
 //   /test/...           integrations/three/test
-//   /three/NAME/...     integrations/three/node_modules/NAME (three = newest, three-r160 = oldest)
+//   /three/NAME/...     integrations/three/node_modules/NAME (three = newest, three-r160 = oldest
+//                       for WebGLRenderer, three-r171 = oldest for WebGPURenderer)
 //   /tables/...         tables/baked (the default table set)
 //   /samples/...        ../shared/gltf-samples (Khronos glTF samples; not in the repository)
 //   /page/NAME.html     an empty page whose import map points `three` at node_modules/NAME
@@ -52,7 +53,10 @@ function page(threeName) {
 <script type="importmap">{"imports": {
   "three": "/three/${threeName}/build/three.module.js",
   "three/addons/": "/three/${threeName}/examples/jsm/",
-  "@nacre/three": "/pkg/index.js"
+  "three/webgpu": "/three/${threeName}/build/three.webgpu.js",
+  "three/tsl": "/three/${threeName}/build/three.tsl.js",
+  "@nacre/three": "/pkg/index.js",
+  "@nacre/three/webgpu": "/pkg/webgpu.js"
 }}</script>
 <style>body { margin: 0; background: #000 }</style>
 </head><body></body></html>`;

@@ -1,0 +1,218 @@
+// Browser side of the WebGPURenderer tests (loaded into /page/THREE.html by run.mjs):
+// renders NacreFilmNodeMaterial with three/webgpu's WebGPURenderer on the WebGPU backend
+// into float render targets and reads the floats back; the same cases as cases.js.
+import * as THREE from 'three/webgpu';
+import { NacreDebugView, NacreFilmNodeMaterial } from '@nacre/three/webgpu';
+import { loadNacreRawTable, loadNacreTable } from '@nacre/three';
+
+const tables = {};
+async function table(name) {
+  if (!tables[name]) {
+    tables[name] = name.startsWith('export:')
+      ? await loadNacreRawTable(`/export/${name.slice('export:'.length)}.raw`)
+      : await loadNacreTable(`/tables/${name}.json`);
+  }
+  return tables[name];
+}
+
+/** A WebGPURenderer on the WebGPU backend (never the WebGL 2 fallback), initialised. */
+async function makeRenderer(width, height) {
+  if (!navigator.gpu) throw new Error('navigator.gpu is missing: no WebGPU in this browser');
+  const adapter = await navigator.gpu.requestAdapter();
+  if (!adapter) throw new Error('navigator.gpu.requestAdapter() gave no adapter');
+  const canvas = document.createElement('canvas');
+  canvas.width = width;
+  canvas.height = height;
+  document.body.appendChild(canvas);
+  const renderer = new THREE.WebGPURenderer({ canvas, antialias: false, forceWebGL: false });
+  renderer.setPixelRatio(1);
+  renderer.setSize(width, height, false);
+  await renderer.init();
+  if (!renderer.backend.isWebGPUBackend) throw new Error('WebGPURenderer fell back to WebGL 2');
+  const info = adapter.info ?? {};
+  return { renderer, adapter: `${info.vendor ?? ''} ${info.architecture ?? ''} ${info.description ?? ''}`.trim() };
+}
+
+/** Sets three's film thickness range to [d, d] (r187: minimum/maximum; before: the range). */
+function withThickness(material, d) {
+  if ('iridescenceThicknessMaximum' in material) {
+    material.iridescenceThicknessMinimum = d;
+    material.iridescenceThicknessMaximum = d;
+  } else {
+    material.iridescenceThicknessRange = [d, d];
+  }
+  return material;
+}
+
+/** A uniform white environment (radiance 1 in every direction), prefiltered by three. */
+async function whiteEnvironment(renderer) {
+  const scene = new THREE.Scene();
+  scene.background = new THREE.Color(1, 1, 1);
+  const pmrem = new THREE.PMREMGenerator(renderer);
+  const target = pmrem.fromScene(scene);
+  return target.texture;
+}
+
+/**
+ * The film cases of cases.js's filmCases, on WebGPU: for each case and angle a plane whose
+ * normal makes θ with the view direction (orthographic camera: n·v = cos θ on every pixel)
+ * drawn into a 1×1 RGBA32F target — the debug view FILM (film colour, n·v) and, for each
+ * light (environment, directional, point), the shaded colour with the film and with a unit
+ * film, whose ratio is what the film does to that light.
+ */
+export async function filmCases(cases) {
+  const { renderer, adapter } = await makeRenderer(1, 1);
+  const target = new THREE.RenderTarget(1, 1, { type: THREE.FloatType, depthBuffer: true });
+  const camera = new THREE.OrthographicCamera(-2, 2, 2, -2, 0.1, 100);
+  camera.position.set(0, 0, 10);
+  camera.lookAt(0, 0, 0);
+  const geometry = new THREE.PlaneGeometry(20, 20);
+  const environment = await whiteEnvironment(renderer);
+  const read = async (scene) => {
+    renderer.setRenderTarget(target);
+    renderer.render(scene, camera);
+    const pixel = await renderer.readRenderTargetPixelsAsync(target, 0, 0, 1, 1);
+    renderer.setRenderTarget(null);
+    return Array.from(pixel.slice(0, 4));
+  };
+  const out = [];
+  for (const c of cases) {
+    const nacre = new NacreFilmNodeMaterial({
+      table: await table(c.table),
+      harmonics: c.harmonics ?? 0,
+      color: 0x000000,
+      metalness: 0,
+      roughness: 0.3,
+      ior: c.baseIor,
+      filmIor: c.filmIor,
+      filmThicknessNm: c.thicknessNm,
+    });
+    const mesh = new THREE.Mesh(geometry, nacre);
+    const scenes = {};
+    scenes.environment = new THREE.Scene();
+    scenes.environment.environment = environment;
+    scenes.directional = new THREE.Scene();
+    const sun = new THREE.DirectionalLight(0xffffff, 1);
+    scenes.directional.add(sun, sun.target);
+    scenes.point = new THREE.Scene();
+    const bulb = new THREE.PointLight(0xffffff, 100, 0, 2);
+    scenes.point.add(bulb);
+    const result = { ...c, angles: [] };
+    for (const deg of c.anglesDeg) {
+      const theta = (deg * Math.PI) / 180;
+      mesh.rotation.set(0, theta, 0);
+      mesh.updateMatrixWorld();
+      const n = new THREE.Vector3(Math.sin(theta), 0, Math.cos(theta));
+      const mirror = n.clone().multiplyScalar(2 * n.z).sub(new THREE.Vector3(0, 0, 1));
+      sun.position.copy(mirror);
+      bulb.position.copy(mirror).multiplyScalar(5);
+      const row = { deg };
+      nacre.debugView = NacreDebugView.FILM;
+      scenes.environment.add(mesh);
+      row.film = await read(scenes.environment);
+      for (const light of ['environment', 'directional', 'point']) {
+        scenes[light].add(mesh);
+        nacre.debugView = NacreDebugView.NONE;
+        const lit = await read(scenes[light]);
+        nacre.debugView = NacreDebugView.UNIT_FILM;
+        const unit = await read(scenes[light]);
+        row[light] = { lit, unit };
+      }
+      result.angles.push(row);
+    }
+    nacre.dispose();
+    out.push(result);
+  }
+  renderer.dispose();
+  return { info: { revision: THREE.REVISION, renderer: `WebGPU: ${adapter}`, version: 'WebGPU' }, cases: out };
+}
+
+/**
+ * Frame time of a sphere filling a size × size view with NacreFilmNodeMaterial (film-dielectric
+ * lut, and fourier) against the same sphere with a plain MeshPhysicalNodeMaterial (no film) and
+ * with three's own iridescence, same lights (environment + directional), same run, interleaved
+ * rounds; each frame waits for the GPU (a 1-pixel readback).
+ */
+export async function frameTime(size, frames, rounds) {
+  const { renderer } = await makeRenderer(size, size);
+  const target = new THREE.RenderTarget(size, size, { type: THREE.HalfFloatType, depthBuffer: true });
+  const scene = new THREE.Scene();
+  scene.environment = await whiteEnvironment(renderer);
+  const sun = new THREE.DirectionalLight(0xffffff, 2);
+  sun.position.set(1, 2, 3);
+  scene.add(sun);
+  const camera = new THREE.PerspectiveCamera(40, 1, 0.1, 10);
+  camera.position.set(0, 0, 2.9);
+  const geometry = new THREE.SphereGeometry(1, 64, 32);
+  const common = { color: 0x202020, roughness: 0.3 };
+  const materials = {
+    plain: new THREE.MeshPhysicalNodeMaterial(common),
+    threeIridescence: withThickness(new THREE.MeshPhysicalNodeMaterial({ ...common, iridescence: 1, iridescenceIOR: 1.33 }), 400),
+    nacreLut: new NacreFilmNodeMaterial({ ...common, table: await table('film-dielectric'), filmIor: 1.33, filmThicknessNm: 400 }),
+    nacreFourier: new NacreFilmNodeMaterial({ ...common, table: await table('fourier-srgb'), filmIor: 1.33, filmThicknessNm: 400 }),
+  };
+  const mesh = new THREE.Mesh(geometry, materials.plain);
+  scene.add(mesh);
+  renderer.setRenderTarget(target);
+  const frame = async () => {
+    renderer.render(scene, camera);
+    await renderer.readRenderTargetPixelsAsync(target, 0, 0, 1, 1);
+  };
+  const times = Object.fromEntries(Object.keys(materials).map((k) => [k, []]));
+  for (const name of Object.keys(materials)) {
+    mesh.material = materials[name];
+    await frame(); // compile
+    await frame();
+  }
+  for (let r = 0; r < rounds; r++) {
+    for (const name of Object.keys(materials)) {
+      mesh.material = materials[name];
+      const t0 = performance.now();
+      for (let i = 0; i < frames; i++) await frame();
+      times[name].push((performance.now() - t0) / frames);
+    }
+  }
+  const median = (a) => [...a].sort((x, y) => x - y)[Math.floor(a.length / 2)];
+  renderer.dispose();
+  return Object.fromEntries(Object.entries(times).map(([k, v]) => [k, median(v)]));
+}
+
+/**
+ * The control for the direct-light check on WebGPU: three's own iridescence
+ * (MeshPhysicalNodeMaterial, the same film and base) lit by the directional light of
+ * filmCases, over nacre's unit-film render — what the check would see if the film every
+ * direct light reads were three's rather than nacre's. run.mjs checks that the direct-light
+ * comparison rejects it, so that comparison can fail.
+ */
+export async function threeFilmDirectional(c) {
+  const { renderer } = await makeRenderer(1, 1);
+  const target = new THREE.RenderTarget(1, 1, { type: THREE.FloatType, depthBuffer: true });
+  const camera = new THREE.OrthographicCamera(-2, 2, 2, -2, 0.1, 100);
+  camera.position.set(0, 0, 10);
+  camera.lookAt(0, 0, 0);
+  const params = { color: 0x000000, metalness: 0, roughness: 0.3, ior: c.baseIor, iridescence: 1, iridescenceIOR: c.filmIor };
+  const three = withThickness(new THREE.MeshPhysicalNodeMaterial(params), c.thicknessNm);
+  const nacre = new NacreFilmNodeMaterial({ ...params, filmThicknessNm: c.thicknessNm, table: await table(c.table), debugView: NacreDebugView.UNIT_FILM });
+  const mesh = new THREE.Mesh(new THREE.PlaneGeometry(20, 20), three);
+  const scene = new THREE.Scene();
+  const sun = new THREE.DirectionalLight(0xffffff, 1);
+  scene.add(mesh, sun, sun.target);
+  const rows = [];
+  for (const deg of c.anglesDeg) {
+    const theta = (deg * Math.PI) / 180;
+    mesh.rotation.set(0, theta, 0);
+    const n = new THREE.Vector3(Math.sin(theta), 0, Math.cos(theta));
+    sun.position.copy(n.clone().multiplyScalar(2 * n.z).sub(new THREE.Vector3(0, 0, 1)));
+    const row = { deg };
+    for (const [key, material] of [['lit', three], ['unit', nacre]]) {
+      mesh.material = material;
+      renderer.setRenderTarget(target);
+      renderer.render(scene, camera);
+      row[key] = Array.from((await renderer.readRenderTargetPixelsAsync(target, 0, 0, 1, 1)).slice(0, 4));
+    }
+    renderer.setRenderTarget(null);
+    rows.push(row);
+  }
+  renderer.dispose();
+  return rows;
+}
