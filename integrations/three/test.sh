@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # The browser tests of @nacre/three (test/run.mjs): Debian's Chromium driven by playwright-core,
-# WebGL 2 on SwiftShader, three.js r187 (newest on npm) and r160 (oldest supported).
+# WebGL 2 on SwiftShader, three.js r187 (newest on npm) and r160 (oldest supported); and
+# WebGPURenderer on Chromium's WebGPU over SwiftShader (Debian's chromium ships
+# libvk_swiftshader.so), r187 and r171 (oldest supported there).
 # Installs what it needs: apt `chromium` when /usr/bin/chromium is missing (root or sudo), the
 # npm packages from package-lock.json (`npm ci`). Needs Node.js ≥ 20 and npm (Debian 12's
 # nodejs is 18: install 20 or newer). Like every step of scripts/test.sh it fails, never
