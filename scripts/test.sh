@@ -41,7 +41,30 @@ step_rust() {
         echo "scripts/test.sh: installing glslang-tools (glslangValidator for the engine shader libraries)" >&2
         apt_install glslang-tools
     fi
+    slangpy_venv
     cargo test --workspace --locked
+}
+
+# Slang from PyPI's slangpy (pinned), in a virtual environment under target/ kept between runs,
+# for tests/tests/hlsl_slang.rs (the engine HLSL compiled by a second HLSL compiler; neither
+# DXC nor FXC installs on Linux from the registries). Its first install takes about 20 s
+# (a 289 MB package); later runs reuse it. NACRE_SLANGPY_PYTHON already set: used as it is.
+SLANGPY_VERSION=0.43.1
+slangpy_venv() {
+    if [ -n "${NACRE_SLANGPY_PYTHON:-}" ]; then return; fi
+    local venv="${CARGO_TARGET_DIR:-$PWD/target}/slangpy-venv"
+    if ! "$venv/bin/python" -c "import slangpy, sys; sys.exit(slangpy.__version__ != '$SLANGPY_VERSION')" >/dev/null 2>&1; then
+        if ! python3 -c 'import venv, ensurepip' >/dev/null 2>&1; then
+            apt_install python3-venv
+        fi
+        local start
+        start=$(date +%s)
+        rm -rf "$venv"
+        python3 -m venv "$venv"
+        "$venv/bin/python" -m pip install --quiet "slangpy==$SLANGPY_VERSION"
+        echo "scripts/test.sh: slangpy $SLANGPY_VERSION installed in $((  $(date +%s) - start )) s ($venv)" >&2
+    fi
+    export NACRE_SLANGPY_PYTHON="$venv/bin/python"
 }
 
 # The GL pass: the GPU test binaries again, on wgpu's OpenGL backend (WGPU_BACKEND=gl: Mesa's

@@ -9,7 +9,8 @@
 // Each section below starts with its WGSL module's header: symbols, equations, sources.
 //
 // Targets: Shader Model 4.0+ HLSL as Unity (2022.3 LTS, Unity 6; FXC or DXC) and Unreal
-// Engine (5.3+, DXC; HLSL 2018 and 2021 rules alike: no vector `?:`, no vector `&&`) compile
+// Engine (5.3+: FXC for Direct3D SM5, DXC for SM6, Vulkan and Metal; HLSL 2018 and 2021
+// rules alike: no vector `?:`, no vector `&&`) compile
 // it; shaders/hlsl/unity/NacreShaderGraph.hlsl wraps it for Shader Graph's Custom Function
 // node, and Unreal includes it from a plugin shader directory as a .ush
 // (docs/engines/unreal.md). It declares no resources: every function takes its table

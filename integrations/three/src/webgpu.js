@@ -47,7 +47,7 @@ import * as TSL from 'three/tsl';
 import { DataTexture, FloatType, NearestFilter, ClampToEdgeWrapping, NoColorSpace, RGBAFormat } from 'three/webgpu';
 
 const {
-  Fn, If, Loop, Break, float, int, vec2, vec3, vec4, ivec2, uniform, texture3D, textureLoad, select,
+  Fn, If, Loop, Break, float, int, vec3, vec4, ivec2, uniform, texture3D, textureLoad, select,
   mix, clamp, max, min, sqrt, floor, fract, cos, sin, abs, pow, smoothstep,
   specularColor, specularF90, diffuseColor, metalness, roughness, iridescence, iridescenceIOR,
   iridescenceThickness, normalView, positionViewDirection,

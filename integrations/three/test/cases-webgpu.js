@@ -97,28 +97,34 @@ export async function filmCases(cases) {
     scenes.point = new THREE.Scene();
     const bulb = new THREE.PointLight(0xffffff, 100, 0, 2);
     scenes.point.add(bulb);
-    const result = { ...c, angles: [] };
-    for (const deg of c.anglesDeg) {
+    const result = { ...c, angles: c.anglesDeg.map((deg) => ({ deg })) };
+    // One debug view at a time over every angle and light: a view change rebuilds the
+    // material's nodes (see NacreFilmNodeMaterial's debugView), so it happens 3 times per case.
+    const pose = (deg) => {
       const theta = (deg * Math.PI) / 180;
       mesh.rotation.set(0, theta, 0);
       mesh.updateMatrixWorld();
+      // The mirror direction of the view (0, 0, 1) about the normal: the highlight's peak.
       const n = new THREE.Vector3(Math.sin(theta), 0, Math.cos(theta));
       const mirror = n.clone().multiplyScalar(2 * n.z).sub(new THREE.Vector3(0, 0, 1));
       sun.position.copy(mirror);
       bulb.position.copy(mirror).multiplyScalar(5);
-      const row = { deg };
-      nacre.debugView = NacreDebugView.FILM;
-      scenes.environment.add(mesh);
+    };
+    nacre.debugView = NacreDebugView.FILM;
+    scenes.environment.add(mesh);
+    for (const row of result.angles) {
+      pose(row.deg);
       row.film = await read(scenes.environment);
+    }
+    for (const [view, key] of [[NacreDebugView.NONE, 'lit'], [NacreDebugView.UNIT_FILM, 'unit']]) {
+      nacre.debugView = view;
       for (const light of ['environment', 'directional', 'point']) {
         scenes[light].add(mesh);
-        nacre.debugView = NacreDebugView.NONE;
-        const lit = await read(scenes[light]);
-        nacre.debugView = NacreDebugView.UNIT_FILM;
-        const unit = await read(scenes[light]);
-        row[light] = { lit, unit };
+        for (const row of result.angles) {
+          pose(row.deg);
+          row[light] = { ...row[light], [key]: await read(scenes[light]) };
+        }
       }
-      result.angles.push(row);
     }
     nacre.dispose();
     out.push(result);

@@ -6,7 +6,10 @@
 // to Single (or the graph's to Single). Texture ports arrive as Shader Graph's
 // `UnityTexture3D` / `UnityTexture2DArray` (fields `tex`, `samplerstate`) and sampler ports
 // as `UnitySamplerState` (field `samplerstate`); integer-valued inputs (texel counts, the
-// level count, the harmonics) are Float ports, rounded here. docs/engines/unity.md lists
+// level count, the harmonics) are Float ports, rounded here. A table reaches a texture port
+// from a Blackboard Texture 3D / Texture 2D Array property set with material.SetTexture (a
+// texture made by a script cannot be a port's default). Clamp the film colour (max(·, 0))
+// before lighting: out-of-gamut channels are negative. docs/engines/unity.md lists
 // the ports in order and where their values come from (the table's manifest or the sidecar
 // of `nacre export`). Everything else is shaders/hlsl/nacre.hlsl, unchanged.
 //
