@@ -83,7 +83,12 @@ fn unity_guide_states_the_soap_film_axes() {
     let text = read(file);
     let a = soap_film();
     // "for the default `soap-film` table they are `cos_theta_count` 32, `opd_count` 640, …"
-    let sentence = after(file, &text, "for the default `soap-film` table they are", 400);
+    let sentence = after(
+        file,
+        &text,
+        "for the default `soap-film` table they are",
+        400,
+    );
     let names = [
         "cos_theta_count",
         "opd_count",
@@ -96,15 +101,34 @@ fn unity_guide_states_the_soap_film_axes() {
     ];
     for (name, want) in names.iter().zip(a) {
         let got = stated(file, sentence, &format!("`{name}`"), 1)[0];
-        assert_eq!(got, want, "{file}: soap-film `{name}` stated {got}, the manifest has {want}");
+        assert_eq!(
+            got, want,
+            "{file}: soap-film `{name}` stated {got}, the manifest has {want}"
+        );
     }
     // The hand-written shader's Properties defaults are the same table's.
-    assert_eq!(stated(file, &text, "_NacreCounts (\"Texel counts (x, y, z, unused)\", Vector) =", 3), a[..3]);
     assert_eq!(
-        stated(file, &text, "_NacreRanges (\"Thickness min/max nm, index min/max\", Vector) =", 4),
+        stated(
+            file,
+            &text,
+            "_NacreCounts (\"Texel counts (x, y, z, unused)\", Vector) =",
+            3
+        ),
+        a[..3]
+    );
+    assert_eq!(
+        stated(
+            file,
+            &text,
+            "_NacreRanges (\"Thickness min/max nm, index min/max\", Vector) =",
+            4
+        ),
         a[3..7]
     );
-    assert_eq!(stated(file, &text, "_NacreAmbient (\"Ambient index\", Float) =", 1), [a[7]]);
+    assert_eq!(
+        stated(file, &text, "_NacreAmbient (\"Ambient index\", Float) =", 1),
+        [a[7]]
+    );
 }
 
 #[test]
@@ -112,12 +136,28 @@ fn unreal_guide_states_the_soap_film_axes() {
     let file = "docs/engines/unreal.md";
     let text = read(file);
     let a = soap_film();
-    assert_eq!(stated(file, &text, "`(cos_theta_count, opd_count, ior_count)` — soap-film:", 3), a[..3]);
     assert_eq!(
-        stated(file, &text, "`(thickness_min_nm, thickness_max_nm, ior_min, ior_max)` — soap-film:", 4),
+        stated(
+            file,
+            &text,
+            "`(cos_theta_count, opd_count, ior_count)` — soap-film:",
+            3
+        ),
+        a[..3]
+    );
+    assert_eq!(
+        stated(
+            file,
+            &text,
+            "`(thickness_min_nm, thickness_max_nm, ior_min, ior_max)` — soap-film:",
+            4
+        ),
         a[3..7]
     );
-    assert_eq!(stated(file, &text, "`ambient_index` — soap-film:", 1), [a[7]]);
+    assert_eq!(
+        stated(file, &text, "`ambient_index` — soap-film:", 1),
+        [a[7]]
+    );
     // "32 and 640 for the default `soap-film` table; its `ior_count` is 8"
     let tiles = stated(file, &text, "(from `nacre info soap-film`:", 2);
     assert_eq!(tiles, a[..2]);
@@ -143,19 +183,30 @@ fn fourier_table_values_and_default_harmonics() {
     for lib in ["shaders/hlsl/nacre.hlsl", "shaders/glsl/nacre.glsl"] {
         let src = read(lib);
         let v = stated(lib, &src, "NACRE_FOURIER_DEFAULT_HARMONICS =", 1)[0];
-        assert_eq!(v, f64::from(default_m), "{lib}: NACRE_FOURIER_DEFAULT_HARMONICS");
+        assert_eq!(
+            v,
+            f64::from(default_m),
+            "{lib}: NACRE_FOURIER_DEFAULT_HARMONICS"
+        );
     }
     // … and what every guide, wrapper and package says it is.
     for (file, marker) in [
         (unity, "Harmonics ("),
-        ("shaders/hlsl/unity/NacreShaderGraph.hlsl", "Harmonics = M ("),
+        (
+            "shaders/hlsl/unity/NacreShaderGraph.hlsl",
+            "Harmonics = M (",
+        ),
         ("docs/engines/README.md", "`harmonics` M ("),
         ("integrations/three/src/material.js", "{ harmonics ="),
         ("integrations/three/src/webgpu.js", "{ harmonics ="),
     ] {
         let text = read(file);
         let v = stated(file, &text, marker, 1)[0];
-        assert_eq!(v, f64::from(default_m), "{file}: the default harmonics after `{marker}`");
+        assert_eq!(
+            v,
+            f64::from(default_m),
+            "{file}: the default harmonics after `{marker}`"
+        );
         let context = after(file, &text, marker, 200);
         assert!(
             context.contains("automatic") || context.contains("0,") || context.contains("0;"),
