@@ -246,6 +246,16 @@ function fourierFilm(table, harmonics) {
   });
 }
 
+// A serial number per table object: the film's code holds the table's axes as constants, so
+// materials over different tables must not share a compiled program (three keys node
+// programs by the material's type and its node-valued properties only).
+const tableSerials = new WeakMap();
+let nextTableSerial = 1;
+function tableSerial(table) {
+  if (!tableSerials.has(table)) tableSerials.set(table, nextTableSerial++);
+  return tableSerials.get(table);
+}
+
 /** nacre's state on a MeshPhysicalNodeMaterial: the table, its uniforms, the film function. */
 class NacreNodeState {
   constructor(table, { harmonics = 0, debugView = NacreDebugView.NONE } = {}) {
@@ -422,6 +432,11 @@ export class NacreFilmNodeMaterial extends MeshPhysicalNodeMaterial {
   set debugView(v) {
     this.nacre.debugViewUniform.value = v;
     this.needsUpdate = true;
+  }
+
+  customProgramCacheKey() {
+    const nacre = this.nacre ? `${this.nacre.table.kind}:${tableSerial(this.nacre.table)}` : 'none';
+    return `${super.customProgramCacheKey()}|nacre:${nacre}`;
   }
 
   setupLightingModel(builder) {

@@ -222,3 +222,37 @@ export async function threeFilmDirectional(c) {
   renderer.dispose();
   return rows;
 }
+
+/**
+ * Two NacreFilmNodeMaterials over different tables in one frame (a 2 × 1 target: the left
+ * pixel `a`'s material, the right `b`'s; debug view FILM at normal incidence). Their
+ * programs must differ (the film's code holds each table's axes): run.mjs compares each
+ * pixel with its case's CPU colour at 0°.
+ */
+export async function twoTables(a, b) {
+  const { renderer } = await makeRenderer(2, 1);
+  const target = new THREE.RenderTarget(2, 1, { type: THREE.FloatType, depthBuffer: true });
+  // Far away: r171 takes the view direction from the position even for an orthographic
+  // camera, and 0.5 / 1000 off axis is n·v = 1 − 1.25×10⁻⁷.
+  const camera = new THREE.OrthographicCamera(-1, 1, 0.5, -0.5, 1, 2000);
+  camera.position.set(0, 0, 1000);
+  camera.lookAt(0, 0, 0);
+  const scene = new THREE.Scene();
+  // A light: without one three runs no lighting model, and the film is not evaluated.
+  const sun = new THREE.DirectionalLight(0xffffff, 1);
+  scene.add(sun, sun.target);
+  for (const [c, x] of [[a, -0.5], [b, 0.5]]) {
+    const material = new NacreFilmNodeMaterial({
+      table: await table(c.table), color: 0x000000, metalness: 0, roughness: 0.3, ior: c.baseIor,
+      filmIor: c.filmIor, filmThicknessNm: c.thicknessNm, debugView: NacreDebugView.FILM,
+    });
+    const mesh = new THREE.Mesh(new THREE.PlaneGeometry(1, 1), material);
+    mesh.position.x = x;
+    scene.add(mesh);
+  }
+  renderer.setRenderTarget(target);
+  renderer.render(scene, camera);
+  const px = Array.from(await renderer.readRenderTargetPixelsAsync(target, 0, 0, 2, 1));
+  renderer.dispose();
+  return [px.slice(0, 4), px.slice(4, 8)];
+}

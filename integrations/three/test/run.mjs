@@ -156,6 +156,17 @@ async function filmTests(threeName, webgpu = false) {
       summary.cases[c.name].threeFilmRejectedAngles = rejected;
       if (!(rejected * 2 > rows.length)) fail(`${label} ${c.name}: the direct-light check accepts three's own film at ${rows.length - rejected} of ${rows.length} angles`);
     }
+    // Two materials over different tables in one frame keep their own films (three keys
+    // node programs by material type; the package adds the table).
+    const a = expected.cases.find((k) => k.table === 'soap-film');
+    const b = expected.cases.find((k) => k.technique === 'fourier' && k.baseIor !== 1);
+    const pair = await page.evaluate(async ([a, b]) => (await import('/test/cases-webgpu.js')).twoTables(a, b), [a, b]);
+    const pairErr = [maxAbs(pair[0].slice(0, 3), a.expected[0]), maxAbs(pair[1].slice(0, 3), b.expected[0])];
+    console.log(`${label} two tables in one frame (${a.name}; ${b.name}): max |GPU − CPU| ${pairErr.map((e) => e.toExponential(2)).join(', ')}`);
+    summary.twoTables = pairErr;
+    if (!(pairErr[0] <= TOLERANCE[a.technique] && pairErr[1] <= TOLERANCE[b.technique])) {
+      fail(`${label}: two NacreFilmNodeMaterials over different tables in one frame do not keep their films (${pairErr})`);
+    }
     await page.close();
     return summary;
   }
