@@ -49,6 +49,7 @@ fn spec(case: &Case) -> StackSpec {
             .collect(),
         substrate: m(&case.substrate),
         base_dir: None,
+        incoherent: Vec::new(),
     }
 }
 

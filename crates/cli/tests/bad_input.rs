@@ -385,6 +385,14 @@ fn fixtures(d: &Path) -> Vec<Case> {
     for (name, text) in recipes {
         write(&d.join(format!("r/{name}.toml")), text);
     }
+    write(
+        &d.join("r/stack-incoherent-substrate.toml"),
+        "substrate = \"bk7:incoherent\"\n[[layers]]\nmaterial = \"mgf2\"\nthickness_nm = 100\n",
+    );
+    write(
+        &d.join("r/stack-metre.toml"),
+        "substrate = \"1.0\"\n[[layers]]\nmaterial = \"bk7\"\nthickness_nm = 1e9\nincoherent = true\n",
+    );
     write(&d.join("r/bad name.toml"), RECIPE);
     write(
         &d.join("r/binary.toml"),
@@ -1227,6 +1235,104 @@ fn fixtures(d: &Path) -> Vec<Case> {
             "flag: empty layer material",
             &["spectrum", "--layer", "@100", "-o", "out.csv"],
             &["--layer `@100`", "empty"],
+        ),
+        case(
+            "flag: incoherent substrate",
+            &[
+                "spectrum",
+                "--layer",
+                "mgf2@100",
+                "--substrate",
+                "bk7:incoherent",
+                "-o",
+                "out.csv",
+            ],
+            &[
+                "--substrate `bk7:incoherent`",
+                "semi-infinite",
+                "marks a layer",
+            ],
+        ),
+        case(
+            "flag: incoherent ambient",
+            &[
+                "color",
+                "--ambient",
+                "1.0:incoherent",
+                "--layer",
+                "bk7@2mm:incoherent",
+                "-o",
+                "out.csv",
+            ],
+            &["--ambient `1.0:incoherent`", "semi-infinite"],
+        ),
+        case(
+            "flag: unknown layer suffix",
+            &["spectrum", "--layer", "bk7@2mm:incoherant", "-o", "out.csv"],
+            &[
+                "--layer `bk7@2mm:incoherant`",
+                "unknown suffix `:incoherant`",
+                ":incoherent",
+            ],
+        ),
+        case(
+            "flag: a metre-thick layer",
+            &[
+                "spectrum",
+                "--layer",
+                "bk7@1000mm:incoherent",
+                "-o",
+                "out.csv",
+            ],
+            &["--layer `bk7@1000mm:incoherent`", "thinner than 1 m"],
+        ),
+        case(
+            "flag: a slab that absorbs everything",
+            &[
+                "spectrum",
+                "--layer",
+                "1.5+0.01i@1mm:incoherent",
+                "-o",
+                "out.csv",
+            ],
+            &["layer 1", "absorbs everything", "1000000 nm"],
+        ),
+        case(
+            "flag: a colour method that takes no slab",
+            &[
+                "color",
+                "--layer",
+                "mgf2@100",
+                "--layer",
+                "bk7@2mm:incoherent",
+                "--method",
+                "fourier",
+                "-o",
+                "out.csv",
+            ],
+            &["--method `fourier`", "layer 2 is incoherent", "spectral"],
+        ),
+        case(
+            "recipe: incoherent substrate",
+            &[
+                "spectrum",
+                "--recipe",
+                "r/stack-incoherent-substrate.toml",
+                "-o",
+                "out.csv",
+            ],
+            &["r/stack-incoherent-substrate.toml:1", "semi-infinite"],
+        ),
+        case(
+            "recipe: a metre-thick layer",
+            &[
+                "spectrum",
+                "--recipe",
+                "r/stack-metre.toml",
+                "-o",
+                "out.csv",
+            ],
+            &["r/stack-metre.toml:4", "thinner than 1 m"],
         ),
         case(
             "flag: negative thickness step",

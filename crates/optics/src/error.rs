@@ -86,6 +86,46 @@ pub enum Error {
         /// The thickness given, in nm.
         thickness_nm: f64,
     },
+    /// An incoherent slab that lets (almost) nothing through in one pass: less than
+    /// [`crate::incoherent::OPAQUE_PASS`] (10⁻³⁰).
+    #[error(
+        "layer {layer} (`{material}`, {thickness_nm} nm, incoherent) absorbs everything at {wavelength_nm} nm and {angle_deg:.3}°: one pass lets through {pass:.3e} of the light; make it thinner, or make it the substrate"
+    )]
+    OpaqueSlab {
+        /// 1-based layer number, top layer first.
+        layer: usize,
+        /// Material name.
+        material: String,
+        /// The slab's thickness, nm.
+        thickness_nm: f64,
+        /// Vacuum wavelength, nm.
+        wavelength_nm: f64,
+        /// Incidence angle in the ambient, degrees.
+        angle_deg: f64,
+        /// The single-pass transmission exp(−4π d Im(ñ cos θ)/λ).
+        pass: f64,
+    },
+    /// A computation that needs the amplitudes of a fully coherent stack was asked of a
+    /// stack with incoherent layers (whose powers only [`crate::Stack::sweep`] gives).
+    #[error(
+        "{operation} needs a coherent stack, but layer {layer} (`{material}`) is incoherent: only reflectance and transmittance spectra take incoherent layers"
+    )]
+    IncoherentLayer {
+        /// What was asked, e.g. `complex amplitudes`.
+        operation: &'static str,
+        /// 1-based layer number of the first incoherent layer.
+        layer: usize,
+        /// Its material's name.
+        material: String,
+    },
+    /// The coherence flags of a stack do not match its layers.
+    #[error("{given} coherence flag(s) for a stack of {count} layer(s)")]
+    CoherenceCount {
+        /// Flags given.
+        given: usize,
+        /// Films in the stack.
+        count: usize,
+    },
     /// An incidence angle outside (−90°, 90°) or not finite.
     #[error("incidence angle {angle_deg}° must be finite and strictly between −90° and 90°")]
     InvalidAngle {

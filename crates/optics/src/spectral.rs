@@ -319,13 +319,16 @@ pub struct FilmColours {
 }
 
 impl Stack {
-    /// An upper bound of the optical path difference Σⱼ 2 dⱼ |ñⱼ| of the films, nm, with
+    /// An upper bound of the optical path difference Σⱼ 2 dⱼ |ñⱼ| of the coherent films (an
+    /// incoherent slab has no fringes), nm, with
     /// film `layer` (1-based) at `thickness_nm` instead of its own thickness; indices
     /// are sampled at 380, 480, … 780 nm where the materials have data.
     pub fn max_opd_nm(&self, layer: Option<(usize, f64)>) -> f64 {
         self.layers()
             .iter()
             .enumerate()
+            // An incoherent slab adds no fringes.
+            .filter(|(j, _)| !self.is_incoherent(j + 1))
             .map(|(j, l)| {
                 let d = match layer {
                     Some((k, d)) if k == j + 1 => d,

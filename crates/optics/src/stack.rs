@@ -306,12 +306,16 @@ impl<'a> ThicknessSweep<'a> {
     }
 }
 
-/// An ambient medium, 0..N films (top first) and a substrate.
+/// An ambient medium, 0..N films (top first) and a substrate. Every film is coherent
+/// unless marked incoherent ([`Stack::with_incoherent`]: a thick slab whose reflections add
+/// in intensity, [`crate::incoherent`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Stack {
     ambient: Material,
     layers: Vec<Layer>,
     substrate: Material,
+    /// Per film: incoherent. Empty when every film is coherent.
+    incoherent: Vec<bool>,
 }
 
 impl Stack {
@@ -334,7 +338,95 @@ impl Stack {
             ambient,
             layers,
             substrate,
+            incoherent: Vec::new(),
         })
+    }
+
+    /// The stack with film j (1-based) incoherent where `incoherent[j − 1]` (one flag per
+    /// film; all `false` is the coherent stack). Its powers come from the intensity
+    /// recurrence of [`crate::incoherent`]; the operations that need amplitudes
+    /// ([`Stack::evaluate`], [`Stack::sweep_thickness`]) refuse it with [`Error::IncoherentLayer`].
+    pub fn with_incoherent(mut self, incoherent: Vec<bool>) -> Result<Self> {
+        if incoherent.len() != self.layers.len() {
+            return Err(Error::CoherenceCount {
+                given: incoherent.len(),
+                count: self.layers.len(),
+            });
+        }
+        self.incoherent = if incoherent.iter().any(|&i| i) {
+            incoherent
+        } else {
+            Vec::new()
+        };
+        Ok(self)
+    }
+
+    /// Whether film `layer` (1-based) is incoherent.
+    pub fn is_incoherent(&self, layer: usize) -> bool {
+        self.incoherent.get(layer.wrapping_sub(1)) == Some(&true)
+    }
+
+    /// Per film, top first: whether it is incoherent.
+    pub fn incoherent_flags(&self) -> Vec<bool> {
+        (1..=self.layers.len())
+            .map(|j| self.is_incoherent(j))
+            .collect()
+    }
+
+    /// Whether every film is coherent.
+    pub fn is_coherent(&self) -> bool {
+        self.incoherent.is_empty()
+    }
+
+    /// `Ok` for a fully coherent stack, else [`Error::IncoherentLayer`] naming `operation`
+    /// and the first incoherent film.
+    pub fn require_coherent(&self, operation: &'static str) -> Result<()> {
+        match self.incoherent.iter().position(|&i| i) {
+            None => Ok(()),
+            Some(j) => Err(Error::IncoherentLayer {
+                operation,
+                layer: j + 1,
+                material: self.layers[j].material.name().to_string(),
+            }),
+        }
+    }
+
+    /// The coherent films whose interference fringes are finer, in wavelength, than the
+    /// sampling of `wavelengths_nm` (ascending) can follow: the fringe period of film j at
+    /// normal incidence, Δλ ≈ λ² / (2 Re ñ_j d_j) (successive orders of 2 Re ñ d = mλ;
+    /// Born & Wolf §7.5.1; oblique incidence only widens it), below the step to the next
+    /// sample somewhere on the grid. Such a film's spectrum aliases; a slab that thick
+    /// should be marked incoherent. Films whose index is unknown somewhere on the grid are
+    /// skipped (the sweep reports that).
+    pub fn undersampled_films(&self, wavelengths_nm: &[f64]) -> Vec<Undersampled> {
+        let mut out = Vec::new();
+        for (j, layer) in self.layers.iter().enumerate() {
+            if self.is_incoherent(j + 1) || layer.thickness_nm == 0.0 {
+                continue;
+            }
+            let mut worst: Option<(f64, f64, f64)> = None;
+            for pair in wavelengths_nm.windows(2) {
+                let (wl, step) = (pair[0], pair[1] - pair[0]);
+                let Ok(n) = layer.material.index_at(wl) else {
+                    continue;
+                };
+                let period = wl * wl / (2.0 * n.re.abs() * layer.thickness_nm);
+                if period < step && worst.is_none_or(|(p, s, _)| period / step < p / s) {
+                    worst = Some((period, step, wl));
+                }
+            }
+            if let Some((period, step, wl)) = worst {
+                out.push(Undersampled {
+                    layer: j + 1,
+                    material: layer.material.name().to_string(),
+                    thickness_nm: layer.thickness_nm,
+                    wavelength_nm: wl,
+                    fringe_period_nm: period,
+                    step_nm: step,
+                });
+            }
+        }
+        out
     }
 
     /// The ambient (incidence) medium.
@@ -371,6 +463,7 @@ impl Stack {
     /// Amplitudes and powers at incidence `angle_deg` (in the ambient) and vacuum
     /// wavelength `wavelength_nm`.
     pub fn evaluate(&self, angle_deg: f64, wavelength_nm: f64) -> Result<Response> {
+        self.require_coherent("complex amplitudes")?;
         let sin_theta = sin_of_angle(angle_deg)?;
         let indices = self.indices_at(wavelength_nm)?;
         let prepared = Prepared::new(&indices, indices[0].re * sin_theta);
@@ -392,6 +485,16 @@ impl Stack {
     pub fn sweep(&self, angles_deg: &[f64], wavelengths_nm: &[f64]) -> Result<Vec<Power>> {
         let thickness = self.thicknesses_nm();
         let (sines, columns) = self.resolve_columns(angles_deg, wavelengths_nm)?;
+        if !self.is_coherent() {
+            return crate::incoherent::sweep(
+                &crate::incoherent::Groups::new(&self.incoherent),
+                &sines,
+                &columns,
+                wavelengths_nm,
+                &thickness,
+                &self.layer_names(),
+            );
+        }
         let Some(media) = Media::from_columns(&columns, wavelengths_nm, &thickness) else {
             let indices: Vec<Vec<C64>> = (0..wavelengths_nm.len())
                 .map(|w| columns.iter().map(|c| c[w]).collect())
@@ -421,6 +524,48 @@ impl Stack {
         Ok(out)
     }
 
+    /// [`Stack::sweep`] with, per (angle, wavelength) and polarisation, the power absorbed in
+    /// each part of the stack: its coherent groups and incoherent slabs, top first
+    /// ([`Stack::parts`]; a coherent stack is one group). R + T + ΣA = 1.
+    pub fn sweep_absorbed(
+        &self,
+        angles_deg: &[f64],
+        wavelengths_nm: &[f64],
+    ) -> Result<Vec<crate::incoherent::Absorbed>> {
+        let thickness = self.thicknesses_nm();
+        let (sines, columns) = self.resolve_columns(angles_deg, wavelengths_nm)?;
+        let incoherent = if self.is_coherent() {
+            vec![false; self.layers.len()]
+        } else {
+            self.incoherent.clone()
+        };
+        crate::incoherent::sweep_absorbed(
+            &crate::incoherent::Groups::new(&incoherent),
+            &sines,
+            &columns,
+            wavelengths_nm,
+            &thickness,
+            &self.layer_names(),
+        )
+    }
+
+    /// The parts [`Stack::sweep_absorbed`] reports, top first.
+    pub fn parts(&self) -> Vec<crate::incoherent::Part> {
+        let incoherent = if self.is_coherent() {
+            vec![false; self.layers.len()]
+        } else {
+            self.incoherent.clone()
+        };
+        crate::incoherent::Groups::new(&incoherent).parts()
+    }
+
+    fn layer_names(&self) -> Vec<String> {
+        self.layers
+            .iter()
+            .map(|l| l.material.name().to_string())
+            .collect()
+    }
+
     /// Powers over every (angle, wavelength, thickness) triple with film `layer`
     /// (1-based, top film = 1) taking each of `thicknesses_nm` and the other films as
     /// given; element `(a * wavelengths.len() + w) * thicknesses.len() + d`.
@@ -432,6 +577,7 @@ impl Stack {
         thicknesses_nm: &[f64],
     ) -> Result<Vec<Power>> {
         self.check_layer(layer, thicknesses_nm)?;
+        self.require_coherent("a thickness sweep")?;
         let thickness = self.thicknesses_nm();
         let (sines, indices) = self.resolve(angles_deg, wavelengths_nm)?;
         let per_angle = wavelengths_nm.len() * thicknesses_nm.len();
@@ -495,10 +641,22 @@ impl Stack {
     /// of the module docs, |Γⱼ| ≤ (|r_{j,j+1}| + |Γ_{j+1}|) / (1 + |r_{j,j+1}| |Γ_{j+1}|)
     /// (exact for real Fresnel coefficients, with the films' attenuation taken as 1), so ρ
     /// is an upper bound there. Clamped to [0, 1].
+    ///
+    /// With incoherent layers, the largest finesse of its coherent groups (each group between
+    /// the incoherent media that bound it, [`crate::incoherent`]): the incoherent slabs have
+    /// no fringes.
     pub fn fringe_finesse(&self, angle_deg: f64, wavelength_nm: f64) -> Result<f64> {
         let sin_theta = sin_of_angle(angle_deg)?;
         let indices = self.indices_at(wavelength_nm)?;
-        Ok(fringe_finesse_of(&indices, indices[0].re * sin_theta))
+        let beta = indices[0].re * sin_theta;
+        if self.is_coherent() {
+            return Ok(fringe_finesse_of(&indices, beta));
+        }
+        let media = crate::incoherent::Groups::new(&self.incoherent).media;
+        Ok(media
+            .windows(2)
+            .map(|g| fringe_finesse_of(&indices[g[0]..=g[1]], beta))
+            .fold(0.0, f64::max))
     }
 
     /// [`Stack::resolve`] with the indices per medium (ambient, films top first, substrate),
@@ -546,6 +704,38 @@ impl Stack {
             .map(|&wl| self.indices_at(wl))
             .collect::<Result<Vec<_>>>()?;
         Ok((sines, indices))
+    }
+}
+
+/// A coherent film too thick for a wavelength sampling ([`Stack::undersampled_films`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Undersampled {
+    /// 1-based layer number, top first.
+    pub layer: usize,
+    /// Its material's name.
+    pub material: String,
+    /// Its thickness, nm.
+    pub thickness_nm: f64,
+    /// The wavelength where the fringes are finest relative to the step, nm.
+    pub wavelength_nm: f64,
+    /// The fringe period there, nm.
+    pub fringe_period_nm: f64,
+    /// The sampling step there, nm.
+    pub step_nm: f64,
+}
+
+impl std::fmt::Display for Undersampled {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "layer {} (`{}`, {} nm) is coherent but its fringes are {:.3e} nm apart near {} nm, finer than the {} nm wavelength step: its spectrum aliases; a layer that thick adds its reflections in intensity, mark it `:incoherent`",
+            self.layer,
+            self.material,
+            self.thickness_nm,
+            self.fringe_period_nm,
+            self.wavelength_nm,
+            self.step_nm
+        )
     }
 }
 

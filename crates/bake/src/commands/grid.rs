@@ -65,12 +65,14 @@ pub fn parse_thickness_nm(context: impl Into<Origin>, text: &str) -> Result<f64>
         (v, 1e3)
     } else if let Some(v) = t.strip_suffix("µm") {
         (v, 1e3)
+    } else if let Some(v) = lower.strip_suffix("mm") {
+        (v, 1e6)
     } else {
         (lower.as_str(), 1.0)
     };
     let err = |message: &str| Error::value(context.clone(), text, message);
     let v = number.trim().parse::<f64>().map_err(|_| {
-        err("thickness must be a number of nanometres, e.g. `635` or `635nm` (or `1.2um`)")
+        err("thickness must be a number of nanometres, e.g. `635` or `635nm` (or `1.2um`, `2mm`)")
     })?;
     let v = v * scale;
     if !v.is_finite() || v < 0.0 {
@@ -127,8 +129,9 @@ mod tests {
         assert_eq!(parse_thickness_nm(Param::Layer, "635nm").unwrap(), 635.0);
         assert_eq!(parse_thickness_nm(Param::Layer, "635 nm").unwrap(), 635.0);
         assert_eq!(parse_thickness_nm(Param::Layer, "1.2um").unwrap(), 1200.0);
+        assert_eq!(parse_thickness_nm(Param::Layer, "2mm").unwrap(), 2e6);
         assert_eq!(parse_thickness_nm(Param::Layer, "0").unwrap(), 0.0);
-        for bad in ["-5", "abc", "nan", "inf", "5mm", ""] {
+        for bad in ["-5", "abc", "nan", "inf", "5cm", ""] {
             assert!(parse_thickness_nm(Param::Layer, bad).is_err(), "{bad}");
         }
     }

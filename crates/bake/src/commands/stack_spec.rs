@@ -12,8 +12,16 @@
 //!
 //! [[layers]]                 # films, top first; none for a bare interface
 //! material = "mgf2"          # material spec (number, n+ki, bundled name, .yml/.csv path)
-//! thickness_nm = 99.75       # physical thickness in nm, ≥ 0
+//! thickness_nm = 99.75       # physical thickness in nm, ≥ 0 and below 1 m
+//!
+//! [[layers]]                 # a 2 mm glass slab whose reflections add in intensity
+//! material = "bk7"
+//! thickness_nm = 2e6
+//! incoherent = true          # optional, default false (nacre_optics::incoherent)
 //! ```
+//!
+//! On the command line a layer is `MATERIAL@THICKNESS[:incoherent]`, the thickness in nm
+//! (`400`, `400nm`) or with a unit (`1.2um`, `2mm`): `bk7@2mm:incoherent`.
 //!
 //! Relative material paths are resolved from the recipe's folder. Unknown keys are errors.
 
@@ -55,6 +63,25 @@ pub struct StackSpec {
     pub substrate: MaterialRef,
     /// Folder that relative material paths are resolved from.
     pub base_dir: Option<PathBuf>,
+    /// Per layer: incoherent (a thick slab, [`nacre_optics::incoherent`]). Empty when every
+    /// layer is coherent.
+    pub incoherent: Vec<bool>,
+}
+
+/// The suffix that marks a layer incoherent: `bk7@2mm:incoherent`.
+pub const INCOHERENT_SUFFIX: &str = "incoherent";
+
+/// The thickness from which a layer is refused as absurd: 1 m, in nm.
+pub const MAX_THICKNESS_NM: f64 = 1e9;
+
+/// `Some(message)` when `spec` (an ambient or substrate) carries the incoherent suffix.
+fn suffix_on_medium(spec: &str) -> Option<&'static str> {
+    spec.trim()
+        .strip_suffix(INCOHERENT_SUFFIX)
+        .is_some_and(|m| m.ends_with(':'))
+        .then_some(
+            "the ambient and the substrate are semi-infinite and always add their reflections in intensity: `:incoherent` marks a layer (a slab with air behind it is a layer `bk7@2mm:incoherent` on an air substrate)",
+        )
 }
 
 impl StackSpec {
@@ -68,6 +95,12 @@ impl StackSpec {
             spec: spec.to_string(),
             context,
         };
+        for (param, spec) in [(Param::Ambient, ambient), (Param::Substrate, substrate)] {
+            if let Some(message) = spec.and_then(suffix_on_medium) {
+                return Err(Error::value(param, spec.unwrap_or_default(), message));
+            }
+        }
+        let mut incoherent = Vec::new();
         let layers = if ambient.is_none() && layers.is_empty() && substrate.is_none() {
             vec![(
                 flag(DEFAULT_LAYER.0, "default stack".into()),
@@ -91,12 +124,39 @@ impl StackSpec {
                             "the material before `@` is empty",
                         ));
                     }
+                    let (d, suffix) = match d.split_once(':') {
+                        Some((d, suffix)) => (d, Some(suffix)),
+                        None => (d, None),
+                    };
+                    let inc = match suffix {
+                        None => false,
+                        Some(s) if s.trim() == INCOHERENT_SUFFIX => true,
+                        Some(s) => {
+                            return Err(Error::value(
+                                Param::Layer,
+                                text.clone(),
+                                format!(
+                                    "unknown suffix `:{s}`: the one suffix a layer takes is `:incoherent`, e.g. `bk7@2mm:incoherent`"
+                                ),
+                            ));
+                        }
+                    };
                     let d = parse_thickness_nm(Param::Layer, d).map_err(|e| match e {
                         Error::Value { message, .. } => {
                             Error::value(Param::Layer, text.clone(), message)
                         }
                         other => other,
                     })?;
+                    if d >= MAX_THICKNESS_NM {
+                        return Err(Error::value(
+                            Param::Layer,
+                            text.clone(),
+                            format!(
+                                "thickness {d} nm is a metre or more: a layer must be thinner than 1 m (units: `nm`, `um`, `mm`)"
+                            ),
+                        ));
+                    }
+                    incoherent.push(inc);
                     Ok((flag(m, Param::Layer.into()), d))
                 })
                 .collect::<Result<_>>()?
@@ -106,6 +166,11 @@ impl StackSpec {
             layers,
             substrate: flag(substrate.unwrap_or(DEFAULT_MEDIUM), Param::Substrate.into()),
             base_dir: None,
+            incoherent: if incoherent.contains(&true) {
+                incoherent
+            } else {
+                Vec::new()
+            },
         })
     }
 
@@ -137,6 +202,7 @@ impl StackSpec {
             layers,
             substrate: from(&m.base, "base"),
             base_dir: path.parent().map(Path::to_path_buf),
+            incoherent: Vec::new(),
         })
     }
 
@@ -191,7 +257,13 @@ impl StackSpec {
             })
             .collect::<Result<Vec<_>>>()?;
         let substrate = load(&self.substrate)?;
-        Stack::new(ambient, layers, substrate)
+        let stack = Stack::new(ambient, layers, substrate)
+            .map_err(|source| Error::optics_in(self.ambient.context.clone(), source))?;
+        if self.incoherent.is_empty() {
+            return Ok(stack);
+        }
+        stack
+            .with_incoherent(self.incoherent.clone())
             .map_err(|source| Error::optics_in(self.ambient.context.clone(), source))
     }
 }
@@ -201,6 +273,8 @@ impl StackSpec {
 struct RawLayer {
     material: Spanned<String>,
     thickness_nm: Spanned<f64>,
+    #[serde(default)]
+    incoherent: bool,
 }
 
 #[derive(Deserialize)]
@@ -261,8 +335,27 @@ impl StackRecipe {
                     format!("thickness_nm = {d}: must be finite and non-negative"),
                 ));
             }
+            if d >= MAX_THICKNESS_NM {
+                return Err(Error::recipe(
+                    path.to_path_buf(),
+                    line_of(text, layer.thickness_nm.span().start),
+                    format!("thickness_nm = {d}: a layer must be thinner than 1 m (1e9 nm)"),
+                ));
+            }
             layers.push((mref(&layer.material), d));
         }
+        for (what, medium) in [("ambient", &raw.ambient), ("substrate", &raw.substrate)] {
+            if let Some(m) = medium
+                && let Some(message) = suffix_on_medium(m.get_ref())
+            {
+                return Err(Error::recipe(
+                    path.to_path_buf(),
+                    line_of(text, m.span().start),
+                    format!("{what} = \"{}\": {message}", m.get_ref()),
+                ));
+            }
+        }
+        let incoherent: Vec<bool> = raw.layers.iter().map(|l| l.incoherent).collect();
         Ok(StackRecipe {
             stack: StackSpec {
                 ambient: raw
@@ -275,6 +368,11 @@ impl StackRecipe {
                     .as_ref()
                     .map_or_else(|| default("substrate"), mref),
                 base_dir: path.parent().map(Path::to_path_buf),
+                incoherent: if incoherent.contains(&true) {
+                    incoherent
+                } else {
+                    Vec::new()
+                },
             },
             angles: raw.angles,
             wavelengths: raw.wavelengths,

@@ -105,7 +105,8 @@ const SIGN: u64 = 1 << 63;
 
 /// A stack's media indices per wavelength, structure of arrays, and its film thicknesses.
 pub(crate) struct Media {
-    /// Re ñ_j(λ_w) at `re[j][w]`, j = 0 ambient … N+1 substrate.
+    /// Re ñ_j(λ_w) at `re[j][w]`, j = 0 ambient … N+1 substrate; `re[0]` is the real index
+    /// n₀ of β = n₀ sin θ₀ (the ambient's, or that of [`Media::from_columns_beta`]).
     re: Vec<Vec<f64>>,
     /// ñ_j² as (re, im) and |ñ_j|², computed once per wavelength (angle-independent).
     n2_re: Vec<Vec<f64>>,
@@ -211,7 +212,24 @@ impl Media {
         wavelengths_nm: &[f64],
         thickness_nm: &[f64],
     ) -> Option<Self> {
+        Self::from_columns_beta(columns, None, wavelengths_nm, thickness_nm)
+    }
+
+    /// [`Media::from_columns`] for a stack whose tangential component β is set by another
+    /// medium than its first one: `beta_index[w]` is the real index n₀ with β = n₀ sin θ₀
+    /// (a coherent group between incoherent slabs, [`crate::incoherent`], whose first
+    /// medium may absorb); `None` takes the first medium's Re ñ.
+    pub(crate) fn from_columns_beta(
+        columns: &[Vec<C64>],
+        beta_index: Option<&[f64]>,
+        wavelengths_nm: &[f64],
+        thickness_nm: &[f64],
+    ) -> Option<Self> {
         let media = thickness_nm.len() + 2;
+        let beta_column: Vec<f64> = match beta_index {
+            Some(b) => b.to_vec(),
+            None => columns[0].iter().map(|n| n.re).collect(),
+        };
         debug_assert_eq!(columns.len(), media);
         let k0_per_nm: Vec<f64> = wavelengths_nm.iter().map(|&wl| wavenumber(wl)).collect();
         for (j, column) in columns.iter().enumerate() {
@@ -222,7 +240,10 @@ impl Media {
                 if !(a <= MAX_INDEX && b <= MAX_INDEX && a.max(b) >= MIN_INDEX) {
                     return None;
                 }
-                let n0 = columns[0][w].re.abs();
+                let n0 = beta_column[w].abs();
+                if !(n0 <= MAX_INDEX) {
+                    return None;
+                }
                 if (1..media - 1).contains(&j)
                     && !(k0_per_nm[w] * thickness_nm[j - 1] * (a + b + n0) <= MAX_PHASE_RAD)
                 {
@@ -246,7 +267,8 @@ impl Media {
                 .map(|c| pad(c.iter().map(f).collect()))
                 .collect()
         };
-        let re = map(|n| n.re);
+        let mut re = map(|n| n.re);
+        re[0] = pad(beta_column.clone());
         let n2_re = map(|n| (n * n).re);
         let n2_im = map(|n| (n * n).im);
         let n_abs2 = map(|n| n.norm_sqr());
@@ -256,7 +278,10 @@ impl Media {
         // q = √(ñ² − β²) is the same along a row where ñ and the ambient's index (β = n₀ sin θ₀)
         // are.
         let uniform = |j: usize| column(j).all(|n| Some(n) == column(j).next());
-        let constant = |j: usize| uniform(j) && uniform(0);
+        let beta_uniform = beta_column
+            .iter()
+            .all(|b| b.to_bits() == beta_column[0].to_bits());
+        let constant = |j: usize| uniform(j) && beta_uniform;
         let media_slots = Slots::new(media, 2, MEDIA_SLOTS - 2, same_medium, constant);
         // Films 1..=N as items 0..N − 1 (a film's phase depends on the wavelength).
         let film_slots = Slots::new(

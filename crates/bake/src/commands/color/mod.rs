@@ -260,11 +260,10 @@ fn stack_at(stack: &Stack, point: &Point) -> Result<Stack> {
             ],
         ));
     }
-    Ok(Stack::new(
-        stack.ambient().clone(),
-        layers,
-        stack.substrate().clone(),
-    )?)
+    Ok(
+        Stack::new(stack.ambient().clone(), layers, stack.substrate().clone())?
+            .with_incoherent(stack.incoherent_flags())?,
+    )
 }
 
 /// The (thickness, real index) a point has for the first film, for the output columns.
@@ -556,6 +555,9 @@ pub fn evaluate(
         }
         .into());
     }
+    if !stack.is_coherent() {
+        refuse_incoherent(stack, method)?;
+    }
     // The stack technique's rules and indices, prepared once for the stack's own films (a
     // point that overrides the top film's index prepares its own).
     let stack_eval = match method {
@@ -637,6 +639,18 @@ pub fn evaluate(
                 .map(|e| e[0].colour),
                 Method::Spectral => {
                     let s = stack_at(stack, point)?;
+                    if !s.is_coherent() {
+                        // Incoherent slabs: the rule resolves the coherent groups' fringes;
+                        // the slabs add in intensity ([`nacre_optics::incoherent`]).
+                        let rule = SpectralRule::for_stack(
+                            colorimeter,
+                            &s,
+                            &[point.angle_deg],
+                            s.max_opd_nm(None),
+                        )?;
+                        let p = s.sweep(&[point.angle_deg], rule.wavelengths_nm())?;
+                        return Ok(rule.colour(p.iter().map(|p| value(p, quantity))));
+                    }
                     if s.layers().is_empty() {
                         let rule = SpectralRule::new(colorimeter, 0.0);
                         let p = s.sweep(&[point.angle_deg], rule.wavelengths_nm())?;
@@ -754,6 +768,49 @@ pub fn evaluate(
             }
         })
         .collect()
+}
+
+/// `Ok` when `method` takes a stack with incoherent layers (`spectral`, `rgb3`,
+/// `samples:N`: each integrates the stack's reflectance or transmittance spectrum, which
+/// [`Stack::sweep`] gives with the slabs added in intensity); otherwise an error that says
+/// why the method's physics does not apply.
+fn refuse_incoherent(stack: &Stack, method: &Method) -> Result<()> {
+    let (name, why) = match method {
+        Method::Spectral | Method::Rgb3 | Method::Samples(_) => return Ok(()),
+        Method::Lut(_) => (
+            "lut",
+            "a film-lut holds one film over fixed coherent layers, baked without incoherent slabs",
+        ),
+        Method::Fourier(..) => (
+            "fourier",
+            "the Fourier series in 1/λ describes one coherent film on a base; an incoherent slab below it has no such series",
+        ),
+        Method::GaussianFitBelcour2017 => (
+            "gaussian",
+            "the Gaussian fit describes one coherent film on a base given by its Fresnel reflectance",
+        ),
+        Method::RoughLut { .. } => (
+            "rough-lut",
+            "a rough-film-lut holds one film over fixed coherent layers, baked without incoherent slabs",
+        ),
+        Method::RoughMonteCarlo { .. } => (
+            "rough-mc",
+            "the microfacet model reflects from one rough interface; light returning through an incoherent slab behind it leaves at other points and angles",
+        ),
+        Method::Stack(_) => (
+            "stack",
+            "the real-time technique sums coherent amplitudes at a few wavelengths; it has no incoherent slab",
+        ),
+    };
+    let layer = (1..=stack.layers().len())
+        .find(|&j| stack.is_incoherent(j))
+        .unwrap_or(0);
+    Err(Error::invalid(
+        Param::Method.given(name),
+        format!(
+            "layer {layer} is incoherent and {why}: use `spectral` (exact), `rgb3` or `samples:N`"
+        ),
+    ))
 }
 
 fn mat3(m: [[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
