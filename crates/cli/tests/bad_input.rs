@@ -1310,7 +1310,7 @@ fn fixtures(d: &Path) -> Vec<Case> {
                 "-o",
                 "out.csv",
             ],
-            &["--method `fourier`", "layer 2 is incoherent", "spectral"],
+            &["--method fourier", "layer 2 is incoherent", "spectral"],
         ),
         case(
             "recipe: incoherent substrate",

@@ -54,7 +54,6 @@ use crate::error::{Error, Result};
 use crate::fresnel::normal_component;
 use crate::multilayer::{Media, stack_powers};
 use crate::power::{Power, wavenumber};
-use crate::stack::Prepared;
 use num_complex::Complex64 as C64;
 use rayon::prelude::*;
 
@@ -137,6 +136,11 @@ impl Groups {
     }
 }
 
+/// The scalar recurrence of one coherent stack: its powers for media `indices` (first to
+/// last), tangential component β, vacuum wavelength (nm) and film thicknesses (nm). Handed in
+/// by [`crate::stack`] (its `Prepared`), for media outside the vectorised kernel's ranges.
+pub(crate) type Scalar = fn(&[C64], f64, f64, &[f64]) -> Power;
+
 /// Everything the recurrence needs at every (angle, wavelength): the groups' forward and
 /// backward powers and the slabs' single passes.
 struct Terms {
@@ -154,6 +158,7 @@ impl Terms {
         wavelengths_nm: &[f64],
         thickness_nm: &[f64],
         names: &[String],
+        scalar: Scalar,
     ) -> Result<Self> {
         let beta_index: Vec<f64> = columns[0].iter().map(|n| n.re).collect();
         let passes = groups.media[1..groups.media.len() - 1]
@@ -183,6 +188,7 @@ impl Terms {
                 sines,
                 wavelengths_nm,
                 thick,
+                scalar,
             ));
             if g < last {
                 let rev_cols: Vec<Vec<C64>> = cols.iter().rev().cloned().collect();
@@ -193,6 +199,7 @@ impl Terms {
                     sines,
                     wavelengths_nm,
                     &rev_thick,
+                    scalar,
                 ));
             }
         }
@@ -264,8 +271,17 @@ pub(crate) fn sweep(
     wavelengths_nm: &[f64],
     thickness_nm: &[f64],
     names: &[String],
+    scalar: Scalar,
 ) -> Result<Vec<Power>> {
-    let terms = Terms::new(groups, sines, columns, wavelengths_nm, thickness_nm, names)?;
+    let terms = Terms::new(
+        groups,
+        sines,
+        columns,
+        wavelengths_nm,
+        thickness_nm,
+        names,
+        scalar,
+    )?;
     let total = sines.len() * wavelengths_nm.len();
     let mut x = vec![0.0; groups.count()];
     Ok((0..total)
@@ -302,8 +318,17 @@ pub(crate) fn sweep_absorbed(
     wavelengths_nm: &[f64],
     thickness_nm: &[f64],
     names: &[String],
+    scalar: Scalar,
 ) -> Result<Vec<Absorbed>> {
-    let terms = Terms::new(groups, sines, columns, wavelengths_nm, thickness_nm, names)?;
+    let terms = Terms::new(
+        groups,
+        sines,
+        columns,
+        wavelengths_nm,
+        thickness_nm,
+        names,
+        scalar,
+    )?;
     let total = sines.len() * wavelengths_nm.len();
     let last = groups.count() - 1;
     let mut x = vec![0.0; groups.count()];
@@ -392,14 +417,15 @@ fn elementary_asin_deg(sin_theta: f64) -> f64 {
 
 /// Powers of one coherent group (media `columns`, first to last, films `thickness_nm`) at
 /// every (angle, wavelength), angle-major, with β = `beta_index[w]` sin θ₀: the vectorised
-/// kernel of [`crate::multilayer`] where its ranges allow, else the scalar recurrence of
-/// [`Prepared`].
+/// kernel of [`crate::multilayer`] where its ranges allow, else the scalar recurrence
+/// `scalar`.
 fn group_powers(
     columns: &[Vec<C64>],
     beta_index: &[f64],
     sines: &[f64],
     wavelengths_nm: &[f64],
     thickness_nm: &[f64],
+    scalar: Scalar,
 ) -> Vec<Power> {
     let per_angle = wavelengths_nm.len();
     let mut out = vec![Power::default(); sines.len() * per_angle];
@@ -417,8 +443,7 @@ fn group_powers(
             .for_each(|(row, &sin_theta)| {
                 for (w, (slot, &wl)) in row.iter_mut().zip(wavelengths_nm).enumerate() {
                     let indices: Vec<C64> = columns.iter().map(|c| c[w]).collect();
-                    let prepared = Prepared::new(&indices, beta_index[w] * sin_theta);
-                    *slot = prepared.power(&prepared.amplitudes(wl, thickness_nm));
+                    *slot = scalar(&indices, beta_index[w] * sin_theta, wl, thickness_nm);
                 }
             }),
     }

@@ -493,6 +493,7 @@ impl Stack {
                 wavelengths_nm,
                 &thickness,
                 &self.layer_names(),
+                scalar_powers,
             );
         }
         let Some(media) = Media::from_columns(&columns, wavelengths_nm, &thickness) else {
@@ -546,6 +547,7 @@ impl Stack {
             wavelengths_nm,
             &thickness,
             &self.layer_names(),
+            scalar_powers,
         )
     }
 
@@ -802,6 +804,15 @@ pub(crate) fn fringe_finesse_of(indices: &[C64], beta: f64) -> f64 {
     } else {
         rho.clamp(0.0, 1.0)
     }
+}
+
+/// The powers of the stack of media `indices` (first to last) at tangential component `beta`,
+/// `wavelength_nm` and film thicknesses `thickness_nm`, by the scalar recurrence of
+/// [`Prepared`] (a coherent group of [`crate::incoherent`] outside the vectorised kernel's
+/// ranges).
+fn scalar_powers(indices: &[C64], beta: f64, wavelength_nm: f64, thickness_nm: &[f64]) -> Power {
+    let prepared = Prepared::new(indices, beta);
+    prepared.power(&prepared.amplitudes(wavelength_nm, thickness_nm))
 }
 
 /// Returns a `Prepared` for `indices`, reusing the cached one when the indices have not
