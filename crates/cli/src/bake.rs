@@ -26,7 +26,6 @@ pub struct BakeArgs {
 
 pub fn run(args: &BakeArgs) -> Result<()> {
     use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
-    use nacre_format::TableKind;
     let paths = if args.recipes.is_empty() {
         set::default_recipes()?
     } else {
@@ -44,12 +43,7 @@ pub fn run(args: &BakeArgs) -> Result<()> {
     // writes only its own files and sums in a fixed order, so the bytes do not depend on
     // the schedule.
     let mut order: Vec<usize> = (0..recipes.len()).collect();
-    order.sort_by_key(|&i| match recipes[i].kind() {
-        TableKind::RoughFilmLut => 0,
-        TableKind::Diffraction => 1,
-        TableKind::Fourier => 2,
-        _ => 3,
-    });
+    order.sort_by_key(|&i| kinds::entry(recipes[i].kind()).map_or(u8::MAX, |e| e.start_rank));
     let bars = MultiProgress::new();
     let failure = std::sync::Mutex::new(None);
     rayon::scope_fifo(|scope| {

@@ -96,7 +96,7 @@ pub fn export_raw(manifest_path: &Path, quantity: &str) -> Result<RawTexture3d> 
     let texel_centres = "texel i of an axis of count texels holds t = i/(count − 1), \
                          sampled at u = (t (count − 1) + 0.5)/count; linear filtering, clamp to edge";
     let (table, axes, mapping, params) = match manifest.kind {
-        TableKind::FilmLut => {
+        TableKind::FILM_LUT => {
             let axes = manifest
                 .film_lut()
                 .cloned()
@@ -116,7 +116,7 @@ pub fn export_raw(manifest_path: &Path, quantity: &str) -> Result<RawTexture3d> 
             });
             (table, serde_json::to_value(&axes), mapping, params)
         }
-        TableKind::RoughFilmLut => {
+        TableKind::ROUGH_FILM_LUT => {
             let loaded = LoadedRoughLut::load(manifest_path)?;
             let axes = loaded.lut.axes.clone();
             let has_t = loaded.lut.transmittance.is_some();

@@ -2,8 +2,9 @@
 //! tables only through it. Its keys are stable (`nacre-table/1`): every manifest the
 //! default set ships loads unchanged.
 //!
-//! A manifest names its [`TableKind`]; the kind's own axes are one [`KindRecord`] (the JSON
-//! key `film_lut`, `fourier`, `rough_film_lut` or `diffraction`); its files are
+//! A manifest names its [`TableKind`]; the kind's own axes are one [`KindRecord`] (under the
+//! JSON key `film_lut`, `fourier`, `rough_film_lut`, `diffraction` or another kind's
+//! [`TableKind::record_key`]); its files are
 //! [`FileRecord`]s with a SHA-256 checked before any file is read.
 
 use crate::diffraction::DiffractionRecord;
@@ -14,7 +15,9 @@ pub use crate::kind::TableKind;
 use crate::rough_film_lut::RoughLutAxes;
 use crate::table_io;
 use nacre_optics::colour::Colorimeter;
-use serde::{Deserialize, Serialize};
+use serde::de::{DeserializeOwned, IgnoredAny, MapAccess, Visitor};
+use serde::ser::SerializeMap;
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use std::path::{Path, PathBuf};
 
 /// Most texels one table may have (2²⁴ ≈ 16.8 million: 96 MiB of half-float RGB per
@@ -27,33 +30,124 @@ pub const MANIFEST_FORMAT: &str = "nacre-table/1";
 /// The `quantity` of a `fourier` table's KTX2 file (every level in one file).
 pub const FOURIER_KTX2_QUANTITY: &str = "all levels";
 
-/// The axes and records of one table kind, as the manifest stores them (flattened: the
-/// variant's JSON key sits beside the common fields).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// The axes and records of one table kind, as the manifest stores them: one JSON key (the
+/// kind's [`TableKind::record_key`]) beside the common fields.
+#[derive(Clone, Debug, PartialEq)]
 pub enum KindRecord {
-    /// Machine-readable axes of a `film-lut`.
-    #[serde(rename = "film_lut")]
+    /// Machine-readable axes of a `film-lut` (key `film_lut`).
     FilmLut(FilmLutAxes),
-    /// Machine-readable axes of a `fourier` table.
-    #[serde(rename = "fourier")]
+    /// Machine-readable axes of a `fourier` table (key `fourier`).
     Fourier(FourierAxes),
-    /// Machine-readable axes of a `rough-film-lut`.
-    #[serde(rename = "rough_film_lut")]
+    /// Machine-readable axes of a `rough-film-lut` (key `rough_film_lut`).
     RoughFilmLut(RoughLutAxes),
-    /// Sampling, Taylor order and conventions of a `diffraction` table.
-    #[serde(rename = "diffraction")]
+    /// Sampling, Taylor order and conventions of a `diffraction` table (key `diffraction`).
     Diffraction(Box<DiffractionRecord>),
+    /// The record of a kind this crate does not type: a kind the CPU alone reads, whose
+    /// module in `nacre-bake` writes it ([`KindRecord::data`]) and reads it back
+    /// ([`Manifest::data_record`]) as its own serde type. (JSON objects keep their keys
+    /// sorted here.)
+    Data {
+        /// The kind.
+        kind: TableKind,
+        /// The record.
+        value: serde_json::Value,
+    },
 }
 
 impl KindRecord {
     /// The kind this record belongs to.
     pub fn kind(&self) -> TableKind {
         match self {
-            KindRecord::FilmLut(_) => TableKind::FilmLut,
-            KindRecord::Fourier(_) => TableKind::Fourier,
-            KindRecord::RoughFilmLut(_) => TableKind::RoughFilmLut,
-            KindRecord::Diffraction(_) => TableKind::Diffraction,
+            KindRecord::FilmLut(_) => TableKind::FILM_LUT,
+            KindRecord::Fourier(_) => TableKind::FOURIER,
+            KindRecord::RoughFilmLut(_) => TableKind::ROUGH_FILM_LUT,
+            KindRecord::Diffraction(_) => TableKind::DIFFRACTION,
+            KindRecord::Data { kind, .. } => *kind,
         }
+    }
+
+    /// The record of a kind without a typed variant: `record` as JSON.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] when `record` does not serialise to JSON (a map with non-string
+    /// keys, say).
+    pub fn data(kind: TableKind, record: &impl Serialize) -> Result<KindRecord> {
+        let value = serde_json::to_value(record).map_err(|e| Error::Invalid {
+            context: format!("the {kind} record").into(),
+            message: e.to_string().into(),
+        })?;
+        Ok(KindRecord::Data { kind, value })
+    }
+}
+
+/// Reads a [`KindRecord`] from a map: the record under the first key that is the record key of
+/// one of its kinds (other keys are skipped). [`KindRecord`]'s `Deserialize` uses
+/// [`TableKind::ALL`].
+struct RecordVisitor<'k>(&'k [TableKind]);
+
+impl<'de> Visitor<'de> for RecordVisitor<'_> {
+    type Value = KindRecord;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("a table kind's record")
+    }
+
+    fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> std::result::Result<KindRecord, A::Error> {
+        let mut record = None;
+        while let Some(key) = map.next_key::<String>()? {
+            let kind = match record {
+                None => TableKind::from_record_key(self.0, &key),
+                Some(_) => None,
+            };
+            record = Some(match kind {
+                Some(TableKind::FILM_LUT) => KindRecord::FilmLut(map.next_value()?),
+                Some(TableKind::FOURIER) => KindRecord::Fourier(map.next_value()?),
+                Some(TableKind::ROUGH_FILM_LUT) => KindRecord::RoughFilmLut(map.next_value()?),
+                Some(TableKind::DIFFRACTION) => KindRecord::Diffraction(map.next_value()?),
+                Some(kind) => KindRecord::Data {
+                    kind,
+                    value: map.next_value()?,
+                },
+                None => {
+                    map.next_value::<IgnoredAny>()?;
+                    continue;
+                }
+            });
+        }
+        record.ok_or_else(|| {
+            let keys: Vec<String> = self
+                .0
+                .iter()
+                .map(|k| format!("`{}`", k.record_key()))
+                .collect();
+            serde::de::Error::custom(format_args!(
+                "no table record: expected one of the keys {}",
+                keys.join(", ")
+            ))
+        })
+    }
+}
+
+impl Serialize for KindRecord {
+    /// One entry: the kind's record key and its record.
+    fn serialize<S: Serializer>(&self, serializer: S) -> std::result::Result<S::Ok, S::Error> {
+        let mut map = serializer.serialize_map(Some(1))?;
+        let key = self.kind().record_key();
+        match self {
+            KindRecord::FilmLut(a) => map.serialize_entry(&key, a)?,
+            KindRecord::Fourier(a) => map.serialize_entry(&key, a)?,
+            KindRecord::RoughFilmLut(a) => map.serialize_entry(&key, a)?,
+            KindRecord::Diffraction(r) => map.serialize_entry(&key, r)?,
+            KindRecord::Data { value, .. } => map.serialize_entry(&key, value)?,
+        }
+        map.end()
+    }
+}
+
+impl<'de> Deserialize<'de> for KindRecord {
+    /// The first key that is the record key of a kind of [`TableKind::ALL`].
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> std::result::Result<Self, D::Error> {
+        deserializer.deserialize_map(RecordVisitor(TableKind::ALL))
     }
 }
 
@@ -179,8 +273,7 @@ pub struct Manifest {
     pub base: String,
     /// The axes in x, y, z order.
     pub axes: Vec<AxisRecord>,
-    /// The kind's own axes and records (JSON key `film_lut`, `fourier`, `rough_film_lut`
-    /// or `diffraction`).
+    /// The kind's own axes and records (JSON key: the kind's [`TableKind::record_key`]).
     #[serde(flatten)]
     pub record: KindRecord,
     /// Texel-centre convention.
@@ -344,6 +437,27 @@ impl Manifest {
         }
     }
 
+    /// The record of a kind without a typed [`KindRecord`] variant (a CPU-only kind's) as
+    /// its module's type `T`; `None` for a table of another kind.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] naming `manifest_path` when the record is not a `T`.
+    pub fn data_record<T: DeserializeOwned>(
+        &self,
+        kind: TableKind,
+        manifest_path: &Path,
+    ) -> Option<Result<T>> {
+        match &self.record {
+            KindRecord::Data { kind: k, value } if *k == kind => {
+                Some(T::deserialize(value).map_err(|e| Error::Invalid {
+                    context: format!("{}: {}", manifest_path.display(), kind.record_key()).into(),
+                    message: e.to_string().into(),
+                }))
+            }
+            _ => None,
+        }
+    }
+
     /// The file of `quantity` in `format`, if the manifest lists one.
     pub fn file(&self, quantity: &str, format: FileFormat) -> Option<&FileRecord> {
         self.files
@@ -388,3 +502,108 @@ pub use crate::checksum::sha256_text;
 
 /// Most texels of level 0 of a `fourier` table.
 pub const MAX_FOURIER_SAMPLES: usize = 1 << 20;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A kind without a typed record, as a CPU-only kind's module would add it.
+    const PROBE: TableKind = TableKind::new("probe-kind");
+
+    #[derive(Debug, PartialEq, Serialize, Deserialize)]
+    struct ProbeAxes {
+        samples: usize,
+        max_nm: f64,
+    }
+
+    #[test]
+    fn a_kind_without_a_typed_record_writes_and_reads_its_own_type() {
+        let axes = ProbeAxes {
+            samples: 7,
+            max_nm: 1200.5,
+        };
+        let record = KindRecord::data(PROBE, &axes).unwrap();
+        assert_eq!(record.kind(), PROBE);
+        assert_eq!(
+            serde_json::to_string(&record).unwrap(),
+            r#"{"probe_kind":{"max_nm":1200.5,"samples":7}}"#
+        );
+        // Read back with the kind known, skipping keys of no kind.
+        let kinds = [TableKind::FILM_LUT, PROBE];
+        let json = r#"{"other": [1, 2], "probe_kind": {"samples": 7, "max_nm": 1200.5}}"#;
+        let back = serde_json::Deserializer::from_str(json)
+            .deserialize_map(RecordVisitor(&kinds))
+            .unwrap();
+        assert_eq!(back, record);
+        let err = serde_json::Deserializer::from_str(r#"{"other": 1}"#)
+            .deserialize_map(RecordVisitor(&kinds))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.starts_with("no table record: expected one of the keys `film_lut`, `probe_kind`"),
+            "{err}"
+        );
+
+        let colorimeter = Colorimeter::new(
+            "1931".parse().unwrap(),
+            "d65".parse().unwrap(),
+            "srgb".parse().unwrap(),
+        );
+        let path = Path::new("probe.json");
+        let m = Manifest::for_recipe(
+            record,
+            "probe",
+            "",
+            Path::new("probe.toml"),
+            "",
+            &colorimeter,
+        );
+        assert_eq!(m.kind, PROBE);
+        let read: ProbeAxes = m.data_record(PROBE, path).unwrap().unwrap();
+        assert_eq!(read, axes);
+        assert!(
+            m.data_record::<ProbeAxes>(TableKind::FOURIER, path)
+                .is_none()
+        );
+        let err = m.data_record::<Vec<f64>>(PROBE, path).unwrap().unwrap_err();
+        assert!(err.to_string().contains("probe.json: probe_kind"), "{err}");
+        // A manifest may name only the kinds of TableKind::ALL.
+        let text = serde_json::to_string(&m).unwrap();
+        let err = Manifest::parse(path, &text).unwrap_err().to_string();
+        assert!(err.contains("unknown variant `probe-kind`"), "{err}");
+    }
+
+    #[test]
+    fn the_typed_records_keep_their_keys() {
+        for entry in std::fs::read_dir(crate::set::default_baked_dir()).unwrap() {
+            let path = entry.unwrap().path();
+            if path.extension().is_none_or(|e| e != "json") {
+                continue;
+            }
+            let text = std::fs::read_to_string(&path).unwrap();
+            let m = Manifest::parse(&path, &text).unwrap();
+            assert!(
+                !matches!(m.record, KindRecord::Data { .. }),
+                "{}",
+                path.display()
+            );
+            // Written again, the manifest has the same top-level keys in the same order, its
+            // record under the kind's key. (Its bytes are `nacre bake`'s:
+            // `crates/cli/tests/default_set.rs`; serde_json's float parser may move a value
+            // read back by an ulp, so values are not compared here.)
+            let keys = |text: &str| -> Vec<String> {
+                text.lines()
+                    .filter_map(|l| l.strip_prefix("  \""))
+                    .filter_map(|l| l.split_once("\": ").map(|(k, _)| k.to_string()))
+                    .collect()
+            };
+            let again = serde_json::to_string_pretty(&m).unwrap();
+            assert_eq!(keys(&again), keys(&text), "{}", path.display());
+            assert!(
+                keys(&text).contains(&m.kind.record_key()),
+                "{}",
+                path.display()
+            );
+        }
+    }
+}

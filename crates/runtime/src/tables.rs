@@ -116,13 +116,13 @@ impl TableSet {
     ) -> Result<()> {
         verify_files(&manifest, manifest_path)?;
         match manifest.kind {
-            TableKind::FilmLut => {
+            TableKind::FILM_LUT => {
                 self.film_lut = Some(upload_film_lut(ctx, manifest, manifest_path)?)
             }
-            TableKind::Fourier => {
+            TableKind::FOURIER => {
                 self.fourier = Some(upload_fourier(ctx, manifest, manifest_path)?)
             }
-            TableKind::RoughFilmLut => {
+            TableKind::ROUGH_FILM_LUT => {
                 self.rough_film_lut = Some(upload_rough_film_lut(ctx, manifest, manifest_path)?)
             }
             // Kinds the GPU does not sample (`diffraction` has its own loaders in

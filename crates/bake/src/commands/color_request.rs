@@ -330,7 +330,7 @@ pub fn load_fourier_table(given: Option<&str>, colorimeter: &Colorimeter) -> Res
                 paths.sort();
                 for p in paths {
                     if let Ok(m) = Manifest::read(&p)
-                        && m.kind == nacre_format::TableKind::Fourier
+                        && m.kind == nacre_format::TableKind::FOURIER
                         && (m.observer.clone(), m.illuminant.clone(), m.space.clone()) == settings
                     {
                         found = Some(p);

@@ -734,7 +734,7 @@ pub fn plan(
 
 /// The registry entry of `diffraction` ([`crate::kinds::REGISTRY`]).
 pub const ENTRY: KindEntry = KindEntry {
-    kind: TableKind::Diffraction,
+    kind: TableKind::DIFFRACTION,
     parse: |path, text| {
         #[derive(Deserialize)]
         struct ColourOnly {
@@ -750,11 +750,12 @@ pub const ENTRY: KindEntry = KindEntry {
             colorimeter,
         )?))
     },
+    start_rank: 1,
 };
 
 impl TableRecipe for DiffractionRecipe {
     fn kind(&self) -> TableKind {
-        TableKind::Diffraction
+        TableKind::DIFFRACTION
     }
 
     fn name(&self) -> &str {
@@ -830,7 +831,7 @@ mod tests {
         let out = dir.path().join("out");
         let manifest_path = r.bake(&out, &|| {}).unwrap();
         let m = Manifest::read(&manifest_path).unwrap();
-        assert_eq!(m.kind, TableKind::Diffraction);
+        assert_eq!(m.kind, TableKind::DIFFRACTION);
         let (record, terms) = m.load_diffraction(&manifest_path).unwrap();
         assert_eq!((record.nx, record.ny), (terms.size().0, 1));
         assert!(record.taylor_bound <= 1e-4);

@@ -419,13 +419,14 @@ impl FilmLutJob {
 
 /// The registry entry of `film-lut` ([`crate::kinds::REGISTRY`]).
 pub const ENTRY: KindEntry = KindEntry {
-    kind: TableKind::FilmLut,
+    kind: TableKind::FILM_LUT,
     parse: |path, text| Ok(Box::new(FilmLutRecipe::parse(path, text)?)),
+    start_rank: 3,
 };
 
 impl TableRecipe for FilmLutRecipe {
     fn kind(&self) -> TableKind {
-        TableKind::FilmLut
+        TableKind::FILM_LUT
     }
 
     fn name(&self) -> &str {

@@ -208,13 +208,14 @@ pub fn bake_table(colorimeter: &Colorimeter, axes: FourierAxes) -> FourierTable 
 
 /// The registry entry of `fourier` ([`crate::kinds::REGISTRY`]).
 pub const ENTRY: KindEntry = KindEntry {
-    kind: TableKind::Fourier,
+    kind: TableKind::FOURIER,
     parse: |path, text| Ok(Box::new(FourierRecipe::parse(path, text)?)),
+    start_rank: 2,
 };
 
 impl TableRecipe for FourierRecipe {
     fn kind(&self) -> TableKind {
-        TableKind::Fourier
+        TableKind::FOURIER
     }
 
     fn name(&self) -> &str {

@@ -3,8 +3,9 @@
 //!
 //! Each kind's module parses its recipe (the shared sections through [`crate::recipe`]),
 //! estimates the work and bakes the table through `nacre_format`'s writers and staging.
-//! Adding a kind: its axes and record in `nacre-format` (`TableKind`, `KindRecord`), one
-//! module here that exports a [`KindEntry`], and one line in [`REGISTRY`].
+//! Adding a kind: one line in `nacre_format::TableKind::ALL`, one module here that exports a
+//! [`KindEntry`], and one line in [`REGISTRY`] (a kind the GPU samples also has a typed
+//! record and its axes in `nacre-format`: `docs/architecture.md`).
 
 pub mod diffraction;
 pub mod diffraction_integrated;
@@ -49,12 +50,16 @@ impl std::fmt::Debug for dyn TableRecipe {
     }
 }
 
-/// One registry entry: a kind and the parser of its recipes.
+/// One registry entry: a kind, the parser of its recipes and when a bake of many starts it.
 pub struct KindEntry {
     /// The kind.
     pub kind: TableKind,
     /// Parses recipe text (`path` names it and anchors relative material paths).
     pub parse: fn(&Path, String) -> Result<Box<dyn TableRecipe>>,
+    /// Where `nacre bake` starts this kind's tables among others': the slowest kinds
+    /// first (0), so that the quick ones fill the cores at the end. It changes the
+    /// schedule only, never the bytes.
+    pub start_rank: u8,
 }
 
 /// Every table kind `nacre bake` knows, in the order error messages list them.
@@ -64,6 +69,11 @@ pub const REGISTRY: &[KindEntry] = &[
     fourier::ENTRY,
     diffraction::ENTRY,
 ];
+
+/// The registry entry of `kind`, if `nacre bake` knows it.
+pub fn entry(kind: TableKind) -> Option<&'static KindEntry> {
+    REGISTRY.iter().find(|e| e.kind == kind)
+}
 
 /// Reads a recipe of any kind, dispatching on its `kind`.
 pub fn read_recipe(path: &Path) -> Result<Box<dyn TableRecipe>> {

@@ -75,7 +75,7 @@ impl DiffractionLayout {
 /// [`Error::Manifest`] for a table of another kind or a manifest without the record.
 pub(super) fn diffraction_record(manifest_path: &Path) -> Result<(Manifest, DiffractionRecord)> {
     let manifest = Manifest::read(manifest_path)?;
-    if manifest.kind != nacre_format::TableKind::Diffraction {
+    if manifest.kind != nacre_format::TableKind::DIFFRACTION {
         return Err(Error::Manifest {
             path: manifest_path.to_path_buf(),
             message: format!(

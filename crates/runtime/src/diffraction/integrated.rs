@@ -201,7 +201,7 @@ impl DiffractionIntegrated {
             message,
         };
         let manifest = Manifest::read(manifest_path)?;
-        if manifest.kind != nacre_format::TableKind::Diffraction {
+        if manifest.kind != nacre_format::TableKind::DIFFRACTION {
             return Err(bad(format!(
                 "table `{}` is a `{}` table, not a `diffraction` table",
                 manifest.name, manifest.kind

@@ -771,13 +771,14 @@ fn axis_records(a: &RoughLutAxes) -> Vec<AxisRecord> {
 
 /// The registry entry of `rough-film-lut` ([`crate::kinds::REGISTRY`]).
 pub const ENTRY: KindEntry = KindEntry {
-    kind: TableKind::RoughFilmLut,
+    kind: TableKind::ROUGH_FILM_LUT,
     parse: |path, text| Ok(Box::new(RoughRecipe::parse(path, text)?)),
+    start_rank: 0,
 };
 
 impl TableRecipe for RoughRecipe {
     fn kind(&self) -> TableKind {
-        TableKind::RoughFilmLut
+        TableKind::ROUGH_FILM_LUT
     }
 
     fn name(&self) -> &str {
