@@ -84,6 +84,11 @@ macro_rules! uniform {
                 }
             }
 
+            /// The uniform's bytes, as the GPU reads them.
+            pub fn as_bytes(&self) -> &[u8] {
+                bytemuck::bytes_of(self)
+            }
+
             /// The same fields as JSON, with the manifest's numbers (no padding): the
             /// `shader_params` of an exported sidecar.
             pub fn shader_params($($arg: $arg_ty),*) -> serde_json::Value {

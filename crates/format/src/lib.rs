@@ -8,7 +8,9 @@
 //! atomic writes ([`atomic`]) and staged table commits ([`stage`]), the loaders that read a
 //! table through its manifest ([`load`]), and the material references that
 //! manifests and recipes name ([`materials`]: numbers, bundled materials, data files,
-//! refractiveindex.info pages).
+//! refractiveindex.info pages), the uniforms that mirror each kind's axes on the GPU
+//! ([`gpu_params`]) and the import header of the WGSL modules that read them
+//! ([`wgsl_header`]).
 //!
 //! No GPU, no TOML, no plotting: the runtime and engine integrations read tables through
 //! this crate alone; `nacre-bake` writes them through it.
@@ -35,6 +37,7 @@ pub mod rough_film_lut;
 pub mod set;
 pub mod stage;
 pub mod table_io;
+pub mod wgsl_header;
 
 pub use error::{Error, Result};
 pub use kind::TableKind;

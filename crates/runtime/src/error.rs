@@ -255,8 +255,11 @@ pub enum Error {
         /// The texture.
         label: String,
     },
-    /// A request the runtime refuses that none of the typed variants describes (composing
-    /// WGSL, a SPIR-V probe, a Monte Carlo reference, …).
+    /// WGSL modules that do not compose (an unknown or malformed import, a cycle).
+    #[error("composing WGSL: {0}")]
+    Compose(#[from] crate::shaders::ComposeError),
+    /// A request the runtime refuses that none of the typed variants describes (a SPIR-V
+    /// probe, a Monte Carlo reference, …).
     #[error("{context}: {message}")]
     Invalid {
         /// Where.

@@ -2,7 +2,8 @@
 //!
 //! WGSL has no `import`: a pipeline's source is the concatenation of modules, each followed by
 //! a newline. Every module declares what it needs in its comment header, on one line that
-//! [`parse_imports`] reads:
+//! [`parse_imports`] reads (through `nacre_format::wgsl_header`, which the Bevy plugin reads
+//! it with too):
 //!
 //! ```text
 //! // import: common, <technique>, rough_lut_mapping
@@ -63,8 +64,7 @@ pub const MESH: &str = include_str!("../../../shaders/mesh.wgsl");
 /// The box-filter mip-level pass of the picture behind transmissive glTF surfaces.
 pub const MIP_DOWN: &str = include_str!("../../../shaders/mip_down.wgsl");
 
-/// The placeholder of an import header for the technique module chosen by the host.
-pub const TECHNIQUE_SLOT: &str = "<technique>";
+pub use nacre_format::wgsl_header::{Import, TECHNIQUE_SLOT};
 
 /// One WGSL module of `shaders/`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -163,24 +163,6 @@ pub fn module(name: &str) -> Option<&'static Module> {
     MODULES.iter().find(|m| m.name == name)
 }
 
-/// One entry of an import header.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Import<'a> {
-    /// A module of [`MODULES`], by name.
-    Module(&'a str),
-    /// [`TECHNIQUE_SLOT`]: the technique module the host composes with.
-    Technique,
-}
-
-impl fmt::Display for Import<'_> {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Import::Module(name) => f.write_str(name),
-            Import::Technique => f.write_str(TECHNIQUE_SLOT),
-        }
-    }
-}
-
 /// Why a composition failed.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum ComposeError {
@@ -217,52 +199,18 @@ pub enum ComposeError {
     },
 }
 
-impl From<ComposeError> for crate::error::Error {
-    fn from(e: ComposeError) -> Self {
-        crate::error::Error::Invalid {
-            context: "composing WGSL".into(),
-            message: e.to_string(),
-        }
-    }
-}
-
-/// The imports declared in the leading comment block of `source` (the lines that begin with
-/// `//`, up to the first that does not): every line `// import: a, b, <technique>`, in order;
-/// `// import: (none)` declares none. `module` names the source in errors.
+/// The imports declared in the leading comment block of `source`
+/// ([`nacre_format::wgsl_header::parse_imports`], the one reader of the header); `module`
+/// names the source in errors.
 ///
 /// # Errors
 /// [`ComposeError::BadImport`] for a malformed import line.
 pub fn parse_imports<'a>(module: &str, source: &'a str) -> Result<Vec<Import<'a>>, ComposeError> {
-    let mut imports = Vec::new();
-    for (i, line) in source.lines().enumerate() {
-        let Some(comment) = line.strip_prefix("//") else {
-            break;
-        };
-        let Some(list) = comment.trim_start().strip_prefix("import:") else {
-            continue;
-        };
-        let list = list.trim();
-        if list == "(none)" {
-            continue;
-        }
-        let bad = || ComposeError::BadImport {
-            module: module.to_string(),
-            line: i + 1,
-            text: line.to_string(),
-        };
-        for name in list.split(',').map(str::trim) {
-            if name == TECHNIQUE_SLOT {
-                imports.push(Import::Technique);
-            } else if !name.is_empty()
-                && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
-            {
-                imports.push(Import::Module(name));
-            } else {
-                return Err(bad());
-            }
-        }
-    }
-    Ok(imports)
+    nacre_format::wgsl_header::parse_imports(module, source).map_err(|e| ComposeError::BadImport {
+        module: e.module,
+        line: e.line,
+        text: e.text,
+    })
 }
 
 /// A root of a composition: a module of [`MODULES`] by name, or a source text of the host's

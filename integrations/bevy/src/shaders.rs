@@ -5,7 +5,8 @@
 //!
 //! * `#define_import_path nacre::<module>` is prepended (`nacre::common`,
 //!   `nacre::lut_mapping`, `nacre::film_lut`, `nacre::film_fourier`, `nacre::film_stack`);
-//! * the module's `// import: a, b` header line (shaders/README.md) becomes one
+//! * the module's `// import: a, b` header line (shaders/README.md, read by
+//!   `nacre_format::wgsl_header`, as the runtime reads it) becomes one
 //!   `#import nacre::a::{…}` line per name, listing every top-level `fn`, `struct` and
 //!   `const` of module `a` (naga_oil imports items, not whole namespaces);
 //! * a technique's bind group 1 (`@group(1) @binding(k)`) moves into Bevy's material bind
@@ -22,6 +23,7 @@
 
 use bevy::asset::{Assets, Handle, uuid_handle};
 use bevy::shader::Shader;
+use nacre_format::wgsl_header::{BadImport, Import, parse_imports};
 use std::fmt::Write as _;
 
 /// First binding of `film_lut.wgsl`'s group 1 in the material bind group (bindings 100–103:
@@ -85,6 +87,9 @@ pub enum ShaderError {
         /// The unknown name.
         import: String,
     },
+    /// A malformed `// import:` line.
+    #[error("shaders/{0}")]
+    BadImport(#[from] BadImport),
     /// A binding outside group 1, or a group-1 binding in a module without a binding base.
     #[error(
         "shaders/{module}.wgsl line {line}: binding `{text}` has no place in the material bind group"
@@ -97,24 +102,6 @@ pub enum ShaderError {
         /// The line's text.
         text: String,
     },
-}
-
-/// The names listed on a module's `// import:` lines (its leading comment block).
-pub fn header_imports(source: &str) -> Vec<String> {
-    source
-        .lines()
-        .take_while(|l| l.trim_start().starts_with("//"))
-        .filter_map(|l| {
-            l.trim_start()
-                .trim_start_matches('/')
-                .trim()
-                .strip_prefix("import:")
-        })
-        .flat_map(|list| list.split(','))
-        .map(str::trim)
-        .filter(|n| !n.is_empty() && *n != "(none)")
-        .map(str::to_owned)
-        .collect()
 }
 
 /// The module's top-level `fn`, `struct` and `const` names, in source order.
@@ -206,14 +193,16 @@ pub fn naga_oil_source(name: &str) -> Result<String, ShaderError> {
             import: name.to_owned(),
         })?;
     let mut out = format!("#define_import_path nacre::{name}\n");
-    for import in header_imports(source) {
-        let (_, imported, _) = MODULES
-            .iter()
-            .find(|(n, _, _)| *n == import)
-            .ok_or_else(|| ShaderError::UnknownImport {
-                module: name.to_owned(),
-                import: import.clone(),
-            })?;
+    for import in parse_imports(name, source)? {
+        let imported = match import {
+            Import::Module(import) => MODULES.iter().find(|(n, _, _)| *n == import),
+            // The plugin composes no consumer that imports a technique.
+            Import::Technique => None,
+        };
+        let (_, imported, _) = imported.ok_or_else(|| ShaderError::UnknownImport {
+            module: name.to_owned(),
+            import: import.to_string(),
+        })?;
         let items = top_level_items(imported).join(", ");
         let _ = writeln!(out, "#import nacre::{import}::{{{items}}}");
     }
@@ -290,8 +279,7 @@ mod tests {
         assert!(s.contains("#import nacre::common::{"));
         assert!(s.contains("#import nacre::lut_mapping::{FilmLutParams, lut_counts"));
         assert!(s.contains("sanitize_input"));
-        assert_eq!(header_imports(MODULES[0].1), Vec::<String>::new());
-        assert_eq!(header_imports(MODULES[2].1), vec!["common", "lut_mapping"]);
+        assert!(!naga_oil_source("common").unwrap().contains("#import"));
     }
 
     #[test]
@@ -331,11 +319,7 @@ mod tests {
     }
 
     #[test]
-    fn header_and_item_parsing() {
-        assert_eq!(
-            header_imports("// x\n// import: a, b\n// import: c\nfn f() {}"),
-            ["a", "b", "c"]
-        );
+    fn top_level_item_parsing() {
         assert_eq!(
             top_level_items("fn a_b(x: f32) {}\nstruct S {}\n  fn inner() {}\nconst K: f32 = 1.0;"),
             ["a_b", "S", "K"]

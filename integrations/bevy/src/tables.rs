@@ -22,8 +22,8 @@ use bevy::reflect::TypePath;
 use bevy::render::render_resource::{ShaderType, TextureDimension, TextureFormat};
 use nacre_format::film_lut::FilmLutAxes;
 use nacre_format::fourier::FourierAxes;
+use nacre_format::gpu_params::{FilmLutParams, FourierParams};
 use nacre_format::{FileFormat, FileRecord, Manifest, TableKind};
-use sha2::{Digest, Sha256};
 use std::path::Path;
 
 /// The default film-lut table: `tables/baked/film-dielectric` (a film of index 1.0–2.5,
@@ -36,7 +36,9 @@ pub const DEFAULT_FILM_LUT: Handle<NacreTable> =
 pub const DEFAULT_FOURIER: Handle<NacreTable> =
     uuid_handle!("6f0e35a4-3c1e-4b47-9d0e-4c5b1d6b0b02");
 
-/// Mirror of `FilmLutParams` (`shaders/lut_mapping.wgsl`, 48 bytes): a film-lut table's axes.
+/// `nacre_format::gpu_params::FilmLutParams` (the mirror of `FilmLutParams` in
+/// `shaders/lut_mapping.wgsl`, 48 bytes) as Bevy binds it: the same fields, laid out by
+/// [`ShaderType`] to the same bytes (tested). Made only from the format crate's uniform.
 #[derive(Clone, Copy, Debug, Default, PartialEq, ShaderType, bevy::reflect::Reflect)]
 pub struct FilmLutUniform {
     /// Texels along cos θ (x).
@@ -66,25 +68,48 @@ pub struct FilmLutUniform {
 }
 
 impl FilmLutUniform {
-    /// From a manifest's film-lut axes (the runtime's `FilmLutParams::new`).
+    /// From a manifest's film-lut axes ([`FilmLutParams::new`], as the runtime binds them).
     pub fn new(axes: &FilmLutAxes, has_transmittance: bool) -> Self {
+        FilmLutParams::new(axes, has_transmittance).into()
+    }
+}
+
+impl From<FilmLutParams> for FilmLutUniform {
+    fn from(p: FilmLutParams) -> Self {
+        // Every field named: a field added to the format's uniform fails to build here.
+        let FilmLutParams {
+            cos_theta_count,
+            opd_count,
+            ior_count,
+            thickness_min_nm,
+            thickness_max_nm,
+            ior_min,
+            ior_max,
+            ambient_index,
+            has_transmittance,
+            _pad: [_pad0, _pad1, _pad2],
+        } = p;
         FilmLutUniform {
-            cos_theta_count: axes.cos_theta_count as u32,
-            opd_count: axes.opd_count as u32,
-            ior_count: axes.ior_count as u32,
-            thickness_min_nm: axes.thickness_min_nm as f32,
-            thickness_max_nm: axes.thickness_max_nm as f32,
-            ior_min: axes.ior_min as f32,
-            ior_max: axes.ior_max as f32,
-            ambient_index: axes.ambient_index as f32,
-            has_transmittance: u32::from(has_transmittance),
-            ..Default::default()
+            cos_theta_count,
+            opd_count,
+            ior_count,
+            thickness_min_nm,
+            thickness_max_nm,
+            ior_min,
+            ior_max,
+            ambient_index,
+            has_transmittance,
+            _pad0,
+            _pad1,
+            _pad2,
         }
     }
 }
 
-/// Mirror of `FourierParams` (`shaders/film_fourier.wgsl`, 48 bytes): a fourier table's axes
-/// and the number of harmonics to sum (0: automatic).
+/// `nacre_format::gpu_params::FourierParams` (the mirror of `FourierParams` in
+/// `shaders/film_fourier.wgsl`, 48 bytes) as Bevy binds it: the same fields, the
+/// three-channel ones as [`Vec3`] (a WGSL `vec3<f32>`, where [`ShaderType`] would lay out an
+/// `[f32; 3]` as an array of 16-byte strides), to the same bytes (tested).
 #[derive(Clone, Copy, Debug, Default, PartialEq, ShaderType, bevy::reflect::Reflect)]
 pub struct FourierUniform {
     /// D_max, nm.
@@ -106,18 +131,35 @@ pub struct FourierUniform {
 }
 
 impl FourierUniform {
-    /// From a manifest's fourier axes, automatic harmonics (the runtime's
-    /// `FourierParams::new(axes, 0)`).
+    /// From a manifest's fourier axes, automatic harmonics ([`FourierParams::new`]`(axes,
+    /// 0)`, as the runtime binds them by default).
     pub fn new(axes: &FourierAxes) -> Self {
+        FourierParams::new(axes, 0).into()
+    }
+}
+
+impl From<FourierParams> for FourierUniform {
+    fn from(p: FourierParams) -> Self {
+        // Every field named: a field added to the format's uniform fails to build here.
+        let FourierParams {
+            max_opd_nm,
+            level_count,
+            sigma1_nm,
+            harmonics,
+            carrier_nu_per_nm,
+            _pad0,
+            white,
+            _pad1,
+        } = p;
         FourierUniform {
-            max_opd_nm: axes.max_opd_nm as f32,
-            level_count: axes.level_samples.len() as u32,
-            sigma1_nm: axes.level_sigma_nm.get(1).copied().unwrap_or(0.0) as f32,
-            harmonics: 0,
-            carrier_nu_per_nm: Vec3::from_array(axes.carrier_nu_per_nm.map(|v| v as f32)),
-            _pad0: 0.0,
-            white: Vec3::from_array(axes.white.map(|v| v as f32)),
-            _pad1: 0.0,
+            max_opd_nm,
+            level_count,
+            sigma1_nm,
+            harmonics,
+            carrier_nu_per_nm: Vec3::from_array(carrier_nu_per_nm),
+            _pad0,
+            white: Vec3::from_array(white),
+            _pad1,
         }
     }
 }
@@ -224,14 +266,14 @@ fn ktx2_files<'m>(
             .map(|f| (quantity, f))
     };
     match manifest.kind {
-        TableKind::FilmLut => {
+        TableKind::FILM_LUT => {
             let r = find("reflectance").ok_or_else(|| TableError::MissingFile {
                 manifest: context.to_owned(),
                 quantity: "reflectance".into(),
             })?;
             Ok(std::iter::once(r).chain(find("transmittance")).collect())
         }
-        TableKind::Fourier => {
+        TableKind::FOURIER => {
             let f = manifest
                 .files
                 .iter()
@@ -257,10 +299,7 @@ fn decode_ktx2(
     path: &str,
     bytes: &[u8],
 ) -> Result<Image, TableError> {
-    let actual: String = Sha256::digest(bytes)
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect();
+    let actual = nacre_format::checksum::sha256_bytes(bytes);
     if actual != f.sha256 {
         return Err(TableError::Checksum {
             path: path.to_owned(),
@@ -524,9 +563,32 @@ mod tests {
         assert!(matches!(err, TableError::Format(_)), "{err}");
     }
 
+    /// The bytes [`ShaderType`] writes for `uniform`.
+    fn shader_bytes<T: ShaderType + bevy::render::render_resource::encase::internal::WriteInto>(
+        uniform: &T,
+    ) -> Vec<u8> {
+        let mut buffer = bevy::render::render_resource::encase::UniformBuffer::new(Vec::new());
+        buffer.write(uniform).unwrap();
+        buffer.into_inner()
+    }
+
     #[test]
-    fn uniforms_match_the_wgsl_layouts() {
+    fn uniforms_are_the_format_crates_bytes() {
         assert_eq!(FilmLutUniform::min_size().get(), 48);
         assert_eq!(FourierUniform::min_size().get(), 48);
+        let lut = Manifest::parse(Path::new("lut"), default_set::FILM_LUT_MANIFEST).unwrap();
+        let params = FilmLutParams::new(lut.film_lut().unwrap(), true);
+        assert_eq!(
+            shader_bytes(&FilmLutUniform::from(params)),
+            params.as_bytes()
+        );
+        let fourier = Manifest::parse(Path::new("f"), default_set::FOURIER_MANIFEST).unwrap();
+        for harmonics in [0, 5] {
+            let params = FourierParams::new(fourier.fourier().unwrap(), harmonics);
+            assert_eq!(
+                shader_bytes(&FourierUniform::from(params)),
+                params.as_bytes()
+            );
+        }
     }
 }

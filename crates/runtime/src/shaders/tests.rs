@@ -106,17 +106,12 @@ fn every_header_declares_its_imports() {
 
 #[test]
 fn header_syntax() {
-    let src = "// title\n// import: a, <technique>\n//\n// import: b_2\nfn f() {}\n// import: c\n";
+    // The syntax is tested with its reader, `nacre_format::wgsl_header`; here, that the
+    // composer reads it and reports a bad line as a `ComposeError`.
     assert_eq!(
-        parse_imports("x", src).unwrap(),
-        [
-            Import::Module("a"),
-            Import::Technique,
-            Import::Module("b_2")
-        ]
+        parse_imports("x", "// import: a, <technique>\nfn f() {}\n").unwrap(),
+        [Import::Module("a"), Import::Technique]
     );
-    assert_eq!(parse_imports("x", "// import: (none)\n").unwrap(), []);
-    assert_eq!(parse_imports("x", "fn f() {}\n").unwrap(), []);
     assert_eq!(
         parse_imports("x", "// t\n// import: a b\n"),
         Err(ComposeError::BadImport {
@@ -125,7 +120,6 @@ fn header_syntax() {
             text: "// import: a b".into()
         })
     );
-    assert!(parse_imports("x", "// import: a,\n").is_err());
 }
 
 fn src<'a>(label: &'a str, source: &'a str) -> Part<'a> {
