@@ -1,6 +1,7 @@
 //! The runtime's error type.
 
 use nacre_format::param::{Msg, Naming, Render};
+use nacre_format::wgsl_header::TECHNIQUE_SLOT;
 use std::fmt;
 use std::path::PathBuf;
 
@@ -257,7 +258,7 @@ pub enum Error {
     },
     /// WGSL modules that do not compose (an unknown or malformed import, a cycle).
     #[error("composing WGSL: {0}")]
-    Compose(#[from] crate::shaders::ComposeError),
+    Compose(#[from] ComposeError),
     /// A request the runtime refuses that none of the typed variants describes (a SPIR-V
     /// probe, a Monte Carlo reference, …).
     #[error("{context}: {message}")]
@@ -396,3 +397,39 @@ impl fmt::Display for ThicknessMapProblem {
 
 /// `Result` with [`Error`].
 pub type Result<T> = std::result::Result<T, Error>;
+
+/// Why a composition failed.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum ComposeError {
+    /// An import names no module of [`MODULES`](crate::shaders::MODULES).
+    #[error("{importer} imports `{name}`, which is no module of shaders/")]
+    UnknownModule {
+        /// The importing module (or the root asked for).
+        importer: String,
+        /// The unknown name.
+        name: String,
+    },
+    /// The imports form a cycle.
+    #[error("import cycle: {}", cycle.join(" → "))]
+    Cycle {
+        /// The modules of the cycle, the first repeated at the end.
+        cycle: Vec<String>,
+    },
+    /// A module imports `<technique>` but the composition has no technique.
+    #[error("{importer} imports {TECHNIQUE_SLOT}, but no technique was given")]
+    NoTechnique {
+        /// The importing module.
+        importer: String,
+    },
+    /// An import line that is not `// import: name, name, …` (names of letters, digits and
+    /// `_`, or `<technique>`) or `// import: (none)`.
+    #[error("{module} line {line}: bad import header `{text}`")]
+    BadImport {
+        /// The module.
+        module: String,
+        /// 1-based line in the module.
+        line: usize,
+        /// The line.
+        text: String,
+    },
+}

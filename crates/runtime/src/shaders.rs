@@ -64,6 +64,7 @@ pub const MESH: &str = include_str!("../../../shaders/mesh.wgsl");
 /// The box-filter mip-level pass of the picture behind transmissive glTF surfaces.
 pub const MIP_DOWN: &str = include_str!("../../../shaders/mip_down.wgsl");
 
+pub use crate::error::ComposeError;
 pub use nacre_format::wgsl_header::{Import, TECHNIQUE_SLOT};
 
 /// One WGSL module of `shaders/`.
@@ -161,42 +162,6 @@ pub const TECHNIQUE_MODULES: &[&str] = &{
 /// The module of [`MODULES`] called `name`.
 pub fn module(name: &str) -> Option<&'static Module> {
     MODULES.iter().find(|m| m.name == name)
-}
-
-/// Why a composition failed.
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-pub enum ComposeError {
-    /// An import names no module of [`MODULES`].
-    #[error("{importer} imports `{name}`, which is no module of shaders/")]
-    UnknownModule {
-        /// The importing module (or the root asked for).
-        importer: String,
-        /// The unknown name.
-        name: String,
-    },
-    /// The imports form a cycle.
-    #[error("import cycle: {}", cycle.join(" → "))]
-    Cycle {
-        /// The modules of the cycle, the first repeated at the end.
-        cycle: Vec<String>,
-    },
-    /// A module imports `<technique>` but the composition has no technique.
-    #[error("{importer} imports {TECHNIQUE_SLOT}, but no technique was given")]
-    NoTechnique {
-        /// The importing module.
-        importer: String,
-    },
-    /// An import line that is not `// import: name, name, …` (names of letters, digits and
-    /// `_`, or `<technique>`) or `// import: (none)`.
-    #[error("{module} line {line}: bad import header `{text}`")]
-    BadImport {
-        /// The module.
-        module: String,
-        /// 1-based line in the module.
-        line: usize,
-        /// The line.
-        text: String,
-    },
 }
 
 /// The imports declared in the leading comment block of `source`
