@@ -21,3 +21,41 @@ impl Rng {
 pub fn percentile(sorted: &[f64], p: f64) -> f64 {
     sorted[((sorted.len() - 1) as f64 * p).round() as usize]
 }
+
+/// The worst reflectance and transmittance differences of a cross-check and where they
+/// occurred (`tmm_golden`, `inc_tmm_golden`).
+#[derive(Debug, Default)]
+pub struct WorstRt {
+    /// Worst |ΔR| and where.
+    pub r: (f64, String),
+    /// Worst |ΔT| and where.
+    pub t: (f64, String),
+}
+
+impl WorstRt {
+    /// Keeps `dr` and `dt` where they are the worst so far.
+    pub fn record(&mut self, dr: f64, dt: f64, where_: String) {
+        if dr > self.r.0 {
+            self.r = (dr, where_.clone());
+        }
+        if dt > self.t.0 {
+            self.t = (dt, where_);
+        }
+    }
+
+    /// Fails when either worst difference exceeds `tolerance`.
+    pub fn assert_within(&self, tolerance: f64) {
+        assert!(
+            self.r.0 <= tolerance,
+            "worst |ΔR| {:.3e} at {}",
+            self.r.0,
+            self.r.1
+        );
+        assert!(
+            self.t.0 <= tolerance,
+            "worst |ΔT| {:.3e} at {}",
+            self.t.0,
+            self.t.1
+        );
+    }
+}

@@ -69,7 +69,7 @@ fn agrees_with_inc_tmm_to_1e_10() {
         .map(|c| c.layers.iter().filter(|l| l.incoherent).count())
         .sum();
     assert!(slabs >= 30, "the stacks hold incoherent slabs ({slabs})");
-    let (mut worst_r, mut worst_t) = ((0.0f64, String::new()), (0.0f64, String::new()));
+    let mut worst = nacre_tests::WorstRt::default();
     let mut points = 0;
     for case in &golden.cases {
         let stack = spec(case)
@@ -87,33 +87,17 @@ fn agrees_with_inc_tmm_to_1e_10() {
             let dr = (p.R_s - g[2]).abs().max((p.R_p - g[3]).abs());
             let dt = (p.T_s - g[4]).abs().max((p.T_p - g[5]).abs());
             assert!(dr.is_finite() && dt.is_finite(), "{where_}: {p:?}");
-            if dr > worst_r.0 {
-                worst_r = (dr, where_.clone());
-            }
-            if dt > worst_t.0 {
-                worst_t = (dt, where_);
-            }
+            worst.record(dr, dt, where_);
             points += 1;
         }
     }
     eprintln!(
         "inc_tmm cross-check: {} stacks ({slabs} incoherent slabs), {points} points; worst |ΔR| = {:.3e} ({}), worst |ΔT| = {:.3e} ({})",
         golden.cases.len(),
-        worst_r.0,
-        worst_r.1,
-        worst_t.0,
-        worst_t.1
+        worst.r.0,
+        worst.r.1,
+        worst.t.0,
+        worst.t.1
     );
-    assert!(
-        worst_r.0 <= TOLERANCE,
-        "worst |ΔR| {:.3e} at {}",
-        worst_r.0,
-        worst_r.1
-    );
-    assert!(
-        worst_t.0 <= TOLERANCE,
-        "worst |ΔT| {:.3e} at {}",
-        worst_t.0,
-        worst_t.1
-    );
+    worst.assert_within(TOLERANCE);
 }

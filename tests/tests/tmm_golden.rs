@@ -83,8 +83,7 @@ fn agrees_with_tmm_to_1e_10() {
     let text = std::fs::read_to_string(dir.join("cases.toml")).unwrap();
     let cases: Cases = toml::from_str(&text).unwrap();
     assert!(cases.case.len() >= 20, "at least 20 golden stacks");
-    let mut worst_r: (f64, String) = (0.0, String::new());
-    let mut worst_t: (f64, String) = (0.0, String::new());
+    let mut worst = nacre_tests::WorstRt::default();
     let mut points = 0;
     for case in &cases.case {
         let stack = spec(case)
@@ -100,33 +99,17 @@ fn agrees_with_tmm_to_1e_10() {
             let where_ = format!("{} at {a}°, {w} nm", case.name);
             let dr = (p.R_s - g[2]).abs().max((p.R_p - g[3]).abs());
             let dt = (p.T_s - g[4]).abs().max((p.T_p - g[5]).abs());
-            if dr > worst_r.0 {
-                worst_r = (dr, where_.clone());
-            }
-            if dt > worst_t.0 {
-                worst_t = (dt, where_);
-            }
+            worst.record(dr, dt, where_);
             points += 1;
         }
     }
     eprintln!(
         "tmm cross-check: {} stacks, {points} points; worst |ΔR| = {:.3e} ({}), worst |ΔT| = {:.3e} ({})",
         cases.case.len(),
-        worst_r.0,
-        worst_r.1,
-        worst_t.0,
-        worst_t.1
+        worst.r.0,
+        worst.r.1,
+        worst.t.0,
+        worst.t.1
     );
-    assert!(
-        worst_r.0 <= TOLERANCE,
-        "worst |ΔR| {:.3e} at {}",
-        worst_r.0,
-        worst_r.1
-    );
-    assert!(
-        worst_t.0 <= TOLERANCE,
-        "worst |ΔT| {:.3e} at {}",
-        worst_t.0,
-        worst_t.1
-    );
+    worst.assert_within(TOLERANCE);
 }
