@@ -397,7 +397,7 @@ fn slab_passes(
                         material: name.to_string(),
                         thickness_nm,
                         wavelength_nm: wl,
-                        angle_deg: elementary_asin_deg(sin_theta),
+                        angle_deg: asin_deg(sin_theta),
                         pass: p,
                     });
                 }
@@ -411,8 +411,9 @@ fn slab_passes(
 }
 
 /// θ₀ in degrees from sin θ₀, for messages.
-fn elementary_asin_deg(sin_theta: f64) -> f64 {
-    sin_theta.asin().to_degrees()
+fn asin_deg(sin_theta: f64) -> f64 {
+    let cos_theta = (1.0 - sin_theta * sin_theta).max(0.0).sqrt();
+    elementary::atan2(sin_theta, cos_theta).to_degrees()
 }
 
 /// Powers of one coherent group (media `columns`, first to last, films `thickness_nm`) at
