@@ -213,6 +213,14 @@ pub enum Error {
         /// The largest |u| or |v| reached.
         max_uv: f64,
     },
+    /// A fit template's free parameter is malformed ([`crate::fit::Template`]).
+    #[error("free parameter of layer {layer}: {message}")]
+    FitTemplate {
+        /// 1-based film number (0: the template as a whole).
+        layer: usize,
+        /// What was wrong.
+        message: String,
+    },
 }
 
 /// Shorthand for `Result<T, nacre_optics::Error>`.

@@ -29,6 +29,7 @@ pub mod elementary;
 pub mod error;
 pub mod few_wavelengths;
 pub mod film_series;
+pub mod fit;
 pub mod fourier;
 pub mod fresnel;
 pub mod incoherent;

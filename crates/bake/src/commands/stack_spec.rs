@@ -24,11 +24,30 @@
 //! (`400`, `400nm`) or with a unit (`1.2um`, `2mm`): `bk7@2mm:incoherent`.
 //!
 //! Relative material paths are resolved from the recipe's folder. Unknown keys are errors.
+//!
+//! # Templates: ranges mark free parameters
+//!
+//! A fit template ([`TemplateSpec`], what `nacre fit` reads) is the same stack where a range
+//! marks a free parameter. On the command line a thickness range is `LO:HI`
+//! (`sio2@50:400`, units allowed: `sio2@0.5um:2um`) and a constant real index range is
+//! `NLO:NHI` in place of the material (`1.3:1.7@100:600`: index free in 1.3–1.7, thickness
+//! free in 100–600 nm). In a recipe:
+//!
+//! ```toml
+//! [[layers]]
+//! material = "1.3:1.7"         # a constant index free in 1.3–1.7
+//! thickness_nm = [100, 600]    # thickness free in 100–600 nm
+//! ```
+//!
+//! A fit writes the recipe back with the fitted values and their 1σ uncertainties beside
+//! them (`thickness_sigma_nm`, `index_sigma`) and a `[fit]` table; every reader accepts
+//! those keys and ignores them. A stack recipe (not a template) refuses ranges.
 
 use crate::commands::grid::parse_thickness_nm;
 use crate::error::{Error, Origin, Param, Result};
 use crate::recipe::{line_of, toml_error};
 use nacre_format::materials::{MaterialDb, database, resolve_with};
+use nacre_optics::fit::{Free, FreeKind};
 use nacre_optics::{Layer, Stack};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -84,6 +103,213 @@ fn suffix_on_medium(spec: &str) -> Option<&'static str> {
         )
 }
 
+/// One `--layer` value, parsed.
+struct LayerFlag {
+    /// The material spec (for a free index, the middle of its range as text).
+    material: String,
+    /// A free constant index's bounds.
+    index: Option<(f64, f64)>,
+    /// The thickness (nm), or a range's lower bound, and a range's upper bound.
+    thickness_nm: (f64, Option<f64>),
+    incoherent: bool,
+}
+
+/// `Some((lo, hi))` when `text` is `A:B` with both numbers.
+fn number_pair(text: &str) -> Option<(f64, f64)> {
+    let (a, b) = text.split_once(':')?;
+    Some((a.trim().parse().ok()?, b.trim().parse().ok()?))
+}
+
+/// Refuses bounds `lo:hi` of `what` that are inverted or (for an index) not positive.
+fn check_bounds(lo: f64, hi: f64, what: &str) -> std::result::Result<(), String> {
+    if !(lo.is_finite() && hi.is_finite()) {
+        return Err(format!("{what} bounds {lo}:{hi} must be finite"));
+    }
+    if lo > hi {
+        return Err(format!(
+            "{what} bounds {lo}:{hi} are inverted: write the lower bound first ({hi}:{lo})"
+        ));
+    }
+    if what == "index" && lo <= 0.0 {
+        return Err(format!("index bounds {lo}:{hi}: an index must be positive"));
+    }
+    Ok(())
+}
+
+/// Parses `MATERIAL@THICKNESS[:incoherent]`; with `ranges`, also `MATERIAL@LO:HI` and
+/// `NLO:NHI@…` (a template's free parameters).
+fn parse_layer_flag(text: &str, ranges: bool) -> Result<LayerFlag> {
+    let bad = |message: String| Error::value(Param::Layer, text.to_string(), message);
+    let (m, d) = text.rsplit_once('@').ok_or_else(|| {
+        Error::value(
+            Param::Layer,
+            text.to_string(),
+            "expected MATERIAL@THICKNESS, e.g. `water@400nm`",
+        )
+    })?;
+    if m.trim().is_empty() {
+        return Err(bad("the material before `@` is empty".into()));
+    }
+    let index = match number_pair(m) {
+        Some((lo, hi)) if ranges => {
+            check_bounds(lo, hi, "index").map_err(bad)?;
+            Some((lo, hi))
+        }
+        _ => None,
+    };
+    let thickness = |d: &str| {
+        let d = parse_thickness_nm(Param::Layer, d).map_err(|e| match e {
+            Error::Value { message, .. } => Error::value(Param::Layer, text.to_string(), message),
+            other => other,
+        })?;
+        if d >= MAX_THICKNESS_NM {
+            return Err(bad(format!(
+                "thickness {d} nm is a metre or more: a layer must be thinner than 1 m (units: `nm`, `um`, `mm`)"
+            )));
+        }
+        Ok(d)
+    };
+    let (d, suffix) = match d.split_once(':') {
+        Some((d, suffix)) => (d, Some(suffix)),
+        None => (d, None),
+    };
+    let (thickness_nm, incoherent) = match suffix {
+        None => ((thickness(d)?, None), false),
+        Some(s) if s.trim() == INCOHERENT_SUFFIX => ((thickness(d)?, None), true),
+        Some(s) if ranges => {
+            let (lo, hi) = (thickness(d)?, thickness(s)?);
+            check_bounds(lo, hi, "thickness").map_err(bad)?;
+            ((lo, Some(hi)), false)
+        }
+        Some(s) => {
+            return Err(bad(format!(
+                "unknown suffix `:{s}`: the one suffix a layer takes is `:incoherent`, e.g. `bk7@2mm:incoherent`"
+            )));
+        }
+    };
+    Ok(LayerFlag {
+        material: match index {
+            Some((lo, hi)) => format!("{}", 0.5 * (lo + hi)),
+            None => m.to_string(),
+        },
+        index,
+        thickness_nm,
+        incoherent,
+    })
+}
+
+/// A free parameter of a template and where it was given.
+#[derive(Clone, Debug)]
+pub struct FreeSpec {
+    /// The parameter and its bounds.
+    pub free: Free,
+    /// The flag or `file:line` that set it free.
+    pub origin: Origin,
+}
+
+/// A fit template before the materials are loaded: a stack whose thicknesses and constant
+/// indices may be ranges (the module's documentation gives the syntax).
+#[derive(Clone, Debug)]
+pub struct TemplateSpec {
+    /// The stack, each free parameter at the middle of its range.
+    pub stack: StackSpec,
+    /// The free parameters, films top first, a film's index before its thickness.
+    pub free: Vec<FreeSpec>,
+    /// `angles` range text of a recipe, if given.
+    pub angles: Option<String>,
+    /// `wavelengths` range text of a recipe, if given.
+    pub wavelengths: Option<String>,
+}
+
+/// The free parameters of film `layer` (1-based): its index range, its thickness range.
+fn free_of(
+    layer: usize,
+    index: Option<(f64, f64)>,
+    thickness_nm: (f64, Option<f64>),
+    origin: &Origin,
+) -> impl Iterator<Item = FreeSpec> {
+    let index = index.map(|(lo, hi)| Free {
+        layer,
+        kind: FreeKind::Index,
+        lo,
+        hi,
+    });
+    let thickness = thickness_nm.1.map(|hi| Free {
+        layer,
+        kind: FreeKind::ThicknessNm,
+        lo: thickness_nm.0,
+        hi,
+    });
+    index
+        .into_iter()
+        .chain(thickness)
+        .map(move |free| FreeSpec {
+            free,
+            origin: origin.clone(),
+        })
+}
+
+impl TemplateSpec {
+    /// From command-line values (`--layer` values may hold ranges). With no value at all,
+    /// the default soap film with nothing free.
+    pub fn from_flags(
+        ambient: Option<&str>,
+        layers: &[String],
+        substrate: Option<&str>,
+    ) -> Result<Self> {
+        let plain: Vec<String> = Vec::new();
+        let mut stack = StackSpec::from_flags(ambient, &plain, substrate)?;
+        if layers.is_empty() {
+            return Ok(TemplateSpec {
+                stack,
+                free: Vec::new(),
+                angles: None,
+                wavelengths: None,
+            });
+        }
+        let mut free = Vec::new();
+        let mut incoherent = Vec::new();
+        stack.layers.clear();
+        for (i, text) in layers.iter().enumerate() {
+            let l = parse_layer_flag(text, true)?;
+            let origin = Param::Layer.given(text.clone());
+            free.extend(free_of(i + 1, l.index, l.thickness_nm, &origin));
+            let d = match l.thickness_nm {
+                (lo, Some(hi)) => 0.5 * (lo + hi),
+                (d, None) => d,
+            };
+            incoherent.push(l.incoherent);
+            stack.layers.push((
+                MaterialRef {
+                    spec: l.material,
+                    context: Param::Layer.into(),
+                },
+                d,
+            ));
+        }
+        if incoherent.contains(&true) {
+            stack.incoherent = incoherent;
+        }
+        Ok(TemplateSpec {
+            stack,
+            free,
+            angles: None,
+            wavelengths: None,
+        })
+    }
+
+    /// Reads a template recipe file (a stack recipe whose values may be ranges).
+    pub fn read(path: &Path) -> Result<Self> {
+        let text = read_text(path)?;
+        Self::parse(path, &text)
+    }
+
+    /// Parses a template recipe's text; `path` names it in messages.
+    pub fn parse(path: &Path, text: &str) -> Result<Self> {
+        parse_recipe(path, text, true)
+    }
+}
+
 impl StackSpec {
     /// From command-line values. With no value at all, the default soap film.
     pub fn from_flags(
@@ -110,54 +336,9 @@ impl StackSpec {
             layers
                 .iter()
                 .map(|text| {
-                    let (m, d) = text.rsplit_once('@').ok_or_else(|| {
-                        Error::value(
-                            Param::Layer,
-                            text.clone(),
-                            "expected MATERIAL@THICKNESS, e.g. `water@400nm`",
-                        )
-                    })?;
-                    if m.trim().is_empty() {
-                        return Err(Error::value(
-                            Param::Layer,
-                            text.clone(),
-                            "the material before `@` is empty",
-                        ));
-                    }
-                    let (d, suffix) = match d.split_once(':') {
-                        Some((d, suffix)) => (d, Some(suffix)),
-                        None => (d, None),
-                    };
-                    let inc = match suffix {
-                        None => false,
-                        Some(s) if s.trim() == INCOHERENT_SUFFIX => true,
-                        Some(s) => {
-                            return Err(Error::value(
-                                Param::Layer,
-                                text.clone(),
-                                format!(
-                                    "unknown suffix `:{s}`: the one suffix a layer takes is `:incoherent`, e.g. `bk7@2mm:incoherent`"
-                                ),
-                            ));
-                        }
-                    };
-                    let d = parse_thickness_nm(Param::Layer, d).map_err(|e| match e {
-                        Error::Value { message, .. } => {
-                            Error::value(Param::Layer, text.clone(), message)
-                        }
-                        other => other,
-                    })?;
-                    if d >= MAX_THICKNESS_NM {
-                        return Err(Error::value(
-                            Param::Layer,
-                            text.clone(),
-                            format!(
-                                "thickness {d} nm is a metre or more: a layer must be thinner than 1 m (units: `nm`, `um`, `mm`)"
-                            ),
-                        ));
-                    }
-                    incoherent.push(inc);
-                    Ok((flag(m, Param::Layer.into()), d))
+                    let l = parse_layer_flag(text, false)?;
+                    incoherent.push(l.incoherent);
+                    Ok((flag(&l.material, Param::Layer.into()), l.thickness_nm.0))
                 })
                 .collect::<Result<_>>()?
         };
@@ -268,13 +449,27 @@ impl StackSpec {
     }
 }
 
+/// A thickness in a recipe: a number, or `[LO, HI]` in a template.
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum RawThickness {
+    Fixed(f64),
+    Range([f64; 2]),
+}
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawLayer {
     material: Spanned<String>,
-    thickness_nm: Spanned<f64>,
+    thickness_nm: Spanned<RawThickness>,
     #[serde(default)]
     incoherent: bool,
+    /// A fit's 1σ uncertainty of the thickness (written by a fit, ignored here).
+    #[allow(dead_code)]
+    thickness_sigma_nm: Option<f64>,
+    /// A fit's 1σ uncertainty of a constant index (written by a fit, ignored here).
+    #[allow(dead_code)]
+    index_sigma: Option<f64>,
 }
 
 #[derive(Deserialize)]
@@ -286,6 +481,9 @@ struct RawStackRecipe {
     layers: Vec<RawLayer>,
     angles: Option<String>,
     wavelengths: Option<String>,
+    /// A fit's summary (written by a fit, ignored here).
+    #[allow(dead_code)]
+    fit: Option<toml::Table>,
 }
 
 /// A stack recipe file: the stack plus optional sampling ranges.
@@ -299,83 +497,141 @@ pub struct StackRecipe {
     pub wavelengths: Option<String>,
 }
 
+/// The text of the file at `path`.
+fn read_text(path: &Path) -> Result<String> {
+    Ok(
+        std::fs::read_to_string(path).map_err(|source| nacre_format::Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?,
+    )
+}
+
+/// Parses a stack recipe (`ranges` false: ranges are refused) or a template recipe.
+fn parse_recipe(path: &Path, text: &str, ranges: bool) -> Result<TemplateSpec> {
+    let raw: RawStackRecipe = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
+    let at = |span: std::ops::Range<usize>| Origin::Line {
+        path: path.to_path_buf(),
+        line: line_of(text, span.start),
+    };
+    let mref = |s: &Spanned<String>| MaterialRef {
+        spec: s.get_ref().clone(),
+        context: at(s.span()),
+    };
+    let default = |what: &str| MaterialRef {
+        spec: DEFAULT_MEDIUM.into(),
+        context: format!("{} ({what} default)", path.display()).into(),
+    };
+    let mut layers = Vec::with_capacity(raw.layers.len());
+    let mut free = Vec::new();
+    for (i, layer) in raw.layers.iter().enumerate() {
+        let line = line_of(text, layer.thickness_nm.span().start);
+        let refuse = |message: String| Error::recipe(path.to_path_buf(), line, message);
+        let check = |d: f64| {
+            if !(d >= 0.0 && d.is_finite()) {
+                return Err(refuse(format!(
+                    "thickness_nm = {d}: must be finite and non-negative"
+                )));
+            }
+            if d >= MAX_THICKNESS_NM {
+                return Err(refuse(format!(
+                    "thickness_nm = {d}: a layer must be thinner than 1 m (1e9 nm)"
+                )));
+            }
+            Ok(d)
+        };
+        let thickness_nm = match layer.thickness_nm.get_ref() {
+            RawThickness::Fixed(d) => (check(*d)?, None),
+            RawThickness::Range([lo, hi]) if ranges => {
+                let (lo, hi) = (check(*lo)?, check(*hi)?);
+                check_bounds(lo, hi, "thickness")
+                    .map_err(|m| refuse(format!("thickness_nm = [{lo}, {hi}]: {m}")))?;
+                (lo, Some(hi))
+            }
+            RawThickness::Range([lo, hi]) => {
+                return Err(refuse(format!(
+                    "thickness_nm = [{lo}, {hi}] is a range: only a fit template takes ranges (a stack needs one thickness)"
+                )));
+            }
+        };
+        let mut material = mref(&layer.material);
+        let index = match number_pair(&material.spec) {
+            Some((lo, hi)) if ranges => {
+                check_bounds(lo, hi, "index").map_err(|m| {
+                    Error::recipe(
+                        path.to_path_buf(),
+                        line_of(text, layer.material.span().start),
+                        format!("material = \"{}\": {m}", material.spec),
+                    )
+                })?;
+                material.spec = format!("{}", 0.5 * (lo + hi));
+                Some((lo, hi))
+            }
+            _ => None,
+        };
+        free.extend(free_of(
+            i + 1,
+            index,
+            thickness_nm,
+            &at(layer.thickness_nm.span()),
+        ));
+        let d = match thickness_nm {
+            (lo, Some(hi)) => 0.5 * (lo + hi),
+            (d, None) => d,
+        };
+        layers.push((material, d));
+    }
+    for (what, medium) in [("ambient", &raw.ambient), ("substrate", &raw.substrate)] {
+        if let Some(m) = medium
+            && let Some(message) = suffix_on_medium(m.get_ref())
+        {
+            return Err(Error::recipe(
+                path.to_path_buf(),
+                line_of(text, m.span().start),
+                format!("{what} = \"{}\": {message}", m.get_ref()),
+            ));
+        }
+    }
+    let incoherent: Vec<bool> = raw.layers.iter().map(|l| l.incoherent).collect();
+    Ok(TemplateSpec {
+        stack: StackSpec {
+            ambient: raw
+                .ambient
+                .as_ref()
+                .map_or_else(|| default("ambient"), mref),
+            layers,
+            substrate: raw
+                .substrate
+                .as_ref()
+                .map_or_else(|| default("substrate"), mref),
+            base_dir: path.parent().map(Path::to_path_buf),
+            incoherent: if incoherent.contains(&true) {
+                incoherent
+            } else {
+                Vec::new()
+            },
+        },
+        free,
+        angles: raw.angles,
+        wavelengths: raw.wavelengths,
+    })
+}
+
 impl StackRecipe {
     /// Reads a stack recipe file.
     pub fn read(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|source| nacre_format::Error::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text = read_text(path)?;
         Self::parse(path, &text)
     }
 
     /// Parses a stack recipe's text; `path` names it in messages and anchors relative
     /// material paths.
     pub fn parse(path: &Path, text: &str) -> Result<Self> {
-        let raw: RawStackRecipe = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
-        let at = |span: std::ops::Range<usize>| Origin::Line {
-            path: path.to_path_buf(),
-            line: line_of(text, span.start),
-        };
-        let mref = |s: &Spanned<String>| MaterialRef {
-            spec: s.get_ref().clone(),
-            context: at(s.span()),
-        };
-        let default = |what: &str| MaterialRef {
-            spec: DEFAULT_MEDIUM.into(),
-            context: format!("{} ({what} default)", path.display()).into(),
-        };
-        let mut layers = Vec::with_capacity(raw.layers.len());
-        for layer in &raw.layers {
-            let d = *layer.thickness_nm.get_ref();
-            if !(d >= 0.0 && d.is_finite()) {
-                return Err(Error::recipe(
-                    path.to_path_buf(),
-                    line_of(text, layer.thickness_nm.span().start),
-                    format!("thickness_nm = {d}: must be finite and non-negative"),
-                ));
-            }
-            if d >= MAX_THICKNESS_NM {
-                return Err(Error::recipe(
-                    path.to_path_buf(),
-                    line_of(text, layer.thickness_nm.span().start),
-                    format!("thickness_nm = {d}: a layer must be thinner than 1 m (1e9 nm)"),
-                ));
-            }
-            layers.push((mref(&layer.material), d));
-        }
-        for (what, medium) in [("ambient", &raw.ambient), ("substrate", &raw.substrate)] {
-            if let Some(m) = medium
-                && let Some(message) = suffix_on_medium(m.get_ref())
-            {
-                return Err(Error::recipe(
-                    path.to_path_buf(),
-                    line_of(text, m.span().start),
-                    format!("{what} = \"{}\": {message}", m.get_ref()),
-                ));
-            }
-        }
-        let incoherent: Vec<bool> = raw.layers.iter().map(|l| l.incoherent).collect();
+        let t = parse_recipe(path, text, false)?;
         Ok(StackRecipe {
-            stack: StackSpec {
-                ambient: raw
-                    .ambient
-                    .as_ref()
-                    .map_or_else(|| default("ambient"), mref),
-                layers,
-                substrate: raw
-                    .substrate
-                    .as_ref()
-                    .map_or_else(|| default("substrate"), mref),
-                base_dir: path.parent().map(Path::to_path_buf),
-                incoherent: if incoherent.contains(&true) {
-                    incoherent
-                } else {
-                    Vec::new()
-                },
-            },
-            angles: raw.angles,
-            wavelengths: raw.wavelengths,
+            stack: t.stack,
+            angles: t.angles,
+            wavelengths: t.wavelengths,
         })
     }
 }
