@@ -33,6 +33,7 @@ pub mod fit;
 pub mod fourier;
 pub mod fresnel;
 pub mod incoherent;
+pub mod jacobian;
 pub mod material;
 pub mod microfacet;
 pub(crate) mod multilayer;
