@@ -43,7 +43,7 @@ impl Dual {
         self.chain(r, if r == 0.0 { 0.0 } else { 0.5 / r })
     }
     /// √(u² + w²).
-    pub fn hypot(self, w: Self) -> Self {
+    pub fn magnitude(self, w: Self) -> Self {
         let h = elementary::hypot(self.v, w.v);
         let inv = if h == 0.0 { 0.0 } else { 1.0 / h };
         Dual {
@@ -52,7 +52,7 @@ impl Dual {
         }
     }
     /// atan2(self, x) in radians.
-    pub fn atan2(self, x: Self) -> Self {
+    pub fn arctan2(self, x: Self) -> Self {
         let r2 = self.v * self.v + x.v * x.v;
         let inv = if r2 == 0.0 { 0.0 } else { 1.0 / r2 };
         Dual {
@@ -61,20 +61,20 @@ impl Dual {
         }
     }
     /// sin u (radians).
-    pub fn sin(self) -> Self {
+    pub fn sine(self) -> Self {
         self.chain(elementary::sin(self.v), elementary::cos(self.v))
     }
     /// cos u (radians).
-    pub fn cos(self) -> Self {
+    pub fn cosine(self) -> Self {
         self.chain(elementary::cos(self.v), -elementary::sin(self.v))
     }
     /// e^u.
-    pub fn exp(self) -> Self {
+    pub fn exponential(self) -> Self {
         let e = elementary::exp(self.v);
         self.chain(e, e)
     }
     /// u^n.
-    pub fn powi(self, n: i32) -> Self {
+    pub fn pow_int(self, n: i32) -> Self {
         self.chain(
             elementary::powi(self.v, n),
             n as f64 * elementary::powi(self.v, n - 1),
@@ -182,16 +182,16 @@ pub fn delta_e_2000(lab1: [f64; 3], lab2: [f64; 3]) -> Dual {
     let l2 = Dual::input(lab2[0], 0);
     let a2 = Dual::input(lab2[1], 1);
     let b2 = Dual::input(lab2[2], 2);
-    let c_bar = (a1.hypot(b1) + a2.hypot(b2)) * 0.5;
-    let c_bar7 = c_bar.powi(7);
+    let c_bar = (a1.magnitude(b1) + a2.magnitude(b2)) * 0.5;
+    let c_bar7 = c_bar.pow_int(7);
     let g = (c(1.0) - (c_bar7 / (c_bar7 + POW25_7)).sqrt()) * 0.5;
     let (a1p, a2p) = ((g + 1.0) * a1, (g + 1.0) * a2);
-    let (c1p, c2p) = (a1p.hypot(b1), a2p.hypot(b2));
+    let (c1p, c2p) = (a1p.magnitude(b1), a2p.magnitude(b2));
     let hue = |b: Dual, ap: Dual| {
         if b.v == 0.0 && ap.v == 0.0 {
             c(0.0)
         } else {
-            let h = b.atan2(ap).to_degrees();
+            let h = b.arctan2(ap).to_degrees();
             if h.v < 0.0 { h + 360.0 } else { h }
         }
     };
@@ -211,7 +211,7 @@ pub fn delta_e_2000(lab1: [f64; 3], lab2: [f64; 3]) -> Dual {
             d + 360.0
         }
     };
-    let dh_big = 2.0 * chroma_product.sqrt() * (dh_deg * 0.5).to_radians().sin();
+    let dh_big = 2.0 * chroma_product.sqrt() * (dh_deg * 0.5).to_radians().sine();
     let l_bar = (l1 + l2) * 0.5;
     let c_bar_p = (c1p + c2p) * 0.5;
     let h_bar = if chroma_product.v == 0.0 {
@@ -223,20 +223,20 @@ pub fn delta_e_2000(lab1: [f64; 3], lab2: [f64; 3]) -> Dual {
     } else {
         (h1p + h2p - 360.0) * 0.5
     };
-    let cos_deg = |deg: Dual| deg.to_radians().cos();
+    let cos_deg = |deg: Dual| deg.to_radians().cosine();
     let t = c(1.0) - 0.17 * cos_deg(h_bar - 30.0)
         + 0.24 * cos_deg(2.0 * h_bar)
         + 0.32 * cos_deg(3.0 * h_bar + 6.0)
         - 0.20 * cos_deg(4.0 * h_bar - 63.0);
     let h_off = (h_bar - 275.0) * (1.0 / 25.0);
-    let d_theta_deg = 30.0 * (-(h_off * h_off)).exp();
-    let c_bar_p7 = c_bar_p.powi(7);
+    let d_theta_deg = 30.0 * (-(h_off * h_off)).exponential();
+    let c_bar_p7 = c_bar_p.pow_int(7);
     let r_c = 2.0 * (c_bar_p7 / (c_bar_p7 + POW25_7)).sqrt();
     let l50 = (l_bar - 50.0) * (l_bar - 50.0);
     let s_l = c(1.0) + 0.015 * l50 / (l50 + 20.0).sqrt();
     let s_c = c(1.0) + 0.045 * c_bar_p;
     let s_h = c(1.0) + 0.015 * c_bar_p * t;
-    let r_t = -((2.0 * d_theta_deg).to_radians().sin()) * r_c;
+    let r_t = -((2.0 * d_theta_deg).to_radians().sine()) * r_c;
     let (ql, qc, qh) = (dl / s_l, dc / s_c, dh_big / s_h);
     (ql * ql + qc * qc + qh * qh + r_t * qc * qh).sqrt()
 }
