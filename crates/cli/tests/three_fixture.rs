@@ -2,7 +2,9 @@
 //! (`integrations/three/test/expected.json`, written by `node test/gen-expected.mjs`) are
 //! still what `nacre color` gives: each case stores its command; this runs it again. And the
 //! raw export the browser tests load (`test/export/`, served with the KTX2 file's level-0
-//! bytes as the `.raw`) is what `nacre export` writes.
+//! bytes as the `.raw`) is what `nacre export` writes, and so are the multilayer stacks the
+//! stack cases load (`test/export/NAME.stack.json`, each with its command in the fixture's
+//! `stacks`).
 
 use std::path::Path;
 use std::process::Command;
@@ -101,4 +103,52 @@ fn three_export_fixture_matches_nacre_export() {
         bytes == ktx2[offset..offset + length],
         "the raw export differs from the KTX2 file's level 0 (the browser tests serve the latter)"
     );
+}
+
+#[test]
+fn three_stack_fixtures_match_nacre_export() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let text = std::fs::read_to_string(root.join("integrations/three/test/expected.json"))
+        .expect("read integrations/three/test/expected.json");
+    let fixture: serde_json::Value = serde_json::from_str(&text).expect("parse the fixture");
+    let stacks = fixture["stacks"].as_array().expect("stacks");
+    assert!(!stacks.is_empty());
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("three_stack_fixtures");
+    std::fs::create_dir_all(&dir).expect("temporary folder");
+    for stack in stacks {
+        let command = stack["command"].as_str().expect("command");
+        let mut args: Vec<&str> = command
+            .strip_prefix("nacre ")
+            .expect("a nacre command")
+            .split(' ')
+            .collect();
+        // The last argument is the committed file (relative to integrations/three): write a
+        // fresh one beside the test's scratch files and compare the bytes.
+        let committed = root
+            .join("integrations/three")
+            .join(args.pop().expect("the --out path"));
+        assert_eq!(
+            args.last(),
+            Some(&"--out"),
+            "`{command}` ends with --out FILE"
+        );
+        let fresh = dir.join(committed.file_name().expect("a file name"));
+        let out = Command::new(env!("CARGO_BIN_EXE_nacre"))
+            .args(&args)
+            .arg(&fresh)
+            .current_dir(&root)
+            .output()
+            .expect("run nacre");
+        assert!(
+            out.status.success(),
+            "`{command}`: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(
+            std::fs::read(&fresh).expect("fresh stack")
+                == std::fs::read(&committed).expect("committed stack"),
+            "{} is stale: run `node test/gen-expected.mjs` in integrations/three",
+            committed.display()
+        );
+    }
 }

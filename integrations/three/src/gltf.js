@@ -8,9 +8,12 @@
 import { applyNacreFilm } from './material.js';
 
 /**
- * @param {import('./index.js').NacreTable} table  the table every film samples: a fourier
+ * @param {import('./index.js').NacreTable | import('./index.js').NacreStack} table  the table every film samples: a fourier
  *   table (any base: three's F0 of each material) or a film-lut (its baked base, e.g.
- *   film-dielectric = glTF's default base of index 1.5)
+ *   film-dielectric = glTF's default base of index 1.5), or a NacreStack (loadNacreStack:
+ *   every film becomes that stack, its own ambient, films and base; the extension's
+ *   thickness range and texture give the top film's thickness and the others' variation,
+ *   material.js)
  * @param {{harmonics?: number}} [options]
  * @returns {(parser: any) => {name: string, afterRoot: (result: any) => Promise<void>}}
  *   the callback for `gltfLoader.register(...)`

@@ -2,6 +2,7 @@
 import type {
   Data3DTexture,
   DataArrayTexture,
+  DataTexture,
   MeshPhysicalMaterial,
   MeshPhysicalMaterialParameters,
 } from 'three';
@@ -39,6 +40,38 @@ export type NacreTable =
     }
   | { kind: 'fourier'; name: string; texture: DataArrayTexture; params: NacreFourierParams };
 
+/** The fields of nacre.glsl's NacreStackParams (the JSON's `shader_params`). */
+export interface NacreStackParams {
+  /** F, 1 … 8 */
+  films: number;
+  /** 1 when some index varies with wavelength */
+  dispersive: 0 | 1;
+  ruleCount: number;
+  /** 1: always rule 0 (`nacre export --wavelengths N`) */
+  fixedRule: 0 | 1;
+  baseCount: number;
+  countPerOpdNm: number;
+  finesse: number;
+  /** 16 values: first node of rule i */
+  ruleOffset: number[];
+  /** 16 values: nodes of rule i */
+  ruleSize: number[];
+  /** 8 × [d_j⁰ nm, r_j nm, k_j, channel c_j] */
+  layers: [number, number, number, number][];
+}
+
+/** A multilayer stack from `nacre export --layer … --out stack.json` (nacre-film-stack v1). */
+export interface NacreStack {
+  kind: 'film-stack';
+  name: string;
+  /** The stack table: 6 × nodeCount RGBA32F, NearestFilter (read with texelFetch). */
+  texture: DataTexture;
+  nodeCount: number;
+  /** The stack as given to `nacre export` (the JSON's `about`). */
+  about: Record<string, unknown> | null;
+  params: NacreStackParams;
+}
+
 export class NacreTableError extends Error {
   url: string;
 }
@@ -59,6 +92,10 @@ export function parseKtx2(buffer: ArrayBuffer, url?: string): Ktx2Image;
 export function loadNacreTable(manifestUrl: string): Promise<NacreTable>;
 /** Loads a film-lut quantity exported by `nacre export` (`FILE.raw` + `FILE.json`). */
 export function loadNacreRawTable(rawUrl: string): Promise<NacreTable>;
+/** Loads a multilayer stack written by `nacre export --layer … --out stack.json`. */
+export function loadNacreStack(url: string): Promise<NacreStack>;
+/** A NacreStack from the parsed stack JSON (checked; errors name `url`). */
+export function nacreStackFromJson(json: unknown, url?: string): NacreStack;
 
 export const NacreDebugView: Readonly<{ NONE: 0; FILM: 1; UNIT_FILM: 2 }>;
 export type NacreDebugViewValue = 0 | 1 | 2;
@@ -69,37 +106,45 @@ export interface NacreFilmOptions {
   debugView?: NacreDebugViewValue;
 }
 
-export interface NacreFilmMaterialParameters extends MeshPhysicalMaterialParameters, NacreFilmOptions {
-  table: NacreTable;
-  /** Sets iridescenceThicknessRange to [d, d] (nm). */
+interface NacreFilmMaterialCommon extends MeshPhysicalMaterialParameters, NacreFilmOptions {
+  /** Sets the thickness range to [d, d] (nm); a stack's top film. */
   filmThicknessNm?: number;
-  /** The film index (three's iridescenceIOR). */
+  /** [min, max] nm spanned by the thickness map (iridescenceThicknessRange, or r187's Minimum/Maximum). */
+  filmThicknessRangeNm?: [number, number];
+  /** The film index (three's iridescenceIOR; not used by a stack). */
   filmIor?: number;
 }
+
+export type NacreFilmMaterialParameters =
+  | (NacreFilmMaterialCommon & { table: NacreTable; stack?: undefined })
+  | (NacreFilmMaterialCommon & { stack: NacreStack; table?: undefined });
 
 export class NacreFilmMaterial extends MeshPhysicalMaterial {
   constructor(parameters?: NacreFilmMaterialParameters);
   readonly isNacreFilmMaterial: true;
-  table: NacreTable;
+  table: NacreTable | NacreStack;
+  /** The stack, or null when the material samples a table. */
+  stack: NacreStack | null;
   filmThicknessNm: number;
+  filmThicknessRangeNm: [number, number];
   filmIor: number;
   harmonics: number;
   debugView: NacreDebugViewValue;
 }
 
 /** Gives an existing MeshPhysicalMaterial nacre's film; returns it. */
-export function applyNacreFilm<T extends MeshPhysicalMaterial>(material: T, table: NacreTable, options?: NacreFilmOptions): T;
+export function applyNacreFilm<T extends MeshPhysicalMaterial>(material: T, table: NacreTable | NacreStack, options?: NacreFilmOptions): T;
 /** Throws when three.js's chunks lack the hooks; returns three's REVISION. */
 export function checkThreeHooks(): string;
 
 export class NacreGLTFPlugin {
-  constructor(parser: unknown, table: NacreTable, options?: NacreFilmOptions);
+  constructor(parser: unknown, table: NacreTable | NacreStack, options?: NacreFilmOptions);
   readonly name: 'NACRE_film';
   materials: MeshPhysicalMaterial[];
   afterRoot(result: { scene: import('three').Group; scenes: import('three').Group[] }): Promise<void>;
 }
 /** The callback for `GLTFLoader.register`: every KHR_materials_iridescence material gets nacre's film. */
-export function nacreGLTFPlugin(table: NacreTable, options?: NacreFilmOptions): (parser: unknown) => NacreGLTFPlugin;
+export function nacreGLTFPlugin(table: NacreTable | NacreStack, options?: NacreFilmOptions): (parser: unknown) => NacreGLTFPlugin;
 
 /** nacre's GLSL library (shaders/glsl/nacre.glsl). */
 export const nacreGlsl: string;

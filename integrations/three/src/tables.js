@@ -1,7 +1,10 @@
 // Loaders for nacre's tables: the KTX2 files of a baked table (through its manifest, the
 // `NAME.json` beside them in tables/baked/) and the raw RGBA16F exports of `nacre export`
 // (through their JSON sidecar). Both give a NacreTable: a three.js texture and the axes the
-// GLSL library's parameter structs need (`NacreFilmLutParams`, `NacreFourierParams`).
+// GLSL library's parameter structs need (`NacreFilmLutParams`, `NacreFourierParams`). And
+// the multilayer stacks `nacre export --layer … --out stack.json` writes (`nacre-film-stack`
+// v1, docs/engines/README.md): a NacreStack, the stack table as an RGBA32F DataTexture and
+// the fields of nacre.glsl's NacreStackParams.
 //
 // KTX2 layout written by nacre (crates/format/src/ktx2.rs; README.md "Table layouts"):
 // uncompressed, no supercompression, levels smallest first in the file; a film-lut quantity
@@ -12,6 +15,7 @@ import {
   ClampToEdgeWrapping,
   Data3DTexture,
   DataArrayTexture,
+  DataTexture,
   FloatType,
   HalfFloatType,
   LinearFilter,
@@ -238,4 +242,104 @@ export async function loadNacreRawTable(rawUrl) {
     transmittance: null,
     params: filmLutParams(p, false),
   };
+}
+
+const STACK_MAX_FILMS = 8; // nacre.glsl NACRE_STACK_MAX_FILMS
+const STACK_MAX_RULES = 16; // StackParams.rule_offset / rule_size: array<vec4<u32>, 4>
+const STACK_TABLE_WIDTH = 6; // texel 0: (λ, W_rgb); texels 1…5: (n, κ) of two media each
+
+/**
+ * A NacreStack from the parsed `nacre-film-stack` JSON (what loadNacreStack fetches):
+ * checks the schema and every field the shader reads, and uploads `texture.data` as a
+ * 6 × node_count RGBA32F DataTexture (NearestFilter: read with texelFetch).
+ * @param {any} json
+ * @param {string} [url] named in errors
+ * @returns {import('./index.js').NacreStack}
+ */
+export function nacreStackFromJson(json, url = 'stack JSON') {
+  const bad = (message) => new NacreTableError(url, message);
+  if (json?.format !== 'nacre-film-stack') throw bad(`format \`${json?.format}\`: expected nacre-film-stack (written by \`nacre export --layer …\`)`);
+  if (json.version !== 1) throw bad(`version ${json.version}: this package reads nacre-film-stack version 1`);
+  if (json.technique !== 'film_stack') throw bad(`technique \`${json.technique}\`: expected film_stack`);
+  const p = json.shader_params ?? {};
+  const int = (k, lo, hi) => {
+    if (!Number.isInteger(p[k]) || p[k] < lo || p[k] > hi) throw bad(`shader_params.${k} = ${JSON.stringify(p[k])}: expected an integer in ${lo}…${hi}`);
+    return p[k];
+  };
+  const num = (k) => {
+    if (typeof p[k] !== 'number' || !Number.isFinite(p[k])) throw bad(`shader_params.${k} = ${JSON.stringify(p[k])}: expected a finite number`);
+    return p[k];
+  };
+  const list = (k, n) => {
+    if (!Array.isArray(p[k]) || p[k].length !== n) throw bad(`shader_params.${k}: expected ${n} entries`);
+    return p[k];
+  };
+  const films = int('films', 1, STACK_MAX_FILMS);
+  const ruleCount = int('rule_count', 1, STACK_MAX_RULES);
+  const ruleOffset = list('rule_offset', STACK_MAX_RULES).map(Number);
+  const ruleSize = list('rule_size', STACK_MAX_RULES).map(Number);
+  const layers = list('layers', STACK_MAX_FILMS).map((l, j) => {
+    if (!Array.isArray(l) || l.length !== 4 || !l.every((v) => typeof v === 'number' && Number.isFinite(v))) {
+      throw bad(`shader_params.layers[${j}]: expected 4 finite numbers [d nm, r nm, k, channel]`);
+    }
+    return [...l];
+  });
+  const t = json.texture ?? {};
+  if (t.width !== STACK_TABLE_WIDTH || t.format !== 'rgba32f' || !Number.isInteger(t.height) || t.height < 1) {
+    throw bad(`texture: ${t.width} × ${t.height} ${t.format}, expected ${STACK_TABLE_WIDTH} × node_count rgba32f`);
+  }
+  if (!Array.isArray(t.data) || t.data.length !== t.width * t.height * 4) {
+    throw bad(`texture.data: ${t.data?.length} floats, expected ${t.width} × ${t.height} × 4`);
+  }
+  if (json.node_count !== undefined && json.node_count !== t.height) throw bad(`node_count ${json.node_count} but texture.height ${t.height}`);
+  for (let i = 0; i < ruleCount; i++) {
+    if (!(Number.isInteger(ruleOffset[i]) && Number.isInteger(ruleSize[i]) && ruleSize[i] >= 1 && ruleOffset[i] + ruleSize[i] <= t.height)) {
+      throw bad(`rule ${i}: nodes ${ruleOffset[i]} + ${ruleSize[i]} outside the ${t.height} of the stack table`);
+    }
+  }
+  const texture = new DataTexture(new Float32Array(t.data), t.width, t.height, RGBAFormat, FloatType);
+  texture.minFilter = NearestFilter; // read with texelFetch: no filtering, no mipmaps
+  texture.magFilter = NearestFilter;
+  texture.wrapS = texture.wrapT = ClampToEdgeWrapping;
+  texture.generateMipmaps = false;
+  texture.unpackAlignment = 1;
+  texture.colorSpace = NoColorSpace;
+  texture.needsUpdate = true;
+  return {
+    kind: 'film-stack',
+    name: url.split('/').pop().replace(/\.json$/, ''),
+    texture,
+    nodeCount: t.height,
+    about: json.about ?? null,
+    params: {
+      films,
+      dispersive: int('dispersive', 0, 1),
+      ruleCount,
+      fixedRule: int('fixed_rule', 0, 1),
+      baseCount: num('base_count'),
+      countPerOpdNm: num('count_per_opd_nm'),
+      finesse: num('finesse'),
+      ruleOffset,
+      ruleSize,
+      layers,
+    },
+  };
+}
+
+/**
+ * Loads a multilayer stack written by `nacre export --layer M@D … --out stack.json` (ambient |
+ * up to 8 films | base; dispersive and absorbing media): the `film_stack` technique of
+ * NacreFilmMaterial (`stack` option).
+ * @param {string} url
+ * @returns {Promise<import('./index.js').NacreStack>}
+ */
+export async function loadNacreStack(url) {
+  const response = await fetchOk(url, 'the stack JSON');
+  let json;
+  try {
+    json = await response.json();
+  } catch (e) {
+    throw new NacreTableError(url, `not JSON: ${e.message}`);
+  }
+  return nacreStackFromJson(json, url);
 }

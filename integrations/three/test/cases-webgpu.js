@@ -3,17 +3,7 @@
 // into float render targets and reads the floats back; the same cases as cases.js.
 import * as THREE from 'three/webgpu';
 import { NacreDebugView, NacreFilmNodeMaterial } from '@nacre/three/webgpu';
-import { loadNacreRawTable, loadNacreTable } from '@nacre/three';
-
-const tables = {};
-async function table(name) {
-  if (!tables[name]) {
-    tables[name] = name.startsWith('export:')
-      ? await loadNacreRawTable(`/export/${name.slice('export:'.length)}.raw`)
-      : await loadNacreTable(`/tables/${name}.json`);
-  }
-  return tables[name];
-}
+import { caseFilm, table } from './common.js';
 
 /** A WebGPURenderer on the WebGPU backend (never the WebGL 2 fallback), initialised. */
 async function makeRenderer(width, height) {
@@ -77,16 +67,7 @@ export async function filmCases(cases) {
   };
   const out = [];
   for (const c of cases) {
-    const nacre = new NacreFilmNodeMaterial({
-      table: await table(c.table),
-      harmonics: c.harmonics ?? 0,
-      color: 0x000000,
-      metalness: 0,
-      roughness: 0.3,
-      ior: c.baseIor,
-      filmIor: c.filmIor,
-      filmThicknessNm: c.thicknessNm,
-    });
+    const nacre = new NacreFilmNodeMaterial({ ...(await caseFilm(THREE, c)), harmonics: c.harmonics ?? 0, color: 0x000000, metalness: 0, roughness: 0.3 });
     const mesh = new THREE.Mesh(geometry, nacre);
     const scenes = {};
     scenes.environment = new THREE.Scene();

@@ -1,18 +1,8 @@
 // Browser side of the tests (loaded into /page/THREE.html by run.mjs): renders
 // NacreFilmMaterial into float render targets and reads the floats back.
 import * as THREE from 'three';
-import { NacreDebugView, NacreFilmMaterial, loadNacreRawTable, loadNacreTable, nacreGLTFPlugin } from '@nacre/three';
-
-const tables = {};
-// `NAME` loads tables/baked/NAME.json (KTX2); `export:NAME.QUANTITY` the raw export and its sidecar.
-async function table(name) {
-  if (!tables[name]) {
-    tables[name] = name.startsWith('export:')
-      ? await loadNacreRawTable(`/export/${name.slice('export:'.length)}.raw`)
-      : await loadNacreTable(`/tables/${name}.json`);
-  }
-  return tables[name];
-}
+import { NacreDebugView, NacreFilmMaterial, nacreGLTFPlugin } from '@nacre/three';
+import { caseFilm, stack, table } from './common.js';
 
 function makeRenderer(width, height) {
   const canvas = document.createElement('canvas');
@@ -64,15 +54,7 @@ export async function filmCases(cases) {
   };
   const out = [];
   for (const c of cases) {
-    const material = new NacreFilmMaterial({
-      table: await table(c.table),
-      color: 0x000000,
-      metalness: 0,
-      roughness: 0.3,
-      ior: c.baseIor,
-      filmIor: c.filmIor,
-      filmThicknessNm: c.thicknessNm,
-    });
+    const material = new NacreFilmMaterial({ ...(await caseFilm(THREE, c)), color: 0x000000, metalness: 0, roughness: 0.3 });
     const mesh = new THREE.Mesh(geometry, material);
     const scenes = {};
     scenes.environment = new THREE.Scene();
@@ -165,12 +147,13 @@ export async function gltfScene(url, size, tableName) {
 }
 
 /**
- * Frame time of a sphere filling the view with NacreFilmMaterial (film-dielectric lut, and
- * fourier) against the same sphere with a plain MeshPhysicalMaterial (no film) and with
+ * Frame time of a sphere filling the view with NacreFilmMaterial (film-dielectric lut,
+ * fourier, and — when `only` names it — `nacreStack`, the stack of five films on silicon:
+ * seconds a frame on SwiftShader, so run on its own in the --bench run) against the same sphere with a plain MeshPhysicalMaterial (no film) and with
  * three's own iridescence, same lights (environment + directional), same run,
  * interleaved rounds; each frame ends with a 1-pixel readback so that the GPU work is in it.
  */
-export async function frameTime(size, frames, rounds) {
+export async function frameTime(size, frames, rounds, only = null) {
   const renderer = makeRenderer(size, size);
   const scene = new THREE.Scene();
   scene.environment = whiteEnvironment(renderer);
@@ -186,6 +169,10 @@ export async function frameTime(size, frames, rounds) {
     nacreLut: new NacreFilmMaterial({ table: await table('film-dielectric'), color: 0x202020, roughness: 0.3, filmIor: 1.33, filmThicknessNm: 400 }),
     nacreFourier: new NacreFilmMaterial({ table: await table('fourier-srgb'), color: 0x202020, roughness: 0.3, filmIor: 1.33, filmThicknessNm: 400 }),
   };
+  if (only?.includes('nacreStack')) {
+    materials.nacreStack = new NacreFilmMaterial({ stack: await stack('five-on-si'), color: 0x202020, roughness: 0.3, filmThicknessNm: 120 });
+  }
+  if (only) for (const name of Object.keys(materials)) if (!only.includes(name)) delete materials[name];
   const mesh = new THREE.Mesh(geometry, materials.plain);
   scene.add(mesh);
   const gl = renderer.getContext();
