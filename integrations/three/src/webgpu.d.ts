@@ -1,7 +1,7 @@
 // Types of @nacre/three/webgpu (src/webgpu.js): NacreFilmNodeMaterial for three.js's
 // WebGPURenderer (three/webgpu).
 import type { MeshPhysicalNodeMaterial } from 'three/webgpu';
-import type { NacreFilmOptions, NacreTable } from './index.js';
+import type { NacreFilmOptions, NacreStack, NacreTable } from './index.js';
 
 export const NacreDebugView: Readonly<{ NONE: 0; FILM: 1; UNIT_FILM: 2 }>;
 export type NacreDebugViewValue = 0 | 1 | 2;
@@ -10,9 +10,14 @@ export type NacreDebugViewValue = 0 | 1 | 2;
 export function checkThreeNodeHooks(): string;
 
 export interface NacreFilmNodeMaterialParameters extends NacreFilmOptions {
-  table: NacreTable;
-  /** Sets three's film thickness range to [d, d] (nm). */
+  /** A film-lut or fourier table; or give `stack`. */
+  table?: NacreTable;
+  /** A multilayer stack (loadNacreStack): the film_stack technique. */
+  stack?: NacreStack;
+  /** Sets three's film thickness range to [d, d] (nm); a stack's top film. */
   filmThicknessNm?: number;
+  /** [min, max] nm spanned by the thickness map. */
+  filmThicknessRangeNm?: [number, number];
   /** The film index (three's iridescenceIOR). */
   filmIor?: number;
   /** Any MeshPhysicalNodeMaterial parameter. */
@@ -23,8 +28,11 @@ export interface NacreFilmNodeMaterialParameters extends NacreFilmOptions {
 export class NacreFilmNodeMaterial extends MeshPhysicalNodeMaterial {
   constructor(parameters?: NacreFilmNodeMaterialParameters);
   readonly isNacreFilmNodeMaterial: true;
-  table: NacreTable;
+  table: NacreTable | NacreStack;
+  /** The stack, or null when the material samples a table. */
+  stack: NacreStack | null;
   filmThicknessNm: number;
+  filmThicknessRangeNm: [number, number];
   filmIor: number;
   harmonics: number;
   debugView: NacreDebugViewValue;

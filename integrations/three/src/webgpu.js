@@ -40,15 +40,22 @@
 //     evanescent, so the amplitudes are computed in real arithmetic (the complex formulas of
 //     common.wgsl with zero imaginary parts) and a film index below 1 is raised to 1. The
 //     table is read at level 0 (σ_d = 0, as `nacre color --method fourier`).
+//   * stack: nacre's film_stack (shaders/film_stack.wgsl, nacre.glsl's nacre_film_stack_colour)
+//     for a NacreStack, the exact per-polarisation recurrence in complex arithmetic on vec2
+//     nodes; the stack's sizes are constants of the generated code (the films and media
+//     unrolled), the nodes of the pixel's rule a Loop over the stack table. Its ambient,
+//     films and base are the stack's own; three's thickness is the top film's, and the lower
+//     films follow s = 2g − 1 as in src/material.js. e^{2πix} is computed with polynomial
+//     trigonometry (SwiftShader's cos/sin are ~1e-3 off, material.js).
 // Tested with three.js r187 and r171 (the first release with the `three/tsl` entry), on the
 // WebGPU backend (Chromium's WebGPU on SwiftShader).
 import { MeshPhysicalNodeMaterial, PhysicalLightingModel, REVISION } from 'three/webgpu';
 import * as TSL from 'three/tsl';
-import { DataTexture, FloatType, NearestFilter, ClampToEdgeWrapping, NoColorSpace, RGBAFormat } from 'three/webgpu';
+import { DataTexture, FloatType, NearestFilter, ClampToEdgeWrapping, NoColorSpace, RGBAFormat, Vector2 } from 'three/webgpu';
 
 const {
-  Fn, If, Loop, Break, float, int, vec3, vec4, ivec2, uniform, texture3D, textureLoad, select,
-  mix, clamp, max, min, sqrt, floor, fract, cos, sin, abs, pow, smoothstep,
+  Fn, If, Loop, Break, float, int, vec2, vec3, vec4, ivec2, uniform, texture3D, textureLoad, select,
+  mix, clamp, max, min, sqrt, floor, fract, cos, sin, abs, pow, smoothstep, exp, ceil, dot,
   specularColor, specularF90, diffuseColor, metalness, roughness, iridescence, iridescenceIOR,
   iridescenceThickness, normalView, positionViewDirection,
 } = TSL;
@@ -66,6 +73,8 @@ const FOURIER_AUTO_LEVEL_FLOOR = 0.01;
 const FOURIER_THIN_FILM_BLEND_NM = 30.0;
 const FOURIER_MIN_ONE_MINUS_RHO2 = 1e-6;
 const TWO_PI = 6.28318530717959;
+const IOR_MIN = 1e-3;
+const BRANCH_TOLERANCE = 1.1920929e-5;
 
 /**
  * Throws, naming the release, when three's node lighting model lost what the material hooks
@@ -246,6 +255,142 @@ function fourierFilm(table, harmonics) {
   });
 }
 
+// Complex numbers as vec2 nodes (shaders/common.wgsl's c_* functions).
+const cmul = (a, b) => vec2(a.x.mul(b.x).sub(a.y.mul(b.y)), a.x.mul(b.y).add(a.y.mul(b.x)));
+// a / b with Smith-style scaling by max(|Re b|, |Im b|) (c_div).
+const cdiv = (a, b) => {
+  const s = max(max(abs(b.x), abs(b.y)), 1e-30);
+  const bs = b.div(s).toVar();
+  const as = a.div(s).toVar();
+  return vec2(as.x.mul(bs.x).add(as.y.mul(bs.y)), as.y.mul(bs.x).sub(as.x.mul(bs.y))).div(dot(bs, bs));
+};
+// Principal square root without cancellation (c_sqrt), r = |z|.
+const csqrt = (z) => {
+  const m = max(max(abs(z.x), abs(z.y)), 1e-30);
+  const r = m.mul(sqrt(dot(z.div(m), z.div(m)))).toVar();
+  const tPos = sqrt(max(r.add(z.x).mul(0.5), 1e-38)).toVar();
+  const tNeg = sqrt(max(r.sub(z.x).mul(0.5), 1e-38)).toVar();
+  const pos = vec2(tPos, z.y.mul(0.5).div(tPos));
+  const neg = vec2(abs(z.y).mul(0.5).div(tNeg), select(z.y.greaterThanEqual(0.0), tNeg, tNeg.negate()));
+  // select, not mix: the branch not taken may divide by a zero t (NaN · 0 is NaN).
+  return select(z.x.greaterThanEqual(0.0), pos, neg);
+};
+// The forward branch of q (forward_branch): Im q > 0, or Re q ≥ 0 when Im q is rounding noise.
+const forwardBranch = (q) => {
+  const scale = max(abs(q.x), abs(q.y));
+  const forward = select(abs(q.y).greaterThan(scale.mul(BRANCH_TOLERANCE)), float(q.y.greaterThan(0.0)), float(q.x.greaterThanEqual(0.0)));
+  return q.mul(forward.mul(2.0).sub(1.0));
+};
+// q = √((n − n₀)(n + n₀) − κ² + (n₀ cos θ)² + 2inκ) on the forward branch (normal_component_cos).
+const normalComponentCos = (n, n0, c) => {
+  const a = n0.mul(c);
+  return forwardBranch(csqrt(vec2(n.x.sub(n0).mul(n.x.add(n0)).sub(n.y.mul(n.y)).add(a.mul(a)), n.x.mul(n.y).mul(2.0))));
+};
+// e^{2πix} with the trigonometry in arithmetic (as src/material.js's PRECISE_EXP_I_CYCLES):
+// x reduced to a quarter turn k/4 plus φ/2π, |φ| ≤ π/4, Taylor polynomials to φ⁹, times i^k.
+const expICycles = (x) => {
+  const r = fract(x).toVar();
+  const k = floor(r.mul(4.0).add(0.5)).toVar();
+  const phi = r.sub(k.mul(0.25)).mul(TWO_PI).toVar();
+  const p2 = phi.mul(phi).toVar();
+  const c = p2.mul(p2.mul(p2.mul(p2.mul(1 / 40320).add(-1 / 720)).add(1 / 24)).add(-0.5)).add(1.0).toVar();
+  const s = phi.mul(p2.mul(p2.mul(p2.mul(p2.mul(1 / 362880).add(-1 / 5040)).add(1 / 120)).add(-1 / 6)).add(1.0)).toVar();
+  // i^k (c + is): k = 0 (c, s), 1 (−s, c), 2 (−c, −s), 3 or 4 (s, −c) / (c, s).
+  const q = k.sub(floor(k.mul(0.25)).mul(4.0)).toVar();
+  const cosK = select(q.equal(0.0), float(1.0), select(q.equal(2.0), float(-1.0), float(0.0)));
+  const sinK = select(q.equal(1.0), float(1.0), select(q.equal(3.0), float(-1.0), float(0.0)));
+  return vec2(c.mul(cosK).sub(s.mul(sinK)), c.mul(sinK).add(s.mul(cosK)));
+};
+
+/**
+ * The multilayer stack (film_stack.wgsl `film_colour`, reflectance; nacre.glsl's
+ * nacre_film_stack_colour) for a NacreStack: ambient | F films | base, the exact recurrence
+ *   Γ_m = (r + Γ_{m+1} e²) / (1 + r Γ_{m+1} e²),  e = e^{iδ_{m+1}},  δ = 2π d q / λ
+ * per polarisation at the nodes of the pixel's rule, R = Σ_k W_k (|Γ_s|² + |Γ_p|²)/2.
+ * The stack's sizes (films, media, rules) are constants of the generated code; the nodes'
+ * wavelengths, weights and indices are read from the stack table with textureLoad. The top
+ * film's thickness is three's; film j ≥ 2 is max(0, d_j⁰ + r_j s), s = 2g − 1, g = (d − min)
+ * / (max − min) from the thickness range `range` (a vec2 uniform; g = 1 for an empty range).
+ */
+function stackFilm(stack, range) {
+  const p = stack.params;
+  const tex = stack.texture;
+  const films = p.films;
+  const media = films + 2;
+  const index = (k, m) => {
+    const texel = textureLoad(tex, ivec2(int(1 + (m >> 1)), k));
+    const n = m % 2 === 0 ? texel.xy : texel.zw;
+    return vec2(clamp(n.x, IOR_MIN, IOR_MAX), clamp(n.y, 0.0, IOR_MAX));
+  };
+  // Amplitudes r_s, r_p of interfaces m → m + 1 (m = 0 … F) and q of every medium at node k.
+  const interfaces = (k, c, declare) => {
+    const n0 = index(k, 0).x.toVar();
+    const q = [vec2(n0.mul(c), 0.0)];
+    const rs = [];
+    const rp = [];
+    let prev = vec2(n0, 0.0);
+    for (let m = 1; m < media; m++) {
+      const n = index(k, m).toVar();
+      q.push(normalComponentCos(n, n0, c).toVar());
+      rs.push(declare(cdiv(q[m - 1].sub(q[m]), q[m - 1].add(q[m]))));
+      const a = cmul(cmul(n, n), q[m - 1]).toVar();
+      const b = cmul(cmul(prev, prev), q[m]).toVar();
+      rp.push(declare(cdiv(a.sub(b), a.add(b))));
+      prev = n;
+    }
+    return { q, rs, rp };
+  };
+  return Fn(([cosTheta, thicknessNm]) => {
+    const c = max(clamp(cosTheta, 0.0, 1.0), COS_THETA_MIN).toVar();
+    const d1 = clamp(thicknessNm, 0.0, THICKNESS_MAX_NM).toVar();
+    const span = range.y.sub(range.x);
+    const g = select(span.greaterThan(0.0), clamp(d1.sub(range.x).div(max(span, 1e-30)), 0.0, 1.0), float(1.0));
+    const s = g.mul(2.0).sub(1.0).toVar();
+    const thickness = p.layers.slice(0, films).map((layer, j) =>
+      j === 0 ? d1 : clamp(s.mul(layer[1]).add(layer[0]), 0.0, THICKNESS_MAX_NM).toVar());
+    const opd = thickness.reduce((sum, d, j) => sum.add(d.mul(p.layers[j][2])), float(0.0)).mul(p.finesse);
+    // The rule: the first whose node count reaches ⌈base + slope · OPD⌉, else the last.
+    let first = int(p.ruleOffset[p.ruleCount - 1]);
+    let count = int(p.ruleSize[p.ruleCount - 1]);
+    if (p.fixedRule === 1) {
+      first = int(p.ruleOffset[0]);
+      count = int(p.ruleSize[0]);
+    } else {
+      const needed = ceil(opd.mul(p.countPerOpdNm).add(p.baseCount)).toVar();
+      for (let i = p.ruleCount - 2; i >= 0; i--) {
+        const fits = float(p.ruleSize[i]).greaterThanEqual(needed);
+        first = select(fits, int(p.ruleOffset[i]), first);
+        count = select(fits, int(p.ruleSize[i]), count);
+      }
+    }
+    const start = first.toVar();
+    const end = start.add(count).toVar();
+    const colour = vec3(0.0).toVar();
+    // Without dispersion the indices, q and interfaces are the same at every node.
+    const fixed = p.dispersive === 0 ? interfaces(start, c, (v) => v.toVar()) : null;
+    Loop({ start, end, type: 'int', condition: '<' }, ({ i }) => {
+      const node = textureLoad(tex, ivec2(int(0), i)).toVar();
+      const lambda = max(node.x, 1e-3);
+      const { q, rs, rp } = fixed ?? interfaces(i, c, (v) => v.toVar());
+      const gammaS = rs[films].toVar();
+      const gammaP = rp[films].toVar();
+      for (let m = films - 1; m >= 0; m--) {
+        const qf = q[m + 1];
+        const x = thickness[m].div(lambda).toVar();
+        const e1 = expICycles(x.mul(qf.x)).mul(exp(x.mul(qf.y).mul(-TWO_PI))).toVar();
+        const e2 = cmul(e1, e1).toVar();
+        const gs = cmul(gammaS, e2).toVar();
+        const gp = cmul(gammaP, e2).toVar();
+        gammaS.assign(cdiv(rs[m].add(gs), vec2(1.0, 0.0).add(cmul(rs[m], gs))));
+        gammaP.assign(cdiv(rp[m].add(gp), vec2(1.0, 0.0).add(cmul(rp[m], gp))));
+      }
+      const reflectance = clamp(dot(gammaS, gammaS), 0.0, 1.0).add(clamp(dot(gammaP, gammaP), 0.0, 1.0)).mul(0.5);
+      colour.addAssign(node.yzw.mul(reflectance));
+    });
+    return colour;
+  });
+}
+
 // A serial number per table object: the film's code holds the table's axes as constants, so
 // materials over different tables must not share a compiled program (three keys node
 // programs by the material's type and its node-valued properties only).
@@ -261,15 +406,22 @@ class NacreNodeState {
   constructor(table, { harmonics = 0, debugView = NacreDebugView.NONE } = {}) {
     this.harmonicsUniform = uniform(harmonics);
     this.debugViewUniform = uniform(debugView).setGroup(TSL.renderGroup);
+    // The material's film thickness range [min, max] nm (the stack's lower films follow it).
+    this.thicknessRangeUniform = uniform(new Vector2()).onObjectUpdate(({ material }, self) => {
+      const [lo, hi] = material.filmThicknessRangeNm;
+      self.value.set(lo, hi);
+    });
     this.setTable(table);
   }
 
   setTable(table) {
-    if (!table || (table.kind !== 'film-lut' && table.kind !== 'fourier')) {
-      throw new Error('@nacre/three/webgpu: a NacreFilmNodeMaterial needs a film-lut or fourier table (loadNacreTable)');
+    if (!table || !['film-lut', 'fourier', 'film-stack'].includes(table.kind)) {
+      throw new Error('@nacre/three/webgpu: a NacreFilmNodeMaterial needs a film-lut or fourier table (loadNacreTable) or a stack (loadNacreStack)');
     }
     this.table = table;
-    const evaluate = table.kind === 'film-lut' ? lutFilm(table) : fourierFilm(table, this.harmonicsUniform);
+    const evaluate = table.kind === 'film-lut'
+      ? lutFilm(table)
+      : table.kind === 'fourier' ? fourierFilm(table, this.harmonicsUniform) : stackFilm(table, this.thicknessRangeUniform);
     const unit = this.debugViewUniform.equal(NacreDebugView.UNIT_FILM);
     // R_f(n·v) for a base of normal-incidence reflectance baseF0 (a film-lut's base is the
     // one it baked: baseF0 is not used).
@@ -302,7 +454,10 @@ class NacreLightingModel extends PhysicalLightingModel {
       // are then set before any branch of the film's code reads them.
       this.nacreDotNV.assign(normalView.dot(positionViewDirection).clamp());
       this.nacreFilmDielectric.assign(state.film(this.nacreDotNV, specularColor));
-      if (this.nacreFilmMetal) {
+      if (this.nacreFilmMetal && state.table.kind === 'film-stack') {
+        // The stack has its own base: the metal's film is the same.
+        this.nacreFilmMetal.assign(this.nacreFilmDielectric);
+      } else if (this.nacreFilmMetal) {
         If(metalness.greaterThan(0.0), () => {
           this.nacreFilmMetal.assign(state.film(this.nacreDotNV, diffuseColor.rgb));
         });
@@ -353,7 +508,8 @@ function nacreLightingModel(model, state) {
 /**
  * MeshPhysicalNodeMaterial (three/webgpu) with nacre's thin film in place of three's
  * iridescence, for every light. Parameters: every MeshPhysicalNodeMaterial parameter plus
- * `table` (loadNacreTable / loadNacreRawTable), `harmonics` (fourier: 0 = automatic),
+ * `table` (loadNacreTable / loadNacreRawTable) or `stack` (loadNacreStack), `harmonics`
+ * (fourier: 0 = automatic), `filmThicknessRangeNm` ([min, max] of the thickness map),
  * `debugView` (NacreDebugView), `filmThicknessNm` (three's film thickness range = [d, d]) and
  * `filmIor` (= iridescenceIOR). `iridescence` defaults to 1.
  */
@@ -363,12 +519,20 @@ export class NacreFilmNodeMaterial extends MeshPhysicalNodeMaterial {
   }
 
   constructor(parameters = {}) {
-    const { table, harmonics, debugView, filmThicknessNm, filmIor, ...physical } = parameters;
+    const { table: tableParameter, stack, harmonics, debugView, filmThicknessNm, filmThicknessRangeNm, filmIor, ...physical } = parameters;
+    if (tableParameter !== undefined && stack !== undefined) {
+      throw new Error('@nacre/three/webgpu: give a NacreFilmNodeMaterial `table` or `stack`, not both');
+    }
+    if (stack !== undefined && stack?.kind !== 'film-stack') {
+      throw new Error('@nacre/three/webgpu: `stack` must be a NacreStack (loadNacreStack)');
+    }
+    const table = stack ?? tableParameter;
     super();
     checkThreeNodeHooks();
     this.isNacreFilmNodeMaterial = true;
     this.nacre = table === undefined ? null : new NacreNodeState(table, { harmonics, debugView });
     this.setValues({ iridescence: 1, ...physical });
+    if (filmThicknessRangeNm !== undefined) this.filmThicknessRangeNm = filmThicknessRangeNm;
     if (filmThicknessNm !== undefined) this.filmThicknessNm = filmThicknessNm;
     if (filmIor !== undefined) this.filmIor = filmIor;
   }
@@ -388,6 +552,32 @@ export class NacreFilmNodeMaterial extends MeshPhysicalNodeMaterial {
     } else {
       this.iridescenceThicknessRange = [d, d];
     }
+  }
+
+  /** [min, max] nm spanned by the thickness map (three's range, or r187's minimum/maximum). */
+  get filmThicknessRangeNm() {
+    return 'iridescenceThicknessMinimum' in this
+      ? [this.iridescenceThicknessMinimum, this.iridescenceThicknessMaximum]
+      : [...this.iridescenceThicknessRange];
+  }
+
+  set filmThicknessRangeNm([lo, hi]) {
+    if ('iridescenceThicknessMinimum' in this) {
+      this.iridescenceThicknessMinimum = lo;
+      this.iridescenceThicknessMaximum = hi;
+    } else {
+      this.iridescenceThicknessRange = [lo, hi];
+    }
+  }
+
+  /** The multilayer stack (a NacreStack), or null when the material samples a table. */
+  get stack() {
+    return this.nacre?.table.kind === 'film-stack' ? this.nacre.table : null;
+  }
+
+  set stack(stack) {
+    if (stack?.kind !== 'film-stack') throw new Error('@nacre/three/webgpu: `stack` must be a NacreStack (loadNacreStack)');
+    this.table = stack;
   }
 
   /** The film's refractive index (three's iridescenceIOR). */

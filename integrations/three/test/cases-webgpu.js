@@ -3,7 +3,7 @@
 // into float render targets and reads the floats back; the same cases as cases.js.
 import * as THREE from 'three/webgpu';
 import { NacreDebugView, NacreFilmNodeMaterial } from '@nacre/three/webgpu';
-import { caseFilm, table } from './common.js';
+import { caseFilm, stack, table } from './common.js';
 
 /** A WebGPURenderer on the WebGPU backend (never the WebGL 2 fallback), initialised. */
 async function makeRenderer(width, height) {
@@ -120,7 +120,7 @@ export async function filmCases(cases) {
  * with three's own iridescence, same lights (environment + directional), same run, interleaved
  * rounds; each frame waits for the GPU (a 1-pixel readback).
  */
-export async function frameTime(size, frames, rounds) {
+export async function frameTime(size, frames, rounds, only = null) {
   const { renderer } = await makeRenderer(size, size);
   const target = new THREE.RenderTarget(size, size, { type: THREE.HalfFloatType, depthBuffer: true });
   const scene = new THREE.Scene();
@@ -138,6 +138,11 @@ export async function frameTime(size, frames, rounds) {
     nacreLut: new NacreFilmNodeMaterial({ ...common, table: await table('film-dielectric'), filmIor: 1.33, filmThicknessNm: 400 }),
     nacreFourier: new NacreFilmNodeMaterial({ ...common, table: await table('fourier-srgb'), filmIor: 1.33, filmThicknessNm: 400 }),
   };
+  // `only` (cases.js frameTime): the materials to time; the stack only when named.
+  if (only?.includes('nacreStack')) {
+    materials.nacreStack = new NacreFilmNodeMaterial({ ...common, stack: await stack('five-on-si'), filmThicknessNm: 120 });
+  }
+  if (only) for (const name of Object.keys(materials)) if (!only.includes(name)) delete materials[name];
   const mesh = new THREE.Mesh(geometry, materials.plain);
   scene.add(mesh);
   renderer.setRenderTarget(target);
@@ -177,9 +182,12 @@ export async function threeFilmDirectional(c) {
   const camera = new THREE.OrthographicCamera(-2, 2, 2, -2, 0.1, 100);
   camera.position.set(0, 0, 10);
   camera.lookAt(0, 0, 0);
-  const params = { color: 0x000000, metalness: 0, roughness: 0.3, ior: c.baseIor, iridescence: 1, iridescenceIOR: c.filmIor };
-  const three = withThickness(new THREE.MeshPhysicalNodeMaterial(params), c.thicknessNm);
-  const nacre = new NacreFilmNodeMaterial({ ...params, filmThicknessNm: c.thicknessNm, table: await table(c.table), debugView: NacreDebugView.UNIT_FILM });
+  // A stack case: three's film at the stack's top-film thickness, index 1.5 over three's
+  // default base (a stack has no single film index; any three film is far from it).
+  const params = { color: 0x000000, metalness: 0, roughness: 0.3, ior: c.baseIor ?? 1.5, iridescence: 1, iridescenceIOR: c.filmIor ?? 1.5 };
+  const [lo, hi] = c.thicknessRangeNm ?? [c.thicknessNm, c.thicknessNm];
+  const three = withThickness(new THREE.MeshPhysicalNodeMaterial(params), lo + (hi - lo) * (c.thicknessMapG ?? 1));
+  const nacre = new NacreFilmNodeMaterial({ ...params, ...(await caseFilm(THREE, c)), debugView: NacreDebugView.UNIT_FILM });
   const mesh = new THREE.Mesh(new THREE.PlaneGeometry(20, 20), three);
   const scene = new THREE.Scene();
   const sun = new THREE.DirectionalLight(0xffffff, 1);

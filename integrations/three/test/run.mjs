@@ -105,8 +105,7 @@ async function filmTests(threeName, webgpu = false) {
   const label = webgpu ? `${threeName} WebGPU` : threeName;
   const module = webgpu ? '/test/cases-webgpu.js' : '/test/cases.js';
   const { page, errors } = await openPage(threeName, webgpu ? webgpuContext : context);
-  // NacreFilmNodeMaterial has no stack technique yet: its cases are the tables'.
-  const wanted = expected.cases.filter((c) => !webgpu || c.technique !== 'stack');
+  const wanted = expected.cases;
   const cases = wanted.map(({ expected: _, ...c }) => c);
   const out = await page.evaluate(async ([module, cases]) => (await import(module)).filmCases(cases), [module, cases]);
   if (errors.length) fail(`${label}: page errors: ${errors.join(' | ')}`);
@@ -151,7 +150,7 @@ async function filmTests(threeName, webgpu = false) {
     // The control on WebGPU: three's own film (Belcour & Barla's analytic approximation)
     // on the directional light over nacre's unit film. The direct-light comparison above must
     // reject it at most angles of every case it is run for, or it could never fail.
-    for (const c of wanted.filter((k) => !k.table.startsWith('export:'))) {
+    for (const c of wanted.filter((k) => !k.table?.startsWith('export:'))) {
       const rows = await page.evaluate(async (c) => (await import('/test/cases-webgpu.js')).threeFilmDirectional(c), c);
       const tol = TOLERANCE[c.technique];
       const rejected = rows.filter((row, j) => !(maxAbs([0, 1, 2].map((k) => row.lit[k] / row.unit[k]), c.expected[j]) <= tol)).length;
@@ -297,6 +296,7 @@ try {
       report.versions[key].bench = await bench(threeName, 256, 5, 3, true);
     } else {
       report.versions[key].bench = await bench(threeName, 512, 10, 7, true);
+      report.versions[key].benchStack = await bench(threeName, 128, 2, 3, true, ['plain', 'nacreStack']);
     }
   }
 } catch (e) {
