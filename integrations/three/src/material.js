@@ -41,6 +41,7 @@
 // three turns the film off where d = 0 (lights_fragment_begin), so the top film needs d > 0.
 import { MeshPhysicalMaterial, REVISION, ShaderChunk, Vector2, Vector3, Vector4 } from 'three';
 import { nacreGlsl } from './nacre-glsl.js';
+import { setThicknessRange, thicknessRange } from './thickness.js';
 
 /** Debug views: the shaded colour, the film colour (rgb) and n·v (alpha), or a unit film. */
 export const NacreDebugView = Object.freeze({ NONE: 0, FILM: 1, UNIT_FILM: 2 });
@@ -463,18 +464,11 @@ export class NacreFilmMaterial extends MeshPhysicalMaterial {
    * iridescenceThicknessMaximum since (r187 deprecates the range, with a warning).
    */
   get filmThicknessRangeNm() {
-    return 'iridescenceThicknessMinimum' in this
-      ? [this.iridescenceThicknessMinimum, this.iridescenceThicknessMaximum]
-      : [...this.iridescenceThicknessRange];
+    return thicknessRange(this);
   }
 
-  set filmThicknessRangeNm([min, max]) {
-    if ('iridescenceThicknessMinimum' in this) {
-      this.iridescenceThicknessMinimum = min;
-      this.iridescenceThicknessMaximum = max;
-    } else {
-      this.iridescenceThicknessRange = [min, max];
-    }
+  set filmThicknessRangeNm(range) {
+    setThicknessRange(this, range);
   }
 
   /** The film's refractive index (three's iridescenceIOR). */

@@ -51,6 +51,7 @@
 // WebGPU backend (Chromium's WebGPU on SwiftShader).
 import { MeshPhysicalNodeMaterial, PhysicalLightingModel, REVISION } from 'three/webgpu';
 import * as TSL from 'three/tsl';
+import { setThicknessRange, thicknessRange } from './thickness.js';
 import { DataTexture, FloatType, NearestFilter, ClampToEdgeWrapping, NoColorSpace, RGBAFormat, Vector2 } from 'three/webgpu';
 
 const {
@@ -542,32 +543,20 @@ export class NacreFilmNodeMaterial extends MeshPhysicalNodeMaterial {
    * iridescenceThicknessMinimum/Maximum from r187, iridescenceThicknessRange before).
    */
   get filmThicknessNm() {
-    return 'iridescenceThicknessMaximum' in this ? this.iridescenceThicknessMaximum : this.iridescenceThicknessRange[1];
+    return thicknessRange(this)[1];
   }
 
   set filmThicknessNm(d) {
-    if ('iridescenceThicknessMaximum' in this) {
-      this.iridescenceThicknessMinimum = d;
-      this.iridescenceThicknessMaximum = d;
-    } else {
-      this.iridescenceThicknessRange = [d, d];
-    }
+    setThicknessRange(this, [d, d]);
   }
 
   /** [min, max] nm spanned by the thickness map (three's range, or r187's minimum/maximum). */
   get filmThicknessRangeNm() {
-    return 'iridescenceThicknessMinimum' in this
-      ? [this.iridescenceThicknessMinimum, this.iridescenceThicknessMaximum]
-      : [...this.iridescenceThicknessRange];
+    return thicknessRange(this);
   }
 
-  set filmThicknessRangeNm([lo, hi]) {
-    if ('iridescenceThicknessMinimum' in this) {
-      this.iridescenceThicknessMinimum = lo;
-      this.iridescenceThicknessMaximum = hi;
-    } else {
-      this.iridescenceThicknessRange = [lo, hi];
-    }
+  set filmThicknessRangeNm(range) {
+    setThicknessRange(this, range);
   }
 
   /** The multilayer stack (a NacreStack), or null when the material samples a table. */

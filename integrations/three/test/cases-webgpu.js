@@ -4,6 +4,8 @@
 import * as THREE from 'three/webgpu';
 import { NacreDebugView, NacreFilmNodeMaterial } from '@nacre/three/webgpu';
 import { caseFilm, stack, table } from './common.js';
+// The package's own helper (src/thickness.js, served under /pkg/): not a public export.
+import { setThicknessRange } from '/pkg/thickness.js';
 
 /** A WebGPURenderer on the WebGPU backend (never the WebGL 2 fallback), initialised. */
 async function makeRenderer(width, height) {
@@ -25,12 +27,7 @@ async function makeRenderer(width, height) {
 
 /** Sets three's film thickness range to [d, d] (r187: minimum/maximum; before: the range). */
 function withThickness(material, d) {
-  if ('iridescenceThicknessMaximum' in material) {
-    material.iridescenceThicknessMinimum = d;
-    material.iridescenceThicknessMaximum = d;
-  } else {
-    material.iridescenceThicknessRange = [d, d];
-  }
+  setThicknessRange(material, [d, d]);
   return material;
 }
 
