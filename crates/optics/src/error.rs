@@ -126,6 +126,14 @@ pub enum Error {
         /// Films in the stack.
         count: usize,
     },
+    /// A sweep's film thicknesses do not match its stack's films.
+    #[error("{given} film thickness(es) for a stack of {count} film(s)")]
+    ThicknessCount {
+        /// Thicknesses given.
+        given: usize,
+        /// Films in the stack.
+        count: usize,
+    },
     /// An incidence angle outside (−90°, 90°) or not finite.
     #[error("incidence angle {angle_deg}° must be finite and strictly between −90° and 90°")]
     InvalidAngle {

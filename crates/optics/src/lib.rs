@@ -41,6 +41,7 @@ pub(crate) mod power;
 pub mod quadrature;
 pub(crate) mod simd;
 pub mod spectral;
+pub mod spectrum_sweep;
 pub mod stack;
 
 pub use colour::{Colorimeter, Illuminant, Observer, OutputSpace, RgbSpace};
@@ -48,4 +49,5 @@ pub use error::{Error, Result};
 pub use material::{Material, MaterialWarning, WarningKind};
 pub use num_complex::Complex64 as C64;
 pub use spectral::{FilmColours, SpectralRule};
+pub use spectrum_sweep::SpectrumSweep;
 pub use stack::{Amplitudes, Layer, Power, Prepared, Response, Stack, Undersampled};

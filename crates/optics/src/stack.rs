@@ -55,7 +55,6 @@ use crate::elementary;
 use crate::error::{Error, Result};
 use crate::fresnel::{Interface, normal_component, power_factor_p, power_factor_s};
 use crate::material::Material;
-use crate::multilayer::{Media, stack_powers};
 use crate::power::PowerSlot;
 pub use crate::power::{Power, wavenumber};
 use num_complex::Complex64 as C64;
@@ -477,52 +476,14 @@ impl Stack {
     /// Powers over every (angle, wavelength) pair, angle-major: element
     /// `a * wavelengths_nm.len() + w`.
     ///
-    /// Indices are resolved once per wavelength; each angle's row then runs through the
-    /// vectorised kernel of the `multilayer` module (wavelengths as SIMD lanes, IEEE basic
+    /// [`crate::SpectrumSweep`] made and run once. Indices are resolved once (a constant
+    /// material once in all, a dispersive one per wavelength); each angle's row then runs
+    /// through the vectorised kernel of the `multilayer` module (wavelengths as SIMD lanes, IEEE basic
     /// operations only: the same bits on every CPU, vector width and thread count), or,
     /// for indices or phases outside the kernel's range (|ñ| beyond [10⁻⁶, 10⁶], film phases
     /// beyond 10⁶ rad), through the scalar recurrence of [`Prepared`].
     pub fn sweep(&self, angles_deg: &[f64], wavelengths_nm: &[f64]) -> Result<Vec<Power>> {
-        let thickness = self.thicknesses_nm();
-        let (sines, columns) = self.resolve_columns(angles_deg, wavelengths_nm)?;
-        if !self.is_coherent() {
-            return crate::incoherent::sweep(
-                &crate::incoherent::Groups::new(&self.incoherent),
-                &sines,
-                &columns,
-                wavelengths_nm,
-                &thickness,
-                &self.layer_names(),
-                scalar_powers,
-            );
-        }
-        let Some(media) = Media::from_columns(&columns, wavelengths_nm, &thickness) else {
-            let indices: Vec<Vec<C64>> = (0..wavelengths_nm.len())
-                .map(|w| columns.iter().map(|c| c[w]).collect())
-                .collect();
-            return Ok(sweep_recurrence(
-                &sines,
-                &indices,
-                wavelengths_nm,
-                &thickness,
-            ));
-        };
-        let per_angle = wavelengths_nm.len();
-        let total = sines.len() * per_angle;
-        let mut out: Vec<Power> = Vec::with_capacity(total);
-        if per_angle == 0 {
-            return Ok(out);
-        }
-        // Every slot is written once, straight into the fresh allocation (no zeroing pass).
-        out.spare_capacity_mut()[..total]
-            .par_chunks_mut(per_angle)
-            .zip(&sines)
-            .for_each(|(row, &sin_theta)| stack_powers(&media, sin_theta, row, true));
-        // SAFETY: the rows partition `spare_capacity_mut()[..total]` (per_angle > 0) and
-        // `stack_powers` writes every slot of its row, so the first `total` elements are
-        // initialised.
-        unsafe { out.set_len(total) };
-        Ok(out)
+        crate::spectrum_sweep::SpectrumSweep::new(self, angles_deg, wavelengths_nm)?.powers()
     }
 
     /// [`Stack::sweep`] with, per (angle, wavelength) and polarisation, the power absorbed in
@@ -810,7 +771,12 @@ pub(crate) fn fringe_finesse_of(indices: &[C64], beta: f64) -> f64 {
 /// `wavelength_nm` and film thicknesses `thickness_nm`, by the scalar recurrence of
 /// [`Prepared`] (a coherent group of [`crate::incoherent`] outside the vectorised kernel's
 /// ranges).
-fn scalar_powers(indices: &[C64], beta: f64, wavelength_nm: f64, thickness_nm: &[f64]) -> Power {
+pub(crate) fn scalar_powers(
+    indices: &[C64],
+    beta: f64,
+    wavelength_nm: f64,
+    thickness_nm: &[f64],
+) -> Power {
     let prepared = Prepared::new(indices, beta);
     prepared.power(&prepared.amplitudes(wavelength_nm, thickness_nm))
 }
@@ -824,7 +790,7 @@ fn reuse<'c>(cache: &'c mut Option<Prepared>, indices: &[C64], sin_theta: f64) -
     cache.as_ref().expect("just filled")
 }
 
-fn sin_of_angle(angle_deg: f64) -> Result<f64> {
+pub(crate) fn sin_of_angle(angle_deg: f64) -> Result<f64> {
     if !(angle_deg.abs() < 90.0) {
         return Err(Error::InvalidAngle { angle_deg });
     }

@@ -8,7 +8,7 @@
 use crate::commands::grid::MAX_AXIS_SAMPLES;
 use crate::error::{Error, Param, Result};
 use nacre_optics::elementary;
-use nacre_optics::{Power, Stack};
+use nacre_optics::{Power, SpectrumSweep, Stack};
 use std::io::Write;
 
 /// Most rows one spectrum table may have (about 1 GB of CSV).
@@ -32,13 +32,23 @@ pub fn fmt_sig(v: f64) -> String {
     }
 }
 
-/// Computes the table (checks the size limit and the angles first).
+/// Computes the table (checks the size limit and the angles first): [`Stack::sweep`]
+/// through a [`SpectrumSweep`], which resolves the indices once and gives the phase check
+/// of [`check_phases`] without a per-wavelength lookup.
 pub fn compute(stack: &Stack, angles_deg: &[f64], wavelengths_nm: &[f64]) -> Result<Vec<Power>> {
     check_axes(angles_deg, wavelengths_nm, 1)?;
-    check_phases(stack, None, wavelengths_nm)?;
-    stack
-        .sweep(angles_deg, wavelengths_nm)
-        .map_err(optics_error)
+    let sweep = match SpectrumSweep::new(stack, angles_deg, wavelengths_nm) {
+        Ok(sweep) => sweep,
+        Err(e) => {
+            // The error the phase check would meet first, else the sweep's.
+            check_phases(stack, None, wavelengths_nm)?;
+            return Err(optics_error(e));
+        }
+    };
+    if let Some((film, wavelength_nm, d)) = sweep.overflowing_phase(None) {
+        return Err(phase_overflow(stack, film, wavelength_nm, d));
+    }
+    sweep.powers().map_err(optics_error)
 }
 
 /// The table over a third axis, film `layer`'s thickness (1-based, top film = 1; the other
@@ -114,7 +124,8 @@ fn check_axes(angles_deg: &[f64], wavelengths_nm: &[f64], per_row: u64) -> Resul
     Ok(())
 }
 
-/// Refuses films whose phase overflows: a film of thickness d and index ñ under an ambient
+/// Refuses films whose phase overflows ([`SpectrumSweep::overflowing_phase`] computes the
+/// same, in the same order, from its index table): a film of thickness d and index ñ under an ambient
 /// n₀ has the phase 2π ñ cos θ d / λ with |ñ cos θ| ≤ |ñ| + n₀, and a phase beyond f64
 /// (a 10³⁰⁰ nm film at 10⁻³⁰⁰ nm) would make the sweep return NaN. `swept` is the film
 /// (1-based) whose thickness a sweep varies, with its largest thickness.
@@ -131,20 +142,26 @@ fn check_phases(stack: &Stack, swept: Option<(usize, f64)>, wavelengths_nm: &[f6
                 2.0 * std::f64::consts::PI * (elementary::norm(indices[j + 1]) + ambient) * d
                     / wavelength_nm;
             if !phase.is_finite() {
-                return Err(Error::invalid(
-                    Param::Wavelengths,
-                    format!(
-                        "film {} (`{}`, {} nm) at {} nm: its phase 2π ñ d / λ overflows; the film is too thick for the wavelength",
-                        j + 1,
-                        layer.material.name(),
-                        short(d),
-                        short(wavelength_nm)
-                    ),
-                ));
+                return Err(phase_overflow(stack, j + 1, wavelength_nm, d));
             }
         }
     }
     Ok(())
+}
+
+/// The error of [`check_phases`]: film `film`'s (1-based) phase at `wavelength_nm` for
+/// thickness `d` overflows.
+fn phase_overflow(stack: &Stack, film: usize, wavelength_nm: f64, d: f64) -> Error {
+    Error::invalid(
+        Param::Wavelengths,
+        format!(
+            "film {} (`{}`, {} nm) at {} nm: its phase 2π ñ d / λ overflows; the film is too thick for the wavelength",
+            film,
+            stack.layers()[film - 1].material.name(),
+            short(d),
+            short(wavelength_nm)
+        ),
+    )
 }
 
 /// `v` for a message: plain (`400`, `0.5`) in [10⁻⁴, 10¹⁵), else scientific (`1e300`).

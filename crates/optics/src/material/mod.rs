@@ -254,6 +254,23 @@ impl Material {
             .collect()
     }
 
+    /// The one index of a constant material when [`Material::index_at`] gives it, without
+    /// an error, at every one of `wavelengths_nm` (none empty); `None` otherwise (a
+    /// dispersive material, or some wavelength with an error: [`Material::indices_at`] then
+    /// gives the values or the error). A constant's index does not depend on the
+    /// wavelength, so this is [`Material::indices_at`]'s every value, checked once.
+    pub fn constant_over(&self, wavelengths_nm: &[f64]) -> Option<C64> {
+        let (lo, hi) = self.range_nm;
+        let valid = |wl: f64| wl > 0.0 && wl.is_finite() && wl >= lo && wl <= hi;
+        if !self.is_constant() || !self.gaps_nm.is_empty() || wavelengths_nm.is_empty() {
+            return None;
+        }
+        if !wavelengths_nm.iter().all(|&wl| valid(wl)) {
+            return None;
+        }
+        self.index_at(wavelengths_nm[0]).ok()
+    }
+
     /// [`Material::index_at`] with the tables' cursors (n, κ) of [`Dispersion::eval_from`].
     fn index_from(&self, wavelength_nm: f64, cursors: &mut [Cursor; 2]) -> Result<C64> {
         if !(wavelength_nm > 0.0) || !wavelength_nm.is_finite() {

@@ -103,6 +103,32 @@ const MAX_PHASE_RAD: f64 = 5e5;
 /// The sign bit of an f64.
 const SIGN: u64 = 1 << 63;
 
+/// One medium's index over a sweep's wavelengths: the same at every one, or one each.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Column<'a> {
+    Constant(C64),
+    Varying(&'a [C64]),
+}
+
+impl Column<'_> {
+    /// The index at wavelength `w`.
+    #[inline]
+    pub(crate) fn at(&self, w: usize) -> C64 {
+        match self {
+            Column::Constant(n) => *n,
+            Column::Varying(c) => c[w],
+        }
+    }
+
+    /// Number of wavelengths, `None` for a constant.
+    fn len(&self) -> Option<usize> {
+        match self {
+            Column::Constant(_) => None,
+            Column::Varying(c) => Some(c.len()),
+        }
+    }
+}
+
 /// A stack's media indices per wavelength, structure of arrays, and its film thicknesses.
 pub(crate) struct Media {
     /// Re ñ_j(λ_w) at `re[j][w]`, j = 0 ambient … N+1 substrate; `re[0]` is the real index
@@ -118,6 +144,11 @@ pub(crate) struct Media {
     wavelengths: usize,
     /// Film thicknesses, top first, nm.
     thickness_nm: Vec<f64>,
+    /// Per medium: its arrays hold one block ([`BLOCK`] copies of its one index, read for
+    /// every block of a row) rather than one value per wavelength.
+    constant: Vec<bool>,
+    /// `re[0]` (β's n₀) likewise.
+    beta_constant: bool,
     /// Per medium: no Im ñ_j² has its sign bit set, so that Im q_j ≥ +0 in every lane and
     /// the forward-branch correction of [`medium`] changes nothing.
     forward: Vec<bool>,
@@ -207,6 +238,7 @@ impl Media {
     /// at each of `wavelengths_nm`), or `None` when an index or a film's phase is outside the
     /// ranges the kernel takes (see the constants; the caller then runs the scalar
     /// recurrence).
+    #[cfg(test)]
     pub(crate) fn from_columns(
         columns: &[Vec<C64>],
         wavelengths_nm: &[f64],
@@ -225,35 +257,63 @@ impl Media {
         wavelengths_nm: &[f64],
         thickness_nm: &[f64],
     ) -> Option<Self> {
+        let columns: Vec<Column> = columns.iter().map(|c| Column::Varying(c)).collect();
+        Self::from_compact(&columns, beta_index, wavelengths_nm, thickness_nm)
+    }
+
+    /// [`Media::from_columns_beta`] for media given as [`Column`]s: a medium whose index is
+    /// the same at every wavelength is kept as one block of copies (the kernel reads the
+    /// same lanes for every block of a row), so a stack of constant media costs nothing per
+    /// wavelength to set up. The same values, hence the same bits, as the full columns.
+    pub(crate) fn from_compact(
+        columns: &[Column],
+        beta_index: Option<&[f64]>,
+        wavelengths_nm: &[f64],
+        thickness_nm: &[f64],
+    ) -> Option<Self> {
         let media = thickness_nm.len() + 2;
-        let beta_column: Vec<f64> = match beta_index {
-            Some(b) => b.to_vec(),
-            None => columns[0].iter().map(|n| n.re).collect(),
-        };
         debug_assert_eq!(columns.len(), media);
+        let wavelengths = wavelengths_nm.len();
+        // β's real index n₀: one value (`beta_constant`) or one per wavelength.
+        let (beta_column, beta_constant): (Vec<f64>, bool) = match (beta_index, columns[0]) {
+            (Some(b), _) => (b.to_vec(), false),
+            (None, Column::Constant(n)) => (vec![n.re], true),
+            (None, Column::Varying(c)) => (c.iter().map(|n| n.re).collect(), false),
+        };
+        let beta_at = |w: usize| beta_column[if beta_constant { 0 } else { w }];
         let k0_per_nm: Vec<f64> = wavelengths_nm.iter().map(|&wl| wavenumber(wl)).collect();
+        // The largest k₀ (NaN if any is): a film's phase bound k₀ d (|Re ñ| + |Im ñ| + n₀)
+        // with ñ and n₀ the same at every wavelength is largest there (a correctly rounded
+        // product is monotonic in each factor), so one check stands for every wavelength.
+        let k0_max = k0_per_nm
+            .iter()
+            .fold(0.0_f64, |m, &k| if k > m || k.is_nan() { k } else { m });
         for (j, column) in columns.iter().enumerate() {
-            debug_assert_eq!(column.len(), wavelengths_nm.len());
-            for (w, n) in column.iter().enumerate() {
+            debug_assert!(column.len().is_none_or(|l| l == wavelengths));
+            let film = (1..media - 1).contains(&j);
+            let in_range = |w: usize, n: C64, k0: f64| {
                 let (a, b) = (n.re.abs(), n.im.abs());
                 // Negated comparisons: NaN fails them.
                 if !(a <= MAX_INDEX && b <= MAX_INDEX && a.max(b) >= MIN_INDEX) {
-                    return None;
+                    return false;
                 }
-                let n0 = beta_column[w].abs();
+                let n0 = beta_at(w).abs();
                 if !(n0 <= MAX_INDEX) {
-                    return None;
+                    return false;
                 }
-                if (1..media - 1).contains(&j)
-                    && !(k0_per_nm[w] * thickness_nm[j - 1] * (a + b + n0) <= MAX_PHASE_RAD)
-                {
-                    return None;
-                }
+                !film || k0 * thickness_nm[j - 1] * (a + b + n0) <= MAX_PHASE_RAD
+            };
+            let ok = match column {
+                Column::Constant(n) if beta_constant => wavelengths == 0 || in_range(0, *n, k0_max),
+                _ => (0..wavelengths).all(|w| in_range(w, column.at(w), k0_per_nm[w])),
+            };
+            if !ok {
+                return None;
             }
         }
-        // Each array padded to a multiple of `PAD` with its last wavelength's values, so that
-        // a row's last vector is whole (its extra lanes repeat a real one, and are dropped).
-        let wavelengths = wavelengths_nm.len();
+        // Each varying array padded to a multiple of `PAD` with its last wavelength's values,
+        // so that a row's last vector is whole (its extra lanes repeat a real one, and are
+        // dropped); a constant one is one block of copies.
         let padded = wavelengths.next_multiple_of(PAD);
         let pad = |mut v: Vec<f64>| {
             if let Some(&last) = v.last() {
@@ -264,25 +324,43 @@ impl Media {
         let map = |f: fn(&C64) -> f64| -> Vec<Vec<f64>> {
             columns
                 .iter()
-                .map(|c| pad(c.iter().map(f).collect()))
+                .map(|c| match c {
+                    Column::Constant(n) => vec![f(n); BLOCK],
+                    Column::Varying(c) => pad(c.iter().map(f).collect()),
+                })
                 .collect()
         };
+        let constant: Vec<bool> = columns
+            .iter()
+            .map(|c| matches!(c, Column::Constant(_)))
+            .collect();
         let mut re = map(|n| n.re);
-        re[0] = pad(beta_column.clone());
+        re[0] = if beta_constant {
+            vec![beta_column[0]; BLOCK]
+        } else {
+            pad(beta_column.clone())
+        };
         let n2_re = map(|n| (n * n).re);
         let n2_im = map(|n| (n * n).im);
         let n_abs2 = map(|n| n.norm_sqr());
         let k0_per_nm = pad(k0_per_nm);
-        let column = |j: usize| columns[j].iter().map(|n| (n.re.to_bits(), n.im.to_bits()));
-        let same_medium = |i: usize, j: usize| column(i).eq(column(j));
+        let bits = |n: C64| (n.re.to_bits(), n.im.to_bits());
+        let same_medium = |i: usize, j: usize| match (columns[i], columns[j]) {
+            (Column::Constant(a), Column::Constant(b)) => bits(a) == bits(b),
+            (a, b) => (0..wavelengths).all(|w| bits(a.at(w)) == bits(b.at(w))),
+        };
         // q = √(ñ² − β²) is the same along a row where ñ and the ambient's index (β = n₀ sin θ₀)
         // are.
-        let uniform = |j: usize| column(j).all(|n| Some(n) == column(j).next());
-        let beta_uniform = beta_column
-            .iter()
-            .all(|b| b.to_bits() == beta_column[0].to_bits());
-        let constant = |j: usize| uniform(j) && beta_uniform;
-        let media_slots = Slots::new(media, 2, MEDIA_SLOTS - 2, same_medium, constant);
+        let uniform = |j: usize| match columns[j] {
+            Column::Constant(_) => true,
+            c => (0..wavelengths).all(|w| bits(c.at(w)) == bits(c.at(0))),
+        };
+        let beta_uniform = beta_constant
+            || beta_column
+                .iter()
+                .all(|b| b.to_bits() == beta_column[0].to_bits());
+        let constant_q = |j: usize| uniform(j) && beta_uniform;
+        let media_slots = Slots::new(media, 2, MEDIA_SLOTS - 2, same_medium, constant_q);
         // Films 1..=N as items 0..N − 1 (a film's phase depends on the wavelength).
         let film_slots = Slots::new(
             media - 2,
@@ -297,12 +375,18 @@ impl Media {
             .iter()
             .map(|y| y.iter().all(|y| y.to_bits() & SIGN == 0))
             .collect();
+        let blocks = padded.div_ceil(BLOCK);
         let lossless = n2_im
             .iter()
-            .map(|y| {
-                y.chunks(BLOCK)
-                    .map(|b| b.iter().all(|&y| y == 0.0))
-                    .collect()
+            .zip(&constant)
+            .map(|(y, &constant)| {
+                if constant {
+                    vec![y.iter().all(|&y| y == 0.0); blocks]
+                } else {
+                    y.chunks(BLOCK)
+                        .map(|b| b.iter().all(|&y| y == 0.0))
+                        .collect()
+                }
             })
             .collect();
         Some(Media {
@@ -313,6 +397,8 @@ impl Media {
             k0_per_nm,
             wavelengths,
             thickness_nm: thickness_nm.to_vec(),
+            constant,
+            beta_constant,
             forward,
             lossless,
             media_slots,
@@ -795,12 +881,14 @@ impl<T: PowerSlot, const SHORTCUTS: bool> WithSimd for RowOp<'_, T, SHORTCUTS> {
                 lossless | forward
             };
             // Interface j between media j and j + 1 (the substrate alone for j = N + 1).
+            // A constant medium's arrays are one block, the same for every block of the row.
+            let at = |constant: bool| if constant { 0..n } else { w.clone() };
             let ctx = |j: usize| Ctx {
-                n2_re: &media.n2_re[j][w.clone()],
-                n2_im: &media.n2_im[j][w.clone()],
-                n_abs2: &media.n_abs2[j][w.clone()],
+                n2_re: &media.n2_re[j][at(media.constant[j])],
+                n2_im: &media.n2_im[j][at(media.constant[j])],
+                n_abs2: &media.n_abs2[j][at(media.constant[j])],
                 k0_per_nm: &media.k0_per_nm[w.clone()],
-                n0_re: &media.re[0][w.clone()],
+                n0_re: &media.re[0][at(media.beta_constant)],
                 two_d_nm: if j + 1 < count - 1 {
                     2.0 * media.thickness_nm[j]
                 } else {
