@@ -229,4 +229,44 @@ mod tests {
         assert_eq!(fmt_sig(0.0), "0");
         assert_eq!(fmt_sig(-2.5e-17), "-2.50000000000e-17");
     }
+
+    /// The errors of `compute` come in the order of the per-wavelength checks: a film's
+    /// phase overflowing at one wavelength before a material's range ends at a later one,
+    /// and the other way round.
+    #[test]
+    fn phase_and_index_errors_in_wavelength_order() {
+        use nacre_optics::{C64, Layer, Material};
+        let constant = |n: f64| Material::constant(format!("{n}"), C64::new(n, 0.0)).unwrap();
+        let tabulated = Material::from_nk_csv(
+            "tab",
+            "tab.csv",
+            "wavelength_nm,n,k\n1e-310,1.5,0\n600,1.5,0\n",
+        )
+        .unwrap();
+        let stack = |film: Material, d: f64| {
+            Stack::new(
+                constant(1.0),
+                vec![Layer {
+                    material: film,
+                    thickness_nm: d,
+                }],
+                constant(1.5),
+            )
+            .unwrap()
+        };
+        let message = |stack: &Stack, wl: &[f64]| match compute(stack, &[0.0], wl) {
+            Ok(_) => "ok".to_string(),
+            Err(e) => e.to_string(),
+        };
+        let thick = stack(constant(2.0), 1e307);
+        assert!(message(&thick, &[500.0]).contains("film 1 (`2`, 1e307 nm) at 500 nm"));
+        let tab = stack(tabulated, 100.0);
+        // 1e-310 nm overflows the phase; 700 nm is beyond the table.
+        let first = message(&tab, &[1e-310, 700.0]);
+        assert!(first.contains("its phase 2π ñ d / λ overflows"), "{first}");
+        let first = message(&tab, &[700.0, 1e-310]);
+        assert!(first.contains("700"), "{first}");
+        assert!(!first.contains("overflows"), "{first}");
+        assert_eq!(message(&tab, &[400.0, 500.0]), "ok");
+    }
 }
