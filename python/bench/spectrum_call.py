@@ -5,8 +5,8 @@ call").
 
 The work: one angle (30°) × 10⁵ wavelengths (380–780 nm) of 1, 5 and 8 constant-index films
 (indices 2.35, 1.38, 2.1, 1.46, 1.9, 1.6, 2.2, 1.7 top first, thicknesses 60 + 17 j nm) on
-glass 1.52 in air, R_s, R_p, T_s, T_p in f64 — the stacks of ``cargo bench -p nacre-optics
---bench spectrum``. Timed, one thread each, best and median of N calls after warm-up:
+glass 1.52 in air, R_s, R_p, T_s, T_p in f64 — the stacks of ``cargo bench -p nacre-optics --bench
+sweep -- spectrum-call``. Timed, one thread each, best and median of N calls after warm-up:
 
 * ``nacre.spectrum(stack, [30], wavelengths)``, numpy arrays back (``RAYON_NUM_THREADS=1``,
   in a subprocess);
@@ -90,7 +90,7 @@ def rust_kernel() -> dict:
     if shutil.which("cargo") is None:
         return {}
     r = subprocess.run(
-        ["cargo", "bench", "-p", "nacre-optics", "--bench", "spectrum", "--", "kernel",
+        ["cargo", "bench", "-p", "nacre-optics", "--bench", "sweep", "--", "spectrum-call/.*kernel",
          "--warm-up-time", "1", "--measurement-time", "5"],
         cwd=REPO, capture_output=True, text=True,
     )
