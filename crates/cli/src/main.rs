@@ -22,6 +22,7 @@ mod conformance;
 mod diffraction;
 mod error;
 mod export;
+mod fit;
 mod gpu;
 mod info;
 mod materials;
@@ -79,6 +80,9 @@ enum Command {
     /// stack (--layer …) as the JSON the engine libraries' film_stack reads; docs/engines/.
     #[command(after_help = export::EXAMPLES)]
     Export(export::ExportArgs),
+    /// Fit parameters to a target: `nacre fit gltf`, the closest glTF
+    /// KHR_materials_iridescence material to a stack.
+    Fit(fit::FitArgs),
     /// Print a baked table's manifest as JSON.
     Info(info::InfoArgs),
     /// List the bundled materials.
@@ -117,6 +121,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Render(args) => render::run(&args),
         Command::BenchGpu(args) => bench_gpu::run(&args),
         Command::Export(args) => export::run(&args),
+        Command::Fit(args) => fit::run(&args),
         Command::Info(args) => info::run(&args),
         Command::Materials => materials::run(),
     }

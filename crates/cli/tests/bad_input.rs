@@ -1207,6 +1207,26 @@ fn fixtures(d: &Path) -> Vec<Case> {
         ),
         // --- flags ---
         case(
+            "fit gltf: inverted thickness range",
+            &["fit", "gltf", "--thicknesses", "600:200", "-o", "out.json"],
+            &["--thicknesses `600:200`", "START must be below END"],
+        ),
+        case(
+            "fit gltf: thickness range without an end",
+            &["fit", "gltf", "--thicknesses", "300", "-o", "out.json"],
+            &["--thicknesses `300`", "START:END"],
+        ),
+        case(
+            "fit gltf: NaN thickness range end",
+            &["fit", "gltf", "--thicknesses", "100:nan", "-o", "out.json"],
+            &["--thicknesses `nan`"],
+        ),
+        case(
+            "fit gltf: a stack without a film",
+            &["fit", "gltf", "--substrate", "1.5", "-o", "out.json"],
+            &["--layer", "at least one film"],
+        ),
+        case(
             "flag: NaN angle",
             &["spectrum", "--angles", "nan", "-o", "out.csv"],
             &["--angles `nan`", "finite"],

@@ -1274,3 +1274,50 @@ fn a_closed_pipe_ends_quietly() {
     assert!(out.status.success(), "{:?}: {}", out.status, stderr(&out));
     assert!(out.stderr.is_empty(), "{}", stderr(&out));
 }
+
+#[test]
+fn fit_gltf_writes_a_material_and_prints_both_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = nacre(
+        &[
+            "fit",
+            "gltf",
+            "--layer",
+            "tio2@100",
+            "--substrate",
+            "bk7",
+            "-o",
+            "material.json",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(o.stdout.is_empty());
+    let text = std::fs::read_to_string(dir.path().join("material.json")).unwrap();
+    let j: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let irid = &j["extensions"]["KHR_materials_iridescence"];
+    for key in [
+        "iridescenceFactor",
+        "iridescenceIor",
+        "iridescenceThicknessMinimum",
+        "iridescenceThicknessMaximum",
+    ] {
+        assert!(irid[key].is_number(), "{key} in {text}");
+    }
+    assert!(j["extensions"]["KHR_materials_ior"]["ior"].is_number(), "{text}");
+    // stderr: `fitted: ΔE2000 mean M, max X (…)` then `naive:  ΔE2000 mean M, max X (…)`.
+    let err = stderr(&o);
+    let mean = |prefix: &str| -> f64 {
+        let line = err.lines().find(|l| l.starts_with(prefix)).unwrap();
+        let rest = line.split("mean ").nth(1).unwrap();
+        rest.split(',').next().unwrap().parse().unwrap()
+    };
+    assert!(mean("fitted:") <= mean("naive:"), "{err}");
+    // To standard output: the same material.
+    let o = nacre(
+        &["fit", "gltf", "--layer", "tio2@100", "--substrate", "bk7"],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(String::from_utf8(o.stdout).unwrap(), text);
+}
