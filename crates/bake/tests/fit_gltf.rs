@@ -98,7 +98,7 @@ fn the_fit_is_never_worse_than_the_naive_mapping_on_named_stacks() {
 }
 
 #[test]
-fn the_scored_glTF_evaluation_is_nacre_color_gaussian() {
+fn the_scored_gltf_evaluation_is_nacre_color_gaussian() {
     // One constant film on a constant dielectric in air: the naive material (factor 1, base
     // ior = the substrate's) evaluated by the fit's model equals `--method gaussian`.
     let s = stack("1.0", &[("1.8", 320.0)], "1.5");
@@ -130,7 +130,7 @@ fn the_scored_glTF_evaluation_is_nacre_color_gaussian() {
 }
 
 #[test]
-fn a_single_glTF_like_film_fits_back_near_its_own_parameters() {
+fn a_single_gltf_like_film_fits_back_near_its_own_parameters() {
     // A constant film on a constant dielectric is what glTF describes; the fit stays near
     // its index and thickness (the glTF closed form is itself approximate, so not exactly).
     let s = stack("1.0", &[("1.8", 320.0)], "1.5");
