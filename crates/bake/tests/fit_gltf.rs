@@ -27,8 +27,10 @@ fn stack(ambient: &str, layers: &[(&str, f64)], substrate: &str) -> Stack {
     .unwrap()
 }
 
-/// (name, stack, thickness range of the top film).
-fn named() -> Vec<(&'static str, Stack, Option<(f64, f64)>)> {
+/// A named stack and the thickness range of its top film.
+type Named = (&'static str, Stack, Option<(f64, f64)>);
+
+fn named() -> Vec<Named> {
     vec![
         ("soap film", stack("1.0", &[("water", 400.0)], "1.0"), None),
         (

@@ -6,7 +6,6 @@ use crate::error::Result;
 use clap::{Args, Subcommand};
 use nacre_bake::commands::fit_gltf;
 use nacre_format::atomic::write_atomic;
-use std::io::Write;
 use std::path::PathBuf;
 
 pub const GLTF_EXAMPLES: &str = "\

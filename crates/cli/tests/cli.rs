@@ -1304,7 +1304,10 @@ fn fit_gltf_writes_a_material_and_prints_both_errors() {
     ] {
         assert!(irid[key].is_number(), "{key} in {text}");
     }
-    assert!(j["extensions"]["KHR_materials_ior"]["ior"].is_number(), "{text}");
+    assert!(
+        j["extensions"]["KHR_materials_ior"]["ior"].is_number(),
+        "{text}"
+    );
     // stderr: `fitted: ΔE2000 mean M, max X (…)` then `naive:  ΔE2000 mean M, max X (…)`.
     let err = stderr(&o);
     let mean = |prefix: &str| -> f64 {

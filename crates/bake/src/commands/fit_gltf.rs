@@ -195,8 +195,8 @@ fn round4(v: f64) -> f64 {
     if v == 0.0 || !v.is_finite() {
         return v;
     }
-    let digits = 3 - v.abs().log10().floor() as i32;
-    let scale = 10f64.powi(digits);
+    let digits = 3 - nacre_optics::elementary::log10(v.abs()).floor() as i32;
+    let scale = nacre_optics::elementary::powi(10.0, digits);
     (v * scale).round() / scale
 }
 
