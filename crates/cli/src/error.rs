@@ -61,6 +61,7 @@ pub fn flag(param: Param) -> &'static str {
         Param::Camera => "--camera",
         Param::Yaw => "--yaw",
         Param::Distance => "--distance",
+        Param::Jacobian => "--jacobian",
         Param::BenchFilmIor => "--film-ior",
         Param::BenchBaseIor => "--base-ior",
     }

@@ -26,7 +26,9 @@ Examples:
   # oil slick: oil film on water, seen from air
   nacre spectrum --ambient air --layer oil@450 --substrate water -o oil.csv
   # the same stack from a recipe file (docs/guide/src/spectrum.md, \"Stack recipes\")
-  nacre spectrum --recipe tables/examples/ar-coating.toml -o ar.csv";
+  nacre spectrum --recipe tables/examples/ar-coating.toml -o ar.csv
+  # with dR/dd and dT/dd of both films, per nm, after the usual columns
+  nacre spectrum --layer tio2@60 --layer mgf2@100 --substrate bk7 --angles 0 --jacobian";
 
 #[derive(Args)]
 pub struct SpectrumArgs {
@@ -46,6 +48,11 @@ pub struct SpectrumArgs {
         default_value = "-"
     )]
     output: PathBuf,
+    /// Append the derivatives of the unpolarised R and T columns by each film's thickness,
+    /// per nm: `dR_dd1 … dR_ddL, dT_dd1 … dT_ddL` (films top first; exact, not finite
+    /// differences). Coherent stacks only.
+    #[arg(long)]
+    jacobian: bool,
 }
 
 pub fn run(args: &SpectrumArgs) -> Result<()> {
@@ -66,6 +73,12 @@ pub fn run(args: &SpectrumArgs) -> Result<()> {
         "380:780:5",
     )?;
     let stack = spec.build()?;
+    if args.jacobian {
+        let (powers, jacobian) = spectrum::compute_jacobian(&stack, &angles, &wavelengths)?;
+        return Ok(write_atomic(&args.output, |w| {
+            spectrum::write_csv_jacobian(w, &angles, &wavelengths, &powers, &jacobian)
+        })?);
+    }
     let powers = spectrum::compute(&stack, &angles, &wavelengths)?;
     Ok(write_atomic(&args.output, |w| {
         spectrum::write_csv(w, &angles, &wavelengths, &powers)

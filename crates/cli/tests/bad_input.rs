@@ -1257,6 +1257,20 @@ fn fixtures(d: &Path) -> Vec<Case> {
             &["--layer `@100`", "empty"],
         ),
         case(
+            "flag: --jacobian with an incoherent layer",
+            &[
+                "spectrum",
+                "--layer",
+                "1.5@1000000:incoherent",
+                "--layer",
+                "mgf2@100",
+                "--jacobian",
+                "-o",
+                "out.csv",
+            ],
+            &["--jacobian", "derivatives", "layer 1", "incoherent"],
+        ),
+        case(
             "flag: incoherent substrate",
             &[
                 "spectrum",

@@ -51,6 +51,69 @@ fn default_spectrum_to_stdout() {
     assert!(nacre(&["spectrum", "--help"], dir.path()).status.success());
 }
 
+/// `--jacobian` appends dR/dd_j and dT/dd_j (unpolarised, per nm, films top first) after the
+/// unchanged value columns; they match central differences of two runs.
+#[test]
+fn spectrum_jacobian_columns_match_finite_differences() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |d1: f64, d2: f64, jacobian: bool| {
+        let (l1, l2) = (format!("2.3+0.02i@{d1}"), format!("1.38@{d2}"));
+        let mut args = vec![
+            "spectrum",
+            "--layer",
+            &l1,
+            "--layer",
+            &l2,
+            "--substrate",
+            "1.52",
+            "--angles",
+            "0:60:30",
+            "--wavelengths",
+            "400:700:50",
+        ];
+        if jacobian {
+            args.push("--jacobian");
+        }
+        let o = nacre(&args, dir.path());
+        assert!(o.status.success(), "{}", stderr(&o));
+        String::from_utf8(o.stdout).unwrap()
+    };
+    let (d1, d2) = (60.0, 100.0);
+    let with = run(d1, d2, true);
+    assert_eq!(
+        with.lines().next(),
+        Some("angle_deg,wavelength_nm,R_s,R_p,R,T_s,T_p,T,A,dR_dd1,dR_dd2,dT_dd1,dT_dd2")
+    );
+    let (rows, plain) = (csv_numbers(&with), csv_numbers(&run(d1, d2, false)));
+    assert_eq!(rows.len(), plain.len());
+    for (r, p) in rows.iter().zip(&plain) {
+        assert_eq!(&r[..9], &p[..], "value columns unchanged");
+    }
+    let h = 0.01;
+    for film in 0..2 {
+        let shift = |s: f64| {
+            let (a, b) = if film == 0 {
+                (d1 + s, d2)
+            } else {
+                (d1, d2 + s)
+            };
+            csv_numbers(&run(a, b, false))
+        };
+        let (up, down) = (shift(h), shift(-h));
+        for (k, r) in rows.iter().enumerate() {
+            for (col, quantity) in [(4, 9), (7, 11)] {
+                let fd = (up[k][col] - down[k][col]) / (2.0 * h);
+                let exact = r[quantity + film];
+                assert!(
+                    (exact - fd).abs() < 1e-6,
+                    "row {k} column {}: {exact} vs {fd}",
+                    quantity + film
+                );
+            }
+        }
+    }
+}
+
 /// The defaults work at every wavelength (issue 16 §5): vacuum around a 1.33 film, not the
 /// bundled `air` (230–1690 nm) and `water` (182–1129 nm); `--help` says what they are.
 #[test]

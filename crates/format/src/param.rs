@@ -148,6 +148,8 @@ params! {
     Yaw => "yaw",
     /// Orbit camera: distance from the scene's centre, world units.
     Distance => "distance",
+    /// Derivatives of a spectrum by the films' thicknesses.
+    Jacobian => "jacobian",
 }
 
 impl Param {

@@ -4,10 +4,16 @@
 //! ambient (degrees), vacuum wavelength (nm), s/p/unpolarised reflectance, s/p/unpolarised
 //! transmittance into the substrate (Byrnes' `tmm` convention, with the Re(ñ cos θ)
 //! factor), and absorptance A = 1 − R − T. One row per (angle, wavelength), angle-major.
+//!
+//! With derivatives ([`compute_jacobian`], [`write_csv_jacobian`]) the row goes on with
+//! `dR_dd1 … dR_ddL, dT_dd1 … dT_ddL`: the derivatives of the unpolarised R and T columns
+//! by each film's thickness d_j, per nm, films top first (exact: the reverse sweep of
+//! [`nacre_optics::jacobian`]).
 
 use crate::commands::grid::MAX_AXIS_SAMPLES;
 use crate::error::{Error, Param, Result};
 use nacre_optics::elementary;
+use nacre_optics::jacobian::{SweepJacobian, Wrt, sweep_jacobian};
 use nacre_optics::{Power, SpectrumSweep, Stack};
 use std::io::Write;
 
@@ -49,6 +55,74 @@ pub fn compute(stack: &Stack, angles_deg: &[f64], wavelengths_nm: &[f64]) -> Res
         return Err(phase_overflow(stack, film, wavelength_nm, d));
     }
     sweep.powers().map_err(optics_error)
+}
+
+/// [`compute`] and the derivatives of the powers by every film's thickness
+/// ([`sweep_jacobian`]); the size limit counts the 2L derivative columns. A stack with an
+/// incoherent layer is refused (its derivatives are not implemented), as an error of
+/// [`Param::Jacobian`].
+pub fn compute_jacobian(
+    stack: &Stack,
+    angles_deg: &[f64],
+    wavelengths_nm: &[f64],
+) -> Result<(Vec<Power>, SweepJacobian)> {
+    let films = stack.layers().len() as u64;
+    // The 2L derivative columns beside the 9 of a row.
+    check_axes(angles_deg, wavelengths_nm, 1 + (2 * films).div_ceil(9))?;
+    if let Err(e) = stack.require_coherent("derivatives") {
+        return Err(Error::optics_in(Param::Jacobian, e));
+    }
+    let powers = compute(stack, angles_deg, wavelengths_nm)?;
+    let jacobian =
+        sweep_jacobian(stack, angles_deg, wavelengths_nm, Wrt::Thickness).map_err(optics_error)?;
+    Ok((powers, jacobian))
+}
+
+/// The CSV header with the derivative columns of `films` films.
+pub fn header_jacobian(films: usize) -> String {
+    let mut h = HEADER.to_string();
+    for q in ["R", "T"] {
+        for j in 1..=films {
+            h.push_str(&format!(",d{q}_dd{j}"));
+        }
+    }
+    h
+}
+
+/// Writes the CSV table with the derivative columns ([`compute_jacobian`]).
+pub fn write_csv_jacobian(
+    w: &mut dyn Write,
+    angles_deg: &[f64],
+    wavelengths_nm: &[f64],
+    powers: &[Power],
+    jacobian: &SweepJacobian,
+) -> std::io::Result<()> {
+    let films = jacobian.films;
+    let mut csv = crate::csv_text::writer(w);
+    csv.write_record(header_jacobian(films).split(','))?;
+    let mut e = 0;
+    for &a in angles_deg {
+        for &wl in wavelengths_nm {
+            let p = &powers[e];
+            let d = &jacobian.d_thickness[e * films..(e + 1) * films];
+            let mut row = vec![
+                a.to_string(),
+                wl.to_string(),
+                fmt_sig(p.R_s),
+                fmt_sig(p.R_p),
+                fmt_sig(p.R()),
+                fmt_sig(p.T_s),
+                fmt_sig(p.T_p),
+                fmt_sig(p.T()),
+                fmt_sig(p.A()),
+            ];
+            row.extend(d.iter().map(|x| fmt_sig(x.R())));
+            row.extend(d.iter().map(|x| fmt_sig(x.T())));
+            csv.write_record(row)?;
+            e += 1;
+        }
+    }
+    csv.flush()
 }
 
 /// The table over a third axis, film `layer`'s thickness (1-based, top film = 1; the other

@@ -164,6 +164,9 @@ struct Scratch {
     a_r: Vec<C64>,
     a_lnt: Vec<C64>,
     a_delta: Vec<C64>,
+    /// The indices and sin θ₀ that q, ñ², α, β, r, t were computed for.
+    prepared_for: Option<Vec<C64>>,
+    sin_theta: f64,
 }
 
 impl Scratch {
@@ -243,27 +246,34 @@ fn point_into(
 ) -> Power {
     let n = thickness_nm.len();
     let media = n + 2;
-    w.resize(media);
-    let beta_t = indices[0].re * sin_theta;
     let k0 = wavenumber(wavelength_nm);
-    for (j, &nj) in indices.iter().enumerate() {
-        w.q[j] = normal_component(nj, beta_t);
-        w.n2[j] = nj * nj;
-    }
-    // Interfaces j = 0 … N: as `fresnel::Interface::new` (the same operations).
-    for j in 0..=n {
-        let (qi, qj) = (w.q[j], w.q[j + 1]);
-        let sum_s = qi + qj;
-        let a = w.n2[j + 1] * qi;
-        let b = w.n2[j] * qj;
-        let sum_p = a + b;
-        w.alpha[j] = [qi, a];
-        w.beta[j] = [qj, b];
-        w.r[j] = [(qi - qj) / sum_s, (a - b) / sum_p];
-        w.t[j] = [
-            2.0 * qi / sum_s,
-            2.0 * indices[j] * indices[j + 1] * qi / sum_p,
-        ];
+    // The media and interfaces depend on the indices and the angle only: kept from the last
+    // element when those are the same (constant materials along a row).
+    let same = w.prepared_for.as_deref() == Some(indices) && w.sin_theta == sin_theta;
+    if !same {
+        w.resize(media);
+        let beta_t = indices[0].re * sin_theta;
+        for (j, &nj) in indices.iter().enumerate() {
+            w.q[j] = normal_component(nj, beta_t);
+            w.n2[j] = nj * nj;
+        }
+        // Interfaces j = 0 … N: as `fresnel::Interface::new` (the same operations).
+        for j in 0..=n {
+            let (qi, qj) = (w.q[j], w.q[j + 1]);
+            let sum_s = qi + qj;
+            let a = w.n2[j + 1] * qi;
+            let b = w.n2[j] * qj;
+            let sum_p = a + b;
+            w.alpha[j] = [qi, a];
+            w.beta[j] = [qj, b];
+            w.r[j] = [(qi - qj) / sum_s, (a - b) / sum_p];
+            w.t[j] = [
+                2.0 * qi / sum_s,
+                2.0 * indices[j] * indices[j + 1] * qi / sum_p,
+            ];
+        }
+        w.prepared_for = Some(indices.to_vec());
+        w.sin_theta = sin_theta;
     }
     for j in 1..=n {
         let e = exp_i(w.q[j] * (k0 * thickness_nm[j - 1]));
