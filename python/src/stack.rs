@@ -4,13 +4,13 @@
 //! pages `SHELF/BOOK/PAGE` of a local database.
 
 use crate::errors::{Result, bake_err};
-use nacre_bake::commands::stack_spec::StackRecipe;
+use nacre_bake::commands::stack_spec::{StackRecipe, parse_layer};
 use nacre_bake::error::{Error, Origin, Param};
 use nacre_format::materials::{MaterialDb, resolve_with};
 use nacre_optics::{Layer, Material, Stack};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
-use pyo3::types::{PyBool, PyComplex, PyString};
+use pyo3::types::{PyBool, PyComplex, PyString, PyTuple};
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -89,13 +89,16 @@ pub struct PyStack {
 #[pymethods]
 impl PyStack {
     /// Builds a stack. `ambient` (non-absorbing) and `substrate` (absorbing allowed) are
-    /// materials; `layers` is a sequence of `(material, thickness_nm)`, top first.
+    /// materials; `layers` is a sequence, top first, of `(material, thickness_nm)`,
+    /// `(material, thickness_nm, incoherent)` (a bool: a thick slab whose reflections add
+    /// in intensity) or strings in the `--layer` syntax of the `nacre` binary,
+    /// `MATERIAL@THICKNESS[:incoherent]` (`"mgf2@99.75nm"`, `"bk7@2mm:incoherent"`).
     #[new]
     #[pyo3(signature = (ambient, layers, substrate, material_db=None))]
     fn new(
         py: Python<'_>,
         ambient: &Bound<'_, PyAny>,
-        layers: Vec<(Bound<'_, PyAny>, f64)>,
+        layers: Vec<Bound<'_, PyAny>>,
         substrate: &Bound<'_, PyAny>,
         material_db: Option<PathBuf>,
     ) -> PyResult<Self> {
@@ -103,7 +106,8 @@ impl PyStack {
         let substrate = MaterialArg::extract(substrate)?;
         let layers = layers
             .iter()
-            .map(|(m, d)| Ok((MaterialArg::extract(m)?, *d)))
+            .enumerate()
+            .map(|(i, layer)| LayerArg::extract(i, layer))
             .collect::<PyResult<Vec<_>>>()?;
         let db = database_of(material_db);
         let stack = py
@@ -140,6 +144,13 @@ impl PyStack {
         self.stack.substrate().name().to_string()
     }
 
+    /// Per film, top first: whether it is incoherent (a slab whose reflections add in
+    /// intensity, `nacre_optics::incoherent`).
+    #[getter]
+    fn incoherent(&self) -> Vec<bool> {
+        self.stack.incoherent_flags()
+    }
+
     /// The films, top first, as `(material name, thickness_nm)`.
     #[getter]
     fn layers(&self) -> Vec<(String, f64)> {
@@ -164,7 +175,11 @@ impl PyStack {
             .stack
             .layers()
             .iter()
-            .map(|l| format!("({:?}, {})", l.material.name(), l.thickness_nm))
+            .zip(self.stack.incoherent_flags())
+            .map(|(l, inc)| match inc {
+                false => format!("({:?}, {})", l.material.name(), l.thickness_nm),
+                true => format!("({:?}, {}, True)", l.material.name(), l.thickness_nm),
+            })
             .collect();
         format!(
             "Stack(ambient={:?}, layers=[{}], substrate={:?})",
@@ -175,18 +190,74 @@ impl PyStack {
     }
 }
 
-/// Loads every material and builds the stack; thicknesses must be finite and non-negative.
+/// A film argument: its material, thickness (nm) and whether it is incoherent.
+pub struct LayerArg {
+    material: MaterialArg,
+    thickness_nm: f64,
+    incoherent: bool,
+}
+
+impl LayerArg {
+    /// Reads film `index` of `layers=`: a `(material, thickness_nm)` or `(material,
+    /// thickness_nm, incoherent)` tuple, or a string in the `--layer` syntax read by the
+    /// binary's own parser ([`parse_layer`]: `"bk7@2mm:incoherent"`).
+    fn extract(index: usize, obj: &Bound<'_, PyAny>) -> PyResult<Self> {
+        if let Ok(text) = obj.cast::<PyString>() {
+            let text = text.to_str()?;
+            let (material, thickness_nm, incoherent) =
+                parse_layer(format!("layers[{index}]"), text).map_err(bake_err)?;
+            return Ok(LayerArg {
+                material: MaterialArg::Spec(material.to_string()),
+                thickness_nm,
+                incoherent,
+            });
+        }
+        let parts: Vec<Bound<'_, PyAny>> = match obj.cast::<PyTuple>() {
+            Ok(t) => t.iter().collect(),
+            Err(_) => obj.extract().map_err(|_| {
+                PyTypeError::new_err(format!(
+                    "layers[{index}]: a layer is (material, thickness_nm), (material, thickness_nm, incoherent) or a string MATERIAL@THICKNESS[:incoherent]"
+                ))
+            })?,
+        };
+        let (material, thickness_nm, incoherent) = match parts.as_slice() {
+            [m, d] => (m, d, false),
+            [m, d, inc] if inc.is_instance_of::<PyBool>() => (m, d, inc.extract::<bool>()?),
+            [_, _, inc] => {
+                return Err(PyTypeError::new_err(format!(
+                    "layers[{index}]: the third item says whether the layer is incoherent (True or False), not {}",
+                    inc.get_type().name()?
+                )));
+            }
+            _ => {
+                return Err(PyTypeError::new_err(format!(
+                    "layers[{index}]: a layer tuple has 2 or 3 items (material, thickness_nm[, incoherent]), not {}",
+                    parts.len()
+                )));
+            }
+        };
+        Ok(LayerArg {
+            material: MaterialArg::extract(material)?,
+            thickness_nm: thickness_nm.extract()?,
+            incoherent,
+        })
+    }
+}
+
+/// Loads every material and builds the stack; thicknesses must be finite and non-negative
+/// (a string layer is also held to the command line's limit of a metre).
 fn build(
     ambient: &MaterialArg,
-    layers: &[(MaterialArg, f64)],
+    layers: &[LayerArg],
     substrate: &MaterialArg,
     db: Option<&MaterialDb>,
 ) -> Result<Stack> {
     let ambient = ambient.load(Param::Ambient.into(), db)?;
-    let layers = layers
+    let built = layers
         .iter()
         .enumerate()
-        .map(|(i, (m, d))| {
+        .map(|(i, l)| {
+            let (m, d) = (&l.material, &l.thickness_nm);
             let context = Origin::from(format!("layers[{i}]"));
             if !(*d >= 0.0 && d.is_finite()) {
                 return Err(Error::value(
@@ -202,5 +273,13 @@ fn build(
         })
         .collect::<Result<Vec<_>>>()?;
     let substrate = substrate.load(Param::Substrate.into(), db)?;
-    Stack::new(ambient, layers, substrate).map_err(|e| Error::optics_in(Param::Ambient, e))
+    let stack =
+        Stack::new(ambient, built, substrate).map_err(|e| Error::optics_in(Param::Ambient, e))?;
+    if layers.iter().any(|l| l.incoherent) {
+        let flags = layers.iter().map(|l| l.incoherent).collect();
+        return stack
+            .with_incoherent(flags)
+            .map_err(|e| Error::optics_in(Param::Ambient, e));
+    }
+    Ok(stack)
 }

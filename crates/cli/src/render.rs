@@ -5,6 +5,7 @@ use crate::args::{DEFAULT_WAVELENGTH_STEP_NM, StackArgs, load_stack, refuse_step
 use crate::choices::{ChannelArg, FilmEvalArg, SceneArg, TechniqueArg};
 use crate::error::{self, Result};
 use clap::Args;
+use nacre_bake::commands::stack_spec::StackSpec;
 use nacre_format::atomic::write_atomic;
 use nacre_format::{Manifest, Param, Render, set};
 use std::path::PathBuf;
@@ -162,6 +163,30 @@ pub struct RenderArgs {
     output: PathBuf,
 }
 
+/// Refuses a stack with an incoherent layer (`--layer bk7@2mm:incoherent`, or
+/// `incoherent = true` in `--recipe`): no render technique draws a slab whose reflections
+/// add in intensity (`film_stack` sums coherent amplitudes at a few wavelengths, and the
+/// other techniques draw their tables' film), so rendering it would be silently wrong.
+fn refuse_slabs(spec: &StackSpec, args: &StackArgs) -> Result<()> {
+    let Some(j) = spec.incoherent.iter().position(|&i| i) else {
+        return Ok(());
+    };
+    let (material, thickness_nm) = &spec.layers[j];
+    let value = match args.layers.get(j) {
+        Some(text) if args.recipe.is_none() => text.clone(),
+        _ => format!("{}@{}nm:incoherent", material.spec, thickness_nm),
+    };
+    Err(nacre_bake::Error::value(
+        material.context.clone(),
+        value,
+        format!(
+            "layer {} is incoherent and `nacre render` draws no incoherent slab (the stack technique sums coherent amplitudes; the table techniques draw one film): compute its colour with `nacre color --method spectral`",
+            j + 1
+        ),
+    )
+    .into())
+}
+
 pub fn run(args: &RenderArgs) -> Result<()> {
     use nacre_runtime::mesh::{RenderInputs, TableFile, load_environment};
     use nacre_runtime::render::{FilmEval, SceneOptions, render_scene};
@@ -188,8 +213,17 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if let Some(n) = args.wavelengths {
         options.spectral_samples = n;
     }
+    let s = &args.stack;
+    if technique != Technique::Stack && (!s.layers.is_empty() || s.recipe.is_some()) {
+        // The other techniques leave the stack flags unused; a slab among them is refused
+        // all the same, rather than rendered as something else.
+        if let Ok((spec, _, _)) = load_stack(s) {
+            refuse_slabs(&spec, s)?;
+        }
+    }
     if technique == Technique::Stack {
-        let (spec, _, _) = load_stack(&args.stack)?;
+        let (spec, _, _) = load_stack(s)?;
+        refuse_slabs(&spec, s)?;
         let stack = spec.build()?;
         let relative = if args.relative.is_empty() {
             vec![0.0; stack.layers().len()]

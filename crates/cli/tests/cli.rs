@@ -285,6 +285,76 @@ fn bad_input_exits_2_with_a_message_and_keeps_existing_output() {
 
 /// `--method stack` (the GPU technique's CPU twin) against the exact reference on a
 /// three-film stack with a 10 nm silver film, and a points file overriding the top film.
+/// A coherent film whose fringes the wavelength grid cannot follow is named on stderr, once,
+/// with a pointer to `:incoherent`; a normal film, or the same slab marked incoherent, gives
+/// no warning (issue 31 §1).
+#[test]
+fn undersampled_coherent_films_are_warned_about() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let warnings = |args: &[&str]| {
+        let o = nacre(args, d);
+        assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+        stderr(&o)
+            .lines()
+            .filter(|l| l.starts_with("nacre: warning: "))
+            .map(str::to_string)
+            .collect::<Vec<_>>()
+    };
+    let slab = [
+        "--layer",
+        "mgf2@100nm",
+        "--layer",
+        "bk7@2mm",
+        "--substrate",
+        "air",
+        "--angles",
+        "0:30:10",
+    ];
+    let w = warnings(&[&["spectrum"][..], &slab].concat());
+    assert_eq!(w.len(), 1, "{w:?}");
+    for needle in [
+        "layer 2 (`bk7`, 2000000 nm) is coherent",
+        "2.385e-2 nm apart near 380 nm",
+        "the 5 nm wavelength step",
+        "mark it `:incoherent` (`bk7@2000000nm:incoherent`)",
+    ] {
+        assert!(w[0].contains(needle), "`{needle}` not in {}", w[0]);
+    }
+    let marked = [&["spectrum"][..], &slab].concat();
+    let marked: Vec<&str> = marked
+        .iter()
+        .map(|a| {
+            if *a == "bk7@2mm" {
+                "bk7@2mm:incoherent"
+            } else {
+                a
+            }
+        })
+        .collect();
+    assert_eq!(warnings(&marked), Vec::<String>::new());
+    assert_eq!(
+        warnings(&["spectrum", "--angles", "0:30:10"]),
+        Vec::<String>::new()
+    );
+    // `samples:N` samples 400–700 nm every 300/(N − 1) nm: a 20 µm film is too thick for 16.
+    let color = |layer: &str, method: &str| {
+        warnings(&[
+            "color", "--layer", layer, "--angles", "0:60:30", "--method", method,
+        ])
+    };
+    let w = color("1.33@20um", "samples:16");
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].contains("layer 1 (`1.33`, 20000 nm)") && w[0].contains("the 20 nm wavelength step"),
+        "{}",
+        w[0]
+    );
+    assert_eq!(color("1.33@400", "samples:16"), Vec::<String>::new());
+    // `spectral` steps its rule by the fringes' phase: never undersampled.
+    assert_eq!(color("1.33@20um", "spectral"), Vec::<String>::new());
+}
+
 #[test]
 fn color_stack_method_is_close_to_spectral() {
     let dir = tempfile::tempdir().unwrap();

@@ -391,12 +391,14 @@ impl Stack {
     }
 
     /// The coherent films whose interference fringes are finer, in wavelength, than the
-    /// sampling of `wavelengths_nm` (ascending) can follow: the fringe period of film j at
-    /// normal incidence, Δλ ≈ λ² / (2 Re ñ_j d_j) (successive orders of 2 Re ñ d = mλ;
-    /// Born & Wolf §7.5.1; oblique incidence only widens it), below the step to the next
-    /// sample somewhere on the grid. Such a film's spectrum aliases; a slab that thick
-    /// should be marked incoherent. Films whose index is unknown somewhere on the grid are
-    /// skipped (the sweep reports that).
+    /// sampling of `wavelengths_nm` (ascending) can follow: film j's fringes are the orders
+    /// m of 2 Re ñ_j d_j = mλ at normal incidence (Born & Wolf §7.5.1; oblique incidence
+    /// only widens them), so between neighbouring samples λ₁ < λ₂ the spectrum passes
+    /// Δm = 2 Re ñ_j d_j (1/λ₁ − 1/λ₂) fringes (ñ_j at λ₁); more than one somewhere on the
+    /// grid and the samples cannot follow them. The mean fringe period over that step,
+    /// (λ₂ − λ₁)/Δm (≈ λ²/(2 Re ñ d) for fine fringes), is reported against the step. Such
+    /// a film's spectrum aliases; a slab that thick should be marked incoherent. Films
+    /// whose index is unknown somewhere on the grid are skipped (the sweep reports that).
     pub fn undersampled_films(&self, wavelengths_nm: &[f64]) -> Vec<Undersampled> {
         let mut out = Vec::new();
         for (j, layer) in self.layers.iter().enumerate() {
@@ -409,8 +411,9 @@ impl Stack {
                 let Ok(n) = layer.material.index_at(wl) else {
                     continue;
                 };
-                let period = wl * wl / (2.0 * n.re.abs() * layer.thickness_nm);
-                if period < step && worst.is_none_or(|(p, s, _)| period / step < p / s) {
+                let fringes = 2.0 * n.re.abs() * layer.thickness_nm * (1.0 / wl - 1.0 / pair[1]);
+                let period = step / fringes;
+                if fringes > 1.0 && worst.is_none_or(|(p, s, _)| period / step < p / s) {
                     worst = Some((period, step, wl));
                 }
             }
@@ -691,15 +694,23 @@ impl std::fmt::Display for Undersampled {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "layer {} (`{}`, {} nm) is coherent but its fringes are {:.3e} nm apart near {} nm, finer than the {} nm wavelength step: its spectrum aliases; a layer that thick adds its reflections in intensity, mark it `:incoherent`",
+            "layer {} (`{}`, {} nm) is coherent but its fringes are {:.3e} nm apart near {} nm, finer than the {} nm wavelength step: its spectrum aliases; a layer that thick adds its reflections in intensity, mark it `:incoherent` (`{}@{}nm:incoherent`)",
             self.layer,
             self.material,
             self.thickness_nm,
             self.fringe_period_nm,
-            self.wavelength_nm,
-            self.step_nm
+            round6(self.wavelength_nm),
+            round6(self.step_nm),
+            self.material,
+            self.thickness_nm,
         )
     }
+}
+
+/// `v` rounded to 6 decimals for a message (a grid step of `380:780:5` is 5, not
+/// 5.000000000000057).
+fn round6(v: f64) -> f64 {
+    (v * 1e6).round() / 1e6
 }
 
 /// [`Stack::sweep`] by the scalar recurrence of [`Prepared`] (one per angle and distinct set

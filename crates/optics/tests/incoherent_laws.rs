@@ -246,6 +246,29 @@ fn a_thick_coherent_film_is_undersampled() {
     assert_eq!(u.len(), 1);
     assert_eq!(u[0].layer, 1);
     assert!(u[0].to_string().contains(":incoherent"), "{}", u[0]);
+    // Fine fringes: the mean period over the step is λ²/(2nd) to first order in step/λ.
+    let linear = 380.0 * 380.0 / (2.0 * 1.5 * 2e6);
+    assert!(
+        (u[0].fringe_period_nm / linear - 1.0).abs() < 0.02,
+        "{} against {linear}",
+        u[0].fringe_period_nm
+    );
+    assert_eq!((u[0].wavelength_nm, u[0].step_nm), (380.0, 5.0));
     let s = s.with_incoherent(vec![true, false]).unwrap();
     assert!(s.undersampled_films(&wl).is_empty());
+    // A 400 nm soap film passes Δm = 2·1.33·400·(1/2000 − 1/11000) = 0.43 fringes between
+    // samples 9 µm apart: not undersampled, although the linearised period λ²/(2nd) = 3.8 µm
+    // at 2 µm is below the step. Nor on the default grid.
+    let soap = stack(1.0, &[(1.33, 0.0, 400.0, false)], (1.0, 0.0));
+    assert!(
+        soap.undersampled_films(&[2000.0, 11000.0, 20000.0])
+            .is_empty()
+    );
+    assert!(soap.undersampled_films(&wl).is_empty());
+    // 20 µm of it on a 20 nm grid over 400–700 nm (`samples:16`): Δm = 6.3 at 400 nm.
+    let thick = stack(1.0, &[(1.33, 0.0, 2e4, false)], (1.0, 0.0));
+    let grid: Vec<f64> = (0..16).map(|k| 400.0 + 20.0 * k as f64).collect();
+    let u = thick.undersampled_films(&grid);
+    assert_eq!(u.len(), 1);
+    assert_eq!(u[0].wavelength_nm, 400.0);
 }

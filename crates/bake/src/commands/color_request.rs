@@ -9,8 +9,8 @@ use crate::error::{Error, Param, Result};
 use nacre_format::fourier::FourierTable;
 use nacre_format::msg;
 use nacre_format::{Manifest, set};
-use nacre_optics::Stack;
 use nacre_optics::colour::Colorimeter;
+use nacre_optics::{Stack, Undersampled};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -243,6 +243,9 @@ pub struct Colours {
     /// The Monte Carlo reference's samples per point and largest standard error per
     /// channel (`rough-mc` only).
     pub monte_carlo: Option<(usize, f64)>,
+    /// The coherent films whose fringes the method's wavelength sampling cannot follow
+    /// ([`color::undersampled`]): warnings for the user, one per film.
+    pub undersampled: Vec<Undersampled>,
 }
 
 /// Evaluates `prepared` at every point.
@@ -252,6 +255,7 @@ pub fn compute(
     prepared: &Prepared,
     quantity: Quantity,
 ) -> Result<Colours> {
+    let undersampled = color::undersampled(stack, points, &prepared.method, &prepared.colorimeter);
     Ok(match &prepared.method {
         // The Monte Carlo reference reports its noise: the largest standard error.
         Method::RoughMonteCarlo { alpha, samples } => {
@@ -270,6 +274,7 @@ pub fn compute(
             Colours {
                 colours: estimates.iter().map(|e| e.colour).collect(),
                 monte_carlo: Some((*samples, worst)),
+                undersampled,
             }
         }
         _ => Colours {
@@ -282,6 +287,7 @@ pub fn compute(
                 prepared.lut.as_ref(),
             )?,
             monte_carlo: None,
+            undersampled,
         },
     })
 }

@@ -137,12 +137,13 @@ fn check_bounds(lo: f64, hi: f64, what: &str) -> std::result::Result<(), String>
 }
 
 /// Parses `MATERIAL@THICKNESS[:incoherent]`; with `ranges`, also `MATERIAL@LO:HI` and
-/// `NLO:NHI@…` (a template's free parameters).
-fn parse_layer_flag(text: &str, ranges: bool) -> Result<LayerFlag> {
-    let bad = |message: String| Error::value(Param::Layer, text.to_string(), message);
+/// `NLO:NHI@…` (a template's free parameters). `context` names the input in messages
+/// (`--layer`, or Python's `layers[i]`).
+fn parse_layer_flag(context: &Origin, text: &str, ranges: bool) -> Result<LayerFlag> {
+    let bad = |message: String| Error::value(context.clone(), text.to_string(), message);
     let (m, d) = text.rsplit_once('@').ok_or_else(|| {
         Error::value(
-            Param::Layer,
+            context.clone(),
             text.to_string(),
             "expected MATERIAL@THICKNESS, e.g. `water@400nm`",
         )
@@ -158,8 +159,10 @@ fn parse_layer_flag(text: &str, ranges: bool) -> Result<LayerFlag> {
         _ => None,
     };
     let thickness = |d: &str| {
-        let d = parse_thickness_nm(Param::Layer, d).map_err(|e| match e {
-            Error::Value { message, .. } => Error::value(Param::Layer, text.to_string(), message),
+        let d = parse_thickness_nm(context.clone(), d).map_err(|e| match e {
+            Error::Value { message, .. } => {
+                Error::value(context.clone(), text.to_string(), message)
+            }
             other => other,
         })?;
         if d >= MAX_THICKNESS_NM {
@@ -196,6 +199,15 @@ fn parse_layer_flag(text: &str, ranges: bool) -> Result<LayerFlag> {
         thickness_nm,
         incoherent,
     })
+}
+
+/// One layer in the command line's syntax `MATERIAL@THICKNESS[:incoherent]` (`water@400`,
+/// `mgf2@99.75nm`, `bk7@2mm:incoherent`; no ranges): the material spec, the thickness in nm
+/// (below [`MAX_THICKNESS_NM`]) and whether the layer is incoherent, with the messages of
+/// `--layer`. `context` names the input (Python's `layers[i]`).
+pub fn parse_layer(context: impl Into<Origin>, text: &str) -> Result<(String, f64, bool)> {
+    let l = parse_layer_flag(&context.into(), text, false)?;
+    Ok((l.material, l.thickness_nm.0, l.incoherent))
 }
 
 /// A free parameter of a template and where it was given.
@@ -271,7 +283,7 @@ impl TemplateSpec {
         let mut incoherent = Vec::new();
         stack.layers.clear();
         for (i, text) in layers.iter().enumerate() {
-            let l = parse_layer_flag(text, true)?;
+            let l = parse_layer_flag(&Param::Layer.into(), text, true)?;
             let origin = Param::Layer.given(text.clone());
             free.extend(free_of(i + 1, l.index, l.thickness_nm, &origin));
             let d = match l.thickness_nm {
@@ -336,7 +348,7 @@ impl StackSpec {
             layers
                 .iter()
                 .map(|text| {
-                    let l = parse_layer_flag(text, false)?;
+                    let l = parse_layer_flag(&Param::Layer.into(), text, false)?;
                     incoherent.push(l.incoherent);
                     Ok((flag(&l.material, Param::Layer.into()), l.thickness_nm.0))
                 })

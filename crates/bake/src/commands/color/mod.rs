@@ -49,7 +49,7 @@ use nacre_optics::elementary;
 use nacre_optics::few_wavelengths::StackEvaluation;
 use nacre_optics::fourier::{FilmOnBase, Harmonics, gltf_iridescence};
 use nacre_optics::spectral::sample_weights;
-use nacre_optics::{C64, Layer, Material, SpectralRule, Stack};
+use nacre_optics::{C64, Layer, Material, SpectralRule, Stack, Undersampled};
 use rayon::prelude::*;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -768,6 +768,51 @@ pub fn evaluate(
             }
         })
         .collect()
+}
+
+/// The coherent films of `stack` (with the top film as `points` override it) whose
+/// interference fringes `method`'s wavelength sampling cannot follow
+/// ([`Stack::undersampled_films`]): at most one per film, for a warning. Only `samples:N`
+/// samples a spectrum on a fixed grid (N wavelengths over 400–700 nm, step 300/(N − 1) nm);
+/// `spectral` steps its rule by the fringes' phase ([`SpectralRule::for_stack`], so it
+/// never undersamples: a film too thick for it is refused instead), `rgb3` takes one
+/// wavelength per channel by design and integrates nothing, and the table and closed-form
+/// methods integrate exactly when baked or model one film. For the top film the point
+/// with the finest fringes is checked: the largest optical thickness Re(ñ)·d (the fringe
+/// period λ²/(2 Re ñ d) is the smallest there on any grid), the first such point on ties.
+pub fn undersampled(
+    stack: &Stack,
+    points: &[Point],
+    method: &Method,
+    colorimeter: &Colorimeter,
+) -> Vec<Undersampled> {
+    let Method::Samples(n) = method else {
+        return Vec::new();
+    };
+    let (wavelengths_nm, _) = sample_weights(colorimeter, *n);
+    let own_index = stack.layers().first().map_or(0.0, |l| {
+        l.material.index_at(550.0).map_or(0.0, |n| n.re.abs())
+    });
+    let optical = |p: &Point| -> f64 {
+        let d = p
+            .thickness_nm
+            .or(stack.layers().first().map(|l| l.thickness_nm))
+            .unwrap_or(0.0);
+        p.film_ior.map_or(own_index, f64::abs) * d
+    };
+    let finest = points.iter().filter(|p| optical(p).is_finite()).fold(
+        None::<&Point>,
+        |best, p| match best {
+            Some(b) if optical(b) >= optical(p) => Some(b),
+            _ => Some(p),
+        },
+    );
+    // A point the stack refuses is reported by the evaluation itself.
+    match finest {
+        Some(p) => stack_at(stack, p)
+            .map_or_else(|_| Vec::new(), |s| s.undersampled_films(&wavelengths_nm)),
+        None => stack.undersampled_films(&wavelengths_nm),
+    }
 }
 
 /// `Ok` when `method` takes a stack with incoherent layers (`spectral`, `rgb3`,
