@@ -395,7 +395,11 @@ impl Stack {
     /// m of 2 Re ñ_j d_j = mλ at normal incidence (Born & Wolf §7.5.1; oblique incidence
     /// only widens them), so between neighbouring samples λ₁ < λ₂ the spectrum passes
     /// Δm = 2 Re ñ_j d_j (1/λ₁ − 1/λ₂) fringes (ñ_j at λ₁); more than one somewhere on the
-    /// grid and the samples cannot follow them. The mean fringe period over that step,
+    /// grid and the samples cannot follow them. Only films far beyond the interference
+    /// colours are named: more than [`UNDERSAMPLED_MIN_ORDER`] orders thick there
+    /// (m = 2 Re ñ d / λ₁), the thickness from which a slab is better treated as
+    /// incoherent; a thin film on a deliberately sparse grid (a 400 nm film at 100, 150 and
+    /// 200 nm: 10.6 orders) is not. The mean fringe period over that step,
     /// (λ₂ − λ₁)/Δm (≈ λ²/(2 Re ñ d) for fine fringes), is reported against the step. Such
     /// a film's spectrum aliases; a slab that thick should be marked incoherent. Films
     /// whose index is unknown somewhere on the grid are skipped (the sweep reports that).
@@ -413,7 +417,11 @@ impl Stack {
                 };
                 let fringes = 2.0 * n.re.abs() * layer.thickness_nm * (1.0 / wl - 1.0 / pair[1]);
                 let period = step / fringes;
-                if fringes > 1.0 && worst.is_none_or(|(p, s, _)| period / step < p / s) {
+                let order = 2.0 * n.re.abs() * layer.thickness_nm / wl;
+                if fringes > 1.0
+                    && order > UNDERSAMPLED_MIN_ORDER
+                    && worst.is_none_or(|(p, s, _)| period / step < p / s)
+                {
                     worst = Some((period, step, wl));
                 }
             }
@@ -672,6 +680,12 @@ impl Stack {
         Ok((sines, indices))
     }
 }
+
+/// The interference order m = 2 Re ñ d / λ above which [`Stack::undersampled_films`] names
+/// a film: interference colours fade to white by the fifth to seventh order (the
+/// Michel-Lévy chart; Born & Wolf §7.5.1 for the orders), so a film of more than 20 orders
+/// shows none and its fine fringes only average, as an incoherent slab's do.
+pub const UNDERSAMPLED_MIN_ORDER: f64 = 20.0;
 
 /// A coherent film too thick for a wavelength sampling ([`Stack::undersampled_films`]).
 #[derive(Clone, Debug, PartialEq)]

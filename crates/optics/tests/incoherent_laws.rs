@@ -265,6 +265,9 @@ fn a_thick_coherent_film_is_undersampled() {
             .is_empty()
     );
     assert!(soap.undersampled_films(&wl).is_empty());
+    // On 100, 150, 200 nm it passes 3.5 fringes per step but is 10.6 orders thick there:
+    // a thin film on a sparse grid, not a slab (UNDERSAMPLED_MIN_ORDER).
+    assert!(soap.undersampled_films(&[100.0, 150.0, 200.0]).is_empty());
     // 20 µm of it on a 20 nm grid over 400–700 nm (`samples:16`): Δm = 6.3 at 400 nm.
     let thick = stack(1.0, &[(1.33, 0.0, 2e4, false)], (1.0, 0.0));
     let grid: Vec<f64> = (0..16).map(|k| 400.0 + 20.0 * k as f64).collect();
