@@ -202,10 +202,10 @@ impl LayerArg {
     /// thickness_nm, incoherent)` tuple, or a string in the `--layer` syntax read by the
     /// binary's own parser ([`parse_layer`]: `"bk7@2mm:incoherent"`).
     fn extract(index: usize, obj: &Bound<'_, PyAny>) -> PyResult<Self> {
-        if let Ok(text) = obj.cast::<PyString>() {
-            let text = text.to_str()?;
+        if obj.is_instance_of::<PyString>() {
+            let text: String = obj.extract()?;
             let (material, thickness_nm, incoherent) =
-                parse_layer(format!("layers[{index}]"), text).map_err(bake_err)?;
+                parse_layer(format!("layers[{index}]"), &text).map_err(bake_err)?;
             return Ok(LayerArg {
                 material: MaterialArg::Spec(material.to_string()),
                 thickness_nm,

@@ -41,8 +41,9 @@ def _stack(ambient: Any, layers: List[Tuple[Any, float]], substrate: Any) -> Dic
 
 def _stack_args(s: Dict[str, Any]) -> List[str]:
     args = ["--ambient", _cli(s["ambient"]), "--substrate", _cli(s["substrate"])]
-    for m, d in s["layers"]:
-        args += ["--layer", f"{_cli(m)}@{d}"]
+    for m, d, *incoherent in s["layers"]:
+        suffix = ":incoherent" if incoherent and incoherent[0] else ""
+        args += ["--layer", f"{_cli(m)}@{d}{suffix}"]
     return args
 
 
@@ -55,6 +56,8 @@ def _cli(m: Any) -> str:
 SOAP = _stack(1.0, [(1.33, 400.0)], 1.0)
 GLTF_BASE = _stack(1.0, [(1.5, 300.0)], 1.5)
 ROUGH = _stack(1.0, [(1.33, 400.0)], 1.5)
+# A 2 mm BK7 pane, incoherent, with a quarter-wave MgF2 coating on both faces (issue 31).
+PANE = _stack("air", [("mgf2", 99.75), ("bk7", 2e6, True), ("mgf2", 99.75)], "air")
 
 # name -> (command, stack, options). Spectrum options: angles, wavelengths (range text).
 SPECTRUM_CASES: Dict[str, Tuple[Dict[str, Any], str, str]] = {
@@ -63,6 +66,7 @@ SPECTRUM_CASES: Dict[str, Tuple[Dict[str, Any], str, str]] = {
     "spectrum-gold-on-bk7": (_stack("air", [("au", 30.0)], "bk7"), "0:80:20", "400:700:25"),
     "spectrum-absorbing-const": (_stack(1.0, [(1.5 + 0.01j, 250.0), ("tio2", 60.0)], 0.27 + 2.9j), "0:60:15", "380:780:40"),
     "spectrum-tir": (_stack(1.52, [(1.38, 200.0)], 1.0), "20:80:5", "450:650:50"),
+    "spectrum-coated-pane": (PANE, "0:80:20", "380:780:20"),
     "spectrum-multilayer": (_stack("air", [("tio2", 56.45), ("mgf2", 99.75), ("tio2", 56.45), ("fused-silica", 120.0)], "bk7"), "0:60:30", "380:780:20"),
 }
 
@@ -73,6 +77,9 @@ COLOR_CASES: Dict[str, Tuple[Dict[str, Any], str, Dict[str, Any], bool]] = {
     "color-spectral-t-1964-a": (_stack("air", [("water", 600.0)], "air"), "spectral", {"quantity": "t", "observer": "1964", "illuminant": "a"}, False),
     "color-spectral-rec2020": (_stack("air", [("oil", 450.0)], "water"), "spectral", {"space": "rec2020"}, False),
     "color-spectral-xyz-gold": (_stack("air", [("1.4", 120.0)], "au"), "spectral", {"space": "xyz"}, False),
+    "color-spectral-coated-pane": (PANE, "spectral", {}, False),
+    "color-spectral-coated-pane-t": (PANE, "spectral", {"quantity": "t"}, False),
+    "color-samples-coated-pane": (PANE, "samples:8", {}, True),
     "color-lut": (SOAP, "lut:soap-film", {}, False),
     "color-lut-points": (SOAP, "lut:soap-film", {}, True),
     "color-lut-t": (SOAP, "lut:soap-film", {"quantity": "t"}, False),

@@ -214,3 +214,30 @@ def test_the_gil_is_released_while_nacre_computes():
     worker.join()
     assert alone > 0.05, alone
     assert longest < 0.5 * alone, (longest, alone)
+
+
+def test_incoherent_layers_take_the_cli_syntax_or_a_flag():
+    """A slab is `(material, thickness_nm, True)` or the binary's `--layer` text; both give
+    the same stack (the binary's own numbers: test_cli_identity's coated-pane cases)."""
+    tuples = nacre.Stack("air", [("mgf2", 99.75), ("bk7", 2e6, True), ("mgf2", 99.75)], "air")
+    texts = nacre.Stack("air", ["mgf2@99.75nm", "bk7@2mm:incoherent", "mgf2@99.75"], "air")
+    assert tuples.incoherent == texts.incoherent == [False, True, False]
+    assert tuples.layers == texts.layers == [("mgf2", 99.75), ("bk7", 2e6), ("mgf2", 99.75)]
+    assert "('bk7', 2000000.0, True)" in repr(tuples)
+    a = nacre.spectrum(tuples, [0, 45], [500, 501, 502])
+    b = nacre.spectrum(texts, [0, 45], [500, 501, 502])
+    for key in a:
+        assert np.array_equal(a[key], b[key]), key
+    # incoherent: no 2 mm fringes from one nanometre to the next
+    assert np.ptp(a.R[0]) < 1e-3
+    coherent = nacre.spectrum(nacre.Stack("air", ["mgf2@99.75nm", "bk7@2mm", "mgf2@99.75"], "air"), 0, [500, 501, 502])
+    assert np.ptp(coherent.R[0]) > 1e-2
+    assert nacre.Stack(1.0, [(1.33, 400.0, False)], 1.0).incoherent == [False]
+    with pytest.raises(nacre.NacreError, match=r"layers\[1\].*bk7@2mm:incoherant.*unknown suffix"):
+        nacre.Stack("air", ["mgf2@99.75", "bk7@2mm:incoherant"], "air")
+    with pytest.raises(nacre.NacreError, match=r"layers\[0\].*bk7@1000mm:incoherent.*thinner than 1 m"):
+        nacre.Stack("air", ["bk7@1000mm:incoherent"], "air")
+    with pytest.raises(TypeError, match=r"layers\[0\]: the third item"):
+        nacre.Stack("air", [("bk7", 2e6, "incoherent")], "air")
+    with pytest.raises(nacre.NacreError, match="incoherent"):
+        nacre.color(tuples, [0.0], method="fourier")

@@ -19,7 +19,7 @@ class Stack:
     def __init__(
         self,
         ambient: _Material,
-        layers: Sequence[Tuple[_Material, float]],
+        layers: Sequence[Union[Tuple[_Material, float], Tuple[_Material, float, bool], str]],
         substrate: _Material,
         material_db: Optional[Union[str, "os.PathLike[str]"]] = None,
     ) -> None: ...
@@ -34,6 +34,8 @@ class Stack:
     def substrate(self) -> str: ...
     @property
     def layers(self) -> List[Tuple[str, float]]: ...
+    @property
+    def incoherent(self) -> List[bool]: ...
     def indices_at(self, wavelength_nm: float) -> List[Tuple[float, float]]: ...
 
 class Table:
