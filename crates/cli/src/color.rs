@@ -117,7 +117,7 @@ pub fn run(args: &ColorArgs) -> Result<()> {
     )
     .map_err(named)?;
     let out = request::compute(&stack, &points, &prepared, quantity).map_err(named)?;
-    crate::warn(&out.undersampled);
+    crate::error::warn(&out.undersampled);
     if let Some((samples, worst)) = out.monte_carlo {
         eprintln!(
             "rough-mc: {samples} samples per point (seed = point index); largest standard error per channel {worst:.2e}"

@@ -251,3 +251,11 @@ mod pipe_tests {
         }
     }
 }
+
+/// Prints a library's warnings (`nacre: warning: …`, one line each) on stderr: the
+/// libraries return them, the binary shows them.
+pub fn warn<W: fmt::Display>(warnings: &[W]) {
+    for w in warnings {
+        eprintln!("nacre: warning: {w}");
+    }
+}

@@ -146,14 +146,6 @@ fn quiet_vulkan_device_select() {
     }
 }
 
-/// Prints a library's warnings (`nacre: warning: …`, one line each) on stderr: the
-/// libraries return them, the binary shows them.
-fn warn<W: std::fmt::Display>(warnings: &[W]) {
-    for w in warnings {
-        eprintln!("nacre: warning: {w}");
-    }
-}
-
 fn main() -> ExitCode {
     quiet_vulkan_device_select();
     gpu::list_float_targets_on_mesa_gl();
@@ -163,7 +155,7 @@ fn main() -> ExitCode {
     };
     let result = run(cli);
     // What the material readers repaired or set aside (the materials are usable).
-    warn(&nacre_format::materials::take_warnings());
+    error::warn(&nacre_format::materials::take_warnings());
     match result {
         Ok(()) => ExitCode::SUCCESS,
         // `nacre spectrum | head`: the reader closed the pipe; end quietly.

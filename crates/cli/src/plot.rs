@@ -386,7 +386,7 @@ fn run_spectrum(args: &SpectrumPlotArgs) -> Result<()> {
             let wavelengths = parse_range(flag, &text)?;
             let stack = spec.build()?;
             let curves = plot::spectrum_curves(&stack, &angles, &wavelengths)?;
-            crate::warn(&stack.undersampled_films(&wavelengths));
+            crate::error::warn(&stack.undersampled_films(&wavelengths));
             (format!("Spectra of {}", describe(&spec, false)), curves)
         }
     };
@@ -477,7 +477,7 @@ fn run_chromaticity(args: &ChromaticityArgs) -> Result<()> {
             Quantity::Reflectance,
             lut.as_ref(),
         )?;
-        crate::warn(&color::undersampled(&stack, &points, &method, cm));
+        crate::error::warn(&color::undersampled(&stack, &points, &method, cm));
         trajectories.push(plot::Trajectory {
             label: text.trim().to_string(),
             xy: colours
@@ -576,7 +576,7 @@ fn run_chart(args: &ChartArgs) -> Result<()> {
     )?;
     let cm = lut.as_ref().map_or(&c, |l| &l.colorimeter);
     let colours = color::evaluate(&stack, &points, &method, cm, quantity, lut.as_ref())?;
-    crate::warn(&color::undersampled(&stack, &points, &method, cm));
+    crate::error::warn(&color::undersampled(&stack, &points, &method, cm));
     let display = plot::DisplayConverter::new(cm);
     let quantity_name = match quantity {
         Quantity::Reflectance => "Reflected",

@@ -80,7 +80,7 @@ pub fn run(args: &SpectrumArgs) -> Result<()> {
         })?);
     }
     let powers = spectrum::compute(&stack, &angles, &wavelengths)?;
-    crate::warn(&stack.undersampled_films(&wavelengths));
+    crate::error::warn(&stack.undersampled_films(&wavelengths));
     Ok(write_atomic(&args.output, |w| {
         spectrum::write_csv(w, &angles, &wavelengths, &powers)
     })?)
