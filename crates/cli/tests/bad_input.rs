@@ -569,6 +569,17 @@ fn fixtures(d: &Path) -> Vec<Case> {
         &d.join("g/version1.gltf"),
         gltf("tri.bin", 36, 3, "").replace("\"2.0\"", "\"1.0\""),
     );
+    // KHR_texture_basisu: the project's ETC1S quad with its KTX2 cut inside the level index,
+    // and with a supercompression scheme the extension does not allow (ZLIB, 3).
+    let basisu = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/golden/gltf/basisu");
+    let quad = std::fs::read(basisu.join("quad-etc1s.gltf")).unwrap();
+    let ktx2 = std::fs::read(basisu.join("etc1s.ktx2")).unwrap();
+    write(&d.join("g/basisu-cut/quad-etc1s.gltf"), &quad);
+    write(&d.join("g/basisu-cut/etc1s.ktx2"), &ktx2[..100]);
+    let mut zlib = ktx2.clone();
+    zlib[44..48].copy_from_slice(&3u32.to_le_bytes());
+    write(&d.join("g/basisu-scheme/quad-etc1s.gltf"), &quad);
+    write(&d.join("g/basisu-scheme/etc1s.ktx2"), &zlib);
 
     let lut = |manifest: &str| {
         vec![
@@ -1053,6 +1064,16 @@ fn fixtures(d: &Path) -> Vec<Case> {
             "gltf: asset version 1.0",
             render(&["--gltf", "g/version1.gltf"]),
             &["version1.gltf", "2.x"],
+        ),
+        with(
+            "gltf: KHR_texture_basisu KTX2 truncated",
+            render(&["--gltf", "g/basisu-cut/quad-etc1s.gltf"]),
+            &["quad-etc1s.gltf", "texture 0", "image 0", "truncated"],
+        ),
+        with(
+            "gltf: KHR_texture_basisu KTX2 with a ZLIB supercompression",
+            render(&["--gltf", "g/basisu-scheme/quad-etc1s.gltf"]),
+            &["quad-etc1s.gltf", "texture 0", "supercompression scheme 3"],
         ),
         // --- height fields (`nacre diffraction`) ---
         case(

@@ -9,7 +9,7 @@ use std::path::Path;
 /// The glTF extensions nacre implements: a file whose `extensionsRequired` lists only these
 /// loads (`KHR_materials_transmission` and `_volume` refract the opaque scene in screen
 /// space, as the glTF Sample Viewer does: `shaders/mesh.wgsl`).
-pub const SUPPORTED_EXTENSIONS: [&str; 12] = [
+pub const SUPPORTED_EXTENSIONS: [&str; 13] = [
     "KHR_draco_mesh_compression",
     "KHR_lights_punctual",
     "KHR_mesh_quantization",
@@ -21,6 +21,7 @@ pub const SUPPORTED_EXTENSIONS: [&str; 12] = [
     "KHR_materials_unlit",
     "KHR_materials_transmission",
     "KHR_materials_volume",
+    "KHR_texture_basisu",
     "KHR_texture_transform",
 ];
 
@@ -91,9 +92,31 @@ pub(super) fn open(bytes: &[u8], path: &Path) -> Result<(gltf::Gltf, Vec<String>
 /// The `gltf` crate's validation of `root` (what `gltf::Document::from_json` does), except
 /// that an accessor of a `KHR_draco_mesh_compression` primitive may lack a buffer view: its
 /// data is in the Draco stream (the extension's accessors have none), where gltf-json 1.4
-/// wants every accessor to have a buffer view or sparse values.
+/// wants every accessor to have a buffer view or sparse values; and a texture with
+/// `KHR_texture_basisu` may lack `source` (the extension names its image; `source` is only a
+/// fallback), where gltf-json 1.4 wants it. The extension's `source` must be an image.
 fn validate(root: &gltf::json::Root) -> std::result::Result<(), gltf::Error> {
     use gltf::json::validation::{Error as Invalid, Validate};
+    let mut basisu_textures = std::collections::BTreeSet::new();
+    let mut errors = Vec::new();
+    for (t, texture) in root.textures.iter().enumerate() {
+        let at = || {
+            gltf::json::Path::new()
+                .field("textures")
+                .index(t)
+                .field("extensions")
+                .field(super::basisu::EXTENSION)
+                .field("source")
+        };
+        match super::basisu::basisu_source(texture) {
+            Some(Ok(image)) if image < root.images.len() => {
+                basisu_textures.insert(t);
+            }
+            Some(Ok(_)) => errors.push((at(), Invalid::IndexOutOfBounds)),
+            Some(Err(_)) => errors.push((at(), Invalid::Invalid)),
+            None => {}
+        }
+    }
     let mut compressed = std::collections::BTreeSet::new();
     for primitive in root.meshes.iter().flat_map(|m| &m.primitives) {
         let draco = primitive
@@ -105,14 +128,16 @@ fn validate(root: &gltf::json::Root) -> std::result::Result<(), gltf::Error> {
             compressed.extend(primitive.indices.map(|a| a.value()));
         }
     }
-    let mut errors = Vec::new();
     root.validate(root, gltf::json::Path::new, &mut |path, error| {
         let path = path();
-        let draco_data = matches!(error, Invalid::Missing)
-            && compressed
-                .iter()
-                .any(|a| path.as_str() == format!("accessors[{a}].bufferView"));
-        if !draco_data {
+        let missing = |what: String| matches!(error, Invalid::Missing) && path.as_str() == what;
+        let draco_data = compressed
+            .iter()
+            .any(|a| missing(format!("accessors[{a}].bufferView")));
+        let basisu_image = basisu_textures
+            .iter()
+            .any(|t| missing(format!("textures[{t}].source")));
+        if !draco_data && !basisu_image {
             errors.push((path, error));
         }
     });

@@ -307,4 +307,122 @@ pub enum GltfError {
         /// The offending member and value.
         what: String,
     },
+    /// A `KHR_texture_basisu` texture whose KTX2 picture cannot be used: a missing or bad
+    /// image index, or a file that does not decode (`basisu.rs`).
+    #[error("texture {texture} (KHR_texture_basisu, image {image}): {error}")]
+    Basisu {
+        /// Texture index.
+        texture: usize,
+        /// The image index the extension names.
+        image: usize,
+        /// What is wrong.
+        error: Ktx2Error,
+    },
+}
+
+/// What is wrong with the KTX 2.0 file of a `KHR_texture_basisu` texture (KTX 2.0 §3 and the
+/// extension's "KTX2 image requirements").
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum Ktx2Error {
+    /// The image does not exist, or is not where its record says.
+    #[error("{what}")]
+    Image {
+        /// What is wrong with the image record.
+        what: String,
+    },
+    /// The bytes do not start with the KTX 2.0 identifier.
+    #[error("not a KTX 2.0 file (its first 12 bytes are not the KTX2 identifier)")]
+    NotKtx2,
+    /// Fewer bytes than the header or the level index needs.
+    #[error("{bytes} bytes, truncated (the KTX2 header and level index need {need})")]
+    Truncated {
+        /// The file's size, bytes.
+        bytes: usize,
+        /// Bytes the header and index need.
+        need: usize,
+    },
+    /// `vkFormat` is not VK_FORMAT_UNDEFINED (a plain KTX2 texture, not Basis Universal).
+    #[error(
+        "vkFormat {vk_format}: KHR_texture_basisu wants 0 (VK_FORMAT_UNDEFINED, Basis Universal data)"
+    )]
+    VkFormat {
+        /// The header's `vkFormat`.
+        vk_format: u32,
+    },
+    /// Not a 2-D texture.
+    #[error(
+        "pixelDepth {depth}, layerCount {layers}, faceCount {faces}: KHR_texture_basisu wants a 2-D texture (0, 0 or 1, 1)"
+    )]
+    NotTwoD {
+        /// The header's `pixelDepth`.
+        depth: u32,
+        /// The header's `layerCount`.
+        layers: u32,
+        /// The header's `faceCount`.
+        faces: u32,
+    },
+    /// Zero or too large a width or height.
+    #[error("{width}x{height} texels (at least 1, at most {max})")]
+    Dimensions {
+        /// The header's `pixelWidth`.
+        width: u32,
+        /// The header's `pixelHeight`.
+        height: u32,
+        /// The largest side read.
+        max: u32,
+    },
+    /// A supercompression scheme the extension does not allow, or one that does not match
+    /// the codec.
+    #[error("supercompression scheme {scheme}{}: KHR_texture_basisu allows BasisLZ (1) for ETC1S, none (0) or Zstandard (2) for UASTC", codec.map_or(String::new(), |c| format!(" for {c} data")))]
+    Supercompression {
+        /// The header's `supercompressionScheme`.
+        scheme: u32,
+        /// The codec the data holds, when known.
+        codec: Option<&'static str>,
+    },
+    /// More mip levels than any texture within the size limit has.
+    #[error("levelCount {levels} (at most 32)")]
+    LevelCount {
+        /// The header's `levelCount`.
+        levels: u32,
+    },
+    /// A level index entry pointing outside the file.
+    #[error("level {level} lies at bytes {offset} + {length}, beyond the file's {bytes} bytes")]
+    LevelOutside {
+        /// The level.
+        level: u32,
+        /// Its `byteOffset`.
+        offset: u64,
+        /// Its `byteLength`.
+        length: u64,
+        /// The file's size, bytes.
+        bytes: usize,
+    },
+    /// A Zstandard level whose uncompressed length is not that of its UASTC blocks.
+    #[error(
+        "level {level}: uncompressedByteLength {uncompressed}, expected {expected} (16 bytes per 4 × 4 UASTC block)"
+    )]
+    LevelSize {
+        /// The level.
+        level: u32,
+        /// Its `uncompressedByteLength`.
+        uncompressed: u64,
+        /// 16 bytes per block of the level.
+        expected: u64,
+    },
+    /// A Basis codec other than ETC1S and UASTC LDR (the extension's two).
+    #[error("{codec} data (KHR_texture_basisu allows ETC1S and UASTC)")]
+    Codec {
+        /// The codec the transcoder found.
+        codec: String,
+    },
+    /// The transcoder refused the data.
+    #[error("the Basis Universal transcoder refused it ({reason})")]
+    Transcoder {
+        /// The transcoder's error.
+        reason: String,
+    },
+    /// The transcoder failed (panicked) on damaged data.
+    #[error("malformed Basis Universal data (the transcoder failed)")]
+    Panicked,
 }

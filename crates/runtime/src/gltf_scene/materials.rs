@@ -1,10 +1,12 @@
 //! The document's materials (glTF §3.9 and the extensions nacre implements) with the
 //! textures they read, and the `iridescenceThicknessTexture` of each as a thickness map.
 
+use super::error::GltfError;
 use super::model::{AlphaMode, Clearcoat, GltfMaterial, Iridescence, MaterialTextures, Volume};
 use super::textures::{
-    GltfTexture, TextureLoader, TextureRef, thickness_texture, transform_from_json,
+    GltfTexture, TextureFailure, TextureLoader, TextureRef, thickness_texture, transform_from_json,
 };
+use crate::error::Result;
 use crate::thickness_map::ThicknessMap;
 use std::path::Path;
 
@@ -22,8 +24,9 @@ pub(super) struct Materials {
     pub(super) notes: Vec<String>,
 }
 
-/// Reads every material of `doc` (its textures from `buffers`; `path` names the file).
-pub(super) fn read(doc: &gltf::Document, buffers: &[Vec<u8>], path: &Path) -> Materials {
+/// Reads every material of `doc` (its textures from `buffers`; `path` names the file); a
+/// broken `KHR_texture_basisu` texture is an error.
+pub(super) fn read(doc: &gltf::Document, buffers: &[Vec<u8>], path: &Path) -> Result<Materials> {
     let mut loader = TextureLoader {
         doc,
         buffers,
@@ -31,25 +34,31 @@ pub(super) fn read(doc: &gltf::Document, buffers: &[Vec<u8>], path: &Path) -> Ma
         textures: Vec::new(),
         cache: Default::default(),
         notes: Vec::new(),
+        broken: None,
     };
     let mut materials: Vec<GltfMaterial> =
         doc.materials().map(|m| material(&mut loader, &m)).collect();
     let TextureLoader {
         textures,
         mut notes,
+        broken,
         ..
     } = loader;
+    if let Some(error) = broken {
+        return Err(error.at(path));
+    }
     materials.push(GltfMaterial::default());
     let thickness_maps = materials
         .iter()
         .map(|m| thickness_map(doc, m, buffers, path, &mut notes))
-        .collect();
-    Materials {
+        .collect::<std::result::Result<_, GltfError>>()
+        .map_err(|e| e.at(path))?;
+    Ok(Materials {
         materials,
         thickness_maps,
         textures,
         notes,
-    }
+    })
 }
 
 /// One material: its factors, and its textures through `loader`.
@@ -186,19 +195,21 @@ fn material(loader: &mut TextureLoader, m: &gltf::Material) -> GltfMaterial {
 }
 
 /// The thickness map of `m`'s `iridescenceThicknessTexture`, or None (with a note when it
-/// has one that cannot be read: the film is then d_max thick).
+/// has one that cannot be read: the film is then d_max thick), or the error of a broken
+/// `KHR_texture_basisu` texture.
 fn thickness_map(
     doc: &gltf::Document,
     m: &GltfMaterial,
     buffers: &[Vec<u8>],
     path: &Path,
     notes: &mut Vec<String>,
-) -> Option<ThicknessMap> {
+) -> std::result::Result<Option<ThicknessMap>, GltfError> {
     let iri = m.iridescence.unwrap_or_default();
-    match iri.thickness_texture {
+    Ok(match iri.thickness_texture {
         Some((index, _)) => match thickness_texture(doc, index, buffers, path) {
             Ok(map) => Some(map),
-            Err(why) => {
+            Err(TextureFailure::Broken(error)) => return Err(error),
+            Err(TextureFailure::Skip(why)) => {
                 notes.push(format!(
                     "{}: iridescenceThicknessTexture not read ({why}); the film is d_max = {} nm",
                     m.name, iri.thickness_max_nm
@@ -207,7 +218,7 @@ fn thickness_map(
             }
         },
         None => None,
-    }
+    })
 }
 
 /// `KHR_materials_clearcoat` from its JSON object `ext`, the extension's defaults where a

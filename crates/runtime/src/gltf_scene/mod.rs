@@ -2,7 +2,7 @@
 //! tangents, two texture-coordinate sets, vertex colours, indexed or not, node transforms
 //! applied) and their materials — the core metallic-roughness model with all its textures,
 //! `KHR_materials_iridescence`, `KHR_materials_ior`, `KHR_materials_specular`,
-//! `KHR_materials_emissive_strength`, `KHR_materials_unlit`, `KHR_texture_transform`, `KHR_materials_transmission`
+//! `KHR_materials_emissive_strength`, `KHR_materials_unlit`, `KHR_texture_transform`, `KHR_texture_basisu`, `KHR_materials_transmission`
 //! and `KHR_materials_volume` (thickness factor and attenuation) — mapped onto nacre's [`MaterialOptions`] (the uniform
 //! parameters) and [`GltfMaterial`]'s textures (read per fragment by `shaders/mesh.wgsl`).
 //!
@@ -17,11 +17,12 @@
 //!   normal-mapped primitive MikkTSpace tangents (`bevy_mikktspace`, as §3.7.2.1 prescribes),
 //!   computed after the node transform; a mirroring node transform (negative determinant)
 //!   reverses the triangles' winding (§3.5.3);
-//! * textures ([`textures`]): PNG and JPEG pictures (in buffer views, `data:` URIs or files), RGBA8, colour
+//! * textures ([`textures`]): PNG and JPEG pictures (in buffer views, `data:` URIs or files)
+//!   and `KHR_texture_basisu` KTX2 files (ETC1S and UASTC, transcoded on the CPU: [`basisu`];
+//!   a damaged one is an error), RGBA8, colour
 //!   textures (base colour, emissive, specular colour) decoded from sRGB by the GPU's sRGB
-//!   format, mipmaps made on upload; the texture's sampler (wrap modes, filters); KTX2/Basis
-//!   (`KHR_texture_basisu`), WebP and others are not decoded (the texture is ignored with a
-//!   note, its factor kept).
+//!   format, mipmaps made on upload; the texture's sampler (wrap modes, filters); WebP and
+//!   others are not decoded (the texture is ignored with a note, its factor kept).
 //!
 //! # The mapping (glTF → [`MaterialOptions`])
 //!
@@ -84,6 +85,7 @@ use std::path::{Path, PathBuf};
 
 mod accessor;
 pub mod assets;
+pub mod basisu;
 mod document;
 mod draco;
 pub mod error;
@@ -96,7 +98,7 @@ mod primitive;
 pub mod textures;
 
 pub use document::SUPPORTED_EXTENSIONS;
-pub use error::GltfError;
+pub use error::{GltfError, Ktx2Error};
 pub use limits::{MAX_FILE_BYTES, MAX_INDICES, MAX_VERTICES};
 pub use metal::{GOLD_F0, MetalBands, is_gold_like, metal_index_gulbrandsen2014, rgb_metal_for};
 pub use model::{
@@ -172,7 +174,7 @@ impl GltfScene {
             thickness_maps,
             textures,
             mut notes,
-        } = materials::read(&gltf.document, &buffers, path);
+        } = materials::read(&gltf.document, &buffers, path)?;
         let draco_required = required.iter().any(|e| e == draco::EXTENSION);
         let placed = nodes::place(&gltf.document, &buffers, path, &materials, draco_required)?;
         notes.extend(placed.notes);

@@ -1,10 +1,13 @@
 //! The textures of a glTF scene ([`crate::gltf_scene`]): the texture records the materials
 //! refer to ([`GltfTexture`], [`TextureRef`], [`SamplerSpec`]), and their loading — pictures
-//! (PNG and JPEG) from buffer views, `data:` URIs or files, decoded with the `image` crate, the
+//! (PNG and JPEG) from buffer views, `data:` URIs or files, decoded with the `image` crate, or
+//! `KHR_texture_basisu` KTX2 files transcoded by `basisu.rs` (a damaged one is an error), the
 //! glTF sampler, `KHR_texture_transform`, and the iridescence thickness texture as a
 //! [`ThicknessMap`]. What cannot be decoded is skipped with a note, its factor kept.
 
+use super::basisu::basisu_source;
 use super::document::base64_decode;
+use super::error::{GltfError, Ktx2Error};
 use super::limits::MAX_FILE_BYTES;
 use crate::thickness_map::ThicknessMap;
 use std::path::Path;
@@ -87,38 +90,121 @@ pub const IDENTITY_TRANSFORM: [[f32; 3]; 2] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
 /// Largest width or height of a thickness texture, texels.
 pub const MAX_TEXTURE_DIMENSION: u32 = 8192;
 
-/// Decodes texture `index` of `doc` (a PNG, in a buffer view or a `data:`/file URI) into a
-/// thickness map holding its green channel (glTF: "the green channel of this texture defines
-/// the thickness"), as data in [0, 1] (no sRGB decoding).
+/// Why a texture was not read: skipped with a note (a picture format nacre does not read, a
+/// PNG that does not decode), or a broken `KHR_texture_basisu` file, which is the scene's
+/// error.
+#[derive(Debug)]
+pub(crate) enum TextureFailure {
+    /// Skipped: the note's reason.
+    Skip(String),
+    /// The file's error.
+    Broken(GltfError),
+}
+
+impl From<String> for TextureFailure {
+    fn from(why: String) -> Self {
+        TextureFailure::Skip(why)
+    }
+}
+
+impl From<&str> for TextureFailure {
+    fn from(why: &str) -> Self {
+        TextureFailure::Skip(why.to_string())
+    }
+}
+
+/// A texture's picture decoded to RGBA8: width, height, texels, and the image it came from.
+struct Picture {
+    width: u32,
+    height: u32,
+    rgba: Vec<u8>,
+    image: usize,
+}
+
+/// Decodes texture `index` of `doc` into RGBA8 texels: its `KHR_texture_basisu` KTX2 image
+/// where it has the extension (`basisu.rs`), else its core `source` (PNG or JPEG), in a
+/// buffer view or a `data:`/file URI.
+fn decode_picture(
+    doc: &gltf::Document,
+    index: usize,
+    buffers: &[Vec<u8>],
+    path: &Path,
+) -> std::result::Result<Picture, TextureFailure> {
+    let json = doc
+        .as_json()
+        .textures
+        .get(index)
+        .ok_or_else(|| format!("texture {index} does not exist"))?;
+    if let Some(source) = basisu_source(json) {
+        // `document.rs` has checked the index.
+        let image = source.unwrap_or(usize::MAX);
+        let broken = |error: Ktx2Error| {
+            TextureFailure::Broken(GltfError::Basisu {
+                texture: index,
+                image,
+                error,
+            })
+        };
+        let bytes = image_bytes(doc, image, buffers, path, &["image/ktx2"])
+            .map_err(|what| broken(Ktx2Error::Image { what }))?;
+        let decoded = super::basisu::decode(&bytes).map_err(broken)?;
+        return Ok(Picture {
+            width: decoded.width,
+            height: decoded.height,
+            rgba: decoded.rgba,
+            image,
+        });
+    }
+    let image = json.source.value();
+    let bytes = image_bytes(doc, image, buffers, path, &["image/png", "image/jpeg"])?;
+    let picture =
+        crate::image_io::decode_picture(path, "a texture", &bytes).map_err(|e| e.to_string())?;
+    let (width, height) = (picture.width(), picture.height());
+    if width == 0 || height == 0 || width.max(height) > MAX_TEXTURE_DIMENSION {
+        return Err(format!("{width}x{height} texels (at most {MAX_TEXTURE_DIMENSION})").into());
+    }
+    Ok(Picture {
+        width,
+        height,
+        rgba: picture.into_rgba8().into_raw(),
+        image,
+    })
+}
+
+/// Decodes texture `index` of `doc` into a thickness map holding its green channel (glTF:
+/// "the green channel of this texture defines the thickness"), as data in [0, 1] (no sRGB
+/// decoding).
 pub(crate) fn thickness_texture(
     doc: &gltf::Document,
     index: usize,
     buffers: &[Vec<u8>],
     path: &Path,
-) -> std::result::Result<ThicknessMap, String> {
-    let bytes = texture_bytes(doc, index, buffers, path)?;
-    let picture = crate::image_io::decode_picture(path, "a thickness texture", &bytes)
-        .map_err(|e| e.to_string())?;
-    thickness_map_of(&picture)
+) -> std::result::Result<ThicknessMap, TextureFailure> {
+    let p = decode_picture(doc, index, buffers, path)?;
+    let picture = image::RgbaImage::from_raw(p.width, p.height, p.rgba)
+        .ok_or("the decoded picture has the wrong size")?;
+    Ok(thickness_map_of(&image::DynamicImage::ImageRgba8(picture))?)
 }
 
-/// The encoded picture of texture `index` of `doc` (PNG or JPEG, in a buffer view or a
-/// `data:`/file URI).
-pub(crate) fn texture_bytes(
+/// The encoded bytes of image `image` of `doc` (in a buffer view, whose `mimeType` must be
+/// one of `mime_types`, or a `data:`/file URI).
+pub(crate) fn image_bytes(
     doc: &gltf::Document,
-    index: usize,
+    image: usize,
     buffers: &[Vec<u8>],
     path: &Path,
+    mime_types: &[&str],
 ) -> std::result::Result<Vec<u8>, String> {
-    let texture = doc
-        .textures()
-        .nth(index)
-        .ok_or_else(|| format!("texture {index} does not exist"))?;
-    let bytes: Vec<u8> = match texture.source().source() {
+    let picture = doc
+        .images()
+        .nth(image)
+        .ok_or_else(|| format!("image {image} does not exist"))?;
+    let bytes: Vec<u8> = match picture.source() {
         gltf::image::Source::View { view, mime_type } => {
-            if mime_type != "image/png" && mime_type != "image/jpeg" {
+            if !mime_types.contains(&mime_type) {
                 return Err(format!(
-                    "{mime_type} images are not supported (PNG or JPEG only)"
+                    "{mime_type} images are not supported here ({} only)",
+                    mime_types.join(", ")
                 ));
             }
             let data = buffers.get(view.buffer().index()).ok_or("missing buffer")?;
@@ -187,26 +273,17 @@ pub(crate) fn decode_texture(
     srgb: bool,
     buffers: &[Vec<u8>],
     path: &Path,
-) -> std::result::Result<GltfTexture, String> {
+) -> std::result::Result<GltfTexture, TextureFailure> {
+    let picture = decode_picture(doc, index, buffers, path)?;
     let texture = doc
         .textures()
         .nth(index)
         .ok_or_else(|| format!("texture {index} does not exist"))?;
-    let bytes = texture_bytes(doc, index, buffers, path)?;
-    let picture =
-        crate::image_io::decode_picture(path, "a texture", &bytes).map_err(|e| e.to_string())?;
-    let (width, height) = (picture.width(), picture.height());
-    if width == 0 || height == 0 || width.max(height) > MAX_TEXTURE_DIMENSION {
-        return Err(format!(
-            "{width}x{height} texels (at most {MAX_TEXTURE_DIMENSION})"
-        ));
-    }
-    let rgba = picture.into_rgba8().into_raw();
     Ok(GltfTexture {
-        name: format!("texture {index} (image {})", texture.source().index()),
-        width,
-        height,
-        rgba,
+        name: format!("texture {index} (image {})", picture.image),
+        width: picture.width,
+        height: picture.height,
+        rgba: picture.rgba,
         srgb,
         sampler: sampler_spec(&texture.sampler()),
     })
@@ -287,6 +364,8 @@ pub(crate) struct TextureLoader<'a> {
     pub(crate) textures: Vec<GltfTexture>,
     pub(crate) cache: std::collections::BTreeMap<(usize, bool), Option<usize>>,
     pub(crate) notes: Vec<String>,
+    /// The first broken `KHR_texture_basisu` texture met (the scene's error).
+    pub(crate) broken: Option<GltfError>,
 }
 
 impl TextureLoader<'_> {
@@ -309,10 +388,14 @@ impl TextureLoader<'_> {
                         self.textures.push(t);
                         Some(self.textures.len() - 1)
                     }
-                    Err(why) => {
+                    Err(TextureFailure::Skip(why)) => {
                         self.notes.push(format!(
                             "{material}: {slot} (texture {index}) not read ({why}); its factor is used"
                         ));
+                        None
+                    }
+                    Err(TextureFailure::Broken(error)) => {
+                        self.broken.get_or_insert(error);
                         None
                     }
                 };
