@@ -145,7 +145,7 @@ fn decode_picture(
                 error,
             })
         };
-        let bytes = image_bytes(doc, image, buffers, path, &["image/ktx2"])
+        let bytes = image_bytes(doc, image, buffers, path, (&["image/ktx2"], "KTX2"))
             .map_err(|what| broken(Ktx2Error::Image { what }))?;
         let decoded = super::basisu::decode(&bytes).map_err(broken)?;
         return Ok(Picture {
@@ -156,7 +156,13 @@ fn decode_picture(
         });
     }
     let image = json.source.value();
-    let bytes = image_bytes(doc, image, buffers, path, &["image/png", "image/jpeg"])?;
+    let bytes = image_bytes(
+        doc,
+        image,
+        buffers,
+        path,
+        (&["image/png", "image/jpeg"], "PNG or JPEG"),
+    )?;
     let picture =
         crate::image_io::decode_picture(path, "a texture", &bytes).map_err(|e| e.to_string())?;
     let (width, height) = (picture.width(), picture.height());
@@ -187,13 +193,13 @@ pub(crate) fn thickness_texture(
 }
 
 /// The encoded bytes of image `image` of `doc` (in a buffer view, whose `mimeType` must be
-/// one of `mime_types`, or a `data:`/file URI).
+/// one of `mime_types`, named `formats` in the message, or a `data:`/file URI).
 pub(crate) fn image_bytes(
     doc: &gltf::Document,
     image: usize,
     buffers: &[Vec<u8>],
     path: &Path,
-    mime_types: &[&str],
+    (mime_types, formats): (&[&str], &str),
 ) -> std::result::Result<Vec<u8>, String> {
     let picture = doc
         .images()
@@ -203,8 +209,7 @@ pub(crate) fn image_bytes(
         gltf::image::Source::View { view, mime_type } => {
             if !mime_types.contains(&mime_type) {
                 return Err(format!(
-                    "{mime_type} images are not supported here ({} only)",
-                    mime_types.join(", ")
+                    "{mime_type} images are not supported ({formats} only)"
                 ));
             }
             let data = buffers.get(view.buffer().index()).ok_or("missing buffer")?;
