@@ -20,7 +20,7 @@
 //! `source` where the extension gives one, and `textures.rs` reads the extension's image.
 
 use super::error::Ktx2Error;
-use super::textures::MAX_TEXTURE_DIMENSION;
+use super::limits::MAX_TEXTURE_DIMENSION;
 
 /// The extension's name.
 pub const EXTENSION: &str = "KHR_texture_basisu";

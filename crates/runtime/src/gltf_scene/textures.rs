@@ -87,8 +87,7 @@ pub struct TextureRef {
 /// The identity texture transform.
 pub const IDENTITY_TRANSFORM: [[f32; 3]; 2] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
 
-/// Largest width or height of a thickness texture, texels.
-pub const MAX_TEXTURE_DIMENSION: u32 = 8192;
+pub use super::limits::MAX_TEXTURE_DIMENSION;
 
 /// Why a texture was not read: skipped with a note (a picture format nacre does not read, a
 /// PNG that does not decode), or a broken `KHR_texture_basisu` file, which is the scene's
