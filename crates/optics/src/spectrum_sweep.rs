@@ -361,6 +361,23 @@ fn resolve(material: &Material, wavelengths_nm: &[f64]) -> Result<Indices> {
     })
 }
 
+/// The one-shot sweep, defined here so that `stack.rs` needs nothing of this module (no
+/// import circle): [`Stack`]'s powers through a [`SpectrumSweep`].
+impl Stack {
+    /// Powers over every (angle, wavelength) pair, angle-major: element
+    /// `a * wavelengths_nm.len() + w`.
+    ///
+    /// A [`SpectrumSweep`] made and run once. Indices are resolved once (a constant
+    /// material once in all, a dispersive one per wavelength); each angle's row then runs
+    /// through the vectorised kernel of the `multilayer` module (wavelengths as SIMD lanes, IEEE basic
+    /// operations only: the same bits on every CPU, vector width and thread count), or,
+    /// for indices or phases outside the kernel's range (|ñ| beyond [10⁻⁶, 10⁶], film phases
+    /// beyond 10⁶ rad), through the scalar recurrence of [`crate::Prepared`].
+    pub fn sweep(&self, angles_deg: &[f64], wavelengths_nm: &[f64]) -> Result<Vec<Power>> {
+        SpectrumSweep::new(self, angles_deg, wavelengths_nm)?.powers()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -484,19 +484,6 @@ impl Stack {
         })
     }
 
-    /// Powers over every (angle, wavelength) pair, angle-major: element
-    /// `a * wavelengths_nm.len() + w`.
-    ///
-    /// [`crate::SpectrumSweep`] made and run once. Indices are resolved once (a constant
-    /// material once in all, a dispersive one per wavelength); each angle's row then runs
-    /// through the vectorised kernel of the `multilayer` module (wavelengths as SIMD lanes, IEEE basic
-    /// operations only: the same bits on every CPU, vector width and thread count), or,
-    /// for indices or phases outside the kernel's range (|ñ| beyond [10⁻⁶, 10⁶], film phases
-    /// beyond 10⁶ rad), through the scalar recurrence of [`Prepared`].
-    pub fn sweep(&self, angles_deg: &[f64], wavelengths_nm: &[f64]) -> Result<Vec<Power>> {
-        crate::spectrum_sweep::SpectrumSweep::new(self, angles_deg, wavelengths_nm)?.powers()
-    }
-
     /// [`Stack::sweep`] with, per (angle, wavelength) and polarisation, the power absorbed in
     /// each part of the stack: its coherent groups and incoherent slabs, top first
     /// ([`Stack::parts`]; a coherent stack is one group). R + T + ΣA = 1.
