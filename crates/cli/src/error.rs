@@ -64,6 +64,12 @@ pub fn flag(param: Param) -> &'static str {
         Param::Jacobian => "--jacobian",
         Param::BenchFilmIor => "--film-ior",
         Param::BenchBaseIor => "--base-ior",
+        Param::Measured => "MEASURED",
+        Param::Scale => "--scale",
+        Param::Offset => "--offset",
+        Param::FitRange => "--range",
+        Param::Loss => "--loss",
+        Param::Residuals => "--residuals",
     }
 }
 

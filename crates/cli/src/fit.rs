@@ -1,11 +1,21 @@
 //! `nacre fit`: from a look or a measurement back to parameters. `nacre fit gltf`: the
-//! closest glTF `KHR_materials_iridescence` material to a stack.
+//! closest glTF `KHR_materials_iridescence` material to a stack; `nacre fit spectrum`: a
+//! template's free thicknesses and indices (ranges in the stack flags) fitted to measured
+//! spectra.
 
 use crate::args::{StackArgs, load_stack};
 use crate::error::Result;
 use clap::{Args, Subcommand};
 use nacre_bake::commands::fit_gltf;
+use nacre_bake::commands::fit_spectrum::{
+    Request, fit_all, map_csv, parse_baseline, parse_loss, parse_window, read_spectra, recipe_toml,
+    residuals_csv, warnings,
+};
+use nacre_bake::commands::fit_template::FitTemplate;
+use nacre_bake::commands::stack_spec::TemplateSpec;
+use nacre_format::Param;
 use nacre_format::atomic::write_atomic;
+use nacre_optics::fit::{Quantity, Settings};
 use std::path::PathBuf;
 
 pub const GLTF_EXAMPLES: &str = "\
@@ -24,6 +34,22 @@ Examples:
   # anodised titanium: an oxide film on a metal gives a metallic base
   nacre fit gltf --layer tio2@60 --substrate 2.5+3.4i";
 
+pub const SPECTRUM_EXAMPLES: &str = "\
+A range marks a free parameter: --layer sio2@50:400 (thickness free in 50–400 nm),
+--layer 1.3:1.7@100:600 (constant index free in 1.3–1.7, thickness in 100–600 nm); in a
+recipe, thickness_nm = [50, 400] and material = \"1.3:1.7\".
+
+Examples:
+  # one oxide film on silicon, thickness anywhere in 10–2000 nm
+  nacre fit spectrum measured.csv --layer sio2@10:2000 --substrate si -o fit.toml
+  # a relative measurement: free scale, a linear baseline, 450–750 nm only
+  nacre fit spectrum counts.csv --layer sio2@10:2000 --substrate si --scale free \\
+      --offset poly:1 --range 450:750 -o fit.toml --residuals res.csv
+  # a folder of spectra (or a wide CSV): a thickness map
+  nacre fit spectrum wafer/ --layer sio2@10:2000 --substrate si -o map.csv
+  # the fitted stack, back into the forward commands
+  nacre spectrum --recipe fit.toml";
+
 #[derive(Args)]
 pub struct FitArgs {
     #[command(subcommand)]
@@ -37,6 +63,11 @@ enum FitCommand {
     /// to a stack's exact colour over 0-85 degrees, as glTF JSON.
     #[command(after_help = GLTF_EXAMPLES)]
     Gltf(GltfArgs),
+    /// Fit a stack's free thicknesses and indices to measured reflectance or transmittance
+    /// spectra (CSV: wavelength_nm, R or T, optional angle_deg and sigma), globally over the
+    /// bounds.
+    #[command(after_help = SPECTRUM_EXAMPLES)]
+    Spectrum(FitSpectrumArgs),
 }
 
 #[derive(Args)]
@@ -57,9 +88,61 @@ pub struct GltfArgs {
     output: PathBuf,
 }
 
+#[derive(Args)]
+pub struct FitSpectrumArgs {
+    /// The measured spectrum: a CSV file (one R or T column, or several: a wide file) or a
+    /// folder of CSV files.
+    #[arg(value_name = "MEASURED")]
+    measured: PathBuf,
+    /// Ambient (incidence) medium [default: 1.0].
+    #[arg(long, value_name = "M")]
+    ambient: Option<String>,
+    /// A film, top first, with ranges for free values: `sio2@50:400`, `1.3:1.7@100:600`.
+    #[arg(long = "layer", value_name = "M@THICKNESS")]
+    layers: Vec<String>,
+    /// Substrate [default: 1.0].
+    #[arg(long, value_name = "M")]
+    substrate: Option<String>,
+    /// Read the template from a TOML recipe (ranges: thickness_nm = [LO, HI], material =
+    /// "NLO:NHI").
+    #[arg(long, value_name = "FILE.toml", conflicts_with_all = ["ambient", "layers", "substrate"])]
+    recipe: Option<PathBuf>,
+    /// The measured quantity of a wide file's columns: r or t [default: the column's name].
+    #[arg(long, value_name = "r|t")]
+    quantity: Option<String>,
+    /// Scale a(λ) of R_measured ≈ a·R + b: a number, `free` or `poly:N` (degree N in
+    /// wavenumber).
+    #[arg(long, default_value = "1", value_name = "1|free|poly:N")]
+    scale: String,
+    /// Offset b(λ): a number, `free` or `poly:N`.
+    #[arg(long, default_value = "0", value_name = "0|free|poly:N")]
+    offset: String,
+    /// Fit only wavelengths in START:END, nm.
+    #[arg(long = "range", value_name = "START:END")]
+    window: Option<String>,
+    /// Loss: cauchy (robust to outliers) or linear (least squares).
+    #[arg(long, default_value = "cauchy")]
+    loss: String,
+    /// Most starts of the global search.
+    #[arg(long, default_value_t = 64)]
+    starts: usize,
+    /// Output: the fitted recipe (TOML; a CSV thickness map for several spectra), or `-`.
+    #[arg(
+        short = 'o',
+        long = "output",
+        value_name = "FIT.toml",
+        default_value = "-"
+    )]
+    output: PathBuf,
+    /// Write measured, fitted and residual values per point to this CSV.
+    #[arg(long, value_name = "FILE.csv")]
+    residuals: Option<PathBuf>,
+}
+
 pub fn run(args: &FitArgs) -> Result<()> {
     match &args.command {
         FitCommand::Gltf(args) => gltf(args),
+        FitCommand::Spectrum(args) => spectrum(args),
     }
 }
 
@@ -90,5 +173,58 @@ fn gltf(args: &GltfArgs) -> Result<()> {
         n.max,
         fit_gltf::describe(&report.naive)
     );
+    Ok(())
+}
+
+fn spectrum(args: &FitSpectrumArgs) -> Result<()> {
+    let spec = match &args.recipe {
+        Some(path) => TemplateSpec::read(path)?,
+        None => TemplateSpec::from_flags(
+            args.ambient.as_deref(),
+            &args.layers,
+            args.substrate.as_deref(),
+        )?,
+    };
+    let template = FitTemplate::build(spec)?;
+    let quantity = match args.quantity.as_deref() {
+        None => None,
+        Some("r" | "R") => Some(Quantity::Reflectance),
+        Some("t" | "T") => Some(Quantity::Transmittance),
+        Some(other) => {
+            return Err(nacre_bake::Error::value(Param::Quantity, other, "expected r or t").into());
+        }
+    };
+    let request = Request {
+        settings: Settings {
+            scale: parse_baseline(Param::Scale, &args.scale)?,
+            offset: parse_baseline(Param::Offset, &args.offset)?,
+            loss: parse_loss(&args.loss)?,
+            starts: args.starts.max(1),
+            ..Settings::default()
+        },
+        window: args.window.as_deref().map(parse_window).transpose()?,
+    };
+    let spectra = read_spectra(&args.measured, quantity)?;
+    let outcomes = fit_all(&template, &spectra, &request)?;
+    for o in &outcomes {
+        for w in warnings(&template, &o.fit) {
+            eprintln!("warning: {}: {w}", o.name);
+        }
+    }
+    // Everything is computed before anything is written.
+    let output = if outcomes.len() == 1 {
+        recipe_toml(&template, &outcomes[0])?.into_bytes()
+    } else {
+        let mut v = Vec::new();
+        map_csv(&template, &outcomes, &mut v).map_err(|source| nacre_format::Error::Io {
+            path: args.output.clone(),
+            source,
+        })?;
+        v
+    };
+    if let Some(path) = &args.residuals {
+        write_atomic(path, |w| residuals_csv(&outcomes, w))?;
+    }
+    write_atomic(&args.output, |w| w.write_all(&output))?;
     Ok(())
 }

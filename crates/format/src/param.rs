@@ -150,6 +150,18 @@ params! {
     Distance => "distance",
     /// Derivatives of a spectrum by the films' thicknesses.
     Jacobian => "jacobian",
+    /// A measured spectrum to fit: a CSV file or a folder of them.
+    Measured => "measured",
+    /// A fit's scale model (`1`, `free`, `poly:N`).
+    Scale => "scale",
+    /// A fit's offset model (`0`, `free`, `poly:N`).
+    Offset => "offset",
+    /// A fit's wavelength window, nm.
+    FitRange => "fit_range",
+    /// A fit's loss (`linear`, `cauchy`).
+    Loss => "loss",
+    /// The residuals file of a fit.
+    Residuals => "residuals",
 }
 
 impl Param {

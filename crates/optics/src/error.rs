@@ -229,6 +229,12 @@ pub enum Error {
         /// What was wrong.
         message: String,
     },
+    /// Data a fit cannot use (too few points for the free parameters, nothing to fit).
+    #[error("{message}")]
+    FitData {
+        /// What was wrong.
+        message: String,
+    },
 }
 
 /// Shorthand for `Result<T, nacre_optics::Error>`.

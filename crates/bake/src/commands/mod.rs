@@ -11,6 +11,7 @@ pub mod conformance;
 pub mod diffraction;
 pub mod export_stack;
 pub mod fit_gltf;
+pub mod fit_spectrum;
 pub mod fit_template;
 pub mod grid;
 pub mod plot;

@@ -3,12 +3,17 @@
 //!
 //! * [`template`] — a stack with free parameters and their bounds;
 //! * [`nelder_mead`] — the bounded Nelder–Mead simplex for a few parameters;
-//! * [`gltf`] — the closest `KHR_materials_iridescence` film to target colours.
+//! * [`lm`] — a small box-bounded Levenberg–Marquardt;
+//! * [`gltf`] — the closest `KHR_materials_iridescence` film to target colours;
+//! * [`spectrum`] — the global fit of a measured spectrum.
 //!
 //! No I/O: the commands read the data and the template, this module fits.
 
 pub mod gltf;
+pub mod lm;
 pub mod nelder_mead;
+pub mod spectrum;
 pub mod template;
 
+pub use spectrum::{Baseline, Loss, Measurement, Quantity, Settings, SpectrumFit, fit_spectrum};
 pub use template::{Free, FreeKind, Template};
