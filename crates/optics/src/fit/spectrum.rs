@@ -256,9 +256,9 @@ impl<'m, 'a> Projected<'m, 'a> {
         let k = ns + no;
         let column = |j: usize, i: usize| -> f64 {
             if j < ns {
-                self.m[i] * self.u[i].powi(j as i32)
+                self.m[i] * pow(self.u[i], j)
             } else {
-                self.u[i].powi((j - ns) as i32)
+                pow(self.u[i], j - ns)
             }
         };
         let fixed = |i: usize| -> f64 {
@@ -336,6 +336,15 @@ struct Data {
     w: Vec<f64>,
     /// Normalised wavenumber.
     u: Vec<f64>,
+}
+
+/// u^k by repeated multiplication (IEEE basic operations: the same bits everywhere).
+fn pow(u: f64, k: usize) -> f64 {
+    (0..k).fold(1.0, |a, _| a * u)
+}
+
+fn sq(v: f64) -> f64 {
+    v * v
 }
 
 /// The Halton sequence's `i`-th value in base `b` (i ≥ 1), in (0, 1).
@@ -533,9 +542,9 @@ pub fn fit_spectrum(
     full.residuals(&best.x, &mut fitted)?;
     let (scale, offset) = full.solve_linear(&mut fitted);
     let chi2: f64 = (0..n)
-        .map(|i| (data.w[i] * (data.y[i] - fitted[i])).powi(2))
+        .map(|i| sq(data.w[i] * (data.y[i] - fitted[i])))
         .sum();
-    let rms = ((0..n).map(|i| (data.y[i] - fitted[i]).powi(2)).sum::<f64>() / n as f64).sqrt();
+    let rms = ((0..n).map(|i| sq(data.y[i] - fitted[i])).sum::<f64>() / n as f64).sqrt();
     let dof = (n - dims - linear) as f64;
     let s2 = if points.iter().all(|p| p.sigma.is_some()) {
         1.0
