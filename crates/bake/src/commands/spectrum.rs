@@ -105,17 +105,7 @@ pub fn write_csv_jacobian(
         for &wl in wavelengths_nm {
             let p = &powers[e];
             let d = &jacobian.d_thickness[e * films..(e + 1) * films];
-            let mut row = vec![
-                a.to_string(),
-                wl.to_string(),
-                fmt_sig(p.R_s),
-                fmt_sig(p.R_p),
-                fmt_sig(p.R()),
-                fmt_sig(p.T_s),
-                fmt_sig(p.T_p),
-                fmt_sig(p.T()),
-                fmt_sig(p.A()),
-            ];
+            let mut row = value_cells(a, wl, p).to_vec();
             row.extend(d.iter().map(|x| fmt_sig(x.R())));
             row.extend(d.iter().map(|x| fmt_sig(x.T())));
             csv.write_record(row)?;
@@ -274,20 +264,25 @@ pub fn write_csv(
     for &a in angles_deg {
         for &wl in wavelengths_nm {
             let p = cells.next().expect("one power per (angle, wavelength)");
-            csv.write_record([
-                a.to_string(),
-                wl.to_string(),
-                fmt_sig(p.R_s),
-                fmt_sig(p.R_p),
-                fmt_sig(p.R()),
-                fmt_sig(p.T_s),
-                fmt_sig(p.T_p),
-                fmt_sig(p.T()),
-                fmt_sig(p.A()),
-            ])?;
+            csv.write_record(value_cells(a, wl, p))?;
         }
     }
     csv.flush()
+}
+
+/// The value columns of one row ([`HEADER`]): angle, wavelength, R_s, R_p, R, T_s, T_p, T, A.
+fn value_cells(angle_deg: f64, wavelength_nm: f64, p: &Power) -> [String; 9] {
+    [
+        angle_deg.to_string(),
+        wavelength_nm.to_string(),
+        fmt_sig(p.R_s),
+        fmt_sig(p.R_p),
+        fmt_sig(p.R()),
+        fmt_sig(p.T_s),
+        fmt_sig(p.T_p),
+        fmt_sig(p.T()),
+        fmt_sig(p.A()),
+    ]
 }
 
 #[cfg(test)]
