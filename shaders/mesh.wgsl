@@ -148,6 +148,9 @@ const MESH_FLAG_LINEAR_OUTPUT: u32 = 2u;
 const MESH_FLAG_BEHIND: u32 = 4u;
 // KHR_materials_unlit: the colour is base colour × texture × COLOR_0, unlit, without film.
 const MESH_FLAG_UNLIT: u32 = 8u;
+// Set by the pipeline (mesh/pipeline.rs Raster) for lines and points without normals: drawn
+// unlit in their base colour, as KHR_materials_unlit draws (a line or point has no surface).
+override MESH_PRIMITIVE_UNLIT: bool = false;
 // MeshParams.coat_slots: no texture.
 const MESH_COAT_SLOT_NONE: u32 = 15u;
 // The clear coat's index 1.5: F0 = ((1.5 − 1)/(1.5 + 1))² (KHR_materials_clearcoat).
@@ -444,7 +447,7 @@ fn mesh_fs(in: MeshVertexOut, @builtin(front_facing) front: bool) -> @location(0
         // glTF's specular BTDF is tinted by the base colour.
         radiance += shade.transmittance * base.rgb * mesh_behind(in.world, n, v, ior, roughness);
     }
-    let unlit = (q.flags & MESH_FLAG_UNLIT) != 0u;
+    let unlit = (q.flags & MESH_FLAG_UNLIT) != 0u || MESH_PRIMITIVE_UNLIT;
     // The clear coat over everything below it (header).
     let coat = clamp(finite_or(q.clearcoat * coat_tex.r, 0.0), 0.0, 1.0);
     if coat > 0.0 {

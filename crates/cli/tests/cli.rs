@@ -1003,28 +1003,29 @@ fn render_gltf_writes_a_png_and_refuses_bad_files() {
         assert!(!err.contains("panicked"), "{extra:?}: {err}");
         assert!(!d.join("out.png").exists(), "{extra:?} wrote an output");
     }
-    // A primitive nacre does not draw (lines) is skipped with a note; the file renders.
-    let o = nacre(
-        &[
-            "render",
-            "--width",
-            "16",
-            "--height",
-            "12",
-            "--gltf",
-            "lines.glb",
-            "-o",
-            "lines.png",
-        ],
-        d,
-    );
-    let err = stderr(&o);
-    assert_eq!(o.status.code(), Some(0), "{err}");
-    assert!(
-        err.contains("skipped 1 primitive") && err.contains("Lines"),
-        "{err}"
-    );
-    assert!(d.join("lines.png").exists());
+    // A line primitive is drawn (as lines: the sphere's wireframe), with no note; the
+    // picture differs from the one of the same file with triangles.
+    std::fs::write(d.join("triangles.glb"), &good).unwrap();
+    let mut pictures = Vec::new();
+    for name in ["lines", "triangles"] {
+        let (glb, png) = (format!("{name}.glb"), format!("{name}.png"));
+        let o = nacre(
+            &[
+                "render", "--width", "100", "--height", "28", "--gltf", &glb, "-o", &png,
+            ],
+            d,
+        );
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(0), "{err}");
+        assert!(!err.contains("skipped"), "{err}");
+        pictures.push(image::open(d.join(&png)).unwrap().to_rgb8());
+    }
+    let differing = pictures[0]
+        .pixels()
+        .zip(pictures[1].pixels())
+        .filter(|(a, b)| a != b)
+        .count();
+    assert!(differing > 20, "{differing} pixels differ");
 }
 
 /// `nacre color --method rough-lut:NAME --roughness A` (issue 6) agrees with the Monte Carlo

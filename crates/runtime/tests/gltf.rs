@@ -6,7 +6,8 @@
 //! * every sweep renders with lut and fourier, the spheres show colour, and spheres whose
 //!   parameters differ get different colours;
 //! * one golden image (the thickness sweep, lut) under the thresholds of `tests/render.rs`;
-//! * bad files (missing, truncated, non-triangle primitives, absurd sizes) are errors.
+//! * bad files (missing, truncated, absurd sizes, a LINES primitive of odd count) are errors;
+//! * points, lines, line strips and line loops, indexed or not, are drawn where they lie.
 
 use nacre_runtime::gltf_scene::assets::{SPHERE_SPACING, SWEEPS, sweep_glb};
 use nacre_runtime::gltf_scene::{GltfError, GltfScene};
@@ -88,15 +89,20 @@ fn mesh_pipelines_validate_for_every_technique() {
 
 /// The image's pixel (x, y) of world point p under the renderer's fitted camera.
 fn project(scene: &GltfScene, p: [f32; 3]) -> (u32, u32) {
+    project_in(scene, p, SIZE)
+}
+
+/// [`project`] in an image of `size`.
+fn project_in(scene: &GltfScene, p: [f32; 3], size: (u32, u32)) -> (u32, u32) {
     let (lo, hi) = scene.bounds();
-    let cam = fit_camera(lo, hi, f64::from(SIZE.0) / f64::from(SIZE.1)).unwrap();
+    let cam = fit_camera(lo, hi, f64::from(size.0) / f64::from(size.1)).unwrap();
     let m = cam.view_proj;
     let c: [f32; 4] =
         std::array::from_fn(|r| m[0][r] * p[0] + m[1][r] * p[1] + m[2][r] * p[2] + m[3][r]);
     let (x, y) = (c[0] / c[3], c[1] / c[3]);
     (
-        ((x * 0.5 + 0.5) * SIZE.0 as f32) as u32,
-        ((0.5 - y * 0.5) * SIZE.1 as f32) as u32,
+        ((x * 0.5 + 0.5) * size.0 as f32) as u32,
+        ((0.5 - y * 0.5) * size.1 as f32) as u32,
     )
 }
 
@@ -341,22 +347,22 @@ fn bad_gltf_files_are_errors() {
         let bin_start = 20 + json_len + 8;
         nacre_runtime::gltf_scene::assets::glb(&doc, &good[bin_start..])
     };
-    let lines = dir.path().join("lines.glb");
+    let odd_lines = dir.path().join("odd-lines.glb");
     std::fs::write(
-        &lines,
-        patch(&|d| d["meshes"][0]["primitives"][0]["mode"] = 1.into()),
+        &odd_lines,
+        patch(&|d| {
+            d["meshes"][0]["primitives"][0]["mode"] = 1.into();
+            let indices = d["meshes"][0]["primitives"][0]["indices"].as_u64().unwrap();
+            d["accessors"][indices as usize]["count"] = 3.into();
+        }),
     )
     .unwrap();
-    // A primitive nacre cannot draw is skipped with one note, not the whole file.
-    let scene = GltfScene::load(&lines).expect("a line primitive is skipped");
-    assert_eq!(scene.primitives.len(), 4);
     assert!(
-        scene
-            .notes
-            .iter()
-            .any(|n| n.contains("skipped 1 primitive") && n.contains("Lines")),
-        "{:?}",
-        scene.notes
+        matches!(
+            gltf_err(&odd_lines, "LINES of 3 ends"),
+            GltfError::NotLines { ends: 3, .. }
+        ),
+        "LINES of 3 ends"
     );
     let huge = dir.path().join("huge.glb");
     std::fs::write(
@@ -916,16 +922,7 @@ fn unlit_materials_show_their_base_colour() {
     .unwrap();
     let image = &out.image;
     let background = pixel(image, (0, 0));
-    // sRGB encoding (IEC 61966-2-1) of the linear base colour, 0–255.
-    let expected = base.map(|c| {
-        let c = f64::from(c);
-        255.0
-            * if c <= 0.003_130_8 {
-                12.92 * c
-            } else {
-                1.055 * c.powf(1.0 / 2.4) - 0.055
-            }
-    });
+    let expected = srgb_255(base);
     let mut covered = 0;
     for y in 0..image.height {
         for x in 0..image.width {
@@ -1171,5 +1168,162 @@ fn clearcoat_layers_over_the_base_as_the_extension_says() {
                 );
             }
         }
+    }
+}
+
+/// A GLB of eight one-primitive meshes without normals, each a unit square's outline
+/// v0 = (0, 0), v1 = (1, 0), v2 = (1, 1), v3 = (0, 1) drawn with mode 0–3 (POINTS, LINES,
+/// LINE_LOOP, LINE_STRIP; column `mode`, placed at x = 2 mode), not indexed (row 0: the
+/// vertices in order) or indexed (row 1, at y = 2: the vertices stored v2, v0, v3, v1 and
+/// indices 1, 3, 0, 2 naming them in order), each with its own material of base colour
+/// `LINE_COLOURS[2 mode + row]`.
+fn lines_glb() -> Vec<u8> {
+    let square = [
+        [0.0f32, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+    ];
+    let mut bin = bytes_of(square.as_flattened(), f32::to_le_bytes); // 0..48
+    let stored = [square[2], square[0], square[3], square[1]];
+    bin.extend(bytes_of(stored.as_flattened(), f32::to_le_bytes)); // 48..96
+    bin.extend(bytes_of(&[1u16, 3, 0, 2], u16::to_le_bytes)); // 96..104
+    let (mut meshes, mut nodes, mut materials) = (vec![], vec![], vec![]);
+    for mode in 0..4u32 {
+        for row in 0..2u32 {
+            let k = (2 * mode + row) as usize;
+            let [r, g, b] = LINE_COLOURS[k];
+            materials.push(serde_json::json!({
+                "pbrMetallicRoughness": {"baseColorFactor": [r, g, b, 1.0], "metallicFactor": 0.0}
+            }));
+            let mut primitive = serde_json::json!({
+                "attributes": {"POSITION": row}, "mode": mode, "material": k
+            });
+            if row == 1 {
+                primitive["indices"] = 2.into();
+            }
+            meshes.push(serde_json::json!({"primitives": [primitive]}));
+            nodes.push(serde_json::json!({
+                "mesh": k, "translation": [2.0 * mode as f32, 2.0 * row as f32, 0.0]
+            }));
+        }
+    }
+    let position = |view: u32| {
+        serde_json::json!({"bufferView": view, "componentType": 5126, "count": 4,
+                           "type": "VEC3", "min": [0.0, 0.0, 0.0], "max": [1.0, 1.0, 0.0]})
+    };
+    let doc = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": (0..8).collect::<Vec<u32>>()}],
+        "nodes": nodes,
+        "meshes": meshes,
+        "materials": materials,
+        "buffers": [{"byteLength": bin.len()}],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": 48},
+            {"buffer": 0, "byteOffset": 48, "byteLength": 48},
+            {"buffer": 0, "byteOffset": 96, "byteLength": 8}
+        ],
+        "accessors": [
+            position(0),
+            position(1),
+            {"bufferView": 2, "componentType": 5123, "count": 4, "type": "SCALAR"}
+        ]
+    });
+    nacre_runtime::gltf_scene::assets::glb(&doc, &bin)
+}
+
+/// The base colours of [`lines_glb`]'s eight primitives (linear RGB).
+const LINE_COLOURS: [[f32; 3]; 8] = [
+    [1.0, 0.0, 0.0],
+    [0.0, 1.0, 0.0],
+    [0.0, 0.0, 1.0],
+    [1.0, 1.0, 0.0],
+    [1.0, 0.0, 1.0],
+    [0.0, 1.0, 1.0],
+    [1.0, 0.5, 0.0],
+    [0.5, 0.0, 1.0],
+];
+
+/// sRGB encoding (IEC 61966-2-1) of a linear colour, 0–255.
+fn srgb_255(rgb: [f32; 3]) -> [f64; 3] {
+    rgb.map(|c| {
+        let c = f64::from(c);
+        255.0
+            * if c <= 0.003_130_8 {
+                12.92 * c
+            } else {
+                1.055 * c.powf(1.0 / 2.4) - 0.055
+            }
+    })
+}
+
+/// POINTS, LINES, LINE_LOOP and LINE_STRIP (glTF 2.0 §3.7.2.1), indexed or not, are drawn:
+/// without normals, unlit in their base colour, one pixel wide, where their vertices and
+/// segments lie — a loop closes back to its first vertex, a strip does not, a line list
+/// joins pairs only, points draw no segment.
+#[test]
+fn points_and_lines_are_drawn_where_they_lie() {
+    let scene = GltfScene::from_bytes(&lines_glb(), Path::new("lines.glb")).unwrap();
+    assert!(scene.notes.is_empty(), "{:?}", scene.notes);
+    assert_eq!(scene.primitives.len(), 8);
+    let size = (240, 120);
+    let mut o = options();
+    (o.width, o.height) = size;
+    let out = render_gltf(
+        ctx(),
+        &film_tables("film-dielectric"),
+        Technique::Lut,
+        &scene,
+        &o,
+    )
+    .unwrap();
+    let image = &out.image;
+    // Whether a pixel of `colour` (within 1.5 of 255) lies within 2 pixels of world point p.
+    let shows = |p: [f32; 3], colour: [f64; 3]| {
+        let (x, y) = project_in(&scene, p, size);
+        (y.saturating_sub(2)..=(y + 2).min(size.1 - 1)).any(|y| {
+            (x.saturating_sub(2)..=(x + 2).min(size.0 - 1))
+                .any(|x| distance(pixel(image, (x, y)), colour) <= 1.5)
+        })
+    };
+    // Per mode: which of the edges v0v1, v1v2, v2v3, v3v0 are drawn.
+    let edges_drawn = [
+        [false; 4],                 // POINTS
+        [true, false, true, false], // LINES: (v0, v1), (v2, v3)
+        [true; 4],                  // LINE_LOOP
+        [true, true, true, false],  // LINE_STRIP
+    ];
+    let corners = [[0.0f32, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+    let mut failures = Vec::new();
+    for (mode, drawn) in edges_drawn.iter().enumerate() {
+        for row in 0..2 {
+            let colour = srgb_255(LINE_COLOURS[2 * mode + row]);
+            let at = |[u, v]: [f32; 2]| [2.0 * mode as f32 + u, 2.0 * row as f32 + v, 0.0];
+            if mode == 0 {
+                for (c, corner) in corners.iter().enumerate() {
+                    if !shows(at(*corner), colour) {
+                        failures.push(format!("POINTS row {row}: vertex {c} not drawn"));
+                    }
+                }
+            }
+            for (e, &expected) in drawn.iter().enumerate() {
+                let (a, b) = (corners[e], corners[(e + 1) % 4]);
+                let mid = at([0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])]);
+                if shows(mid, colour) != expected {
+                    failures.push(format!(
+                        "mode {mode} row {row}: edge v{e}v{} {}",
+                        (e + 1) % 4,
+                        if expected { "not drawn" } else { "drawn" }
+                    ));
+                }
+            }
+        }
+    }
+    if !failures.is_empty() {
+        let path = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("points-and-lines.png");
+        image.write_png(&path).unwrap();
+        panic!("{failures:?}; image {}", path.display());
     }
 }

@@ -89,8 +89,8 @@ pub enum GltfError {
         /// `byteLength`.
         declared: usize,
     },
-    /// No triangle primitive in the scene.
-    #[error("the scene has no triangles")]
+    /// No primitive with anything to draw (triangles, lines or points) in the scene.
+    #[error("the scene has nothing to draw (no triangles, lines or points)")]
     NoTriangles,
     /// A node tree deeper than the loader follows.
     #[error("node {node}: node hierarchy deeper than {max_depth} levels")]
@@ -191,6 +191,18 @@ pub enum GltfError {
         primitive: usize,
         /// The corner count.
         corners: usize,
+    },
+    /// A LINES primitive whose end count is not a multiple of 2.
+    #[error(
+        "mesh {mesh} primitive {primitive}: {ends} line ends (mode LINES) is not a multiple of 2"
+    )]
+    NotLines {
+        /// Mesh index.
+        mesh: usize,
+        /// Primitive index.
+        primitive: usize,
+        /// The end count.
+        ends: usize,
     },
     /// A vertex position that is not finite (after the node transform).
     #[error(

@@ -11,9 +11,13 @@
 //! * `extensionsRequired`: accepted when every entry is in [`SUPPORTED_EXTENSIONS`], refused
 //!   otherwise with a message naming the file and the extension (§3.12: a client that does
 //!   not support a required extension must not load the file);
-//! * primitives of mode TRIANGLES (4), TRIANGLE_STRIP (5) and TRIANGLE_FAN (6) (strips and fans
-//!   made lists, §3.7.2.1); points and lines are skipped with one
-//!   note counting them; missing normals become flat normals, missing tangents of a
+//! * primitives of every mode of §3.7.2.1: TRIANGLES (4), TRIANGLE_STRIP (5) and
+//!   TRIANGLE_FAN (6), strips and fans made triangle lists; POINTS (0), LINES (1), LINE_LOOP
+//!   (2) and LINE_STRIP (3), strips and loops made line lists (a loop closes back to its
+//!   first vertex) and drawn one pixel wide (wgpu has no point size or line width); lines and
+//!   points without normals are drawn unlit in their base colour (the spec's flat normals
+//!   are for triangles; a line or point has no surface to light); missing normals of
+//!   triangles become flat normals, missing tangents of a
 //!   normal-mapped primitive MikkTSpace tangents (`bevy_mikktspace`, as §3.7.2.1 prescribes),
 //!   computed after the node transform; a mirroring node transform (negative determinant)
 //!   reverses the triangles' winding (§3.5.3);
@@ -103,7 +107,7 @@ pub use limits::{MAX_FILE_BYTES, MAX_INDICES, MAX_VERTICES};
 pub use metal::{GOLD_F0, MetalBands, is_gold_like, metal_index_gulbrandsen2014, rgb_metal_for};
 pub use model::{
     AlphaMode, Clearcoat, GltfCamera, GltfLight, GltfMaterial, GltfPrimitive, GltfProjection,
-    Iridescence, LightKind, MaterialTextures, Volume,
+    Iridescence, LightKind, MaterialTextures, Topology, Volume,
 };
 pub use textures::{
     GltfTexture, IDENTITY_TRANSFORM, MAX_TEXTURE_DIMENSION, SamplerSpec, TextureRef, Wrap,
@@ -178,18 +182,6 @@ impl GltfScene {
         let draco_required = required.iter().any(|e| e == draco::EXTENSION);
         let placed = nodes::place(&gltf.document, &buffers, path, &materials, draco_required)?;
         notes.extend(placed.notes);
-        if !placed.skipped.is_empty() {
-            let total: usize = placed.skipped.values().sum();
-            let kinds: Vec<String> = placed
-                .skipped
-                .iter()
-                .map(|(k, n)| format!("{n} {k}"))
-                .collect();
-            notes.push(format!(
-                "skipped {total} primitive(s) nacre does not draw ({}); only triangles (lists, strips, fans) are drawn",
-                kinds.join(", ")
-            ));
-        }
         if placed.primitives.iter().all(|p| p.indices.is_empty()) {
             return Err(GltfError::NoTriangles.at(path));
         }

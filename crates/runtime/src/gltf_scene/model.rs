@@ -1,5 +1,5 @@
 //! The loaded scene's data: materials (glTF §3.9 and the extensions nacre reads), world-space
-//! triangle primitives, `KHR_lights_punctual` lights and cameras.
+//! triangle, line and point primitives, `KHR_lights_punctual` lights and cameras.
 
 use super::metal::{MetalBands, rgb_metal_for};
 use super::textures::TextureRef;
@@ -282,12 +282,28 @@ impl GltfMaterial {
     }
 }
 
-/// One triangle list in world space.
+/// What a primitive's indices draw (glTF 2.0 §3.7.2.1, "Topology Types"): strips, loops
+/// and fans are made lists on loading, so three kinds remain.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Topology {
+    /// TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN: three corners per triangle.
+    #[default]
+    Triangles,
+    /// LINES, LINE_STRIP, LINE_LOOP: two ends per segment, drawn one pixel wide (wgpu has
+    /// no wide lines).
+    Lines,
+    /// POINTS: one index per point, drawn one pixel in size (wgpu, like WebGPU, has no
+    /// point size).
+    Points,
+}
+
+/// One primitive in world space: a triangle, line or point list.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct GltfPrimitive {
     /// World-space positions.
     pub positions: Vec<[f32; 3]>,
-    /// World-space unit normals (one per position).
+    /// World-space unit normals (one per position; flat normals for triangles without
+    /// any; empty for lines and points without any, which are drawn unlit).
     pub normals: Vec<[f32; 3]>,
     /// World-space tangents (xyz unit, w = ±1 the bitangent's sign; one per position), from
     /// the file or MikkTSpace for normal-mapped primitives; empty when neither.
@@ -298,8 +314,11 @@ pub struct GltfPrimitive {
     pub uvs1: Vec<[f32; 2]>,
     /// COLOR_0 as linear RGBA (one per position; white when the primitive has none).
     pub colours: Vec<[f32; 4]>,
-    /// Triangle corners (three per triangle), indices into `positions`.
+    /// Indices into `positions`: triangle corners (three per triangle), line ends (two per
+    /// segment) or points, as `topology` says.
     pub indices: Vec<u32>,
+    /// What the indices draw.
+    pub topology: Topology,
     /// Index into [`GltfScene::materials`].
     pub material: usize,
 }

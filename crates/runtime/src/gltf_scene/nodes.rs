@@ -12,14 +12,12 @@ const MAX_DEPTH: usize = 64;
 
 /// What the default scene's node trees place.
 pub(super) struct Placed {
-    /// The triangle primitives, in world space.
+    /// The primitives (triangle, line and point lists), in world space.
     pub(super) primitives: Vec<GltfPrimitive>,
     /// The cameras, in node order.
     pub(super) cameras: Vec<GltfCamera>,
     /// The lights, in node order.
     pub(super) lights: Vec<GltfLight>,
-    /// Primitives of other modes than TRIANGLES, counted by mode (not drawn).
-    pub(super) skipped: std::collections::BTreeMap<String, usize>,
     /// What the primitives' reader noted (a Draco stream that fell back to its uncompressed
     /// accessors), one line each.
     pub(super) notes: Vec<String>,
@@ -55,7 +53,6 @@ pub(super) fn place(
     let mut primitives = Vec::new();
     let mut cameras = Vec::new();
     let mut lights = Vec::new();
-    let mut skipped: std::collections::BTreeMap<String, usize> = Default::default();
     let quantized = doc.extensions_used().any(|e| e == "KHR_mesh_quantization");
     let mut reader = Primitives::new(doc, path, buffers, materials, quantized, draco_required);
     while let Some((node, parent, depth)) = stack.pop() {
@@ -81,16 +78,6 @@ pub(super) fn place(
         }
         let Some(mesh) = node.mesh() else { continue };
         for prim in mesh.primitives() {
-            use gltf::mesh::Mode;
-            if !matches!(
-                prim.mode(),
-                Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
-            ) {
-                *skipped
-                    .entry(format!("{:?}", prim.mode()))
-                    .or_insert(0usize) += 1;
-                continue;
-            }
             primitives.push(reader.read(&mesh, &prim, &world)?);
         }
     }
@@ -100,7 +87,6 @@ pub(super) fn place(
         primitives,
         cameras: cameras.into_iter().map(|(_, c)| c).collect(),
         lights: lights.into_iter().map(|(_, l)| l).collect(),
-        skipped,
         notes: reader.notes,
     })
 }

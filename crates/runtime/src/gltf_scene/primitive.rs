@@ -1,11 +1,12 @@
-//! One triangle primitive (glTF §3.7.2): its accessors checked, its attributes read and
-//! placed in world space, flat normals and MikkTSpace tangents where the file has none.
+//! One primitive (glTF §3.7.2): its accessors checked, its attributes read and placed in
+//! world space, its strips, fans and loops made lists; for triangles, flat normals and
+//! MikkTSpace tangents where the file has none.
 
 use super::accessor;
 use super::draco::{self, DracoPrimitive};
 use super::error::GltfError;
 use super::limits::{MAX_INDICES, MAX_VERTICES};
-use super::model::{GltfMaterial, GltfPrimitive};
+use super::model::{GltfMaterial, GltfPrimitive, Topology};
 use crate::error::Result;
 use gltf::accessor::{DataType, Dimensions};
 use std::collections::HashMap;
@@ -84,6 +85,36 @@ fn triangle_list(mode: gltf::mesh::Mode, v: &[u32]) -> Vec<u32> {
     out
 }
 
+/// The line list of a LINE_STRIP or LINE_LOOP's vertices `v` (glTF 2.0 §3.7.2.1,
+/// "Topology Types"): strip segment i = (v_i, v_{i+1}) for i < n − 1; a loop adds
+/// (v_{n−1}, v_0), closing back to its first vertex; fewer than two vertices make none.
+fn line_list(mode: gltf::mesh::Mode, v: &[u32]) -> Vec<u32> {
+    let mut out: Vec<u32> = v.windows(2).flatten().copied().collect();
+    if mode == gltf::mesh::Mode::LineLoop
+        && let [first, .., last] = v
+    {
+        out.extend_from_slice(&[*last, *first]);
+    }
+    out
+}
+
+/// What a primitive of `mode` draws, and how many indices its list holds when `listed`
+/// indices (or vertices) are given: strips and fans of n make 3 (n − 2) corners, line strips
+/// 2 (n − 1) ends, line loops 2 n (none below two vertices).
+fn listed_count(mode: gltf::mesh::Mode, listed: usize) -> (Topology, usize) {
+    use gltf::mesh::Mode;
+    match mode {
+        Mode::Triangles => (Topology::Triangles, listed),
+        Mode::TriangleStrip | Mode::TriangleFan => {
+            (Topology::Triangles, 3 * listed.saturating_sub(2))
+        }
+        Mode::Lines => (Topology::Lines, listed),
+        Mode::LineStrip => (Topology::Lines, 2 * listed.saturating_sub(1)),
+        Mode::LineLoop => (Topology::Lines, if listed < 2 { 0 } else { 2 * listed }),
+        Mode::Points => (Topology::Points, listed),
+    }
+}
+
 /// What one accessor of a primitive may be (glTF §3.7.2.1 and `KHR_mesh_quantization`).
 struct Rule {
     /// Its dimensions.
@@ -120,13 +151,13 @@ const COLOR: Rule = Rule {
     core: FLOAT_OR_UNSIGNED_NORMALIZED,
     quantized: FLOAT_OR_UNSIGNED_NORMALIZED,
 };
-/// Unsigned integers, the component types of triangle indices.
+/// Unsigned integers, the component types of indices.
 const UNSIGNED: Allowed = &[
     (DataType::U8, false),
     (DataType::U16, false),
     (DataType::U32, false),
 ];
-/// Triangle indices.
+/// Indices.
 const INDICES: Rule = Rule {
     dimensions: &[Dimensions::Scalar],
     core: UNSIGNED,
@@ -266,8 +297,9 @@ impl<'a> Primitives<'a> {
         Ok(decoded)
     }
 
-    /// Primitive `prim` (mode TRIANGLES) of `mesh` under the node transform `world`. A
-    /// mirroring transform (negative determinant) reverses the winding (§3.5.3); quantised
+    /// Primitive `prim` (any mode: strips, fans and loops made lists) of `mesh` under the
+    /// node transform `world`. A mirroring transform (negative determinant) reverses the
+    /// triangles' winding (§3.5.3); quantised
     /// attributes are dequantised by the node transform (`KHR_mesh_quantization`), which
     /// applies to every attribute as to float ones.
     pub(super) fn read(
@@ -363,13 +395,9 @@ impl<'a> Primitives<'a> {
             (None, a) => a.map_or(n_vertices, |a| a.count()),
         };
         let mode = prim.mode();
-        let list = mode == gltf::mesh::Mode::Triangles;
-        // Strips and fans become lists of listed − 2 triangles.
-        let n_corners = if list {
-            listed
-        } else {
-            3 * listed.saturating_sub(2)
-        };
+        use gltf::mesh::Mode;
+        let list = matches!(mode, Mode::Triangles | Mode::Lines | Mode::Points);
+        let (topology, n_corners) = listed_count(mode, listed);
         self.vertices = self.vertices.saturating_add(n_vertices);
         self.corners = self.corners.saturating_add(n_corners);
         if self.vertices > MAX_VERTICES || self.corners > MAX_INDICES {
@@ -383,11 +411,19 @@ impl<'a> Primitives<'a> {
             }
             .at(path));
         }
-        if !n_corners.is_multiple_of(3) {
+        if topology == Topology::Triangles && !n_corners.is_multiple_of(3) {
             return Err(GltfError::NotTriangles {
                 mesh: m,
                 primitive: p,
                 corners: n_corners,
+            }
+            .at(path));
+        }
+        if topology == Topology::Lines && !n_corners.is_multiple_of(2) {
+            return Err(GltfError::NotLines {
+                mesh: m,
+                primitive: p,
+                ends: n_corners,
             }
             .at(path));
         }
@@ -413,7 +449,10 @@ impl<'a> Primitives<'a> {
             (None, None) => (0..n_vertices as u32).collect(),
         };
         if !list {
-            indices = triangle_list(mode, &indices);
+            indices = match topology {
+                Topology::Lines => line_list(mode, &indices),
+                _ => triangle_list(mode, &indices),
+            };
         }
         if let Some(&bad) = indices.iter().find(|&&i| i as usize >= positions.len()) {
             return Err(GltfError::IndexOutOfRange {
@@ -424,7 +463,7 @@ impl<'a> Primitives<'a> {
             }
             .at(path));
         }
-        if determinant3(world) < 0.0 {
+        if topology == Topology::Triangles && determinant3(world) < 0.0 {
             // A mirroring transform turns counter-clockwise triangles clockwise.
             for tri in indices.chunks_exact_mut(3) {
                 tri.swap(1, 2);
@@ -471,7 +510,13 @@ impl<'a> Primitives<'a> {
             colours,
             indices,
             material,
+            topology,
         };
+        if topology != Topology::Triangles {
+            // Lines and points: no surface, so no flat normals or tangents (without normals
+            // they are drawn unlit: mesh/pipeline.rs).
+            return Ok(out);
+        }
         if out.normals.len() != out.positions.len() {
             out = flat_shaded(&out);
         }
@@ -549,6 +594,7 @@ fn unwelded(p: &GltfPrimitive) -> GltfPrimitive {
         colours: take4(&p.colours),
         indices: (0..n as u32).collect(),
         material: p.material,
+        topology: p.topology,
     }
 }
 
@@ -633,7 +679,7 @@ fn determinant3(m: &[[f32; 4]; 4]) -> f64 {
 
 #[cfg(test)]
 mod topology_tests {
-    use super::triangle_list;
+    use super::{Topology, line_list, listed_count, triangle_list};
     use gltf::mesh::Mode;
 
     /// Strips alternate their winding back to counter-clockwise; fans turn about vertex 0
@@ -649,5 +695,39 @@ mod topology_tests {
             [1, 2, 0, 2, 3, 0]
         );
         assert!(triangle_list(Mode::TriangleStrip, &[0, 1]).is_empty());
+    }
+
+    /// Line strips join consecutive vertices; loops also join the last to the first
+    /// (glTF 2.0 §3.7.2.1); the counts match what the lists hold.
+    #[test]
+    fn line_strips_and_loops_become_lists() {
+        assert_eq!(line_list(Mode::LineStrip, &[4, 5, 6]), [4, 5, 5, 6]);
+        assert_eq!(line_list(Mode::LineLoop, &[4, 5, 6]), [4, 5, 5, 6, 6, 4]);
+        assert!(line_list(Mode::LineStrip, &[4]).is_empty());
+        assert!(line_list(Mode::LineLoop, &[4]).is_empty());
+        for (mode, topology) in [
+            (Mode::LineStrip, Topology::Lines),
+            (Mode::LineLoop, Topology::Lines),
+        ] {
+            for n in 0..6u32 {
+                let v: Vec<u32> = (0..n).collect();
+                assert_eq!(
+                    listed_count(mode, n as usize),
+                    (topology, line_list(mode, &v).len()),
+                    "{mode:?} of {n}"
+                );
+            }
+        }
+        for n in 0..6u32 {
+            let v: Vec<u32> = (0..n).collect();
+            for mode in [Mode::TriangleStrip, Mode::TriangleFan] {
+                assert_eq!(
+                    listed_count(mode, n as usize),
+                    (Topology::Triangles, triangle_list(mode, &v).len())
+                );
+            }
+        }
+        assert_eq!(listed_count(Mode::Points, 7), (Topology::Points, 7));
+        assert_eq!(listed_count(Mode::Lines, 8), (Topology::Lines, 8));
     }
 }

@@ -18,7 +18,7 @@
 use super::camera::view_depth;
 use super::inputs::RenderInputs;
 use super::materials;
-use super::pipeline::{Passes, PipelineState, transmits};
+use super::pipeline::{Passes, PipelineState, Raster, transmits};
 use super::textures::{GltfTextures, MipDown, Samplers, mesh_group_layout};
 use super::{
     BEHIND_FORMAT, DEPTH_FORMAT, FLAG_BEHIND, FLAG_LINEAR_OUTPUT, MeshRender, MeshUniform,
@@ -99,11 +99,13 @@ pub(super) fn draw(
         let groups = frame.opaque_pass(&mut encoder, &targets);
         // The main pass.
         frame.pass(&mut encoder, &targets.view, BACKGROUND, &groups, false);
-        let _ = device.poll(wgpu::PollType::wait_indefinitely());
+        // Let the uploads finish first, so that the time measured is the passes' (a lost
+        // device or a hung queue is an error, as in every other wait).
+        ctx.wait("waiting for the glTF scene's uploads")?;
         let submitted = std::time::Instant::now();
         ctx.queue.submit([encoder.finish()]);
-        (targets.target, submitted)
-    })?;
+        Result::Ok((targets.target, submitted))
+    })??;
 
     // Readback.
     ctx.wait("rendering the glTF scene")?;
@@ -256,6 +258,8 @@ struct Geometry {
     indices: wgpu::Buffer,
     index_count: u32,
     material: usize,
+    /// Its topology and lighting.
+    raster: Raster,
     /// The distance of its bounding box's centre along the view axis.
     depth: f64,
 }
@@ -268,7 +272,7 @@ struct Bound<'r> {
     material_groups: Vec<wgpu::BindGroup>,
     /// Every sampler the used materials read.
     samplers: Samplers,
-    /// The primitives with triangles.
+    /// The primitives with something to draw (triangles, lines or points).
     geometry: Vec<Geometry>,
     /// The used materials.
     used: &'r [usize],
@@ -322,6 +326,7 @@ impl<'r> Bound<'r> {
                 }),
                 index_count: p.indices.len() as u32,
                 material: p.material,
+                raster: Raster::of(p),
                 depth: view_depth(&inputs.camera, p),
             })
             .collect();
@@ -376,16 +381,17 @@ impl<'r> Bound<'r> {
 /// The draw order of `geometry`: opaque and masked primitives grouped by pass and pipeline
 /// state, then blended ones back to front.
 fn draw_order(geometry: &[Geometry], scene: &GltfScene, passes: &Passes) -> Vec<usize> {
-    let state_of = |i: usize| PipelineState::of(&scene.materials[i]);
+    let state_of = |g: &Geometry| PipelineState::of(&scene.materials[g.material], g.raster);
     let mut order: Vec<usize> = (0..geometry.len()).collect();
     order.sort_by(|&a, &b| {
-        let (ma, mb) = (geometry[a].material, geometry[b].material);
-        let (ba, bb) = (state_of(ma).blend, state_of(mb).blend);
+        let (ga, gb) = (&geometry[a], &geometry[b]);
+        let (ba, bb) = (state_of(ga).blend, state_of(gb).blend);
         ba.cmp(&bb).then_with(|| {
             if ba {
-                geometry[b].depth.total_cmp(&geometry[a].depth)
+                gb.depth.total_cmp(&ga.depth)
             } else {
-                (passes.pass_of[ma], state_of(ma)).cmp(&(passes.pass_of[mb], state_of(mb)))
+                (passes.pass_of[ga.material], state_of(ga))
+                    .cmp(&(passes.pass_of[gb.material], state_of(gb)))
             }
         })
     });
@@ -569,7 +575,7 @@ impl Frame<'_> {
                 k,
                 PipelineState {
                     linear,
-                    ..PipelineState::of(&scene.materials[material])
+                    ..PipelineState::of(&scene.materials[material], geometry.raster)
                 },
             );
             let Some(pipeline) = passes.pipelines.get(&key) else {

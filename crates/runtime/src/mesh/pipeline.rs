@@ -4,32 +4,73 @@ use super::{BEHIND_FORMAT, DEPTH_FORMAT, VERTEX_FLOATS};
 use crate::bindings::{TechniqueBinding, TechniqueOptions};
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::gltf_scene::{AlphaMode, GltfMaterial, GltfScene};
+use crate::gltf_scene::{AlphaMode, GltfMaterial, GltfPrimitive, GltfScene, Topology};
 use crate::render::{MaterialOptions, TARGET_FORMAT};
 use crate::shaders::{self, Technique};
 use crate::tables::TableSet;
 use nacre_optics::colour::Colorimeter;
 use std::collections::BTreeMap;
 
+/// How a primitive is rasterised: its topology, and whether it is drawn unlit.
+///
+/// Lines and points without normals are drawn unlit, in their base colour (× texture ×
+/// `COLOR_0`), as `KHR_materials_unlit` draws: glTF 2.0 §3.7.2.1's "when normals are not
+/// specified, client implementations MUST calculate flat normals" concerns triangles (a
+/// line or a point has no face to take a normal from), and a line or point has no surface
+/// to light, so renderers conventionally draw them unlit (three.js' `LineBasicMaterial` and
+/// `PointsMaterial`, the glTF Sample Viewer's screenshot of MeshPrimitiveModes). Lines and
+/// points with normals are lit as surfaces are, with those normals.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub(super) struct Raster {
+    /// Triangles, lines or points.
+    pub topology: Topology,
+    /// Drawn unlit (`shaders/mesh.wgsl`'s override `MESH_PRIMITIVE_UNLIT`).
+    pub unlit: bool,
+}
+
+impl Raster {
+    /// How `p` is rasterised.
+    pub(super) fn of(p: &GltfPrimitive) -> Raster {
+        Raster {
+            topology: p.topology,
+            unlit: p.topology != Topology::Triangles && p.normals.len() != p.positions.len(),
+        }
+    }
+
+    /// wgpu's topology: a point, line or triangle list (points and lines are one pixel
+    /// wide: wgpu, like WebGPU, has no point size or line width).
+    fn wgpu_topology(self) -> wgpu::PrimitiveTopology {
+        match self.topology {
+            Topology::Triangles => wgpu::PrimitiveTopology::TriangleList,
+            Topology::Lines => wgpu::PrimitiveTopology::LineList,
+            Topology::Points => wgpu::PrimitiveTopology::PointList,
+        }
+    }
+}
+
 /// The fixed-function state of a mesh pipeline.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub(super) struct PipelineState {
-    /// Single-sided material: back faces culled.
+    /// Single-sided material drawing triangles: back faces culled.
     pub cull_back: bool,
     /// `alphaMode` BLEND: src-alpha blending, no depth writes.
     pub blend: bool,
     /// The picture of the opaque scene (linear radiance, [`BEHIND_FORMAT`]) rather than the
     /// display image.
     pub linear: bool,
+    /// The primitive's topology and lighting.
+    pub raster: Raster,
 }
 
 impl PipelineState {
-    /// The state of glTF material `gm` drawn into the display image.
-    pub(super) fn of(gm: &GltfMaterial) -> PipelineState {
+    /// The state of a primitive rasterised as `raster` with glTF material `gm`, drawn into
+    /// the display image.
+    pub(super) fn of(gm: &GltfMaterial, raster: Raster) -> PipelineState {
         PipelineState {
-            cull_back: !gm.double_sided,
+            cull_back: !gm.double_sided && raster.topology == Topology::Triangles,
             blend: gm.alpha_mode == AlphaMode::Blend,
             linear: false,
+            raster,
         }
     }
 }
@@ -89,13 +130,16 @@ impl Passes {
             }
             let binding = TechniqueBinding::new(ctx, tables, key.0, &options, colorimeter)?;
             let mut states: Vec<PipelineState> = Vec::new();
-            for &i in used.iter().filter(|&&i| key_of(i) == *key) {
-                let gm = &scene.materials[i];
-                states.push(PipelineState::of(gm));
+            for p in scene.primitives.iter().filter(|p| {
+                !p.indices.is_empty() && used.contains(&p.material) && key_of(p.material) == *key
+            }) {
+                let gm = &scene.materials[p.material];
+                let state = PipelineState::of(gm, Raster::of(p));
+                states.push(state);
                 if behind_needed && !transmits(gm) {
                     states.push(PipelineState {
                         linear: true,
-                        ..PipelineState::of(gm)
+                        ..state
                     });
                 }
             }
@@ -133,6 +177,11 @@ fn mesh_pipeline(
     let device = &ctx.device;
     let source = shaders::film_pipeline(technique.module(), &["material", "mesh"])?;
     let module = shaders::create_module(ctx, "mesh", &source)?;
+    let unlit: &[(&str, f64)] = if state.raster.unlit {
+        &[("MESH_PRIMITIVE_UNLIT", 1.0)]
+    } else {
+        &[]
+    };
     ctx.checked("creating the mesh pipeline", || {
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("mesh"),
@@ -161,6 +210,7 @@ fn mesh_pipeline(
                 })],
             },
             primitive: wgpu::PrimitiveState {
+                topology: state.raster.wgpu_topology(),
                 front_face: wgpu::FrontFace::Ccw,
                 cull_mode: state.cull_back.then_some(wgpu::Face::Back),
                 ..Default::default()
@@ -177,7 +227,10 @@ fn mesh_pipeline(
             fragment: Some(wgpu::FragmentState {
                 module: &module,
                 entry_point: Some("mesh_fs"),
-                compilation_options: Default::default(),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: unlit,
+                    ..Default::default()
+                },
                 targets: &[Some(wgpu::ColorTargetState {
                     format: if state.linear {
                         BEHIND_FORMAT

@@ -334,12 +334,13 @@ impl Renderer {
                 pass.set_bind_group(2, &material_group, &[]);
                 pass.draw(0..3, 0..1);
             }
-            // Let the uploads finish first, so that the time measured is the pass's.
-            let _ = device.poll(wgpu::PollType::wait_indefinitely());
+            // Let the uploads finish first, so that the time measured is the pass's (a lost
+            // device or a hung queue is an error, as in every other wait).
+            ctx.wait("waiting for the scene's uploads")?;
             let submitted = std::time::Instant::now();
             ctx.queue.submit([encoder.finish()]);
-            (target, submitted)
-        })?;
+            Result::Ok((target, submitted))
+        })??;
         ctx.wait("rendering the scene")?;
         Ok((target, submitted.elapsed().as_secs_f64()))
     }
