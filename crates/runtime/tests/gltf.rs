@@ -76,8 +76,13 @@ fn mesh_pipelines_validate_for_every_technique() {
         let info = Validator::new(ValidationFlags::all(), Capabilities::default())
             .validate(&module)
             .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
-        naga::back::spv::write_vec(&module, &info, &Default::default(), None)
-            .unwrap_or_else(|e| panic!("{name}: SPIR-V: {e}"));
+        // Both pipelines: lit, and unlit lines and points (MESH_PRIMITIVE_UNLIT).
+        let variants = support::resolved(&name, &module, &info);
+        assert_eq!(variants.len(), 2, "{name}: MESH_PRIMITIVE_UNLIT");
+        for (module, info) in variants {
+            naga::back::spv::write_vec(&module, &info, &Default::default(), None)
+                .unwrap_or_else(|e| panic!("{name}: SPIR-V: {e}"));
+        }
         for entry in ["mesh_vs", "mesh_fs"] {
             assert!(
                 module.entry_points.iter().any(|e| e.name == entry),

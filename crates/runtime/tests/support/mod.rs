@@ -104,9 +104,46 @@ pub fn validate(name: &str, source: &str, map: &str) -> (naga::Module, ModuleInf
     (module, info)
 }
 
-/// Translates a validated module to SPIR-V, MSL, HLSL and GLSL (4.50 core and ES 3.10, per
-/// entry point): what every backend of wgpu would be given.
+/// A validated module with its pipeline-overridable constants resolved as wgpu resolves them
+/// for a pipeline (`naga::back::pipeline_constants::process_overrides`): at their defaults
+/// and, when it has any, all set to 1 (`true`; `shaders/mesh.wgsl`'s `MESH_PRIMITIVE_UNLIT`,
+/// the pipeline of unlit lines and points).
+pub fn resolved(
+    name: &str,
+    module: &naga::Module,
+    info: &ModuleInfo,
+) -> Vec<(naga::Module, ModuleInfo)> {
+    let mut sets = vec![naga::back::PipelineConstants::default()];
+    if !module.overrides.is_empty() {
+        let mut all = naga::back::PipelineConstants::default();
+        for (_, o) in module.overrides.iter() {
+            if let Some(id) = &o.name {
+                all.insert(id.clone(), 1.0);
+            }
+        }
+        sets.push(all);
+    }
+    sets.iter()
+        .map(|constants| {
+            let (m, i) =
+                naga::back::pipeline_constants::process_overrides(module, info, None, constants)
+                    .unwrap_or_else(|e| panic!("{name}: overrides {constants:?}: {e}"));
+            (m.into_owned(), i.into_owned())
+        })
+        .collect()
+}
+
+/// Translates a validated module, its overrides resolved each way ([`resolved`]), to SPIR-V,
+/// MSL, HLSL and GLSL (4.50 core and ES 3.10, per entry point): what every backend of wgpu
+/// would be given.
 pub fn translate(name: &str, module: &naga::Module, info: &ModuleInfo) {
+    for (module, info) in resolved(name, module, info) {
+        translate_resolved(name, &module, &info);
+    }
+}
+
+/// [`translate`] of a module without overrides.
+fn translate_resolved(name: &str, module: &naga::Module, info: &ModuleInfo) {
     spv::write_vec(module, info, &spv::Options::default(), None)
         .unwrap_or_else(|e| panic!("{name}: SPIR-V: {e}"));
 
