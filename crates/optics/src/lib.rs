@@ -46,7 +46,7 @@ pub mod stack;
 
 pub use colour::{Colorimeter, Illuminant, Observer, OutputSpace, RgbSpace};
 pub use error::{Error, Result};
-pub use material::{Material, MaterialWarning, WarningKind};
+pub use material::{Material, MaterialWarning, WarningKind, WavelengthSpan};
 pub use num_complex::Complex64 as C64;
 pub use spectral::{FilmColours, SpectralRule};
 pub use spectrum_sweep::SpectrumSweep;

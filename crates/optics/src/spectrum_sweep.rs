@@ -41,7 +41,8 @@
 //! Per evaluation, [`SpectrumSweep::powers_into`] runs that kernel, one angle's row per
 //! rayon task, straight into the caller's buffer: no allocation, no index lookup. New
 //! thicknesses ([`SpectrumSweep::set_thicknesses_nm`]) re-check the kernel's phase range and
-//! which films repeat (O(films²), plus O(wavelengths) per dispersive film); a new constant
+//! which films repeat (O(films²), plus O(wavelengths) per dispersive film) and keep
+//! everything else (k₀ and the index arrays are not rebuilt); a new constant
 //! film index ([`SpectrumSweep::set_film_index`]) rebuilds the kernel's arrays of the
 //! constant media (O(films × 64)) and re-walks the dispersive ones.
 //!
@@ -53,7 +54,7 @@
 //! recurrence of [`crate::incoherent`], as [`Stack::sweep`] always has.
 
 use crate::error::{Error, Result};
-use crate::material::Material;
+use crate::material::{Material, WavelengthSpan};
 use crate::multilayer::{Column, Media, stack_powers};
 use crate::power::{Power, PowerSlot};
 use crate::stack::{Stack, scalar_powers, sin_of_angle, sweep_recurrence};
@@ -125,9 +126,16 @@ impl SpectrumSweep {
         let media = std::iter::once(stack.ambient())
             .chain(stack.layers().iter().map(|l| &l.material))
             .chain([stack.substrate()]);
-        let resolved: Result<Vec<Indices>> = media.map(|m| resolve(m, wavelengths_nm)).collect();
+        // One pass over the wavelengths for every constant medium.
+        let span = WavelengthSpan::of(wavelengths_nm);
+        let resolved: Result<Vec<Indices>> =
+            media.map(|m| resolve(m, &span, wavelengths_nm)).collect();
+        let lossless_ambient = |ambient: &Indices| match ambient {
+            Indices::Constant(n) => n.im == 0.0,
+            Indices::Varying(c) => c.iter().all(|n| n.im == 0.0),
+        };
         let indices = match resolved {
-            Ok(indices) if (0..wavelengths_nm.len()).all(|w| indices[0].at(w).im == 0.0) => indices,
+            Ok(indices) if wavelengths_nm.is_empty() || lossless_ambient(&indices[0]) => indices,
             // An error: the one the per-wavelength order meets first.
             _ => {
                 let (_, per_wavelength) = stack.resolve(angles_deg, wavelengths_nm)?;
@@ -205,6 +213,17 @@ impl SpectrumSweep {
             .all(|(a, b)| a.to_bits() == b.to_bits())
         {
             return Ok(());
+        }
+        // The kernel's index arrays and k₀ stay: only the phase check and which films
+        // repeat are redone (`Media::set_thicknesses`, the same bits as a fresh
+        // `prepare`). Otherwise (another path, or a phase leaving the kernel's range) all
+        // of it.
+        if let Path::Kernel(media) = &mut self.path {
+            let columns: Vec<Column> = self.indices.iter().map(Indices::column).collect();
+            if media.set_thicknesses(&columns, thickness_nm) {
+                self.thickness_nm.copy_from_slice(thickness_nm);
+                return Ok(());
+            }
         }
         self.thickness_nm.copy_from_slice(thickness_nm);
         self.prepare();
@@ -354,8 +373,8 @@ impl SpectrumSweep {
 }
 
 /// A medium's indices over `wavelengths_nm`: constant when it is constant and valid there.
-fn resolve(material: &Material, wavelengths_nm: &[f64]) -> Result<Indices> {
-    Ok(match material.constant_over(wavelengths_nm) {
+fn resolve(material: &Material, span: &WavelengthSpan, wavelengths_nm: &[f64]) -> Result<Indices> {
+    Ok(match material.constant_over_span(span) {
         Some(n) => Indices::Constant(n),
         None => Indices::Varying(material.indices_at(wavelengths_nm)?),
     })
@@ -500,10 +519,15 @@ mod tests {
             let mut sweep = SpectrumSweep::new(&stack, &angles, &wl).unwrap();
             let mut out = vec![Power::default(); sweep.len()];
             let films = stack.layers().len();
-            for step in 0..4 {
-                // Thicknesses that make films repeat, and part with them.
+            // Thicknesses that make films repeat, and part with them; one beyond the
+            // kernel's phase range (the scalar path) and back.
+            let steps = [40.0, 40.0 + 7.0, 1e3, 1e8, 0.0, 35.0];
+            for (step, &d_step) in steps.iter().enumerate() {
                 let d: Vec<f64> = (0..films)
-                    .map(|j| [40.0, 40.0 + 7.0 * j as f64, 1e3, 0.0][step])
+                    .map(|j| match step {
+                        1 => 40.0 + 7.0 * j as f64,
+                        _ => d_step,
+                    })
                     .collect();
                 let n = C64::new(1.4 + 0.1 * step as f64, 0.01 * step as f64);
                 sweep.set_thicknesses_nm(&d).unwrap();
@@ -519,7 +543,40 @@ mod tests {
                     Stack::new(stack.ambient().clone(), layers, stack.substrate().clone()).unwrap();
                 sweep.powers_into(&mut out).unwrap();
                 assert_eq!(bits(&out), bits(&fresh.sweep(&angles, &wl).unwrap()));
-                assert_eq!(bits(&out), bits(&full_columns(&fresh, &angles, &wl)));
+                let kernel = matches!(sweep.path, Path::Kernel(_));
+                assert_eq!(kernel, films == 0 || step != 3, "step {step}");
+                if kernel {
+                    assert_eq!(bits(&out), bits(&full_columns(&fresh, &angles, &wl)));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_span_of_the_wavelengths_decides_as_a_walk_over_them() {
+        let m = Material::from_nk_csv("c", "c.csv", "wavelength_nm,n,k\n300,1.5,0\n900,1.5,0\n")
+            .unwrap();
+        let k = constant(1.5, 0.0);
+        let grids: [&[f64]; 8] = [
+            &[],
+            &[500.0],
+            &[300.0, 900.0, 400.0, 450.0, 500.0],
+            &[299.0, 500.0, 600.0, 700.0, 800.0, 850.0],
+            &[500.0, 600.0, 700.0, 800.0, 901.0],
+            &[500.0, f64::NAN, 600.0],
+            &[500.0, 600.0, 700.0, 800.0, -1.0, 400.0, f64::INFINITY],
+            &[0.0],
+        ];
+        for wl in grids {
+            for material in [&m, &k] {
+                let walk =
+                    (!wl.is_empty() && material.indices_at(wl).is_ok() && material.is_constant())
+                        .then(|| material.index_at(wl[0]).unwrap());
+                assert_eq!(
+                    material.constant_over_span(&WavelengthSpan::of(wl)),
+                    walk,
+                    "{wl:?}"
+                );
             }
         }
     }

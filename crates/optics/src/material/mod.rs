@@ -58,6 +58,48 @@ use crate::error::{Error, Result};
 use dispersion::{Cursor, Dispersion};
 use num_complex::Complex64 as C64;
 
+/// What [`Material::constant_over_span`] needs of a list of wavelengths, found in one pass.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WavelengthSpan {
+    /// `(first, smallest, largest)`, nm, when the list is not empty and every wavelength is
+    /// positive and finite; `None` otherwise.
+    valid: Option<(f64, f64, f64)>,
+}
+
+impl WavelengthSpan {
+    /// The span of `wavelengths_nm`.
+    pub fn of(wavelengths_nm: &[f64]) -> Self {
+        let first = wavelengths_nm.first().copied();
+        // Four independent lanes of min, max and validity (branch-free, so the loop
+        // vectorises), folded at the end: min and max are exact whatever the order.
+        let mut ok = [true; 4];
+        let mut min = [f64::INFINITY; 4];
+        let mut max = [f64::NEG_INFINITY; 4];
+        let mut lane = |k: usize, wl: f64| {
+            // Negated comparison: NaN fails it.
+            ok[k] &= wl > 0.0 && wl < f64::INFINITY;
+            min[k] = if wl < min[k] { wl } else { min[k] };
+            max[k] = if wl > max[k] { wl } else { max[k] };
+        };
+        let chunks = wavelengths_nm.chunks_exact(4);
+        let rest = chunks.remainder();
+        for c in chunks {
+            for (k, &wl) in c.iter().enumerate() {
+                lane(k, wl);
+            }
+        }
+        for (k, &wl) in rest.iter().enumerate() {
+            lane(k, wl);
+        }
+        let ok = ok.iter().all(|&o| o);
+        let min = min.iter().fold(f64::INFINITY, |a, &b| a.min(b));
+        let max = max.iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b));
+        WavelengthSpan {
+            valid: first.filter(|_| ok).map(|f| (f, min, max)),
+        }
+    }
+}
+
 /// A medium's complex refractive index ñ(λ) = n(λ) + iκ(λ), κ ≥ 0.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
@@ -260,15 +302,22 @@ impl Material {
     /// gives the values or the error). A constant's index does not depend on the
     /// wavelength, so this is [`Material::indices_at`]'s every value, checked once.
     pub fn constant_over(&self, wavelengths_nm: &[f64]) -> Option<C64> {
+        self.constant_over_span(&WavelengthSpan::of(wavelengths_nm))
+    }
+
+    /// [`Material::constant_over`] for wavelengths summarised by `span` (one pass over them
+    /// for every medium of a stack, not one per medium).
+    pub fn constant_over_span(&self, span: &WavelengthSpan) -> Option<C64> {
         let (lo, hi) = self.range_nm;
-        let valid = |wl: f64| wl > 0.0 && wl.is_finite() && wl >= lo && wl <= hi;
-        if !self.is_constant() || !self.gaps_nm.is_empty() || wavelengths_nm.is_empty() {
+        if !self.is_constant() || !self.gaps_nm.is_empty() {
             return None;
         }
-        if !wavelengths_nm.iter().all(|&wl| valid(wl)) {
+        let (first, min, max) = span.valid?;
+        // Every wavelength is positive and finite; each lies in [lo, hi] iff the extremes do.
+        if !(min >= lo && max <= hi) {
             return None;
         }
-        self.index_at(wavelengths_nm[0]).ok()
+        self.index_at(first).ok()
     }
 
     /// [`Material::index_at`] with the tables' cursors (n, κ) of [`Dispersion::eval_from`].

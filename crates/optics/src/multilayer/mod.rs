@@ -140,6 +140,9 @@ pub(crate) struct Media {
     n_abs2: Vec<Vec<f64>>,
     /// Vacuum wavenumber k₀ = 2π/λ_w, rad/nm.
     k0_per_nm: Vec<f64>,
+    /// The largest k₀ over the wavelengths (NaN if any is): the phase check of constant
+    /// media ([`phases_in_range`]).
+    k0_max: f64,
     /// Number of wavelengths (the arrays are padded beyond it to a multiple of [`PAD`]).
     wavelengths: usize,
     /// Film thicknesses, top first, nm.
@@ -281,35 +284,41 @@ impl Media {
             (None, Column::Varying(c)) => (c.iter().map(|n| n.re).collect(), false),
         };
         let beta_at = |w: usize| beta_column[if beta_constant { 0 } else { w }];
-        let k0_per_nm: Vec<f64> = wavelengths_nm.iter().map(|&wl| wavenumber(wl)).collect();
+        // Room for the padding below from the start (no reallocation and copy).
+        let mut k0_per_nm: Vec<f64> = Vec::with_capacity(wavelengths.next_multiple_of(PAD));
+        k0_per_nm.extend(wavelengths_nm.iter().map(|&wl| wavenumber(wl)));
         // The largest k₀ (NaN if any is): a film's phase bound k₀ d (|Re ñ| + |Im ñ| + n₀)
         // with ñ and n₀ the same at every wavelength is largest there (a correctly rounded
         // product is monotonic in each factor), so one check stands for every wavelength.
-        let k0_max = k0_per_nm
-            .iter()
-            .fold(0.0_f64, |m, &k| if k > m || k.is_nan() { k } else { m });
-        for (j, column) in columns.iter().enumerate() {
+        let k0_max = largest(&k0_per_nm);
+        for column in columns {
             debug_assert!(column.len().is_none_or(|l| l == wavelengths));
-            let film = (1..media - 1).contains(&j);
-            let in_range = |w: usize, n: C64, k0: f64| {
+            let in_range = |w: usize, n: C64| {
                 let (a, b) = (n.re.abs(), n.im.abs());
                 // Negated comparisons: NaN fails them.
                 if !(a <= MAX_INDEX && b <= MAX_INDEX && a.max(b) >= MIN_INDEX) {
                     return false;
                 }
                 let n0 = beta_at(w).abs();
-                if !(n0 <= MAX_INDEX) {
-                    return false;
-                }
-                !film || k0 * thickness_nm[j - 1] * (a + b + n0) <= MAX_PHASE_RAD
+                n0 <= MAX_INDEX
             };
             let ok = match column {
-                Column::Constant(n) if beta_constant => wavelengths == 0 || in_range(0, *n, k0_max),
-                _ => (0..wavelengths).all(|w| in_range(w, column.at(w), k0_per_nm[w])),
+                Column::Constant(n) if beta_constant => wavelengths == 0 || in_range(0, *n),
+                _ => (0..wavelengths).all(|w| in_range(w, column.at(w))),
             };
             if !ok {
                 return None;
             }
+        }
+        if !phases_in_range(
+            columns,
+            beta_at,
+            beta_constant,
+            &k0_per_nm,
+            k0_max,
+            thickness_nm,
+        ) {
+            return None;
         }
         // Each varying array padded to a multiple of `PAD` with its last wavelength's values,
         // so that a row's last vector is whole (its extra lanes repeat a real one, and are
@@ -345,10 +354,7 @@ impl Media {
         let n_abs2 = map(|n| n.norm_sqr());
         let k0_per_nm = pad(k0_per_nm);
         let bits = |n: C64| (n.re.to_bits(), n.im.to_bits());
-        let same_medium = |i: usize, j: usize| match (columns[i], columns[j]) {
-            (Column::Constant(a), Column::Constant(b)) => bits(a) == bits(b),
-            (a, b) => (0..wavelengths).all(|w| bits(a.at(w)) == bits(b.at(w))),
-        };
+        let same_medium = |i: usize, j: usize| same_medium(columns, wavelengths, i, j);
         // q = √(ñ² − β²) is the same along a row where ñ and the ambient's index (β = n₀ sin θ₀)
         // are.
         let uniform = |j: usize| match columns[j] {
@@ -361,16 +367,7 @@ impl Media {
                 .all(|b| b.to_bits() == beta_column[0].to_bits());
         let constant_q = |j: usize| uniform(j) && beta_uniform;
         let media_slots = Slots::new(media, 2, MEDIA_SLOTS - 2, same_medium, constant_q);
-        // Films 1..=N as items 0..N − 1 (a film's phase depends on the wavelength).
-        let film_slots = Slots::new(
-            media - 2,
-            1,
-            FILM_SLOTS - 1,
-            |i, j| {
-                thickness_nm[i].to_bits() == thickness_nm[j].to_bits() && same_medium(i + 1, j + 1)
-            },
-            |_| false,
-        );
+        let film_slots = film_slots(columns, wavelengths, thickness_nm);
         let forward = n2_im
             .iter()
             .map(|y| y.iter().all(|y| y.to_bits() & SIGN == 0))
@@ -395,6 +392,7 @@ impl Media {
             n2_im,
             n_abs2,
             k0_per_nm,
+            k0_max,
             wavelengths,
             thickness_nm: thickness_nm.to_vec(),
             constant,
@@ -410,6 +408,108 @@ impl Media {
     pub(crate) fn wavelengths(&self) -> usize {
         self.wavelengths
     }
+
+    /// New film thicknesses for media made by [`Media::from_compact`] from the same
+    /// `columns` (and no `beta_index`): only what depends on a thickness is redone — the
+    /// films' phase check and which films repeat ([`film_slots`]); the index arrays, k₀ and
+    /// the lossless flags stay. The same values, hence the same bits, as new media made from
+    /// scratch; `false` (nothing changed) when a film's phase leaves the kernel's range,
+    /// where `from_compact` gives `None`.
+    pub(crate) fn set_thicknesses(&mut self, columns: &[Column], thickness_nm: &[f64]) -> bool {
+        debug_assert_eq!(columns.len(), thickness_nm.len() + 2);
+        debug_assert_eq!(thickness_nm.len(), self.thickness_nm.len());
+        let wavelengths = self.wavelengths;
+        // β's n₀ as `from_compact` kept it: the ambient's real index in `re[0]` (one block of
+        // copies when constant).
+        let beta = &self.re[0];
+        let beta_constant = self.beta_constant;
+        let beta_at = |w: usize| beta[if beta_constant { 0 } else { w }];
+        if !phases_in_range(
+            columns,
+            beta_at,
+            beta_constant,
+            &self.k0_per_nm[..wavelengths],
+            self.k0_max,
+            thickness_nm,
+        ) {
+            return false;
+        }
+        self.film_slots = film_slots(columns, wavelengths, thickness_nm);
+        self.thickness_nm.copy_from_slice(thickness_nm);
+        true
+    }
+}
+
+/// Whether every film's phase bound k₀ d_j (|Re ñ_j| + |Im ñ_j| + n₀) stays within
+/// [`MAX_PHASE_RAD`] at every wavelength (`k0_per_nm` one per wavelength, `beta_at(w)` the
+/// ambient's n₀). A film whose index and n₀ are the same at every wavelength is checked
+/// once, at `k0_max` (a correctly rounded product is monotonic in each factor).
+fn phases_in_range(
+    columns: &[Column],
+    beta_at: impl Fn(usize) -> f64,
+    beta_constant: bool,
+    k0_per_nm: &[f64],
+    k0_max: f64,
+    thickness_nm: &[f64],
+) -> bool {
+    let wavelengths = k0_per_nm.len();
+    thickness_nm.iter().enumerate().all(|(i, &d)| {
+        let phase_ok = |w: usize, n: C64, k0: f64| {
+            let (a, b) = (n.re.abs(), n.im.abs());
+            let n0 = beta_at(w).abs();
+            // Negated comparison: NaN fails it.
+            k0 * d * (a + b + n0) <= MAX_PHASE_RAD
+        };
+        match columns[i + 1] {
+            Column::Constant(n) if beta_constant => wavelengths == 0 || phase_ok(0, n, k0_max),
+            column => (0..wavelengths).all(|w| phase_ok(w, column.at(w), k0_per_nm[w])),
+        }
+    })
+}
+
+/// The largest of `values` and 0, or NaN when any is NaN: four independent lanes
+/// (branch-free, so the loop vectorises) folded at the end, the same value as one
+/// left-to-right fold (the largest number is the largest whatever the order, and a NaN
+/// anywhere sticks).
+fn largest(values: &[f64]) -> f64 {
+    let step = |m: f64, k: f64| if k > m || k.is_nan() { k } else { m };
+    let mut lanes = [0.0_f64; 4];
+    let chunks = values.chunks_exact(4);
+    let rest = chunks.remainder();
+    for c in chunks {
+        for (lane, &v) in lanes.iter_mut().zip(c) {
+            *lane = step(*lane, v);
+        }
+    }
+    for (k, &v) in rest.iter().enumerate() {
+        lanes[k] = step(lanes[k], v);
+    }
+    lanes.into_iter().fold(0.0, step)
+}
+
+/// Whether media `i` and `j` have the same index (bit for bit) at every wavelength.
+fn same_medium(columns: &[Column], wavelengths: usize, i: usize, j: usize) -> bool {
+    let bits = |n: C64| (n.re.to_bits(), n.im.to_bits());
+    match (columns[i], columns[j]) {
+        (Column::Constant(a), Column::Constant(b)) => bits(a) == bits(b),
+        (a, b) => (0..wavelengths).all(|w| bits(a.at(w)) == bits(b.at(w))),
+    }
+}
+
+/// The films' slots: films 1..=N as items 0..N − 1, a film repeating an earlier one (same
+/// thickness and medium) sharing its slot; none is constant along a row (a film's phase
+/// depends on the wavelength).
+fn film_slots(columns: &[Column], wavelengths: usize, thickness_nm: &[f64]) -> Slots {
+    Slots::new(
+        thickness_nm.len(),
+        1,
+        FILM_SLOTS - 1,
+        |i, j| {
+            thickness_nm[i].to_bits() == thickness_nm[j].to_bits()
+                && same_medium(columns, wavelengths, i + 1, j + 1)
+        },
+        |_| false,
+    )
 }
 
 /// Writes into `row[w]` the powers at wavelength w and incidence sin θ₀ = `sin_theta`, on

@@ -273,3 +273,27 @@ fn out_of_range_indices_take_the_recurrence() {
     assert!(Media::new(&idx, &[1e-300], &d).is_none());
     assert!(Media::new(&idx, &[500.0], &d).is_some());
 }
+
+#[test]
+fn largest_is_the_left_to_right_fold() {
+    let fold = |v: &[f64]| {
+        v.iter()
+            .fold(0.0_f64, |m, &k| if k > m || k.is_nan() { k } else { m })
+    };
+    let cases: [&[f64]; 7] = [
+        &[],
+        &[0.5],
+        &[0.1, 0.7, 0.3, 0.2, 0.9, 0.05, 0.4],
+        &[-1.0, -2.0, -0.0],
+        &[0.1, 0.2, f64::NAN, 0.3, 0.4, 0.5],
+        &[0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, f64::NAN],
+        &[f64::INFINITY, 1.0, 2.0, 3.0, 4.0],
+    ];
+    for v in cases {
+        let (a, b) = (super::largest(v), fold(v));
+        assert!(
+            a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()),
+            "{v:?}"
+        );
+    }
+}
