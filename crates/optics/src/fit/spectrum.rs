@@ -14,16 +14,29 @@
 //! iteratively reweighted least squares, w_i² = 1/(1 + (r_i/c)²), c = 2.385 × 1.4826 ×
 //! median |r| (Holland & Welsch 1977, *Commun. Stat.* 6, 813).
 //!
+//! # Evaluation and derivatives
+//!
+//! The model runs through one prepared [`SpectrumSweep`] per incidence angle (indices
+//! resolved once; per evaluation only the new thicknesses or free indices), and
+//! Levenberg–Marquardt takes the exact derivatives of [`crate::jacobian`] (reverse mode:
+//! all L thickness derivatives in one sweep; index derivatives with
+//! [`Wrt::ThicknessAndIndex`]), projected off the linear scale/offset columns as in
+//! Kaufman's variable projection.
+//!
 //! # Global search
 //!
 //! Thickness fits have a local minimum per fringe order. The search starts from the points
-//! of a Halton sequence over the bounds; from each it scans every free parameter in turn
-//! over a grid spanning its whole range (thickness steps of a sixth of the shortest fringe
-//! period in thickness, λ_min/(2 n_max), so no fringe order is skipped; 17 values of an
-//! index), twice round, on a subsample of the points, then polishes by Levenberg–Marquardt
-//! ([`super::lm`]) on all points. It stops when a fit reaches the noise of the data
-//! (mean squared residual ≤ 1.5 × the noise variance estimated from second differences,
-//! σ̂² = Σ (y_{i−1} − 2y_i + y_{i+1})² / 6(n − 2)) or the starts run out, keeping the best.
+//! of a Halton sequence over the bounds; from each it scans along every free parameter in
+//! turn over the whole range (thickness steps of a sixth of the shortest fringe period in
+//! thickness, λ_min/(2 n_max), so no fringe order is skipped; 16 steps of an index), and
+//! along every interface between two free films (d_j + t, d_{j+1} − t n_j/n_{j+1}: the
+//! pair's optical thickness kept, so thickness moves between neighbours without crossing
+//! the stack's fringe orders), until a round gains nothing (at most four rounds), on a
+//! subsample of the points; then polishes by Levenberg–Marquardt ([`super::lm`]) on all
+//! points. It stops when a fit reaches the noise of the data (mean squared residual ≤ 1.5
+//! × the noise variance estimated from second differences,
+//! σ̂² = Σ (y_{i−1} − 2y_i + y_{i+1})² / 6(n − 2)) with white residuals (the Durbin–Watson
+//! ratio within 3 standard deviations of 2), or the starts run out, keeping the best.
 //!
 //! # Uncertainty
 //!
@@ -33,7 +46,10 @@
 use super::lm::{self, LmOptions, Residuals};
 use super::template::{FreeKind, Template};
 use crate::error::{Error, Result};
-use crate::stack::{Prepared, sin_of_angle};
+use crate::jacobian::{Wrt, point_jacobian};
+use crate::power::Power;
+use crate::spectrum_sweep::SpectrumSweep;
+use crate::stack::sin_of_angle;
 use num_complex::Complex64 as C64;
 
 /// Which power the data hold.
@@ -146,85 +162,173 @@ pub struct SpectrumFit {
     pub fitted: Vec<f64>,
 }
 
-/// The stack's R or T at every point, for parameter vectors.
+/// What every point's exact derivatives need: the media's indices and sin θ₀.
+struct Points {
+    angle_deg: Vec<f64>,
+    wavelength_nm: Vec<f64>,
+    sin_theta: Vec<f64>,
+    /// Per point: ambient, films top first, substrate.
+    indices: Vec<Vec<C64>>,
+}
+
+impl Points {
+    fn new(template: &Template, points: &[Measurement]) -> Result<Self> {
+        let stack = template.stack();
+        stack.require_coherent("a fit")?;
+        let mut sin_theta = Vec::with_capacity(points.len());
+        let mut indices = Vec::with_capacity(points.len());
+        for p in points {
+            indices.push(stack.indices_at(p.wavelength_nm)?);
+            sin_theta.push(sin_of_angle(p.angle_deg)?);
+        }
+        Ok(Points {
+            angle_deg: points.iter().map(|p| p.angle_deg).collect(),
+            wavelength_nm: points.iter().map(|p| p.wavelength_nm).collect(),
+            sin_theta,
+            indices,
+        })
+    }
+}
+
+/// The stack's R or T on a subset of the points for parameter vectors: one prepared
+/// [`SpectrumSweep`] per incidence angle (indices resolved once; per evaluation only the
+/// new thicknesses and free indices), and the exact derivatives of [`crate::jacobian`]
+/// (reverse mode: every film's thickness derivative in one sweep, index derivatives with
+/// [`Wrt::ThicknessAndIndex`]).
 struct Model<'a> {
     template: &'a Template,
     quantity: Quantity,
-    wavelength_nm: Vec<f64>,
-    beta: Vec<f64>,
-    indices: Vec<Vec<C64>>,
-    /// Prepared per point when no index is free.
-    prepared: Option<Vec<Prepared>>,
-    base_thickness: Vec<f64>,
+    points: &'a Points,
+    subset: Vec<usize>,
+    /// Per angle: its sweep and the positions in `subset` of its points, in its order.
+    groups: Vec<(SpectrumSweep, Vec<usize>)>,
+    /// The free indices the sweeps hold now (per free parameter; NaN for a thickness).
+    held_index: Vec<f64>,
+    thickness_nm: Vec<f64>,
+    powers: Vec<Power>,
 }
 
 impl<'a> Model<'a> {
-    fn new(template: &'a Template, quantity: Quantity, points: &[Measurement]) -> Result<Self> {
-        let stack = template.stack();
-        stack.require_coherent("a fit")?;
-        let mut beta = Vec::with_capacity(points.len());
-        let mut indices = Vec::with_capacity(points.len());
-        for p in points {
-            let n = stack.indices_at(p.wavelength_nm)?;
-            beta.push(n[0].re * sin_of_angle(p.angle_deg)?);
-            indices.push(n);
+    fn new(
+        template: &'a Template,
+        quantity: Quantity,
+        points: &'a Points,
+        subset: Vec<usize>,
+    ) -> Result<Self> {
+        let mut angles: Vec<(f64, Vec<usize>)> = Vec::new();
+        for (pos, &i) in subset.iter().enumerate() {
+            let a = points.angle_deg[i];
+            match angles.iter_mut().find(|(b, _)| b.to_bits() == a.to_bits()) {
+                Some((_, members)) => members.push(pos),
+                None => angles.push((a, vec![pos])),
+            }
         }
-        let free_index = template.free().iter().any(|f| f.kind == FreeKind::Index);
-        let prepared = (!free_index).then(|| {
-            indices
+        let mut groups = Vec::with_capacity(angles.len());
+        for (a, members) in angles {
+            let wavelengths: Vec<f64> = members
                 .iter()
-                .zip(&beta)
-                .map(|(n, &b)| Prepared::new(n, b))
-                .collect()
-        });
+                .map(|&pos| points.wavelength_nm[subset[pos]])
+                .collect();
+            groups.push((
+                SpectrumSweep::new(template.stack(), &[a], &wavelengths)?,
+                members,
+            ));
+        }
         Ok(Model {
             template,
             quantity,
-            wavelength_nm: points.iter().map(|p| p.wavelength_nm).collect(),
-            beta,
-            indices,
-            prepared,
-            base_thickness: stack.thicknesses_nm(),
+            points,
+            subset,
+            groups,
+            held_index: vec![f64::NAN; template.dims()],
+            thickness_nm: template.stack().thicknesses_nm(),
+            powers: Vec::new(),
         })
     }
 
-    /// M at points `subset` for `x`.
-    fn eval(&self, x: &[f64], subset: &[usize], out: &mut [f64]) {
-        let mut d = self.base_thickness.clone();
-        let mut index_of = Vec::new();
-        for (f, &v) in self.template.free().iter().zip(x) {
+    fn value(quantity: Quantity, p: &Power) -> f64 {
+        match quantity {
+            Quantity::Reflectance => 0.5 * (p.R_s + p.R_p),
+            Quantity::Transmittance => 0.5 * (p.T_s + p.T_p),
+        }
+    }
+
+    /// Sets the free parameters `x` into the thicknesses and the sweeps.
+    fn set(&mut self, x: &[f64]) -> Result<()> {
+        for (k, (f, &v)) in self.template.free().iter().zip(x).enumerate() {
             match f.kind {
-                FreeKind::ThicknessNm => d[f.layer - 1] = v,
-                FreeKind::Index => index_of.push((f.layer, v)),
+                FreeKind::ThicknessNm => self.thickness_nm[f.layer - 1] = v,
+                FreeKind::Index => {
+                    if self.held_index[k].to_bits() != v.to_bits() {
+                        for (sweep, _) in &mut self.groups {
+                            sweep.set_film_index(f.layer, C64::new(v, 0.0))?;
+                        }
+                        self.held_index[k] = v;
+                    }
+                }
             }
         }
-        let mut n = Vec::new();
-        for (o, &i) in out.iter_mut().zip(subset) {
-            let own;
-            let p = match &self.prepared {
-                Some(p) => &p[i],
-                None => {
-                    n.clone_from(&self.indices[i]);
-                    for &(layer, v) in &index_of {
-                        n[layer] = C64::new(v, 0.0);
-                    }
-                    own = Prepared::new(&n, self.beta[i]);
-                    &own
-                }
-            };
-            let power = p.power(&p.amplitudes(self.wavelength_nm[i], &d));
-            *o = match self.quantity {
-                Quantity::Reflectance => 0.5 * (power.R_s + power.R_p),
-                Quantity::Transmittance => 0.5 * (power.T_s + power.T_p),
-            };
+        Ok(())
+    }
+
+    /// M at the subset's points for `x`, into `out`.
+    fn eval(&mut self, x: &[f64], out: &mut [f64]) -> Result<()> {
+        self.set(x)?;
+        let mut powers = std::mem::take(&mut self.powers);
+        for (sweep, members) in &mut self.groups {
+            sweep.set_thicknesses_nm(&self.thickness_nm)?;
+            powers.resize(members.len(), Power::default());
+            sweep.powers_into(&mut powers)?;
+            for (p, &pos) in powers.iter().zip(members.iter()) {
+                out[pos] = Self::value(self.quantity, p);
+            }
         }
+        self.powers = powers;
+        Ok(())
+    }
+
+    /// ∂M_i/∂x_k at the subset's points into `dm[i * dims + k]`, exact.
+    fn derivatives(&mut self, x: &[f64], dm: &mut [f64]) -> Result<()> {
+        self.set(x)?;
+        let free = self.template.free();
+        let dims = free.len();
+        let wrt = if free.iter().any(|f| f.kind == FreeKind::Index) {
+            Wrt::ThicknessAndIndex
+        } else {
+            Wrt::Thickness
+        };
+        let mut n = Vec::new();
+        for (row, &i) in dm.chunks_exact_mut(dims.max(1)).zip(&self.subset) {
+            n.clone_from(&self.points.indices[i]);
+            for (f, &v) in free.iter().zip(x) {
+                if f.kind == FreeKind::Index {
+                    n[f.layer] = C64::new(v, 0.0);
+                }
+            }
+            let j = point_jacobian(
+                &n,
+                &self.thickness_nm,
+                self.points.sin_theta[i],
+                self.points.wavelength_nm[i],
+                wrt,
+            );
+            for (d, f) in row.iter_mut().zip(free) {
+                *d = Self::value(
+                    self.quantity,
+                    match f.kind {
+                        FreeKind::ThicknessNm => &j.d_thickness[f.layer - 1],
+                        FreeKind::Index => &j.d_index_re[f.layer - 1],
+                    },
+                );
+            }
+        }
+        Ok(())
     }
 }
 
 /// The projected residuals on a subset of the points.
-struct Projected<'m, 'a> {
-    model: &'m Model<'a>,
-    subset: Vec<usize>,
+struct Projected<'a> {
+    model: Model<'a>,
     /// y_i, 1/σ_i × robust weight, u_i at the subset.
     y: Vec<f64>,
     w: Vec<f64>,
@@ -232,73 +336,93 @@ struct Projected<'m, 'a> {
     scale: Baseline,
     offset: Baseline,
     m: Vec<f64>,
+    dm: Vec<f64>,
 }
 
-impl<'m, 'a> Projected<'m, 'a> {
-    fn new(model: &'m Model<'a>, data: &Data, subset: Vec<usize>, settings: &Settings) -> Self {
-        let pick = |v: &[f64]| subset.iter().map(|&i| v[i]).collect::<Vec<_>>();
+impl<'a> Projected<'a> {
+    fn new(model: Model<'a>, data: &Data, settings: &Settings) -> Self {
+        let pick = |v: &[f64]| model.subset.iter().map(|&i| v[i]).collect::<Vec<_>>();
         Projected {
-            model,
             y: pick(&data.y),
             w: pick(&data.w),
             u: pick(&data.u),
-            m: vec![0.0; subset.len()],
-            subset,
+            m: vec![0.0; model.subset.len()],
+            dm: Vec::new(),
             scale: settings.scale,
             offset: settings.offset,
+            model,
         }
+    }
+
+    /// Column j of the linear model at point i: M u^j for the scale's terms, then u^j for
+    /// the offset's.
+    fn column(&self, j: usize, i: usize) -> f64 {
+        let ns = self.scale.terms();
+        if j < ns {
+            self.m[i] * pow(self.u[i], j)
+        } else {
+            pow(self.u[i], j - ns)
+        }
+    }
+
+    /// The fixed part of the fit at point i (a fixed scale times M plus a fixed offset).
+    fn fixed(&self, i: usize) -> f64 {
+        let a = match self.scale {
+            Baseline::Fixed(a) => a * self.m[i],
+            Baseline::Poly(_) => 0.0,
+        };
+        let b = match self.offset {
+            Baseline::Fixed(b) => b,
+            Baseline::Poly(_) => 0.0,
+        };
+        a + b
+    }
+
+    /// The weighted normal matrix BᵀB of the linear columns (k × k, regularised by 10⁻¹²
+    /// of its trace).
+    fn normal_matrix(&self) -> Vec<f64> {
+        let k = self.scale.terms() + self.offset.terms();
+        let mut a = vec![0.0; k * k];
+        for i in 0..self.m.len() {
+            let w2 = self.w[i] * self.w[i];
+            for p in 0..k {
+                let cp = self.column(p, i);
+                for q in 0..=p {
+                    a[p * k + q] += w2 * cp * self.column(q, i);
+                }
+            }
+        }
+        let trace: f64 = (0..k).map(|p| a[p * k + p]).sum();
+        for p in 0..k {
+            for q in 0..p {
+                a[q * k + p] = a[p * k + q];
+            }
+            a[p * k + p] += 1e-12 * trace + f64::MIN_POSITIVE;
+        }
+        a
     }
 
     /// The linear coefficients (scale's, then offset's) for model values `self.m`, and the
     /// fitted values into `fit`.
     fn solve_linear(&self, fit: &mut [f64]) -> (Vec<f64>, Vec<f64>) {
-        let (ns, no) = (self.scale.terms(), self.offset.terms());
-        let k = ns + no;
-        let column = |j: usize, i: usize| -> f64 {
-            if j < ns {
-                self.m[i] * pow(self.u[i], j)
-            } else {
-                pow(self.u[i], j - ns)
-            }
-        };
-        let fixed = |i: usize| -> f64 {
-            let a = match self.scale {
-                Baseline::Fixed(a) => a * self.m[i],
-                Baseline::Poly(_) => 0.0,
-            };
-            let b = match self.offset {
-                Baseline::Fixed(b) => b,
-                Baseline::Poly(_) => 0.0,
-            };
-            a + b
-        };
+        let ns = self.scale.terms();
+        let k = ns + self.offset.terms();
         let mut c = vec![0.0; k];
         if k > 0 {
-            let mut a = vec![0.0; k * k];
             for i in 0..self.m.len() {
                 let w2 = self.w[i] * self.w[i];
-                let target = self.y[i] - fixed(i);
-                for p in 0..k {
-                    let cp = column(p, i);
-                    c[p] += w2 * cp * target;
-                    for q in 0..=p {
-                        a[p * k + q] += w2 * cp * column(q, i);
-                    }
+                let target = self.y[i] - self.fixed(i);
+                for (p, cp) in c.iter_mut().enumerate() {
+                    *cp += w2 * self.column(p, i) * target;
                 }
             }
-            let trace: f64 = (0..k).map(|p| a[p * k + p]).sum();
-            for p in 0..k {
-                for q in 0..p {
-                    a[q * k + p] = a[p * k + q];
-                }
-                a[p * k + p] += 1e-12 * trace + f64::MIN_POSITIVE;
-            }
+            let mut a = self.normal_matrix();
             if !lm::cholesky_solve(&mut a, k, &mut c) {
                 c.fill(0.0);
             }
         }
         for (i, f) in fit.iter_mut().enumerate() {
-            *f = fixed(i) + (0..k).map(|j| c[j] * column(j, i)).sum::<f64>();
+            *f = self.fixed(i) + (0..k).map(|j| c[j] * self.column(j, i)).sum::<f64>();
         }
         let scale = match self.scale {
             Baseline::Fixed(a) => vec![a],
@@ -312,18 +436,63 @@ impl<'m, 'a> Projected<'m, 'a> {
     }
 }
 
-impl Residuals for Projected<'_, '_> {
+impl Residuals for Projected<'_> {
     fn len(&self) -> usize {
-        self.subset.len()
+        self.model.subset.len()
     }
 
     fn residuals(&mut self, x: &[f64], out: &mut [f64]) -> Result<()> {
-        let mut m = std::mem::take(&mut self.m);
-        self.model.eval(x, &self.subset, &mut m);
-        self.m = m;
+        self.model.eval(x, &mut self.m)?;
         self.solve_linear(out);
         for ((o, w), y) in out.iter_mut().zip(&self.w).zip(&self.y) {
             *o = w * (y - *o);
+        }
+        Ok(())
+    }
+
+    /// The variable-projection Jacobian in Kaufman's form (Kaufman 1975, *BIT* 15, 49):
+    /// J = −P⊥ W diag(a) ∂M/∂x, a(ν) the scale at the optimal linear coefficients, P⊥ the
+    /// projector off the weighted linear columns B, P⊥ v = v − B (BᵀB)⁻¹ Bᵀ v; exact when
+    /// scale and offset are fixed.
+    fn jacobian(&mut self, x: &[f64], _lo: &[f64], _hi: &[f64], jac: &mut [f64]) -> Result<()> {
+        let n = self.len();
+        let dims = x.len();
+        self.model.eval(x, &mut self.m)?;
+        let mut fit = vec![0.0; n];
+        let (scale, _) = self.solve_linear(&mut fit);
+        let mut dm = std::mem::take(&mut self.dm);
+        dm.resize(n * dims, 0.0);
+        self.model.derivatives(x, &mut dm)?;
+        for i in 0..n {
+            let a = match self.scale {
+                Baseline::Fixed(a) => a,
+                Baseline::Poly(_) => scale
+                    .iter()
+                    .enumerate()
+                    .map(|(j, c)| c * pow(self.u[i], j))
+                    .sum(),
+            };
+            for k in 0..dims {
+                jac[i * dims + k] = -self.w[i] * a * dm[i * dims + k];
+            }
+        }
+        self.dm = dm;
+        let terms = self.scale.terms() + self.offset.terms();
+        if terms > 0 {
+            let a = self.normal_matrix();
+            let b = |i: usize, j: usize| self.w[i] * self.column(j, i);
+            for k in 0..dims {
+                let mut s: Vec<f64> = (0..terms)
+                    .map(|j| (0..n).map(|i| b(i, j) * jac[i * dims + k]).sum())
+                    .collect();
+                let mut f = a.clone();
+                if !lm::cholesky_solve(&mut f, terms, &mut s) {
+                    continue;
+                }
+                for i in 0..n {
+                    jac[i * dims + k] -= (0..terms).map(|j| b(i, j) * s[j]).sum::<f64>();
+                }
+            }
         }
         Ok(())
     }
@@ -345,6 +514,48 @@ fn pow(u: f64, k: usize) -> f64 {
 
 fn sq(v: f64) -> f64 {
     v * v
+}
+
+/// Scans `x` along `dir` (pairs parameter, coefficient) over the whole range the bounds
+/// allow, in steps no longer than any of its parameters' `steps`, and moves it to the
+/// lowest cost found (x itself included); returns that cost.
+fn line_scan(
+    scan: &mut Projected,
+    r: &mut [f64],
+    x: &mut [f64],
+    dir: &[(usize, f64)],
+    steps: &[f64],
+    lo: &[f64],
+    hi: &[f64],
+) -> Result<f64> {
+    let (mut t_lo, mut t_hi, mut step) = (f64::NEG_INFINITY, f64::INFINITY, f64::INFINITY);
+    for &(k, c) in dir {
+        let (a, b) = ((lo[k] - x[k]) / c, (hi[k] - x[k]) / c);
+        t_lo = t_lo.max(a.min(b));
+        t_hi = t_hi.min(a.max(b));
+        step = step.min(steps[k] / c.abs());
+    }
+    scan.residuals(x, r)?;
+    let mut best = (lm::sum_sq(r), 0.0);
+    if t_hi > t_lo {
+        let count = (((t_hi - t_lo) / step).ceil() as usize + 1).clamp(2, 100_000);
+        let mut xt = x.to_vec();
+        for i in 0..count {
+            let t = t_lo + (t_hi - t_lo) * i as f64 / (count - 1) as f64;
+            for &(k, c) in dir {
+                xt[k] = (x[k] + c * t).clamp(lo[k], hi[k]);
+            }
+            scan.residuals(&xt, r)?;
+            let cost = lm::sum_sq(r);
+            if cost < best.0 {
+                best = (cost, t);
+            }
+        }
+    }
+    for &(k, c) in dir {
+        x[k] = (x[k] + c * best.1).clamp(lo[k], hi[k]);
+    }
+    Ok(best.0)
 }
 
 /// The Halton sequence's `i`-th value in base `b` (i ≥ 1), in (0, 1).
@@ -378,7 +589,7 @@ pub fn fit_spectrum(
             ),
         });
     }
-    let model = Model::new(template, settings.quantity, points)?;
+    let pts = Points::new(template, points)?;
     let nu: Vec<f64> = points.iter().map(|p| 1.0 / p.wavelength_nm).collect();
     let (nu_min, nu_max) = nu
         .iter()
@@ -404,7 +615,7 @@ pub fn fit_spectrum(
         .iter()
         .map(|f| match f.kind {
             FreeKind::Index => f.hi,
-            FreeKind::ThicknessNm => model
+            FreeKind::ThicknessNm => pts
                 .indices
                 .iter()
                 .map(|n| n[f.layer].re)
@@ -417,11 +628,7 @@ pub fn fit_spectrum(
         .iter()
         .enumerate()
         .map(|(j, l)| {
-            let n = model
-                .indices
-                .iter()
-                .map(|n| n[j + 1].re)
-                .fold(0.0, f64::max);
+            let n = pts.indices.iter().map(|n| n[j + 1].re).fold(0.0, f64::max);
             let d = template
                 .free()
                 .iter()
@@ -441,25 +648,35 @@ pub fn fit_spectrum(
     let stride = (n / wanted.max(1)).max(1);
     let subset: Vec<usize> = (0..n).step_by(stride).collect();
     let lambda_min = 1.0 / nu_max;
-    // The grids of the scans.
-    let grids: Vec<Vec<f64>> = template
+    // The scans' steps: a sixth of the shortest fringe period in thickness, λ_min/(2 n_max);
+    // a sixteenth of an index's range.
+    let steps: Vec<f64> = template
         .free()
         .iter()
         .zip(&n_max)
-        .map(|(f, &nm)| {
-            let count = match f.kind {
-                FreeKind::ThicknessNm => {
-                    let step = lambda_min / (2.0 * nm.max(1.0)) / 6.0;
-                    ((f.hi - f.lo) / step).ceil() as usize + 1
-                }
-                FreeKind::Index => 17,
-            }
-            .clamp(2, 100_000);
-            (0..count)
-                .map(|i| f.lo + (f.hi - f.lo) * i as f64 / (count - 1) as f64)
-                .collect()
+        .map(|(f, &nm)| match f.kind {
+            FreeKind::ThicknessNm => lambda_min / (2.0 * nm.max(1.0)) / 6.0,
+            FreeKind::Index => (f.hi - f.lo) / 16.0,
         })
+        .map(|s| s.max(f64::MIN_POSITIVE))
         .collect();
+    // The scans' directions: every parameter alone, then every interface between two films
+    // whose thicknesses are free moved alone (d_j + t, d_{j+1} − t n_j/n_{j+1}: the optical
+    // thickness of the pair kept), which swaps thickness between neighbours without
+    // crossing the fringe orders of the whole stack.
+    let mut directions: Vec<Vec<(usize, f64)>> = (0..dims).map(|k| vec![(k, 1.0)]).collect();
+    for k in 0..dims {
+        let f = template.free()[k];
+        if f.kind != FreeKind::ThicknessNm {
+            continue;
+        }
+        if let Some(m) = (k + 1..dims).find(|&m| {
+            template.free()[m].kind == FreeKind::ThicknessNm
+                && template.free()[m].layer == f.layer + 1
+        }) {
+            directions.push(vec![(k, 1.0), (m, -n_max[k] / n_max[m].max(1.0))]);
+        }
+    }
     // The noise the data show: second differences along each run of points.
     let noise_var = {
         let (mut s, mut c) = (0.0, 0usize);
@@ -475,37 +692,62 @@ pub fn fit_spectrum(
         if c > 0 { s / (6.0 * c as f64) } else { 0.0 }
     };
     let options = LmOptions::default();
-    let mut scan = Projected::new(&model, &data, subset, settings);
-    let mut full = Projected::new(&model, &data, all.clone(), settings);
+    let mut scan = Projected::new(
+        Model::new(template, settings.quantity, &pts, subset)?,
+        &data,
+        settings,
+    );
+    let mut full = Projected::new(
+        Model::new(template, settings.quantity, &pts, all)?,
+        &data,
+        settings,
+    );
     let mut r_scan = vec![0.0; scan.len()];
     let mut best: Option<lm::LmResult> = None;
     let mut minima: Vec<(f64, Vec<f64>)> = Vec::new();
     let mut iterations = 0;
     let mut starts = 0;
-    let good_enough = |cost: f64| cost / n as f64 <= 1.5 * noise_var;
+    // A fit is good enough to stop at when its residuals are as small as the noise and as
+    // white: the Durbin–Watson ratio Σ (r_i − r_{i−1})² / Σ r_i² over neighbours of one
+    // angle's run is 2 for white noise (standard deviation ≈ 2/√n) and falls towards 0
+    // when a smooth misfit remains (Durbin & Watson 1950, *Biometrika* 37, 409). The noise
+    // estimate from second differences grows with the curvature of a fast-fringing signal,
+    // so the size test alone accepts a neighbouring minimum whose misfit is as large as
+    // the noise.
+    let neighbours: Vec<usize> = (1..n)
+        .filter(|&i| points[i - 1].angle_deg == points[i].angle_deg)
+        .collect();
+    let white = |r: &[f64]| {
+        let num: f64 = neighbours.iter().map(|&i| sq(r[i] - r[i - 1])).sum();
+        let den: f64 = neighbours
+            .iter()
+            .map(|&i| sq(r[i]) + sq(r[i - 1]))
+            .sum::<f64>()
+            / 2.0;
+        let m = neighbours.len() as f64;
+        m < 8.0 || num / den.max(f64::MIN_POSITIVE) >= 2.0 - 6.0 / m.sqrt()
+    };
+    let good_enough =
+        |r: &lm::LmResult| r.cost / n as f64 <= 1.5 * noise_var && white(&r.residuals);
     for s in 1..=settings.starts.max(1) {
         starts = s;
         let mut x: Vec<f64> = (0..dims)
             .map(|k| lo[k] + (hi[k] - lo[k]) * halton(s, PRIMES[k % PRIMES.len()]))
             .collect();
-        for _round in 0..2 {
-            for k in 0..dims {
-                let mut best_v = (f64::INFINITY, x[k]);
-                for &v in &grids[k] {
-                    x[k] = v;
-                    scan.residuals(&x, &mut r_scan)?;
-                    let c = lm::sum_sq(&r_scan);
-                    if c < best_v.0 {
-                        best_v = (c, v);
-                    }
-                }
-                x[k] = best_v.1;
+        let mut cost = f64::INFINITY;
+        for _round in 0..4 {
+            let before = cost;
+            for dir in &directions {
+                cost = line_scan(&mut scan, &mut r_scan, &mut x, dir, &steps, &lo, &hi)?;
+            }
+            if cost >= before * (1.0 - 1e-9) {
+                break;
             }
         }
         let r = lm::minimize(&mut full, &x, &lo, &hi, options)?;
         iterations += r.iterations;
         minima.push((r.cost, r.x.clone()));
-        let done = good_enough(r.cost);
+        let done = good_enough(&r);
         if best.as_ref().is_none_or(|b| r.cost < b.cost) {
             best = Some(r);
         }
