@@ -70,6 +70,7 @@ pub fn flag(param: Param) -> &'static str {
         Param::FitRange => "--range",
         Param::Loss => "--loss",
         Param::Residuals => "--residuals",
+        Param::FitPlot => "--plot",
     }
 }
 

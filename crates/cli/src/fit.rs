@@ -8,10 +8,11 @@ use crate::error::Result;
 use clap::{Args, Subcommand};
 use nacre_bake::commands::fit_gltf;
 use nacre_bake::commands::fit_spectrum::{
-    Request, fit_all, map_csv, parse_baseline, parse_loss, parse_window, read_spectra, recipe_toml,
-    residuals_csv, warnings,
+    Request, fit_all, fit_plot, map_csv, parse_baseline, parse_loss, parse_window, read_spectra,
+    recipe_toml, residuals_csv, warnings,
 };
 use nacre_bake::commands::fit_template::FitTemplate;
+use nacre_bake::commands::plot::{ImageFormat, render};
 use nacre_bake::commands::stack_spec::TemplateSpec;
 use nacre_format::Param;
 use nacre_format::atomic::write_atomic;
@@ -137,6 +138,10 @@ pub struct FitSpectrumArgs {
     /// Write measured, fitted and residual values per point to this CSV.
     #[arg(long, value_name = "FILE.csv")]
     residuals: Option<PathBuf>,
+    /// Draw the measured spectrum against the fitted one, residuals below (PNG or SVG, by
+    /// the extension; one spectrum).
+    #[arg(long, value_name = "FILE.png|svg")]
+    plot: Option<PathBuf>,
 }
 
 pub fn run(args: &FitArgs) -> Result<()> {
@@ -204,7 +209,24 @@ fn spectrum(args: &FitSpectrumArgs) -> Result<()> {
         },
         window: args.window.as_deref().map(parse_window).transpose()?,
     };
+    let plot_format = args
+        .plot
+        .as_deref()
+        .map(|path| ImageFormat::from_path_of(Param::FitPlot, path))
+        .transpose()?;
     let spectra = read_spectra(&args.measured, quantity)?;
+    if let (Some(path), true) = (&args.plot, spectra.len() != 1) {
+        return Err(nacre_bake::Error::value(
+            Param::FitPlot,
+            path.display().to_string(),
+            format!(
+                "a fit plot draws one spectrum: {} holds {}",
+                args.measured.display(),
+                spectra.len()
+            ),
+        )
+        .into());
+    }
     let outcomes = fit_all(&template, &spectra, &request)?;
     for o in &outcomes {
         for w in warnings(&template, &o.fit) {
@@ -222,8 +244,15 @@ fn spectrum(args: &FitSpectrumArgs) -> Result<()> {
         })?;
         v
     };
+    let picture = match plot_format {
+        Some(format) => Some(render(&fit_plot(&template, &outcomes[0])?, format)?),
+        None => None,
+    };
     if let Some(path) = &args.residuals {
         write_atomic(path, |w| residuals_csv(&outcomes, w))?;
+    }
+    if let (Some(path), Some(bytes)) = (&args.plot, &picture) {
+        write_atomic(path, |w| w.write_all(bytes))?;
     }
     write_atomic(&args.output, |w| w.write_all(&output))?;
     Ok(())

@@ -80,6 +80,8 @@ fn fits_a_two_film_stack_and_reads_back() {
             "fit.toml",
             "--residuals",
             "res.csv",
+            "--plot",
+            "fit.png",
         ],
     );
     assert!(
@@ -87,6 +89,10 @@ fn fits_a_two_film_stack_and_reads_back() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    // The picture: a PNG of the figure's size.
+    let png = std::fs::read(d.join("fit.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    assert_eq!(&png[16..24], &[0, 0, 4, 176, 0, 0, 3, 12]);
     let toml = std::fs::read_to_string(d.join("fit.toml")).unwrap();
     let values: Vec<f64> = toml
         .lines()
@@ -152,6 +158,58 @@ fn fits_a_two_film_stack_and_reads_back() {
         );
         String::from_utf8(out.stdout).unwrap()
     };
+    // An SVG of one spectrum; a plot of the two of a wide file is refused, nothing written.
+    let svg = nacre(
+        &d,
+        &[
+            "fit",
+            "spectrum",
+            "m.csv",
+            "--layer",
+            "tio2@143",
+            "--layer",
+            "sio2@10:2000",
+            "--substrate",
+            "si",
+            "-o",
+            "one.toml",
+            "--plot",
+            "fit.svg",
+        ],
+    );
+    assert!(
+        svg.status.success(),
+        "{}",
+        String::from_utf8_lossy(&svg.stderr)
+    );
+    let text = std::fs::read_to_string(d.join("fit.svg")).unwrap();
+    assert!(
+        text.starts_with("<svg") && text.contains("measured − fitted"),
+        "{text:.200}"
+    );
+    let two = nacre(
+        &d,
+        &[
+            "fit",
+            "spectrum",
+            "wide.csv",
+            "--layer",
+            "sio2@10:2000",
+            "--substrate",
+            "si",
+            "-o",
+            "map.csv",
+            "--plot",
+            "map.png",
+        ],
+    );
+    let err = String::from_utf8_lossy(&two.stderr);
+    assert_eq!(two.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--plot") && err.contains("wide.csv holds 2"),
+        "{err}"
+    );
+    assert!(!d.join("map.csv").exists() && !d.join("map.png").exists());
     let m1 = map("1");
     assert_eq!(m1, map("2"));
     let rows: Vec<Vec<f64>> = m1
@@ -242,6 +300,10 @@ fn bad_input_is_refused_with_one_message() {
             &["--range `700:400`", "START must be below END"],
         ),
         (&["missing.csv", "--layer", "sio2@10:500"], &["missing.csv"]),
+        (
+            &["good.csv", "--layer", "sio2@10:500", "--plot", "fit.jpg"],
+            &["--plot `fit.jpg`", ".png or .svg"],
+        ),
     ];
     for (args, needles) in cases {
         let mut all = vec!["fit", "spectrum"];
@@ -256,7 +318,9 @@ fn bad_input_is_refused_with_one_message() {
             assert!(err.contains(n), "{args:?}: `{n}` not in: {err}");
         }
         assert!(
-            !d.join("out.toml").exists() && !d.join("res.csv").exists(),
+            !d.join("out.toml").exists()
+                && !d.join("res.csv").exists()
+                && !d.join("fit.jpg").exists(),
             "{args:?}"
         );
     }

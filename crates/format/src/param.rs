@@ -162,6 +162,8 @@ params! {
     Loss => "loss",
     /// The residuals file of a fit.
     Residuals => "residuals",
+    /// The picture of a fit (PNG or SVG).
+    FitPlot => "fit_plot",
 }
 
 impl Param {

@@ -285,6 +285,8 @@ pub struct Request {
 pub struct Outcome {
     /// The spectrum's name.
     pub name: String,
+    /// R or T.
+    pub quantity: Quantity,
     /// The points fitted (inside the window).
     pub points: Vec<Measurement>,
     /// The result.
@@ -329,6 +331,7 @@ pub fn fit_all(
             })?;
             Ok(Outcome {
                 name: s.name.clone(),
+                quantity: s.quantity,
                 points,
                 fit,
             })
@@ -422,6 +425,49 @@ fn finite(v: f64) -> String {
     } else {
         "nan".into()
     }
+}
+
+/// The picture of a fit (`--plot`): the measured values against the fitted ones per angle,
+/// residuals below, titled with the spectrum's name, the fitted values and the rms.
+pub fn fit_plot(
+    template: &FitTemplate,
+    outcome: &Outcome,
+) -> Result<crate::commands::plot::FitPlot> {
+    let mut title = outcome.name.clone();
+    let values: Vec<String> = template
+        .free()
+        .iter()
+        .zip(outcome.fit.x.iter().zip(&outcome.fit.sigma))
+        .map(|(f, (x, s))| {
+            // Two significant digits of σ, and x to the same place.
+            let places = [1.0, 0.1, 0.01, 0.001]
+                .iter()
+                .position(|&p| *s >= p)
+                .unwrap_or(4)
+                + 1;
+            match f.kind {
+                FreeKind::ThicknessNm => {
+                    format!("d{} = {x:.places$} ± {s:.places$} nm", f.layer)
+                }
+                FreeKind::Index => format!("n{} = {x:.places$} ± {s:.places$}", f.layer),
+            }
+        })
+        .collect();
+    if !values.is_empty() {
+        title = format!("{title}: {}", values.join(", "));
+    }
+    title = format!("{title}; rms {:.2e}", outcome.fit.rms);
+    let quantity = match outcome.quantity {
+        Quantity::Reflectance => "reflectance",
+        Quantity::Transmittance => "transmittance",
+    };
+    let points: Vec<(f64, f64, f64, f64)> = outcome
+        .points
+        .iter()
+        .zip(&outcome.fit.fitted)
+        .map(|(p, &f)| (p.angle_deg, p.wavelength_nm, p.value, f))
+        .collect();
+    crate::commands::plot::FitPlot::new(title, quantity, &points)
 }
 
 /// The residuals CSV: `spectrum,angle_deg,wavelength_nm,measured,fitted,residual`.

@@ -10,6 +10,7 @@
 //! |---|---|
 //! | [`SpectrumPlot`] | R, T, A (and the s/p parts) against vacuum wavelength, one colour per angle |
 //! | [`ChromaticityPlot`] | the CIE 1931 xy diagram: spectral locus, purple line, gamut triangles, white point, and a film's colour trajectory by several methods |
+//! | [`FitPlot`] | a spectrum fit: measured values against the fitted curve, residuals below |
 //! | [`ChartPlot`] | a swatch chart: film thickness rows × angle (or film index) columns |
 //! | [`FilmLutPlot`] | a `film-lut` table: cos θ × optical path difference images at fixed film indices |
 //! | [`FourierPlot`] | a `fourier` table: Re and Im of each channel's stored envelope against μ, one line per mip level |
@@ -93,6 +94,11 @@ impl ImageFormat {
     /// The format of `path` (`.png` or `.svg`, any case); anything else is an error naming
     /// `-o/--output`.
     pub fn from_path(path: &Path) -> Result<Self> {
+        Self::from_path_of(Param::Output, path)
+    }
+
+    /// [`ImageFormat::from_path`] for the file of input `param`.
+    pub fn from_path_of(param: Param, path: &Path) -> Result<Self> {
         let ext = path
             .extension()
             .and_then(|e| e.to_str())
@@ -101,7 +107,7 @@ impl ImageFormat {
             Some("png") => Ok(ImageFormat::Png),
             Some("svg") => Ok(ImageFormat::Svg),
             _ => Err(Error::value(
-                Param::Output,
+                param,
                 path.display().to_string(),
                 "the image format follows the extension: expected a file name ending in .png or .svg",
             )),
@@ -558,11 +564,13 @@ fn draw_side_legend<DB: DrawingBackend>(
 
 mod chart;
 mod chromaticity;
+mod fit;
 mod spectrum;
 mod table;
 
 pub use chart::*;
 pub use chromaticity::*;
+pub use fit::*;
 pub use spectrum::*;
 pub use table::*;
 
