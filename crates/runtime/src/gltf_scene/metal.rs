@@ -157,7 +157,88 @@ impl MetalBands {
 /// its closest fit is (0.794, 0.067, 0.002) with sRGB D65, see the tests). Defined from 200 to 3000 nm, the
 /// index changing over 0.2 nm at each boundary.
 pub fn rgb_metal_for(name: &str, f0: [f64; 3], bands: &MetalBands) -> Result<Material> {
+    banded_metal(name, bands.band_reflectance(f0), bands)
+}
+
+/// The largest difference, in sRGB-encoded units (IEC 61966-2-1, 0–1), between a channel of
+/// a glTF metal's base colour and the reflectance the three-band fit gives that channel's
+/// band, above which [`gltf_metal_for`] falls back to [`per_channel_metal`].
+///
+/// The per-channel techniques (`lut`, `fourier`) read the base index once per channel, at a
+/// wavelength inside that channel's band, so the F0 they draw is the band's ρ_k, not the
+/// integrated colour Σ_k M\[j\]\[k\] ρ_k that the fit matches. For most metals the two are
+/// close (sRGB D65: gold 0.03, copper 0.04 at most), but a saturated colour needs bands far
+/// from it to cancel the sensitivities' negative lobes: TextureEncodingTest's green (0, 0.246,
+/// 0) takes ρ = (0.063, 0.261, 0.010), an olive (red 0.063 is 0.28 in sRGB), and the red
+/// (0.8, 0, 0) takes a blue band of 0.025 (0.17 in sRGB).
+pub const BAND_FIT_TOLERANCE_SRGB: f64 = 0.1;
+
+/// sRGB encoding (IEC 61966-2-1) of a linear value in \[0, 1\].
+fn srgb_encode(c: f64) -> f64 {
+    let c = c.clamp(0.0, 1.0);
+    if c <= 0.003_130_8 {
+        12.92 * c
+    } else {
+        1.055 * nacre_optics::elementary::powf(c, 1.0 / 2.4) - 0.055
+    }
+}
+
+/// Whether the three-band fit ρ of `bands` misses the base colour `f0` per channel by more
+/// than [`BAND_FIT_TOLERANCE_SRGB`] (see there), `f0` clamped to \[0, 0.99\] as the fit is.
+pub fn band_fit_misses(f0: [f64; 3], bands: &MetalBands) -> bool {
     let rho = bands.band_reflectance(f0);
+    (0..3).any(|j| {
+        let want = if f0[j].is_finite() {
+            f0[j].clamp(0.0, 0.99)
+        } else {
+            0.5
+        };
+        (srgb_encode(rho[j]) - srgb_encode(want)).abs() > BAND_FIT_TOLERANCE_SRGB
+    })
+}
+
+/// A metal base whose band k has [`metal_index_gulbrandsen2014`]`(f0_k, f0_k)`: Gulbrandsen's
+/// per-channel inversion, exact at normal incidence for every technique that reads the base
+/// once per channel (the route of textured metals in `shaders/mesh.wgsl`); integrated over
+/// the spectrum (`film_spectral`) its colour is Σ_k M\[j\]\[k\] f0_k. Bands as
+/// [`rgb_metal_for`].
+pub fn per_channel_metal(name: &str, f0: [f64; 3], bands: &MetalBands) -> Result<Material> {
+    banded_metal(
+        name,
+        f0.map(|c| {
+            if c.is_finite() {
+                c.clamp(0.0, 0.99)
+            } else {
+                0.5
+            }
+        }),
+        bands,
+    )
+}
+
+/// The metal base of a glTF base colour `f0`: [`rgb_metal_for`] (the three-band fit, right for
+/// the spectrum) unless the fit misses a channel ([`band_fit_misses`]), then
+/// [`per_channel_metal`] (right per channel). The flag says which: `true` for the fallback.
+pub fn gltf_metal_for(name: &str, f0: [f64; 3], bands: &MetalBands) -> Result<(Material, bool)> {
+    if band_fit_misses(f0, bands) {
+        Ok((
+            per_channel_metal(
+                &format!("{name} (Gulbrandsen 2014, per channel)"),
+                f0,
+                bands,
+            )?,
+            true,
+        ))
+    } else {
+        Ok((
+            rgb_metal_for(&format!("{name} (Gulbrandsen 2014, 3 bands)"), f0, bands)?,
+            false,
+        ))
+    }
+}
+
+/// The metal whose band k (of `bands`) has [`metal_index_gulbrandsen2014`]`(ρ_k, ρ_k)`.
+fn banded_metal(name: &str, rho: [f64; 3], bands: &MetalBands) -> Result<Material> {
     let index = rho.map(|r| metal_index_gulbrandsen2014(r, r));
     let [b1, b2] = bands.boundaries_nm;
     let [r, g, b] = index;

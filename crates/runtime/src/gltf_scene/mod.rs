@@ -39,7 +39,7 @@
 //! | `iridescenceTexture` | its red channel multiplies w per fragment |
 //! | `ior` (`KHR_materials_ior`, default 1.5) | a dielectric base of real index `ior` |
 //! | `metallicFactor` m × texture B | per fragment mix(dielectric lobe, metal lobe, m) (glTF Appendix B), the film on both lobes |
-//! | `metallicFactor` 1, no texture | the uniform's base: a metal from the base colour ([`rgb_metal_for`]) |
+//! | `metallicFactor` 1, no texture | the uniform's base: a metal from the base colour ([`rgb_metal_for`], or [`per_channel_metal`] where its fit misses a channel: [`gltf_metal_for`]) |
 //! | `baseColorFactor` × texture × `COLOR_0` | the dielectric lobe's Lambertian albedo; the metal lobe's F0: the uniform's metal ([`rgb_metal_for`], each channel's F0 where its sensitivity lies) where the colour is the factor's alone, else [`metal_index_gulbrandsen2014`] of the fragment's colour |
 //! | `roughnessFactor` r × texture G | GGX α = r² |
 //! | `transmissionFactor` t | the share t of the dielectric lobe that transmits: the opaque scene behind, refracted in screen space (the environment where it shows nothing), tinted by the base colour |
@@ -81,7 +81,10 @@
 //! textured base colour); `film_spectral` one per wavelength: [`rgb_metal_for`] builds a
 //! piecewise-constant dispersion over three bands split where the colorimeter's channel
 //! sensitivities cross, each band's reflectance chosen so that the spectrally integrated
-//! colour of the bare metal is the glTF colour (see [`rgb_metal_for`]).
+//! colour of the bare metal is the glTF colour (see [`rgb_metal_for`]). Where those bands,
+//! read once per channel as `lut` and `fourier` read the uniform's base, miss the colour
+//! (a saturated one: [`band_fit_misses`]), the uniform's metal is Gulbrandsen's per channel
+//! instead ([`gltf_metal_for`], [`per_channel_metal`]), exact at normal incidence there.
 
 use crate::error::{Error, Result};
 use crate::thickness_map::ThicknessMap;
@@ -104,7 +107,10 @@ pub mod textures;
 pub use document::SUPPORTED_EXTENSIONS;
 pub use error::{GltfError, Ktx2Error};
 pub use limits::{MAX_FILE_BYTES, MAX_INDICES, MAX_VERTICES};
-pub use metal::{GOLD_F0, MetalBands, is_gold_like, metal_index_gulbrandsen2014, rgb_metal_for};
+pub use metal::{
+    BAND_FIT_TOLERANCE_SRGB, GOLD_F0, MetalBands, band_fit_misses, gltf_metal_for, is_gold_like,
+    metal_index_gulbrandsen2014, per_channel_metal, rgb_metal_for,
+};
 pub use model::{
     AlphaMode, Clearcoat, GltfCamera, GltfLight, GltfMaterial, GltfPrimitive, GltfProjection,
     Iridescence, LightKind, MaterialTextures, Topology, Volume,

@@ -1,7 +1,7 @@
 //! The loaded scene's data: materials (glTF §3.9 and the extensions nacre reads), world-space
 //! triangle, line and point primitives, `KHR_lights_punctual` lights and cameras.
 
-use super::metal::{MetalBands, rgb_metal_for};
+use super::metal::{MetalBands, gltf_metal_for};
 use super::textures::TextureRef;
 use crate::error::{Error, Result};
 use crate::render::{BaseKind, MaterialOptions, SceneKind, ThicknessMapping};
@@ -204,7 +204,7 @@ impl GltfMaterial {
 
     /// The material as nacre's uniform holds it (the module's mapping table), plus notes
     /// about what was approximated or ignored. The uniform's base is a metal
-    /// ([`rgb_metal_for`] of the base colour factor, bands of `colorimeter`) when every
+    /// ([`gltf_metal_for`] of the base colour factor, bands of `colorimeter`) when every
     /// fragment is fully metallic, else the dielectric of index `ior`; the fragment shader
     /// mixes both lobes per fragment.
     pub fn material_options(
@@ -239,11 +239,7 @@ impl GltfMaterial {
         // `spectral` technique integrates over.
         if clamp01(self.metallic) >= 0.5 {
             let bands = MetalBands::new(colorimeter);
-            m.base = rgb_metal_for(
-                &format!("{} (Gulbrandsen 2014, 3 bands)", self.name),
-                rgb.map(f64::from),
-                &bands,
-            )?;
+            (m.base, _) = gltf_metal_for(&self.name, rgb.map(f64::from), &bands)?;
             m.base_kind = BaseKind::Metal;
             m.base_colour = [0.0; 3];
             m.transmission = false;

@@ -155,3 +155,72 @@ fn coloured_metals_keep_every_channel() {
         assert!(worst < limit, "{name}: {worst}");
     }
 }
+
+/// The F0 at normal incidence from air of index n + iκ.
+fn normal_f0(n: C64) -> f64 {
+    ((n.re - 1.0).powi(2) + n.im * n.im) / ((n.re + 1.0).powi(2) + n.im * n.im)
+}
+
+/// TextureEncodingTest's factor-only metal, base colour (0, 0.246, 0): its three-band fit
+/// (bands 0.063, 0.261, 0.010) matches the colour integrated over the spectrum but draws an
+/// olive where the base is read once per channel (`lut`, `fourier`); the uniform's base falls
+/// back to Gulbrandsen per channel, whose F0 at normal incidence, at each channel's
+/// wavelength as the uniform reads it ([`crate::render::MaterialUniform`]), is the base
+/// colour. Gold, copper and the greys of the sample spheres keep the three-band fit (their
+/// uniforms, and so the golden images, unchanged).
+#[test]
+fn a_metal_whose_band_fit_misses_a_channel_is_exact_per_channel() {
+    let c = srgb();
+    let bands = MetalBands::new(&c);
+    let uniform_f0 = |base: [f32; 3]| {
+        let gm = GltfMaterial {
+            name: "metal".into(),
+            base_colour: [base[0], base[1], base[2], 1.0],
+            metallic: 1.0,
+            ..GltfMaterial::default()
+        };
+        let (m, _) = gm.material_options(&c).unwrap();
+        assert_eq!(m.base_kind, BaseKind::Metal);
+        let u = crate::render::MaterialUniform::new(&m, &crate::TableSet::default()).unwrap();
+        (
+            m,
+            std::array::from_fn::<f64, 3, _>(|j| {
+                normal_f0(C64::new(
+                    f64::from(u.base_ior[j]),
+                    f64::from(u.base_kappa[j]),
+                ))
+            }),
+        )
+    };
+    let olive = [0.0f32, 0.246, 0.0];
+    let rho = bands.band_reflectance(olive.map(f64::from));
+    assert!(rho[0] > 0.05, "the fit's red band: {rho:?}");
+    assert!(band_fit_misses(olive.map(f64::from), &bands));
+    let (m, f0) = uniform_f0(olive);
+    assert!(m.base.name().contains("per channel"), "{}", m.base.name());
+    for j in 0..3 {
+        assert!(
+            (f0[j] - f64::from(olive[j])).abs() < 1e-4,
+            "channel {j}: F0 {f0:?}, base colour {olive:?}"
+        );
+    }
+    for keep in [
+        [1.0f32, 0.766, 0.336],
+        [0.955, 0.638, 0.538],
+        [0.5, 0.5, 0.5],
+        [1.0, 1.0, 1.0],
+        [0.0, 0.0, 0.0],
+    ] {
+        let f = keep.map(f64::from);
+        assert!(!band_fit_misses(f, &bands), "{keep:?}");
+        let (m, _) = uniform_f0(keep);
+        let banded = rgb_metal_for("x", f, &bands).unwrap();
+        for l in [400.0, 480.0, 500.0, 560.0, 580.0, 700.0] {
+            assert_eq!(
+                m.base.index_at(l).unwrap(),
+                banded.index_at(l).unwrap(),
+                "{keep:?}"
+            );
+        }
+    }
+}
