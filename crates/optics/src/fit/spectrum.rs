@@ -851,3 +851,126 @@ pub fn fit_spectrum(
         fitted,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fit::template::Free;
+    use crate::material::Material;
+    use crate::stack::{Layer, Stack};
+
+    /// Two films on glass, film 1's index and both thicknesses free.
+    fn template() -> Template {
+        let m = |n: f64| Material::constant(format!("{n}"), C64::new(n, 0.0)).unwrap();
+        let stack = Stack::new(
+            m(1.0),
+            vec![
+                Layer {
+                    material: m(2.1),
+                    thickness_nm: 180.0,
+                },
+                Layer {
+                    material: m(1.46),
+                    thickness_nm: 420.0,
+                },
+            ],
+            m(1.52),
+        )
+        .unwrap();
+        let free = |layer, kind, lo, hi| Free {
+            layer,
+            kind,
+            lo,
+            hi,
+        };
+        Template::new(
+            stack,
+            vec![
+                free(1, FreeKind::Index, 1.8, 2.4),
+                free(1, FreeKind::ThicknessNm, 10.0, 2000.0),
+                free(2, FreeKind::ThicknessNm, 10.0, 2000.0),
+            ],
+        )
+        .unwrap()
+    }
+
+    /// The exact Jacobian of the projected residuals against central differences: at any
+    /// point with a fixed scale and offset, and with a free linear scale and offset at the
+    /// truth of noiseless data (zero residuals, where Kaufman's form is exact).
+    #[test]
+    fn exact_jacobian_matches_central_differences() {
+        let t = template();
+        let truth = [2.1, 180.0, 420.0];
+        let stack = t.stack_at(&truth).unwrap();
+        let mut measured = Vec::new();
+        for angle_deg in [0.0, 40.0] {
+            for w in (400..=800).step_by(5) {
+                let wl = w as f64;
+                let p = stack.evaluate(angle_deg, wl).unwrap().power;
+                let value = (0.8 + 30.0 / wl) * 0.5 * (p.R_s + p.R_p) + 0.02;
+                measured.push(Measurement {
+                    angle_deg,
+                    wavelength_nm: wl,
+                    value,
+                    sigma: None,
+                });
+            }
+        }
+        let points = Points::new(&t, &measured).unwrap();
+        let n = measured.len();
+        let data = Data {
+            y: measured.iter().map(|p| p.value).collect(),
+            w: vec![1.0; n],
+            u: measured
+                .iter()
+                .map(|p| {
+                    2.0 * (1.0 / p.wavelength_nm - 1.0 / 800.0) / (1.0 / 400.0 - 1.0 / 800.0) - 1.0
+                })
+                .collect(),
+        };
+        let lo: Vec<f64> = t.free().iter().map(|f| f.lo).collect();
+        let hi: Vec<f64> = t.free().iter().map(|f| f.hi).collect();
+        for (scale, offset, x) in [
+            (
+                Baseline::Fixed(0.9),
+                Baseline::Fixed(0.01),
+                [2.05, 190.0, 400.0],
+            ),
+            (Baseline::Poly(1), Baseline::Poly(0), truth),
+        ] {
+            let settings = Settings {
+                scale,
+                offset,
+                ..Settings::default()
+            };
+            let model = Model::new(&t, Quantity::Reflectance, &points, (0..n).collect()).unwrap();
+            let mut p = Projected::new(model, &data, &settings);
+            let mut exact = vec![0.0; n * 3];
+            let mut numeric = vec![0.0; n * 3];
+            p.jacobian(&x, &lo, &hi, &mut exact).unwrap();
+            // Smaller steps than the search's, for a tighter check.
+            let h = [1e-6, 1e-5, 1e-5];
+            for k in 0..3 {
+                let (mut up, mut down) = (x, x);
+                up[k] += h[k];
+                down[k] -= h[k];
+                let (mut ru, mut rd) = (vec![0.0; n], vec![0.0; n]);
+                p.residuals(&up, &mut ru).unwrap();
+                p.residuals(&down, &mut rd).unwrap();
+                for i in 0..n {
+                    numeric[i * 3 + k] = (ru[i] - rd[i]) / (2.0 * h[k]);
+                }
+            }
+            let scale_of = |k: usize| (0..n).map(|i| numeric[i * 3 + k].abs()).fold(0.0, f64::max);
+            for i in 0..n {
+                for k in 0..3 {
+                    let (e, d) = (exact[i * 3 + k], numeric[i * 3 + k]);
+                    assert!(
+                        (e - d).abs() <= 1e-5 * scale_of(k),
+                        "{scale:?}/{offset:?}: point {i}, parameter {k}: exact {e}, numeric {d}"
+                    );
+                }
+            }
+        }
+    }
+}
