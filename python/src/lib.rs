@@ -7,6 +7,7 @@
 
 mod compute;
 mod errors;
+mod fit;
 mod stack;
 mod table;
 
@@ -26,6 +27,8 @@ fn _nacre(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(compute::unpolarised, m)?)?;
     m.add_function(wrap_pyfunction!(compute::bake, m)?)?;
     m.add_function(wrap_pyfunction!(compute::conformance, m)?)?;
+    m.add_function(wrap_pyfunction!(fit::fit_spectrum, m)?)?;
+    m.add_function(wrap_pyfunction!(fit::fit_gltf, m)?)?;
     m.add_function(wrap_pyfunction!(bundled_materials, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

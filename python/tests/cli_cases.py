@@ -98,6 +98,21 @@ COLOR_CASES: Dict[str, Tuple[Dict[str, Any], str, Dict[str, Any], bool]] = {
 
 COLOR_ANGLES = "0:85:5"
 
+# `nacre fit` cases: output file name -> arguments (run in the repository root; the measured
+# CSVs are committed fixtures made by nacre.spectrum plus a fixed ripple, see their first
+# line). `{out}` is the output folder (for a second output file).
+FIT_MEASURED = "python/tests/fixtures/fit-measured.csv"
+FIT_WIDE = "python/tests/fixtures/fit-wide.csv"
+FIT_CASES: Dict[str, List[str]] = {
+    "fit-spectrum.toml": ["fit", "spectrum", FIT_MEASURED, "--layer", "sio2@10:2000", "--substrate", "si",
+                          "--residuals", "{out}/fit-spectrum-residuals.csv"],
+    "fit-spectrum-two.toml": ["fit", "spectrum", FIT_MEASURED, "--layer", "1.3:1.7@10:2000", "--substrate", "si",
+                              "--offset", "free", "--loss", "linear", "--range", "420:780"],
+    "fit-spectrum-wide.csv": ["fit", "spectrum", FIT_WIDE, "--layer", "sio2@10:2000", "--substrate", "si", "--scale", "free"],
+    "fit-gltf.json": ["fit", "gltf", "--ambient", "air", "--layer", "tio2@120", "--layer", "sio2@180", "--substrate", "bk7"],
+    "fit-gltf-range.json": ["fit", "gltf", "--layer", "1.33@400", "--substrate", "1.5", "--thicknesses", "200:600"],
+}
+
 
 def spectrum_command(name: str) -> List[str]:
     stack, angles, wavelengths = SPECTRUM_CASES[name]
@@ -134,11 +149,29 @@ def run_all(nacre: str, out: pathlib.Path) -> List[str]:
     return names
 
 
-def _run(nacre: str, args: List[str], output: pathlib.Path) -> None:
+def run_fit(nacre: str, out: pathlib.Path) -> List[str]:
+    """Runs every `nacre fit` case, writing into `out`; returns the files written (the second
+    outputs too), and for `fit gltf` cases `NAME.txt` with the errors the command prints."""
+    out.mkdir(parents=True, exist_ok=True)
+    files = []
+    for name, args in FIT_CASES.items():
+        args = [a.replace("{out}", str(out.resolve())) for a in args]
+        stderr = _run(nacre, args, out / name)
+        files.append(name)
+        files += [pathlib.Path(a).name for a in args if a.startswith(str(out.resolve()))]
+        if args[1] == "gltf":
+            txt = name.rsplit(".", 1)[0] + ".txt"
+            (out / txt).write_text(stderr)
+            files.append(txt)
+    return files
+
+
+def _run(nacre: str, args: List[str], output: pathlib.Path) -> str:
     cmd = [nacre, *args, "-o", str(output.resolve())]
     r = subprocess.run(cmd, cwd=REPO, capture_output=True, text=True)
     if r.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} failed ({r.returncode}): {r.stderr}")
+    return r.stderr
 
 
 def find_nacre() -> Optional[str]:
@@ -162,4 +195,6 @@ if __name__ == "__main__":
     if not a.nacre:
         sys.exit("no nacre binary: build one (cargo build --release -p nacre-cli) or pass --nacre")
     for n in run_all(a.nacre, pathlib.Path(a.out)):
+        print(n)
+    for n in run_fit(a.nacre, pathlib.Path(a.out)):
         print(n)

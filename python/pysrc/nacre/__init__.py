@@ -8,6 +8,8 @@ computations as the ``nacre`` command line, returning arrays instead of CSV file
 * :func:`spectrum` — R_s, R_p, R, T_s, T_p, T, A over angle × wavelength (× thickness);
 * :func:`color` — XYZ and RGB by every method of ``nacre color``;
 * :class:`Table` — a baked table, its texels and the CPU lookup that reproduces a GPU's;
+* :func:`fit_spectrum` — a template's free thicknesses and indices fitted to measured
+  spectra (many in parallel); :func:`fit_gltf` — the closest glTF iridescence material;
 * :func:`bake`, :func:`conformance`, :func:`materials`.
 
 Conventions (those of ``nacre spectrum``; Byrnes' ``tmm``): R = (R_s + R_p)/2, T is the
@@ -33,21 +35,27 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _nacre
 from ._nacre import MaterialError, NacreError, ParseError, Stack, TableError
+from ._fit import GltfFilm, GltfFit, SpectrumFit, fit_gltf, fit_spectrum
 
 __version__: str = _nacre.__version__
 
 __all__ = [
     "Colour",
+    "GltfFilm",
+    "GltfFit",
     "MaterialError",
     "NacreError",
     "ParseError",
     "Spectrum",
+    "SpectrumFit",
     "Stack",
     "Table",
     "TableError",
     "bake",
     "color",
     "conformance",
+    "fit_gltf",
+    "fit_spectrum",
     "materials",
     "spectrum",
 ]

@@ -96,3 +96,22 @@ def color(
 def bake(recipes: Sequence[str], out_dir: str) -> List[str]: ...
 def conformance(grid: str = "default") -> Dict[str, Any]: ...
 def bundled_materials() -> List[Tuple[str, str, Tuple[float, float]]]: ...
+def fit_spectrum(
+    measured: NDArray[np.float64],
+    wavelengths_nm: NDArray[np.float64],
+    angles_deg: NDArray[np.float64],
+    sigma: Optional[NDArray[np.float64]],
+    layers: Optional[List[str]],
+    ambient: Optional[str],
+    substrate: Optional[str],
+    recipe: Optional[str],
+    material_db: Optional[str],
+    quantity: str,
+    scale: str,
+    offset: str,
+    fit_range: Optional[str],
+    loss: str,
+    starts: int,
+    names: List[str],
+) -> Dict[str, Any]: ...
+def fit_gltf(stack: Stack, thicknesses: Optional[str] = None) -> Dict[str, Any]: ...
