@@ -92,7 +92,9 @@ def main() -> int:
         # Warm the workers (import nacre) outside the timing.
         client.run(lambda: __import__("nacre") and None)
         t0 = time.perf_counter()
-        futures = client.map(fit_rows, chunks, starts=a.starts, pure=False)
+        # The spectra go to the workers once, as data (not inside the task graph).
+        data = client.scatter(chunks)
+        futures = client.map(fit_rows, data, starts=a.starts, pure=False)
         parts = client.gather(futures)
         t_dask = time.perf_counter() - t0
     distributed = np.concatenate(parts)

@@ -203,3 +203,17 @@ def test_fit_fixtures_are_what_the_binary_writes(tmp_path: pathlib.Path):
             "python python/tests/cli_cases.py"
         )
     assert set(FIT_CASES) <= {p.name for p in tmp_path.iterdir()}
+
+
+def test_the_dask_example_matches_the_serial_fit():
+    """``examples/dask_thickness_map.py`` on 200 spectra: the Dask map is the serial one, bit
+    for bit. Dask is no dependency of nacre and CI does not install it (57 s of pip for this
+    one check): skipped, saying so, where ``dask.distributed`` is not importable."""
+    pytest.importorskip("dask.distributed", reason="dask[distributed] not installed: the Dask example is not run")
+    example = pathlib.Path(__file__).resolve().parents[1] / "examples" / "dask_thickness_map.py"
+    r = subprocess.run(
+        [sys.executable, str(example), "--n", "200", "--chunk", "50", "--starts", "16"],
+        capture_output=True, text=True, timeout=600,
+    )
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "bit for bit): True" in r.stdout
