@@ -70,6 +70,9 @@ pub fn flag(param: Param) -> &'static str {
         Param::FitRange => "--range",
         Param::Loss => "--loss",
         Param::Residuals => "--residuals",
+        Param::Targets => "TARGETS",
+        Param::Solutions => "--solutions",
+        Param::Distinct => "--distinct",
         Param::FitPlot => "--plot",
     }
 }

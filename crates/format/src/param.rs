@@ -164,6 +164,12 @@ params! {
     Residuals => "residuals",
     /// The picture of a fit (PNG or SVG).
     FitPlot => "fit_plot",
+    /// The target colours of a colour design: a CSV file.
+    Targets => "targets",
+    /// Most distinct stacks a colour design returns.
+    Solutions => "solutions",
+    /// The thickness tolerance below which two designed stacks are the same, nm.
+    Distinct => "distinct",
 }
 
 impl Param {

@@ -10,9 +10,11 @@
 //! ΔE2000 over the targets.
 
 use crate::commands::color::{self, Method, Point, Quantity};
+use crate::commands::fit_template::FitTemplate;
 use crate::commands::grid::parse_thickness_nm;
 use crate::error::{Error, Param, Result};
 use nacre_optics::colour::{Colorimeter, Illuminant, Observer, OutputSpace, RgbSpace};
+use nacre_optics::fit::FreeKind;
 use nacre_optics::fit::gltf::{self, Errors, Fit, GltfBase, GltfFilm, Setup, Target};
 use nacre_optics::{SpectralRule, Stack};
 
@@ -54,6 +56,38 @@ pub fn parse_thickness_range(text: &str) -> Result<(f64, f64)> {
         ));
     }
     Ok((a, b))
+}
+
+/// The top film's thickness range of `template`, in the fit commands' one syntax: a range
+/// on the top film's thickness (`--layer oil@200:800`, `thickness_nm = [200, 800]` in a
+/// recipe: the film spans it, as a glTF thickness texture does) or `flag`
+/// (`--thicknesses START:END`, the older spelling), not both. No other value of the stack
+/// may be a range; a range whose ends are equal is the fixed thickness.
+pub fn template_range(
+    template: &FitTemplate,
+    flag: Option<(f64, f64)>,
+) -> Result<Option<(f64, f64)>> {
+    let mut range = None;
+    for (i, f) in template.free().iter().enumerate() {
+        if f.layer == 1 && f.kind == FreeKind::ThicknessNm {
+            range = (f.lo < f.hi).then_some((f.lo, f.hi));
+        } else {
+            return Err(Error::invalid(
+                template.origin(i).clone(),
+                "fit gltf takes a range only on the top film's thickness (the glTF film's thickness texture): give every other value one number",
+            ));
+        }
+    }
+    match (range, flag) {
+        (Some((a, b)), Some(_)) => Err(Error::invalid(
+            Param::Thicknesses,
+            format!(
+                "the top film already spans {a}:{b} nm: give the range once, on the layer (`@{a}:{b}`) or with --thicknesses"
+            ),
+        )),
+        (Some(r), None) => Ok(Some(r)),
+        (None, flag) => Ok(flag),
+    }
 }
 
 /// The result of a fit: the fitted material, the naive one, and their errors.

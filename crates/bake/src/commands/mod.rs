@@ -10,6 +10,7 @@ pub mod compare;
 pub mod conformance;
 pub mod diffraction;
 pub mod export_stack;
+pub mod fit_color;
 pub mod fit_gltf;
 pub mod fit_spectrum;
 pub mod fit_template;

@@ -44,6 +44,7 @@
 use super::lm::{self, LmOptions, Residuals};
 use super::spectrum::Quantity;
 use super::template::{FreeKind, Template};
+use super::{PRIMES, halton};
 use crate::colour::{Colorimeter, delta_e_2000, xyz_to_lab};
 use crate::error::{Error, Result};
 use crate::jacobian::{Wrt, colour_jacobian, delta_e_2000_param_gradient, lab_jacobian};
@@ -315,19 +316,6 @@ impl Residuals for Problem<'_, '_> {
         Ok(())
     }
 }
-
-/// The Halton sequence's `i`-th value in base `b` (i ≥ 1), in (0, 1).
-fn halton(mut i: usize, b: usize) -> f64 {
-    let (mut f, mut r) = (1.0, 0.0);
-    while i > 0 {
-        f /= b as f64;
-        r += f * (i % b) as f64;
-        i /= b;
-    }
-    r
-}
-
-const PRIMES: [usize; 16] = [2, 3, 5, 7, 11, 13, 17, 19, 23, 29, 31, 37, 41, 43, 47, 53];
 
 /// Designs `template`'s free parameters so that its colour matches `targets` (see the
 /// module docs). Errors: no target, a target angle outside (−90°, 90°), a weight that is

@@ -45,6 +45,7 @@
 
 use super::lm::{self, LmOptions, Residuals};
 use super::template::{FreeKind, Template};
+use super::{PRIMES, halton};
 use crate::error::{Error, Result};
 use crate::jacobian::{Wrt, point_jacobian};
 use crate::power::Power;
@@ -557,19 +558,6 @@ fn line_scan(
     }
     Ok(best.0)
 }
-
-/// The Halton sequence's `i`-th value in base `b` (i ≥ 1), in (0, 1).
-fn halton(mut i: usize, b: usize) -> f64 {
-    let (mut f, mut r) = (1.0, 0.0);
-    while i > 0 {
-        f /= b as f64;
-        r += f * (i % b) as f64;
-        i /= b;
-    }
-    r
-}
-
-const PRIMES: [usize; 16] = [2, 3, 5, 7, 11, 13, 17, 19, 23, 29, 31, 37, 41, 43, 47, 53];
 
 /// Fits `template`'s free parameters to `points` (at least one more point than free
 /// parameters and linear coefficients together).

@@ -12,6 +12,7 @@
 //! | [`ChromaticityPlot`] | the CIE 1931 xy diagram: spectral locus, purple line, gamut triangles, white point, and a film's colour trajectory by several methods |
 //! | [`FitPlot`] | a spectrum fit: measured values against the fitted curve, residuals below |
 //! | [`ChartPlot`] | a swatch chart: film thickness rows × angle (or film index) columns |
+//! | [`DesignPlot`] | a colour design (`nacre fit color --plot`): target swatches over the designed stacks', per angle |
 //! | [`FilmLutPlot`] | a `film-lut` table: cos θ × optical path difference images at fixed film indices |
 //! | [`FourierPlot`] | a `fourier` table: Re and Im of each channel's stored envelope against μ, one line per mip level |
 //!
@@ -565,12 +566,14 @@ fn draw_side_legend<DB: DrawingBackend>(
 mod chart;
 mod chromaticity;
 mod fit;
+mod design;
 mod spectrum;
 mod table;
 
 pub use chart::*;
 pub use chromaticity::*;
 pub use fit::*;
+pub use design::*;
 pub use spectrum::*;
 pub use table::*;
 
