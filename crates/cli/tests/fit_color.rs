@@ -171,7 +171,7 @@ fn bad_input_is_refused_with_one_message() {
         ),
         (
             &["nan.csv", "--layer", "sio2@10:500"],
-            &["nan.csv:3", "G `NaN` is not a finite number"],
+            &["nan.csv:3", "R `NaN` is not a finite number"],
         ),
         (
             &["noangle.csv", "--layer", "sio2@10:500"],
@@ -202,7 +202,7 @@ fn bad_input_is_refused_with_one_message() {
             &["--solutions `0`"],
         ),
         (
-            &["good.csv", "--layer", "sio2@10:500", "--distinct", "-1"],
+            &["good.csv", "--layer", "sio2@10:500", "--distinct=-1"],
             &["--distinct `-1`"],
         ),
         (
@@ -289,7 +289,7 @@ fn fit_gltf_takes_the_range_on_the_layer() {
                 "--layer",
                 "sio2@10:100",
             ][..],
-            "--layer `sio2@10:100`",
+            "--layer sio2@10:100: fit gltf takes a range only on the top film",
         ),
     ] {
         let out = nacre(&d, args);
