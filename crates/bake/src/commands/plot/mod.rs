@@ -565,15 +565,15 @@ fn draw_side_legend<DB: DrawingBackend>(
 
 mod chart;
 mod chromaticity;
-mod fit;
 mod design;
+mod fit;
 mod spectrum;
 mod table;
 
 pub use chart::*;
 pub use chromaticity::*;
-pub use fit::*;
 pub use design::*;
+pub use fit::*;
 pub use spectrum::*;
 pub use table::*;
 
