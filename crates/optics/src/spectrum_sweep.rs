@@ -304,6 +304,15 @@ impl SpectrumSweep {
         true
     }
 
+    /// The kernel's media and each angle's sin θ₀, when the sweep takes the kernel's path
+    /// (the vectorised Jacobian of [`crate::jacobian`] runs on the same arrays).
+    pub(crate) fn kernel(&self) -> Option<(&Media, &[f64])> {
+        match &self.path {
+            Path::Kernel(media) => Some((media, &self.sines)),
+            _ => None,
+        }
+    }
+
     /// The powers by the scalar or the incoherent recurrence.
     fn other_paths(&self) -> Result<Vec<Power>> {
         match &self.path {

@@ -89,6 +89,7 @@ use num_complex::Complex64 as C64;
 use pulp::{Simd, WithSimd};
 use std::cell::RefCell;
 
+pub(crate) mod jacobian;
 mod lanes;
 
 use lanes::{Cx, Medium, add, any_nonzero, interface, medium, mul, norm_sqr, sub};
@@ -407,6 +408,11 @@ impl Media {
     /// Number of wavelengths.
     pub(crate) fn wavelengths(&self) -> usize {
         self.wavelengths
+    }
+
+    /// Number of films.
+    pub(crate) fn films(&self) -> usize {
+        self.thickness_nm.len()
     }
 
     /// New film thicknesses for media made by [`Media::from_compact`] from the same
