@@ -128,6 +128,37 @@ pub fn spectrum<'py>(
     Ok(array(py, &shape, powers))
 }
 
+/// [`spectrum`] with the exact derivatives of the powers by every film's thickness (the
+/// computation of `nacre spectrum --jacobian`, [`spectrum_cmd::compute_jacobian`]): the powers,
+/// shape (angles, wavelengths, 4), and ∂R_s, ∂R_p, ∂T_s, ∂T_p per nm of each film's thickness
+/// (top film first), shape (angles, wavelengths, films, 4).
+#[pyfunction]
+pub fn spectrum_jacobian<'py>(
+    py: Python<'py>,
+    stack: &PyStack,
+    angles_deg: PyReadonlyArray1<'py, f64>,
+    wavelengths_nm: PyReadonlyArray1<'py, f64>,
+) -> PyResult<(Bound<'py, PyArrayDyn<f64>>, Bound<'py, PyArrayDyn<f64>>)> {
+    let angles = vec_of(&angles_deg);
+    let wavelengths = vec_of(&wavelengths_nm);
+    let s = stack.stack.clone();
+    let films = s.layers().len();
+    let (powers, d_thickness) = py
+        .detach(|| -> Result<_> {
+            let (powers, jacobian) = spectrum_cmd::compute_jacobian(&s, &angles, &wavelengths)?;
+            Ok((
+                powers_as_floats(powers),
+                powers_as_floats(jacobian.d_thickness),
+            ))
+        })
+        .map_err(bake_err)?;
+    let (na, nw) = (angles.len(), wavelengths.len());
+    Ok((
+        array(py, &[na, nw, 4], powers),
+        array(py, &[na, nw, films, 4], d_thickness),
+    ))
+}
+
 /// The points of `color`: each angle, with the first film's thickness and real index
 /// overridden where given. Checked as `nacre color --points` checks its rows.
 fn points(

@@ -23,6 +23,7 @@ fn _nacre(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<stack::PyStack>()?;
     m.add_class::<table::PyTable>()?;
     m.add_function(wrap_pyfunction!(compute::spectrum, m)?)?;
+    m.add_function(wrap_pyfunction!(compute::spectrum_jacobian, m)?)?;
     m.add_function(wrap_pyfunction!(compute::color, m)?)?;
     m.add_function(wrap_pyfunction!(compute::unpolarised, m)?)?;
     m.add_function(wrap_pyfunction!(compute::bake, m)?)?;

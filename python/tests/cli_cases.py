@@ -70,6 +70,12 @@ SPECTRUM_CASES: Dict[str, Tuple[Dict[str, Any], str, str]] = {
     "spectrum-multilayer": (_stack("air", [("tio2", 56.45), ("mgf2", 99.75), ("tio2", 56.45), ("fused-silica", 120.0)], "bk7"), "0:60:30", "380:780:20"),
 }
 
+# `nacre spectrum --jacobian` (thickness derivatives): name -> (stack, angles, wavelengths).
+JACOBIAN_CASES: Dict[str, Tuple[Dict[str, Any], str, str]] = {
+    "jacobian-multilayer": (_stack("air", [("tio2", 56.45), ("mgf2", 99.75), ("tio2", 56.45), ("fused-silica", 120.0)], "bk7"), "0:60:30", "380:780:20"),
+    "jacobian-absorbing-tir": (_stack(1.52, [(1.38, 200.0), (1.5 + 0.01j, 120.0)], 0.27 + 2.9j), "0:80:20", "450:650:50"),
+}
+
 # name -> (stack, method, extra options, use points)
 COLOR_CASES: Dict[str, Tuple[Dict[str, Any], str, Dict[str, Any], bool]] = {
     "color-spectral": (_stack("air", [("water", 400.0)], "air"), "spectral", {}, False),
@@ -119,6 +125,11 @@ def spectrum_command(name: str) -> List[str]:
     return ["spectrum", *_stack_args(stack), "--angles", angles, "--wavelengths", wavelengths]
 
 
+def jacobian_command(name: str) -> List[str]:
+    stack, angles, wavelengths = JACOBIAN_CASES[name]
+    return ["spectrum", *_stack_args(stack), "--angles", angles, "--wavelengths", wavelengths, "--jacobian"]
+
+
 def color_command(name: str, points_csv: pathlib.Path) -> List[str]:
     stack, method, opts, use_points = COLOR_CASES[name]
     args = ["color", *_stack_args(stack), "--method", method]
@@ -142,6 +153,9 @@ def run_all(nacre: str, out: pathlib.Path) -> List[str]:
     names = []
     for name in SPECTRUM_CASES:
         _run(nacre, spectrum_command(name), out / f"{name}.csv")
+        names.append(name)
+    for name in JACOBIAN_CASES:
+        _run(nacre, jacobian_command(name), out / f"{name}.csv")
         names.append(name)
     for name in COLOR_CASES:
         _run(nacre, color_command(name, points.resolve()), out / f"{name}.csv")

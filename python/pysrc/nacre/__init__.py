@@ -95,6 +95,7 @@ class Spectrum(Mapping[str, FloatArray]):
         wavelengths_nm: FloatArray,
         thickness_nm: Optional[FloatArray],
         powers: FloatArray,
+        d_thickness: Optional[FloatArray] = None,
     ) -> None:
         self.angles_deg = angles_deg
         """Incidence angles in the ambient, degrees."""
@@ -104,7 +105,12 @@ class Spectrum(Mapping[str, FloatArray]):
         """The swept film's thicknesses, nm (None: the stack's own)."""
         self.powers = powers
         """R_s, R_p, T_s, T_p along the last axis: shape (..., 4)."""
+        self.d_thickness = d_thickness
+        """With ``jacobian=True``: ∂R_s, ∂R_p, ∂T_s, ∂T_p per nm of each film's thickness
+        (top film first) along the last axis, shape (angles, wavelengths, films, 4); else
+        None."""
         self._unpolarised: Optional[Tuple[FloatArray, FloatArray, FloatArray]] = None
+        self._d_unpolarised: Optional[Tuple[FloatArray, FloatArray]] = None
 
     @property
     def shape(self) -> Tuple[int, ...]:
@@ -152,6 +158,26 @@ class Spectrum(Mapping[str, FloatArray]):
         """Absorptance 1 − R − T in the films (never below 0)."""
         return self._rta()[2]
 
+    def _d_rt(self) -> Tuple[FloatArray, FloatArray]:
+        if self.d_thickness is None:
+            raise NacreError("no derivatives: call nacre.spectrum(..., jacobian=True)")
+        if self._d_unpolarised is None:
+            r, t, _ = _nacre.unpolarised(self.d_thickness)
+            self._d_unpolarised = (r, t)
+        return self._d_unpolarised
+
+    @property
+    def dR_dd(self) -> FloatArray:
+        """∂R/∂d_j per nm (R unpolarised), shape (angles, wavelengths, films): the
+        ``dR_dd1 … dR_ddL`` columns of ``nacre spectrum --jacobian``."""
+        return self._d_rt()[0]
+
+    @property
+    def dT_dd(self) -> FloatArray:
+        """∂T/∂d_j per nm (T unpolarised), shape (angles, wavelengths, films): the
+        ``dT_dd1 … dT_ddL`` columns of ``nacre spectrum --jacobian``."""
+        return self._d_rt()[1]
+
     def __getitem__(self, key: str) -> FloatArray:
         if key not in self._KEYS:
             raise KeyError(key)
@@ -173,6 +199,7 @@ def spectrum(
     wavelengths_nm: ArrayLike,
     thickness_nm: Optional[ArrayLike] = None,
     layer: int = 1,
+    jacobian: bool = False,
 ) -> Spectrum:
     """Exact reflectance and transmittance of ``stack`` (transfer matrices, complex Snell's
     law and Fresnel coefficients for absorbing media; the computation of ``nacre spectrum``).
@@ -181,12 +208,25 @@ def spectrum(
     numbers or 1-D sequences; the result's arrays have shape (angles, wavelengths). With
     ``thickness_nm`` (a 1-D sequence, nm ≥ 0), film number ``layer`` (1 = top film) takes each
     thickness in turn and the arrays have shape (angles, wavelengths, thicknesses).
+
+    With ``jacobian=True`` (not with ``thickness_nm``; coherent stacks only) the result also
+    holds the exact derivatives of the powers by every film's thickness, per nm, computed
+    through the recurrence by a reverse sweep (the ``--jacobian`` columns of
+    ``nacre spectrum``): :attr:`Spectrum.d_thickness`, shape (angles, wavelengths, films, 4)
+    for ∂R_s, ∂R_p, ∂T_s, ∂T_p, and :attr:`Spectrum.dR_dd`, :attr:`Spectrum.dT_dd`, shape
+    (angles, wavelengths, films), for the unpolarised R and T.
     """
     a = _axis(angles_deg, "angles_deg")
     w = _axis(wavelengths_nm, "wavelengths_nm")
     d = None if thickness_nm is None else _axis(thickness_nm, "thickness_nm")
     if isinstance(layer, bool) or not isinstance(layer, (int, np.integer)) or layer < 1:
         raise NacreError(f"layer `{layer}`: expected a film number, 1 for the top film")
+    if jacobian:
+        if d is not None:
+            raise NacreError("jacobian=True: derivatives are by the stack's own thicknesses, "
+                             "not with thickness_nm")
+        powers, d_thickness = _nacre.spectrum_jacobian(stack, a, w)
+        return Spectrum(a, w, None, powers, d_thickness)
     powers = _nacre.spectrum(stack, a, w, d, int(layer))
     return Spectrum(a, w, d, powers)
 

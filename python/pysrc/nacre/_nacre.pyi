@@ -71,6 +71,11 @@ def spectrum(
     thickness_nm: Optional[NDArray[np.float64]] = None,
     layer: int = 1,
 ) -> NDArray[np.float64]: ...
+def spectrum_jacobian(
+    stack: Stack,
+    angles_deg: NDArray[np.float64],
+    wavelengths_nm: NDArray[np.float64],
+) -> Tuple[NDArray[np.float64], NDArray[np.float64]]: ...
 def unpolarised(
     powers: NDArray[np.float64],
 ) -> List[NDArray[np.float64]]: ...

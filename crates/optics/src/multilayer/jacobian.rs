@@ -158,17 +158,9 @@ impl WithSimd for JacobianOp<'_> {
                 s.splat_f64s(self.sin_theta),
             );
             let beta2 = s.mul_f64s(beta, beta);
-            let medium_at = |j: usize| -> Medium<S> {
-                let i = at(m.constant[j]);
-                let n2 = Cx::<S> {
-                    re: lane::<S>(&m.n2_re[j], i),
-                    im: lane::<S>(&m.n2_im[j], i),
-                };
-                medium::<S, 0>(s, lane::<S>(&m.n_abs2[j], i), n2, beta2)
-            };
             let field = |j: usize, f: usize| (j * FIELDS + f) * lanes;
             // Forward: the value kernel's stages (`SUBSTRATE`, `FIRST`, `MEDIUM_PHASE`, `STEP`).
-            let substrate = medium_at(count - 1);
+            let substrate = medium_of(s, m, count - 1, at(m.constant[count - 1]), beta2);
             let sub_re_n2_conj_q = madd::<S, true>(
                 s,
                 substrate.n2.im,
@@ -176,7 +168,7 @@ impl WithSimd for JacobianOp<'_> {
                 s.mul_f64s(substrate.n2.re, substrate.q.re),
             );
             let mut below = substrate;
-            let mut above = medium_at(count - 2);
+            let mut above = medium_of(s, m, count - 2, at(m.constant[count - 2]), beta2);
             let f = interface(s, &above, &below);
             let zero = Cx::<S> {
                 re: s.splat_f64s(0.0),
@@ -192,7 +184,7 @@ impl WithSimd for JacobianOp<'_> {
             }
             for j in (0..count - 2).rev() {
                 below = above;
-                above = medium_at(j);
+                above = medium_of(s, m, j, at(m.constant[j]), beta2);
                 // Film j + 1: E = e^{2iδ} = e^{−2 Im δ} (cos, sin)(2 Re δ), δ = k₀ q d.
                 let kd2 = s.mul_f64s(k0, s.splat_f64s(2.0 * m.thickness_nm[j]));
                 let (sin_x, cos_x) =
@@ -204,21 +196,20 @@ impl WithSimd for JacobianOp<'_> {
                 };
                 let f = interface(s, &above, &below);
                 let base = field(j, 0);
-                let mut put =
-                    |k: usize, x: S::f64s| *lane_mut::<S>(&mut keep, base + k * lanes) = x;
-                put(E, e2.re);
-                put(E + 1, e2.im);
-                put(Q, below.q.re);
-                put(Q + 1, below.q.im);
+                let k = |f: usize| base + f * lanes;
+                put(s, &mut keep, k(E), e2.re);
+                put(s, &mut keep, k(E + 1), e2.im);
+                put(s, &mut keep, k(Q), below.q.re);
+                put(s, &mut keep, k(Q + 1), below.q.im);
                 let rescale = j.is_multiple_of(RESCALE_EVERY);
                 for pol in 0..2 {
                     let (alpha, beta) = (f.alpha[pol], f.beta[pol]);
-                    put(NUM + 2 * pol, num[pol].re);
-                    put(NUM + 2 * pol + 1, num[pol].im);
-                    put(ALPHA_BETA + 4 * pol, alpha.re);
-                    put(ALPHA_BETA + 4 * pol + 1, alpha.im);
-                    put(ALPHA_BETA + 4 * pol + 2, beta.re);
-                    put(ALPHA_BETA + 4 * pol + 3, beta.im);
+                    put(s, &mut keep, k(NUM + 2 * pol), num[pol].re);
+                    put(s, &mut keep, k(NUM + 2 * pol + 1), num[pol].im);
+                    put(s, &mut keep, k(ALPHA_BETA + 4 * pol), alpha.re);
+                    put(s, &mut keep, k(ALPHA_BETA + 4 * pol + 1), alpha.im);
+                    put(s, &mut keep, k(ALPHA_BETA + 4 * pol + 2), beta.re);
+                    put(s, &mut keep, k(ALPHA_BETA + 4 * pol + 3), beta.im);
                     // N' = α(D + M) − β(D − M), D' = α(D + M) + β(D − M), M = N E.
                     let mm = mul(s, num[pol], e2);
                     let a = mul(s, alpha, add(s, den[pol], mm));
@@ -227,7 +218,7 @@ impl WithSimd for JacobianOp<'_> {
                     let scale;
                     (num[pol], den[pol], u[pol], scale) =
                         rescaled(s, sub(s, a, b), add(s, a, b), uu, rescale);
-                    put(SCALE + pol, scale);
+                    put(s, &mut keep, k(SCALE + pol), scale);
                 }
             }
             // Powers: the value kernel's `POWERS` (`above` is the ambient).
@@ -258,19 +249,17 @@ impl WithSimd for JacobianOp<'_> {
                 *lane_mut::<S>(&mut out[k], 0) = value;
             }
             // Reverse: μ (for R) and λ (for T) per polarisation, from the top down.
-            let get = |j: usize, k: usize| lane::<S>(&keep, field(j, k));
             let four_k0 = s.mul_f64s(s.splat_f64s(-4.0), k0);
             for pol in 0..2 {
                 let (n0, d0, inv) = (num[pol], den[pol], inv[pol]);
                 let r_inv = s.mul_f64s(p[pol], inv);
-                let neg = |a: S::f64s| s.neg_f64s(a);
                 let mut mu = [
                     Cx::<S> {
                         re: s.mul_f64s(n0.re, inv),
-                        im: neg(s.mul_f64s(n0.im, inv)),
+                        im: s.neg_f64s(s.mul_f64s(n0.im, inv)),
                     },
                     Cx::<S> {
-                        re: neg(s.mul_f64s(d0.re, r_inv)),
+                        re: s.neg_f64s(s.mul_f64s(d0.re, r_inv)),
                         im: s.mul_f64s(d0.im, r_inv),
                     },
                 ];
@@ -278,32 +267,21 @@ impl WithSimd for JacobianOp<'_> {
                     zero,
                     Cx::<S> {
                         re: s.mul_f64s(d0.re, inv),
-                        im: neg(s.mul_f64s(d0.im, inv)),
+                        im: s.neg_f64s(s.mul_f64s(d0.im, inv)),
                     },
                 ];
                 // −2 T k₀.
                 let two_t_k0 = s.mul_f64s(s.mul_f64s(s.splat_f64s(-2.0), p[2 + pol]), k0);
                 for j in 0..films {
-                    let cx = |k: usize| Cx::<S> {
-                        re: get(j, k),
-                        im: get(j, k + 1),
-                    };
-                    let e2 = cx(E);
-                    let q = cx(Q);
-                    let alpha = cx(ALPHA_BETA + 4 * pol);
-                    let beta = cx(ALPHA_BETA + 4 * pol + 2);
-                    let scale = get(j, SCALE + pol);
-                    let step = |c: [Cx<S>; 2]| {
-                        let a = mul(s, alpha, add(s, c[0], c[1]));
-                        let b = mul(s, beta, sub(s, c[0], c[1]));
-                        [
-                            scale_cx(s, mul(s, e2, add(s, a, b)), scale),
-                            scale_cx(s, sub(s, a, b), scale),
-                        ]
-                    };
-                    mu = step(mu);
-                    lambda = step(lambda);
-                    let z = mul(s, q, cx(NUM + 2 * pol));
+                    let k = |f: usize| field(j, f);
+                    let e2 = get_cx::<S>(&keep, k(E), lanes);
+                    let q = get_cx::<S>(&keep, k(Q), lanes);
+                    let alpha = get_cx::<S>(&keep, k(ALPHA_BETA + 4 * pol), lanes);
+                    let beta = get_cx::<S>(&keep, k(ALPHA_BETA + 4 * pol + 2), lanes);
+                    let scale = lane::<S>(&keep, k(SCALE + pol));
+                    mu = adjoint_step(s, alpha, beta, e2, scale, mu);
+                    lambda = adjoint_step(s, alpha, beta, e2, scale, lambda);
+                    let z = mul(s, q, get_cx::<S>(&keep, k(NUM + 2 * pol), lanes));
                     let d_r = s.mul_f64s(four_k0, im_mul(s, mu[0], z));
                     let d_t = s.mul_f64s(two_t_k0, nmadd2(s, im_mul(s, lambda[0], z), q.im));
                     *lane_mut::<S>(&mut d_out[4 * j + pol], 0) = d_r;
@@ -332,6 +310,50 @@ impl WithSimd for JacobianOp<'_> {
             }
         }
     }
+}
+
+/// Medium j at lanes `i ..` of its arrays (the general formula of [`medium`]).
+#[inline(always)]
+fn medium_of<S: Simd>(s: S, m: &Media, j: usize, i: usize, beta2: S::f64s) -> Medium<S> {
+    let n2 = Cx::<S> {
+        re: lane::<S>(&m.n2_re[j], i),
+        im: lane::<S>(&m.n2_im[j], i),
+    };
+    medium::<S, 0>(s, lane::<S>(&m.n_abs2[j], i), n2, beta2)
+}
+
+/// Keeps `x` at lanes `at ..` of `keep`.
+#[inline(always)]
+fn put<S: Simd>(_: S, keep: &mut [f64], at: usize, x: S::f64s) {
+    *lane_mut::<S>(keep, at) = x;
+}
+
+/// The complex number kept at `at` (real part) and `at + lanes` (imaginary part).
+#[inline(always)]
+fn get_cx<S: Simd>(keep: &[f64], at: usize, lanes: usize) -> Cx<S> {
+    Cx {
+        re: lane::<S>(keep, at),
+        im: lane::<S>(keep, at + lanes),
+    }
+}
+
+/// One level of the reverse sweep: (λN_{j+1}, λD_{j+1}) from (λN_j, λD_j) = `c` (module
+/// docs): p = λN + λD, m = λN − λD, λN' = s E (αp + βm), λD' = s (αp − βm).
+#[inline(always)]
+fn adjoint_step<S: Simd>(
+    s: S,
+    alpha: Cx<S>,
+    beta: Cx<S>,
+    e2: Cx<S>,
+    scale: S::f64s,
+    c: [Cx<S>; 2],
+) -> [Cx<S>; 2] {
+    let a = mul(s, alpha, add(s, c[0], c[1]));
+    let b = mul(s, beta, sub(s, c[0], c[1]));
+    [
+        scale_cx(s, mul(s, e2, add(s, a, b)), scale),
+        scale_cx(s, sub(s, a, b), scale),
+    ]
 }
 
 /// q − 2 z, as (−2) z + q in one fused multiply–add.
