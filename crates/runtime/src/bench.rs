@@ -184,16 +184,7 @@ pub fn run_bench_with_diffraction(
     });
     let view_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("bench view"),
-        entries: &[wgpu::BindGroupLayoutEntry {
-            binding: 0,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        }],
+        entries: &[gpu::uniform_entry(0)],
     });
     let view_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("bench view"),

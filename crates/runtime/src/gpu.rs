@@ -7,6 +7,73 @@ use crate::error::{Error, Result};
 use crate::image_io::Level;
 use half::f16;
 
+/// An [`Error::Limit`] naming `what` when `needed` exceeds the adapter's `limit`.
+pub(crate) fn check_limit(ctx: &GpuContext, what: &str, needed: u64, limit: u32) -> Result<()> {
+    if needed > u64::from(limit) {
+        return Err(Error::Limit {
+            what: what.to_string(),
+            needed,
+            limit: u64::from(limit),
+            adapter: ctx.info.name.clone(),
+        });
+    }
+    Ok(())
+}
+
+/// A texture the shaders sample and the host fills (`TEXTURE_BINDING | COPY_DST`), one
+/// sample per texel, no view formats.
+pub(crate) fn sampled_texture(
+    device: &wgpu::Device,
+    label: &str,
+    size: wgpu::Extent3d,
+    dimension: wgpu::TextureDimension,
+    format: wgpu::TextureFormat,
+    mip_level_count: u32,
+) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size,
+        mip_level_count,
+        sample_count: 1,
+        dimension,
+        format,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    })
+}
+
+/// Writes `texels` (texels of `texel_bytes` bytes, row after row, then image after image)
+/// into the region `size` of mip `level` of `texture`, from layer (or depth) `first_layer`.
+pub(crate) fn write_region(
+    queue: &wgpu::Queue,
+    texture: &wgpu::Texture,
+    level: u32,
+    first_layer: u32,
+    size: wgpu::Extent3d,
+    texel_bytes: u32,
+    texels: &[u8],
+) {
+    queue.write_texture(
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: level,
+            origin: wgpu::Origin3d {
+                x: 0,
+                y: 0,
+                z: first_layer,
+            },
+            aspect: wgpu::TextureAspect::All,
+        },
+        texels,
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(size.width * texel_bytes),
+            rows_per_image: Some(size.height),
+        },
+        size,
+    );
+}
+
 pub(crate) fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
@@ -96,47 +163,32 @@ pub(crate) fn upload_levels(
     levels: &[(u32, u32, Vec<u8>)],
 ) -> Result<wgpu::Texture> {
     let (width, height) = levels.first().map_or((0, 0), |(w, h, _)| (*w, *h));
-    crate::tables::check_limit(
+    check_limit(
         ctx,
         label,
         u64::from(width.max(height)),
         ctx.device.limits().max_texture_dimension_2d,
     )?;
     ctx.checked(&format!("uploading {label}"), || {
-        let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(label),
-            size: wgpu::Extent3d {
+        let texture = sampled_texture(
+            &ctx.device,
+            label,
+            wgpu::Extent3d {
                 width,
                 height,
                 depth_or_array_layers: 1,
             },
-            mip_level_count: levels.len() as u32,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
+            wgpu::TextureDimension::D2,
             format,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
+            levels.len() as u32,
+        );
         for (k, (w, h, texels)) in levels.iter().enumerate() {
-            ctx.queue.write_texture(
-                wgpu::TexelCopyTextureInfo {
-                    texture: &texture,
-                    mip_level: k as u32,
-                    origin: wgpu::Origin3d::ZERO,
-                    aspect: wgpu::TextureAspect::All,
-                },
-                texels,
-                wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(w * texel_bytes),
-                    rows_per_image: Some(*h),
-                },
-                wgpu::Extent3d {
-                    width: *w,
-                    height: *h,
-                    depth_or_array_layers: 1,
-                },
-            );
+            let size = wgpu::Extent3d {
+                width: *w,
+                height: *h,
+                depth_or_array_layers: 1,
+            };
+            write_region(&ctx.queue, &texture, k as u32, 0, size, texel_bytes, texels);
         }
         texture
     })
@@ -179,35 +231,27 @@ pub(crate) fn upload_layers(
             height: *height as u32,
             depth_or_array_layers: layers.len() as u32,
         };
-        let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(label),
+        let texture = sampled_texture(
+            &ctx.device,
+            label,
             size,
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba16Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
+            wgpu::TextureDimension::D2,
+            wgpu::TextureFormat::Rgba16Float,
+            1,
+        );
         let halves: Vec<u16> = layers
             .iter()
             .flat_map(|l| l.2.iter())
             .flat_map(|t| t.map(|v| f16::from_f32(v).to_bits()))
             .collect();
-        ctx.queue.write_texture(
-            wgpu::TexelCopyTextureInfo {
-                texture: &texture,
-                mip_level: 0,
-                origin: wgpu::Origin3d::ZERO,
-                aspect: wgpu::TextureAspect::All,
-            },
-            bytemuck::cast_slice(&halves),
-            wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some((*width * 8) as u32),
-                rows_per_image: Some(*height as u32),
-            },
+        write_region(
+            &ctx.queue,
+            &texture,
+            0,
+            0,
             size,
+            8,
+            bytemuck::cast_slice(&halves),
         );
         texture
     })

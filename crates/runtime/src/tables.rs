@@ -23,6 +23,7 @@
 
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
+use crate::gpu::{check_limit, sampled_texture, write_region};
 use half::f16;
 use nacre_format::film_lut::FilmLutAxes;
 use nacre_format::fourier::FourierAxes;
@@ -211,18 +212,6 @@ pub(crate) fn verify_files(manifest: &Manifest, manifest_path: &Path) -> Result<
     Ok(())
 }
 
-pub(crate) fn check_limit(ctx: &GpuContext, what: &str, needed: u64, limit: u32) -> Result<()> {
-    if needed > u64::from(limit) {
-        return Err(Error::Limit {
-            what: what.to_string(),
-            needed,
-            limit: u64::from(limit),
-            adapter: ctx.info.name.clone(),
-        });
-    }
-    Ok(())
-}
-
 fn upload_film_lut(
     ctx: &GpuContext,
     manifest: Manifest,
@@ -331,35 +320,27 @@ fn upload_table3(ctx: &GpuContext, label: &str, table: &Table3) -> wgpu::Texture
         height: table.ny as u32,
         depth_or_array_layers: table.nz as u32,
     };
-    let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
+    let texture = sampled_texture(
+        &ctx.device,
+        label,
         size,
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D3,
-        format: wgpu::TextureFormat::Rgba16Float,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
+        wgpu::TextureDimension::D3,
+        wgpu::TextureFormat::Rgba16Float,
+        1,
+    );
     let mut texels: Vec<u16> = Vec::with_capacity(table.data.len() / 3 * 4);
     for rgb in table.data.chunks_exact(3) {
         texels.extend(rgb.iter().map(|&v| f16::from_f32(v).to_bits()));
         texels.push(f16::ONE.to_bits());
     }
-    ctx.queue.write_texture(
-        wgpu::TexelCopyTextureInfo {
-            texture: &texture,
-            mip_level: 0,
-            origin: wgpu::Origin3d::ZERO,
-            aspect: wgpu::TextureAspect::All,
-        },
-        bytemuck::cast_slice(&texels),
-        wgpu::TexelCopyBufferLayout {
-            offset: 0,
-            bytes_per_row: Some(table.nx as u32 * 8),
-            rows_per_image: Some(table.ny as u32),
-        },
+    write_region(
+        &ctx.queue,
+        &texture,
+        0,
+        0,
         size,
+        8,
+        bytemuck::cast_slice(&texels),
     );
     texture
 }
@@ -398,20 +379,18 @@ fn upload_fourier(
     )?;
     let name = manifest.name.clone();
     let texture = ctx.checked("uploading a fourier table", || {
-        let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(&name),
-            size: wgpu::Extent3d {
+        let texture = sampled_texture(
+            &ctx.device,
+            &name,
+            wgpu::Extent3d {
                 width: axes.samples as u32,
                 height: 1,
                 depth_or_array_layers: 2,
             },
-            mip_level_count: levels as u32,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba32Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
+            wgpu::TextureDimension::D2,
+            wgpu::TextureFormat::Rgba32Float,
+            levels as u32,
+        );
         for (k, level) in table.levels.iter().enumerate() {
             for layer in 0..2u32 {
                 let texels: Vec<f32> = level
@@ -422,29 +401,13 @@ fn upload_fourier(
                         [v(a[0]), v(a[1]), v(a[2]), 0.0]
                     })
                     .collect();
-                ctx.queue.write_texture(
-                    wgpu::TexelCopyTextureInfo {
-                        texture: &texture,
-                        mip_level: k as u32,
-                        origin: wgpu::Origin3d {
-                            x: 0,
-                            y: 0,
-                            z: layer,
-                        },
-                        aspect: wgpu::TextureAspect::All,
-                    },
-                    bytemuck::cast_slice(&texels),
-                    wgpu::TexelCopyBufferLayout {
-                        offset: 0,
-                        bytes_per_row: Some(level.len() as u32 * 16),
-                        rows_per_image: Some(1),
-                    },
-                    wgpu::Extent3d {
-                        width: level.len() as u32,
-                        height: 1,
-                        depth_or_array_layers: 1,
-                    },
-                );
+                let size = wgpu::Extent3d {
+                    width: level.len() as u32,
+                    height: 1,
+                    depth_or_array_layers: 1,
+                };
+                let bytes = bytemuck::cast_slice(&texels);
+                write_region(&ctx.queue, &texture, k as u32, layer, size, 16, bytes);
             }
         }
         texture

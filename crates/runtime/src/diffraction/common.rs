@@ -5,8 +5,8 @@
 
 use crate::context::GpuContext;
 use crate::error::{Error, Result};
+use crate::gpu::{self, check_limit};
 use crate::shaders;
-use crate::tables::check_limit;
 use nacre_format::Manifest;
 use nacre_format::diffraction::DiffractionRecord;
 use std::path::Path;
@@ -146,33 +146,26 @@ pub(super) fn upload_rgba32f_array(
             height: height as u32,
             depth_or_array_layers: layers as u32,
         };
-        let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(name),
-            size: wgpu::Extent3d {
-                depth_or_array_layers: allocated_layers([width, height, layers]) as u32,
-                ..size
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba32Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
-        ctx.queue.write_texture(
-            wgpu::TexelCopyTextureInfo {
-                texture: &texture,
-                mip_level: 0,
-                origin: wgpu::Origin3d::ZERO,
-                aspect: wgpu::TextureAspect::All,
-            },
-            bytemuck::cast_slice(texels),
-            wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(width as u32 * 16),
-                rows_per_image: Some(height as u32),
-            },
+        let allocated = wgpu::Extent3d {
+            depth_or_array_layers: allocated_layers([width, height, layers]) as u32,
+            ..size
+        };
+        let texture = gpu::sampled_texture(
+            &ctx.device,
+            name,
+            allocated,
+            wgpu::TextureDimension::D2,
+            wgpu::TextureFormat::Rgba32Float,
+            1,
+        );
+        gpu::write_region(
+            &ctx.queue,
+            &texture,
+            0,
+            0,
             size,
+            16,
+            bytemuck::cast_slice(texels),
         );
         texture
     })

@@ -27,13 +27,14 @@ use super::{
 use crate::context::{BufferInitExt, GpuContext};
 use crate::error::Result;
 use crate::gltf_scene::GltfScene;
+use crate::gpu::check_limit;
 use crate::gpu::{group_layout, read_texture, uniform_texture_group, upload_mips};
 use crate::image_io::RenderedImage;
 use crate::render::{
     EnvironmentTextures, MaterialOptions, MaterialUniform, TARGET_FORMAT, ViewUniform,
 };
 use crate::shaders::Technique;
-use crate::tables::{TableSet, check_limit};
+use crate::tables::TableSet;
 use crate::thickness_map::ThicknessMap;
 use nacre_format::param::Msg;
 

@@ -46,12 +46,13 @@
 use crate::bindings::{TechniqueBinding, TechniqueOptions};
 use crate::context::GpuContext;
 use crate::error::{Error, Result, TableMismatch};
+use crate::gpu::check_limit;
 use crate::gpu::{
     begin_pass, cleared_attachment, fullscreen_pipeline, group_layout, read_texture, render_target,
     uniform_texture_group, upload_mips,
 };
 use crate::shaders::{self, Technique};
-use crate::tables::{TableSet, check_limit};
+use crate::tables::TableSet;
 use std::path::Path;
 
 mod options;
