@@ -1,7 +1,9 @@
 //! Tests of the vectorised multilayer kernel against the scalar transfer-matrix reference.
 
+use super::media::Slots;
 use super::*;
 use crate::stack::sweep_recurrence;
+use num_complex::Complex64 as C64;
 
 fn c(re: f64, im: f64) -> C64 {
     C64::new(re, im)
@@ -290,7 +292,7 @@ fn largest_is_the_left_to_right_fold() {
         &[f64::INFINITY, 1.0, 2.0, 3.0, 4.0],
     ];
     for v in cases {
-        let (a, b) = (super::largest(v), fold(v));
+        let (a, b) = (super::media::largest(v), fold(v));
         assert!(
             a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()),
             "{v:?}"
