@@ -22,6 +22,24 @@ pub(crate) fn rows<'a>(path: &'a Path, text: &'a str) -> impl Iterator<Item = Re
     })
 }
 
+/// The header of a table read with [`rows`]: its line and its trimmed column names. An
+/// empty file is an error at line 0 saying `expected` (the header and rows it wants).
+pub(crate) fn header(
+    path: &Path,
+    rows: &mut impl Iterator<Item = Result<Row>>,
+    expected: &str,
+) -> Result<(usize, Vec<String>)> {
+    let header = rows.next().ok_or_else(|| {
+        Error::recipe(
+            path.to_path_buf(),
+            0,
+            format!("the file is empty: expected {expected}"),
+        )
+    })??;
+    let names = header.fields.iter().map(|f| f.trim().to_string()).collect();
+    Ok((header.line, names))
+}
+
 /// Line `line` (1-based) of `text` as written, trimmed (and without a leading BOM): the
 /// row as error messages quote it.
 pub(crate) fn line_text(text: &str, line: usize) -> &str {

@@ -56,16 +56,11 @@ pub fn read_targets(path: &Path, colorimeter: &Colorimeter) -> Result<Vec<Target
 pub fn parse_targets(path: &Path, text: &str, colorimeter: &Colorimeter) -> Result<Vec<TargetRow>> {
     let at = |line: usize, m: String| Error::recipe(path.to_path_buf(), line, m);
     let mut rows = csv_text::rows(path, text);
-    let header = match rows.next() {
-        Some(r) => r?,
-        None => {
-            return Err(at(
-                0,
-                "the file is empty: expected a header `angle_deg,R,G,B` (or L,a,b) and rows".into(),
-            ));
-        }
-    };
-    let names: Vec<String> = header.fields.iter().map(|f| f.trim().to_string()).collect();
+    let (header_line, names) = csv_text::header(
+        path,
+        &mut rows,
+        "a header `angle_deg,R,G,B` (or L,a,b) and rows",
+    )?;
     let find = |n: &str| names.iter().position(|h| h == n);
     let find_ci = |n: &str| names.iter().position(|h| h.eq_ignore_ascii_case(n));
     const KNOWN: [&str; 13] = [
@@ -86,20 +81,20 @@ pub fn parse_targets(path: &Path, text: &str, colorimeter: &Colorimeter) -> Resu
     for n in &names {
         if !KNOWN.contains(&n.as_str()) {
             return Err(at(
-                header.line,
+                header_line,
                 format!(
                     "unknown column `{n}` in header `{}`: expected angle_deg, the colour as L,a,b or R,G,B or X,Y,Z, and optionally weight",
-                    line_text(text, header.line)
+                    line_text(text, header_line)
                 ),
             ));
         }
     }
     let angle = find_ci("angle_deg").ok_or_else(|| {
         at(
-            header.line,
+            header_line,
             format!(
                 "header `{}` has no `angle_deg` column",
-                line_text(text, header.line)
+                line_text(text, header_line)
             ),
         )
     })?;
@@ -124,10 +119,10 @@ pub fn parse_targets(path: &Path, text: &str, colorimeter: &Colorimeter) -> Resu
         (None, None, Some(c)) => (Given::Lab, c),
         _ => {
             return Err(at(
-                header.line,
+                header_line,
                 format!(
                     "header `{}` has no complete colour: give R,G,B (linear, in the output space), X,Y,Z or L,a,b",
-                    line_text(text, header.line)
+                    line_text(text, header_line)
                 ),
             ));
         }
@@ -192,7 +187,7 @@ pub fn parse_targets(path: &Path, text: &str, colorimeter: &Colorimeter) -> Resu
         });
     }
     if out.is_empty() {
-        return Err(at(header.line, "no target rows below the header".into()));
+        return Err(at(header_line, "no target rows below the header".into()));
     }
     Ok(out)
 }

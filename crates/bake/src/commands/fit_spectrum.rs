@@ -113,23 +113,18 @@ fn read_csv(path: &Path, quantity: Option<Quantity>) -> Result<Vec<Spectrum>> {
     })?;
     let at = |line: usize, m: String| Error::recipe(path.to_path_buf(), line, m);
     let mut rows = csv_text::rows(path, &text);
-    let header = match rows.next() {
-        Some(r) => r?,
-        None => {
-            return Err(at(
-                0,
-                "the file is empty: expected a header `wavelength_nm,R` (or T) and rows".into(),
-            ));
-        }
-    };
-    let names: Vec<String> = header.fields.iter().map(|f| f.trim().to_string()).collect();
+    let (header_line, names) = csv_text::header(
+        path,
+        &mut rows,
+        "a header `wavelength_nm,R` (or T) and rows",
+    )?;
     let find = |n: &str| names.iter().position(|h| h.eq_ignore_ascii_case(n));
     let wl = find("wavelength_nm").ok_or_else(|| {
         at(
-            header.line,
+            header_line,
             format!(
                 "header `{}` has no `wavelength_nm` column",
-                line_text(&text, header.line)
+                line_text(&text, header_line)
             ),
         )
     })?;
@@ -140,7 +135,7 @@ fn read_csv(path: &Path, quantity: Option<Quantity>) -> Result<Vec<Spectrum>> {
         .collect();
     if values.is_empty() {
         return Err(at(
-            header.line,
+            header_line,
             "no measured column: add `R` or `T` beside `wavelength_nm`".into(),
         ));
     }
@@ -155,7 +150,7 @@ fn read_csv(path: &Path, quantity: Option<Quantity>) -> Result<Vec<Spectrum>> {
         .map(|&i| {
             let q = match (named(i), quantity) {
                 (Some(q), Some(asked)) if q != asked => Err(at(
-                    header.line,
+                    header_line,
                     format!(
                         "column `{}` is {}, but the fit was asked for {}",
                         names[i],
@@ -167,7 +162,7 @@ fn read_csv(path: &Path, quantity: Option<Quantity>) -> Result<Vec<Spectrum>> {
                 (None, Some(q)) => Ok(q),
                 (None, None) if values.len() > 1 => Ok(Quantity::Reflectance),
                 (None, None) => Err(at(
-                    header.line,
+                    header_line,
                     format!(
                         "column `{}` is neither `R` nor `T`: name it so, or say which with the quantity",
                         names[i]
@@ -259,7 +254,7 @@ fn read_csv(path: &Path, quantity: Option<Quantity>) -> Result<Vec<Spectrum>> {
         }
     }
     if spectra[0].points.is_empty() {
-        return Err(at(header.line, "the file has a header but no rows".into()));
+        return Err(at(header_line, "the file has a header but no rows".into()));
     }
     Ok(spectra)
 }
