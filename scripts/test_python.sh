@@ -27,7 +27,19 @@ start=$(date +%s)
 "$VENV/bin/python" -m pip install --quiet --upgrade pip
 # The extension shares the workspace's target folder unless CARGO_TARGET_DIR says otherwise.
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$ROOT/target}"
-"$VENV/bin/python" -m pip install --quiet "$ROOT/python" pytest
+# With the extra `mitsuba` (the pinned Mitsuba 3 of nacre.mitsuba), so that the plugin and
+# reference tests (python/tests/test_mitsuba.py) run: NACRE_REQUIRE_MITSUBA makes them fail,
+# never skip, when Mitsuba is missing.
+"$VENV/bin/python" -m pip install --quiet "$ROOT/python[mitsuba]" pytest
+export NACRE_REQUIRE_MITSUBA=1
+# Dr.Jit's LLVM backend (Mitsuba's llvm_ad_* variants) needs a newer libLLVM than Debian
+# bookworm's 14/15 (their instruction selection lacks fminimum: "LLVM ERROR: Cannot select");
+# the Rust toolchain's libLLVM (22 with Rust 1.95) serves, unless DRJIT_LIBLLVM_PATH is set.
+if [ -z "${DRJIT_LIBLLVM_PATH:-}" ]; then
+    for lib in "$(rustc --print sysroot)"/lib/libLLVM*.so*; do
+        if [ -f "$lib" ]; then export DRJIT_LIBLLVM_PATH="$lib"; break; fi
+    done
+fi
 installed=$(date +%s)
 echo "scripts/test_python.sh: pip install ./python took $((installed - start)) s" >&2
 

@@ -142,7 +142,7 @@ class NacreFilm(mi.BSDF):
         self.transmission = bool(props.get("transmission", False))
         self._check_transmission()
         self.base = None
-        if props.has_property("base"):
+        if "base" in props:
             self.base = mi.load_dict({"type": "srgb", "color": props.get("base")})
         self.smooth = self.alpha <= 0.0
         self.distr = None if self.smooth else mi.MicrofacetDistribution(mi.MicrofacetType.GGX, self.alpha, True)
