@@ -110,8 +110,12 @@ def read_picture(path: str, tone: Optional[str]) -> np.ndarray:
             mi.set_variant("scalar_rgb")
         bitmap = mi.Bitmap(path)
         if lower.endswith(".png"):
-            data = np.array(bitmap.convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.UInt8, False), dtype=np.float64)
-            return data[..., :3] / 255.0
+            # The stored (sRGB-encoded) values as they are: no conversion, which would decode them.
+            data = np.array(bitmap)
+            if data.ndim == 2:
+                data = np.repeat(data[..., None], 3, axis=-1)
+            scale = 65535.0 if data.dtype == np.uint16 else 255.0
+            return data[..., :3].astype(np.float64) / scale
         linear = np.array(bitmap.convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32, False), dtype=np.float64)
     if tone is None:
         raise ValueError(f"{path}: a linear picture needs --tone-map or --scene")
