@@ -3,7 +3,7 @@
 //
 // Consumers of the `diffraction` technique (composed after diffraction.wgsl by
 // `nacre_runtime::diffraction`): the ray-cast scenes of `nacre render --scene cd-disc |
-// snake-skin`, the bench pass of `nacre bench-gpu`, and the GPU = CPU probe (compute).
+// snake-skin | grating-plane`, the bench pass of `nacre bench-gpu`, and the GPU = CPU probe (compute).
 //
 // Symbols
 //   p, n          hit point and unit normal (world units; y up)
@@ -41,6 +41,9 @@
 //                 rotation of ±15° and a fan of ±12° across the scale; t is perpendicular
 //                 to the ridges in the tangent plane. The scales' dark skin shows between
 //                 the coloured orders.
+//   3 grating-plane  the square |x|, |z| ≤ 1 in the plane y = 0, a flat 1200 lines/mm
+//                 grating whose grooves run along x (t = +z everywhere); seen from below,
+//                 the same grooves (normal −y).
 //   2 bench       `nacre bench-gpu`: the sphere-like normal field of bench.wgsl over the
 //                 whole target, t swirling over the screen, the light only, no environment.
 //
@@ -50,7 +53,8 @@
 
 // Group 0 is every scene's (view.wgsl: `view`, `env_map`, `env_sampler`; the split-sum
 // textures there are unused placeholders), with view.light_intensity = E_0, the light's
-// irradiance at normal incidence, and view.scene = 0 cd-disc, 1 snake-skin, 2 bench.
+// irradiance at normal incidence, and view.scene = 0 cd-disc, 1 snake-skin, 2 bench,
+// 3 grating-plane.
 //
 // Group 2, the lights as the gratings see them (272 bytes, uniform;
 // `nacre_runtime::diffraction::DiffractionLightsUniform` mirrors it):
@@ -137,6 +141,28 @@ fn cd_disc(origin: vec3<f32>, dir: vec3<f32>) -> Surface {
     s.normal = vec3<f32>(0.0, sign(origin.y), 0.0);
     s.across = vec3<f32>(p.x, 0.0, p.z) / max(r, 1e-6);
     s.grating = select(0.0, 1.0, r >= 0.38 && r <= 0.98);
+    s.base = vec3<f32>(0.0);
+    return s;
+}
+
+fn grating_plane(origin: vec3<f32>, dir: vec3<f32>) -> Surface {
+    if abs(dir.y) < 1e-6 {
+        return miss();
+    }
+    let t = -origin.y / dir.y;
+    if t <= 0.0 {
+        return miss();
+    }
+    let p = origin + t * dir;
+    if abs(p.x) > 1.0 || abs(p.z) > 1.0 {
+        return miss();
+    }
+    var s: Surface;
+    s.hit = true;
+    s.position = p;
+    s.normal = vec3<f32>(0.0, sign(origin.y), 0.0);
+    s.across = vec3<f32>(0.0, 0.0, 1.0);
+    s.grating = 1.0;
     s.base = vec3<f32>(0.0);
     return s;
 }
@@ -260,6 +286,8 @@ fn diffraction_scene_fs(@builtin(position) position: vec4<f32>) -> @location(0) 
     var s: Surface;
     if view.scene == 0u {
         s = cd_disc(origin, dir);
+    } else if view.scene == 3u {
+        s = grating_plane(origin, dir);
     } else {
         s = snake_skin(origin, dir);
     }

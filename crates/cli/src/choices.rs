@@ -83,6 +83,7 @@ pub enum SceneArg {
     RoughRow,
     CdDisc,
     SnakeSkin,
+    GratingPlane,
 }
 
 impl From<SceneArg> for nacre_runtime::Scene {
@@ -97,6 +98,7 @@ impl From<SceneArg> for nacre_runtime::Scene {
             SceneArg::RoughRow => Scene::RoughRow,
             SceneArg::CdDisc => Scene::Diffraction(DiffractionScene::CdDisc),
             SceneArg::SnakeSkin => Scene::Diffraction(DiffractionScene::SnakeSkin),
+            SceneArg::GratingPlane => Scene::Diffraction(DiffractionScene::GratingPlane),
         }
     }
 }

@@ -39,8 +39,10 @@ Examples:
   # the same from above and to the left, or from the file's first camera
   nacre render --gltf scene.glb --yaw -35 --pitch 30 -o orbit.png
   nacre render --gltf scene.glb --camera 0 -o camera.png
-  # diffraction (technique `diffraction`, tables cd-tracks / snake-ridges): a CD and snake scales
+  # diffraction (technique `diffraction`, tables cd-tracks / snake-ridges / grating-1200): a CD,
+  # snake scales and a flat 1200 lines/mm grating under an overhead light
   nacre render --scene cd-disc -o cd.png && nacre render --scene snake-skin -o snake.png
+  nacre render --scene grating-plane -o grating.png
   # the CD from the fast table (layout \"integrated\": the wavelength sum baked in)
   nacre render --scene cd-disc --tables cd-tracks-fast -o cd-fast.png
 
@@ -55,8 +57,9 @@ film-lut table cannot represent is drawn with fourier instead (a note on stderr 
 pub struct RenderArgs {
     /// Scene: sphere, bubble, plane, rough-row (spheres of GGX α 0.05 … 0.8 by the
     /// film-at-n·v shortcut, the exact path and the Monte Carlo reference, three rows), or a
-    /// diffraction scene: cd-disc (a CD-like disc with circular tracks; table cd-tracks) or
-    /// snake-skin (a curved patch of scales with fanned ridges; table snake-ridges).
+    /// diffraction scene: cd-disc (a CD-like disc with circular tracks; table cd-tracks),
+    /// snake-skin (a curved patch of scales with fanned ridges; table snake-ridges) or
+    /// grating-plane (a flat 1200 lines/mm grating; table grating-1200).
     #[arg(long, value_enum, default_value = "sphere")]
     scene: SceneArg,
     /// How the film enters the lighting: classic (the film at v·h for the light, at n·v for
@@ -76,8 +79,9 @@ pub struct RenderArgs {
     gltf: Option<PathBuf>,
     /// A table to load (repeatable): default-set name or manifest path [default: the scene's
     /// film-lut (sphere film-dielectric, bubble soap-film, plane oil-slick) + fourier-srgb;
-    /// cd-disc and snake-skin take one diffraction table, either layout: cd-tracks,
-    /// snake-ridges; cd-tracks-fast is the integrated table of the CD].
+    /// cd-disc, snake-skin and grating-plane take one diffraction table, either layout:
+    /// cd-tracks, snake-ridges, grating-1200, dvd-tracks; cd-tracks-fast is the integrated
+    /// table of the CD].
     #[arg(long = "tables", value_name = "NAME|PATH")]
     tables: Vec<String>,
     /// Technique: lut, fourier, spectral, or stack (a multilayer stack per pixel from
@@ -357,7 +361,7 @@ fn table_names(
     }
 }
 
-/// `nacre render --scene cd-disc | snake-skin`: the `diffraction` technique.
+/// `nacre render --scene cd-disc | snake-skin | grating-plane`: the `diffraction` technique.
 fn run_render_diffraction(
     args: &RenderArgs,
     scene: nacre_runtime::diffraction::DiffractionScene,

@@ -35,17 +35,28 @@ pub enum DiffractionScene {
     /// A patch of a cylinder (a snake's body) tiled with domed scales whose ridges run along
     /// the body, rotated and fanned per scale.
     SnakeSkin,
+    /// A flat 1200 lines/mm grating: the square |x|, |z| ≤ 1 in the plane y = 0 with its
+    /// grooves along x (t = +z across them), seen from the +z side; under the overhead light
+    /// its first order runs along the plane's middle from violet (near) to red (far)
+    /// ([`DiffractionScene::camera`], [`DiffractionScene::light`]: the framing the Mitsuba
+    /// reference copies).
+    GratingPlane,
 }
 
 impl DiffractionScene {
     /// Every scene.
-    pub const ALL: [DiffractionScene; 2] = [DiffractionScene::CdDisc, DiffractionScene::SnakeSkin];
+    pub const ALL: [DiffractionScene; 3] = [
+        DiffractionScene::CdDisc,
+        DiffractionScene::SnakeSkin,
+        DiffractionScene::GratingPlane,
+    ];
 
     /// The name on the command line.
     pub fn name(self) -> &'static str {
         match self {
             DiffractionScene::CdDisc => "cd-disc",
             DiffractionScene::SnakeSkin => "snake-skin",
+            DiffractionScene::GratingPlane => "grating-plane",
         }
     }
 
@@ -54,6 +65,7 @@ impl DiffractionScene {
         match self {
             DiffractionScene::CdDisc => "cd-tracks",
             DiffractionScene::SnakeSkin => "snake-ridges",
+            DiffractionScene::GratingPlane => "grating-1200",
         }
     }
 
@@ -61,10 +73,13 @@ impl DiffractionScene {
         match self {
             DiffractionScene::CdDisc => 0,
             DiffractionScene::SnakeSkin => 1,
+            DiffractionScene::GratingPlane => 3,
         }
     }
 
-    /// The scene's camera.
+    /// The scene's camera (a pinhole, vertical field of view `fov_y_deg`, square pixels; the
+    /// image's aspect ratio is the render's width / height). `grating-plane`: eye
+    /// (0, 1.8, 2.0), looking at the origin, y up, 40°.
     pub fn camera(self) -> Camera {
         match self {
             DiffractionScene::CdDisc => Camera {
@@ -79,21 +94,34 @@ impl DiffractionScene {
                 up: [0.0, 1.0, 0.0],
                 fov_y_deg: 42.0,
             },
+            DiffractionScene::GratingPlane => Camera {
+                eye: [0.0, 1.8, 2.0],
+                target: [0.0, 0.0, 0.0],
+                up: [0.0, 1.0, 0.0],
+                fov_y_deg: 40.0,
+            },
         }
     }
 
-    /// The scene's Fresnel factor: 1 for the disc (an aluminium-coated CD reflects ~90 %),
+    /// The scene's Fresnel factor: 1 for the disc and the grating plane (aluminium-coated,
+    /// ~90 %),
     /// the Fresnel reflectance of keratin (n = 1.56, about 5 % at normal incidence) for the
     /// snake's scales.
     pub fn fresnel(self) -> FresnelTerm {
         match self {
-            DiffractionScene::CdDisc => FresnelTerm::Unity,
+            DiffractionScene::CdDisc | DiffractionScene::GratingPlane => FresnelTerm::Unity,
             DiffractionScene::SnakeSkin => FresnelTerm::Index(nacre_optics::C64::new(1.56, 0.0)),
         }
     }
 
     /// The scene's light: a white directional light (the sun) from behind and to the left
-    /// of the camera for the disc, from above and behind for the snake.
+    /// of the camera for the disc, from above and behind for the snake, straight overhead
+    /// (towards the light (0, 1, 0)) for the grating plane. The grating equation for the
+    /// tangential components along t (Stam 1999: peaks of |P̃(k u, k v)|² at u = mλ/d),
+    /// ω_i·t + ω_r·t = mλ/d with ω_r·t = sin θ_r (θ_r from the normal, positive towards the
+    /// camera, +z), then puts the first order m = 1 at sin θ_r = λ/d (d = 0.8333 µm: 27.1° at
+    /// 380 nm, 41.8° at 555 nm, 69.4° at 780 nm), where the camera sees the plane's middle
+    /// line x = 0.
     pub fn light(self) -> Light {
         match self {
             DiffractionScene::CdDisc => Light {
@@ -103,6 +131,11 @@ impl DiffractionScene {
             },
             DiffractionScene::SnakeSkin => Light {
                 direction: [0.3, 0.85, -0.45],
+                colour: [1.0, 0.97, 0.92],
+                intensity: 3.0,
+            },
+            DiffractionScene::GratingPlane => Light {
+                direction: [0.0, 1.0, 0.0],
                 colour: [1.0, 0.97, 0.92],
                 intensity: 3.0,
             },
@@ -119,7 +152,7 @@ impl FromStr for DiffractionScene {
             .ok_or_else(|| Error::UnknownName {
                 what: "diffraction scene",
                 name: s.to_string(),
-                expected: "cd-disc or snake-skin".into(),
+                expected: "cd-disc, snake-skin or grating-plane".into(),
             })
     }
 }

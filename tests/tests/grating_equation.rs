@@ -1,0 +1,188 @@
+//! The grating equation holds in the rendered picture (issue 37): `nacre render --scene
+//! grating-plane` — a flat 1200 lines/mm grating (`tables/recipes/grating-1200.toml`) under
+//! its overhead directional light, the environment off — puts the first diffraction order
+//! where ω_i·t + ω_r·t = mλ/d (Stam 1999: the peaks of |P̃(k u, k v)|² at u = mλ/d), measured
+//! from the image's pixels alone:
+//!
+//! * every pixel is traced back through the scene's camera to its point on the plane, which
+//!   gives its view direction ω_r and sin θ_r = ω_r·t (t = +z, across the grooves);
+//! * a narrow-band bake of the same recipe (545–565 nm, the 5 nm grid) draws the order near
+//!   555 nm only: the radiance-weighted mean angle θ_r of the lit pixels (radiance recovered
+//!   from the sRGB bytes by inverting `output.wgsl`'s transfer and tone map) must sit within
+//!   0.5° of asin(555 nm / d);
+//! * with the full 380–780 nm table every lit pixel lies within the first order's span
+//!   (sin θ_r from 380/833.3 to 780/833.3, widened by the coherence lobe), blue nearer the
+//!   grating normal than red.
+//!
+//! A missing adapter fails the test: GPU tests never skip.
+
+use nacre_optics::diffraction::FresnelTerm;
+use nacre_runtime::diffraction::{
+    DiffractionScene, DiffractionSceneOptions, DiffractionTables, render_diffraction_scene,
+};
+use std::path::Path;
+
+#[path = "../../crates/runtime/tests/support/mod.rs"]
+mod support;
+use support::ctx;
+
+/// The grating's period, µm (1/1200 mm).
+const PERIOD_UM: f64 = 1.0 / 1.2;
+
+/// One lit pixel: sin θ_r along t, and its linear radiance (R, G, B) as displayed.
+struct Lit {
+    sin_theta_r: f64,
+    rgb: [f64; 3],
+}
+
+/// sRGB byte → linear [0, 1] (IEC 61966-2-1).
+fn linear(byte: u8) -> f64 {
+    let c = f64::from(byte) / 255.0;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// Renders the grating plane with `table` (light only) at `width × height` and returns the
+/// lit pixels of the plane.
+fn lit_pixels(table: &DiffractionTables, width: u32, height: u32) -> Vec<Lit> {
+    let scene = DiffractionScene::GratingPlane;
+    let mut options = DiffractionSceneOptions::new(scene);
+    (options.width, options.height) = (width, height);
+    options.env_intensity = 0.0;
+    options.env_samples = 0;
+    options.technique.wavelength_step_nm = None;
+    let image = render_diffraction_scene(ctx(), table, &options).unwrap();
+    let out = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("grating-plane-{}.png", table.name()));
+    image.write_png(&out).unwrap();
+    eprintln!("wrote {}", out.display());
+    // The camera's rays, as shaders/diffraction_scene.wgsl builds them (WGSL columns).
+    let m = options
+        .camera
+        .inverse_view_projection(f64::from(width) / f64::from(height))
+        .unwrap();
+    let apply = |v: [f64; 4]| -> [f64; 3] {
+        let mut r = [0.0; 4];
+        for (row, out) in r.iter_mut().enumerate() {
+            *out = (0..4).map(|c| f64::from(m[c][row]) * v[c]).sum();
+        }
+        [r[0] / r[3], r[1] / r[3], r[2] / r[3]]
+    };
+    let eye = options.camera.eye.map(f64::from);
+    let mut lit = Vec::new();
+    for py in 0..height {
+        for px in 0..width {
+            let i = 4 * (py * width + px) as usize;
+            let mapped = [0, 1, 2].map(|c| linear(image.pixels[i + c]));
+            let top = mapped.iter().cloned().fold(0.0, f64::max);
+            if top < 0.02 {
+                continue;
+            }
+            // Undo the tone map c/(1 + max c): max c = m/(1 − m).
+            let rgb = mapped.map(|x| x / (1.0 - top.min(0.999)));
+            let ndc = [
+                (f64::from(px) + 0.5) / f64::from(width) * 2.0 - 1.0,
+                1.0 - (f64::from(py) + 0.5) / f64::from(height) * 2.0,
+            ];
+            let near = apply([ndc[0], ndc[1], 0.0, 1.0]);
+            let far = apply([ndc[0], ndc[1], 1.0, 1.0]);
+            let dir = [0, 1, 2].map(|k| far[k] - near[k]);
+            let t = -near[1] / dir[1];
+            let p = [0, 1, 2].map(|k| near[k] + t * dir[k]);
+            assert!(
+                p[0].abs() <= 1.0 + 1e-3 && p[2].abs() <= 1.0 + 1e-3,
+                "pixel ({px}, {py}) is lit off the plane at {p:?}"
+            );
+            let to_eye = [0, 1, 2].map(|k| eye[k] - p[k]);
+            let len = to_eye.iter().map(|x| x * x).sum::<f64>().sqrt();
+            lit.push(Lit {
+                sin_theta_r: to_eye[2] / len,
+                rgb,
+            });
+        }
+    }
+    lit
+}
+
+fn bake(dir: &Path, name: &str, text: String) -> DiffractionTables {
+    let path = dir.join(format!("{name}.toml"));
+    std::fs::write(&path, &text).unwrap();
+    let recipe = nacre_bake::kinds::parse_recipe(&path, text).unwrap();
+    let manifest = recipe.bake(dir, &|| {}).unwrap();
+    DiffractionTables::load(ctx(), &manifest, FresnelTerm::Unity).unwrap()
+}
+
+#[test]
+fn first_order_sits_where_the_grating_equation_puts_it() {
+    let recipe = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../tables/recipes/grating-1200.toml"),
+    )
+    .unwrap();
+    assert!(recipe.contains("wavelengths = \"380:780:5\""));
+    let dir = tempfile::tempdir().unwrap();
+
+    // Narrow band around 555 nm: the band's position.
+    let narrow = bake(
+        dir.path(),
+        "grating-1200-narrow",
+        recipe.replace("380:780:5", "545:565:5"),
+    );
+    let lit = lit_pixels(&narrow, 320, 240);
+    assert!(lit.len() >= 20, "{} lit pixels", lit.len());
+    let weight = |l: &Lit| l.rgb.iter().sum::<f64>();
+    let total: f64 = lit.iter().map(weight).sum();
+    let mean_deg = lit
+        .iter()
+        .map(|l| weight(l) * l.sin_theta_r.asin().to_degrees())
+        .sum::<f64>()
+        / total;
+    let theory_deg = (0.555 / PERIOD_UM).asin().to_degrees();
+    eprintln!(
+        "narrow band 545–565 nm: {} lit pixels, first order at θ_r = {mean_deg:.3}° (theory at 555 nm {theory_deg:.3}°, error {:.3}°)",
+        lit.len(),
+        mean_deg - theory_deg
+    );
+    assert!(
+        (mean_deg - theory_deg).abs() <= 0.5,
+        "first order at {mean_deg}°, theory {theory_deg}°"
+    );
+
+    // The full table: nothing lit outside the first order's span; blue before red.
+    let full = DiffractionTables::load(
+        ctx(),
+        &nacre_format::set::default_baked_dir().join("grating-1200.json"),
+        FresnelTerm::Unity,
+    )
+    .unwrap();
+    let lit = lit_pixels(&full, 320, 240);
+    assert!(lit.len() >= 100, "{} lit pixels", lit.len());
+    // The coherence window (32 µm) widens each wavelength's peak by ~λ/32 µm in sin θ_r.
+    let (lo, hi) = (0.380 / PERIOD_UM - 0.03, 0.780 / PERIOD_UM + 0.03);
+    let outside: Vec<f64> = lit
+        .iter()
+        .map(|l| l.sin_theta_r)
+        .filter(|s| !(lo..=hi).contains(s))
+        .collect();
+    assert!(
+        outside.is_empty(),
+        "{} pixels lit outside the first order (sin θ_r {lo:.3} … {hi:.3}): {:?}",
+        outside.len(),
+        &outside[..outside.len().min(8)]
+    );
+    let centre = |c: usize| {
+        let w: f64 = lit.iter().map(|l| l.rgb[c]).sum();
+        lit.iter()
+            .map(|l| l.rgb[c] * l.sin_theta_r.asin().to_degrees())
+            .sum::<f64>()
+            / w
+    };
+    let (red, green, blue) = (centre(0), centre(1), centre(2));
+    eprintln!(
+        "full table: {} lit pixels; channel centroids θ_r: blue {blue:.2}°, green {green:.2}°, red {red:.2}°",
+        lit.len()
+    );
+    assert!(blue < green && green < red, "{blue} {green} {red}");
+}
