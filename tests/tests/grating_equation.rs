@@ -29,8 +29,12 @@ use support::ctx;
 /// The grating's period, µm (1/1200 mm).
 const PERIOD_UM: f64 = 1.0 / 1.2;
 
-/// One lit pixel: sin θ_r along t, and its linear radiance (R, G, B) as displayed.
+/// One lit pixel: its point p on the surface (y = 0), the unit direction towards the eye,
+/// sin θ_r = ω_r·t for the grating plane (t = +z), and its linear radiance (R, G, B) as
+/// displayed.
 struct Lit {
+    p: [f64; 3],
+    to_eye: [f64; 3],
     sin_theta_r: f64,
     rgb: [f64; 3],
 }
@@ -45,18 +49,29 @@ fn linear(byte: u8) -> f64 {
     }
 }
 
-/// Renders the grating plane with `table` (light only) at `width × height` and returns the
-/// lit pixels of the plane.
-fn lit_pixels(table: &DiffractionTables, width: u32, height: u32) -> Vec<Lit> {
-    let scene = DiffractionScene::GratingPlane;
+/// Renders `scene` (a flat one in y = 0: the grating plane or the CD) with `table` (light
+/// only) at `width × height` and returns its lit pixels.
+fn lit_pixels(
+    scene: DiffractionScene,
+    table: &DiffractionTables,
+    width: u32,
+    height: u32,
+    light_direction: Option<[f32; 3]>,
+) -> Vec<Lit> {
     let mut options = DiffractionSceneOptions::new(scene);
+    if let Some(d) = light_direction {
+        options.light.direction = d;
+    }
     (options.width, options.height) = (width, height);
     options.env_intensity = 0.0;
     options.env_samples = 0;
     options.technique.wavelength_step_nm = None;
     let image = render_diffraction_scene(ctx(), table, &options).unwrap();
-    let out = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("grating-plane-{}.png", table.name()));
+    let out = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!(
+        "{}-{}.png",
+        scene.name(),
+        table.name()
+    ));
     image.write_png(&out).unwrap();
     eprintln!("wrote {}", out.display());
     // The camera's rays, as shaders/diffraction_scene.wgsl builds them (WGSL columns).
@@ -94,12 +109,15 @@ fn lit_pixels(table: &DiffractionTables, width: u32, height: u32) -> Vec<Lit> {
             let p = [0, 1, 2].map(|k| near[k] + t * dir[k]);
             assert!(
                 p[0].abs() <= 1.0 + 1e-3 && p[2].abs() <= 1.0 + 1e-3,
-                "pixel ({px}, {py}) is lit off the plane at {p:?}"
+                "pixel ({px}, {py}) is lit off the surface at {p:?}"
             );
             let to_eye = [0, 1, 2].map(|k| eye[k] - p[k]);
             let len = to_eye.iter().map(|x| x * x).sum::<f64>().sqrt();
+            let to_eye = to_eye.map(|x| x / len);
             lit.push(Lit {
-                sin_theta_r: to_eye[2] / len,
+                p,
+                to_eye,
+                sin_theta_r: to_eye[2],
                 rgb,
             });
         }
@@ -130,7 +148,7 @@ fn first_order_sits_where_the_grating_equation_puts_it() {
         "grating-1200-narrow",
         recipe.replace("380:780:5", "545:565:5"),
     );
-    let lit = lit_pixels(&narrow, 320, 240);
+    let lit = lit_pixels(DiffractionScene::GratingPlane, &narrow, 320, 240, None);
     assert!(lit.len() >= 20, "{} lit pixels", lit.len());
     let weight = |l: &Lit| l.rgb.iter().sum::<f64>();
     let total: f64 = lit.iter().map(weight).sum();
@@ -157,7 +175,7 @@ fn first_order_sits_where_the_grating_equation_puts_it() {
         FresnelTerm::Unity,
     )
     .unwrap();
-    let lit = lit_pixels(&full, 320, 240);
+    let lit = lit_pixels(DiffractionScene::GratingPlane, &full, 320, 240, None);
     assert!(lit.len() >= 100, "{} lit pixels", lit.len());
     // The coherence window (32 µm) widens each wavelength's peak by ~λ/32 µm in sin θ_r.
     let (lo, hi) = (0.380 / PERIOD_UM - 0.03, 0.780 / PERIOD_UM + 0.03);
@@ -185,4 +203,67 @@ fn first_order_sits_where_the_grating_equation_puts_it() {
         lit.len()
     );
     assert!(blue < green && green < red, "{blue} {green} {red}");
+}
+
+/// The CD (`nacre render --scene cd-disc`, a directional light only) of a 545–565 nm bake of
+/// `tables/recipes/cd-tracks.toml`: at every lit pixel of the data area the tracks run in
+/// circles, so t is the radial direction of its point and the grating equation reads
+/// |ω_i·t + ω_r·t| = mλ/d with ω_i·s + ω_r·s = 0 along the tracks (s), d = 1.6 µm. The
+/// first-order pixels (|ω_i·s + ω_r·s| ≤ 0.02, |ω_i·t + ω_r·t| between the zeroth and
+/// second orders; the pits' scatter off that line is left out) must put their radiance-weighted mean diffraction angle
+/// asin|ω_i·t + ω_r·t| within 0.5° of asin(555 nm / 1.6 µm).
+#[test]
+fn the_cds_first_order_sits_where_the_grating_equation_puts_it() {
+    let recipe = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../tables/recipes/cd-tracks.toml"),
+    )
+    .unwrap();
+    assert!(recipe.contains("wavelengths = \"380:780:5\""));
+    let dir = tempfile::tempdir().unwrap();
+    let narrow = bake(
+        dir.path(),
+        "cd-tracks-narrow",
+        recipe.replace("380:780:5", "545:565:5"),
+    );
+    let scene = DiffractionScene::CdDisc;
+    // A light from beyond the disc (−z), 17.5° from the zenith: the 555 nm first order
+    // crosses the near half of the data area (the scene's own light puts it off the disc).
+    let light_f32 = [0.0, 0.95, -0.3];
+    let light = light_f32.map(f64::from);
+    let len = light.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let omega_i = light.map(|x| x / len);
+    let d_um: f64 = 1.6;
+    let (mut weight, mut sum, mut count) = (0.0, 0.0, 0);
+    for l in lit_pixels(scene, &narrow, 320, 240, Some(light_f32)) {
+        let r = (l.p[0] * l.p[0] + l.p[2] * l.p[2]).sqrt();
+        if !(0.38..=0.98).contains(&r) {
+            continue;
+        }
+        let t = [l.p[0] / r, 0.0, l.p[2] / r];
+        let along = [-t[2], 0.0, t[0]];
+        let h = [0, 1, 2].map(|k| omega_i[k] + l.to_eye[k]);
+        let u = (0..3).map(|k| h[k] * t[k]).sum::<f64>().abs();
+        let v = (0..3).map(|k| h[k] * along[k]).sum::<f64>().abs();
+        // The orders of the track pitch lie at v = 0 (within the 32 µm window's lobe,
+        // ~λ/32 µm); elsewhere the light is the pits' scatter along the tracks. Between the
+        // zeroth order (0) and the second (2λ/d ≈ 0.69).
+        if v > 0.02 || !(0.17..=0.52).contains(&u) {
+            continue;
+        }
+        let w = l.rgb.iter().sum::<f64>();
+        weight += w;
+        sum += w * u.asin().to_degrees();
+        count += 1;
+    }
+    assert!(count >= 10, "{count} first-order pixels");
+    let mean_deg = sum / weight;
+    let theory_deg = (0.555 / d_um).asin().to_degrees();
+    eprintln!(
+        "CD, 545–565 nm: {count} first-order pixels at {mean_deg:.3}° (theory at 555 nm {theory_deg:.3}°, error {:.3}°)",
+        mean_deg - theory_deg
+    );
+    assert!(
+        (mean_deg - theory_deg).abs() <= 0.5,
+        "first order at {mean_deg}°, theory {theory_deg}°"
+    );
 }
