@@ -20,9 +20,11 @@ s ∈ [−2 k_max, 0] by FFTs of e^{ish} and interpolated linearly in s (the pha
 under 0.06 rad between samples for |h| ≤ 0.1 µm); the bins within reach of the window
 (window weights ≥ 10⁻⁵) are summed coherently.
 
-Sampling: a bin j with probability ∝ |P_j(s₀)|² (s₀ at 555 nm, normal incidence), then
-q ~ N(κ_j, 1/(2σ_s²)) per axis (the lobe |P̃|²), mixed with 10 % cosine-weighted directions;
-the density of the mixture is evaluated exactly, so the estimator is unbiased.
+Sampling: one of the path's wavelengths λ (uniformly), a bin j with probability ∝
+|P_j(s₀)|² (s₀ at 555 nm, normal incidence), then q ~ N(κ_j, 1/(2σ_s²)) per axis (the lobe
+|P̃|² at k = 2π/λ), mixed with 10 % cosine-weighted directions; the density of the mixture
+(over the wavelengths, bins and the cosine lobe) is evaluated exactly, so the estimator is
+unbiased.
 
 Per point, the scenes may give the grating frame (``set_frame_function``: world normal and
 direction across the lines) and the grating's coverage c ∈ [0, 1]; where c < 1 the surface
@@ -261,10 +263,6 @@ class NacreGrating(mi.BSDF):
             cond=lambda n, re, im: n < count,
             body=body,
         )
-        if sp.ny == 1:
-            lobe_v = dr.exp(-0.5 * sig2 * qy * qy)
-            re *= lobe_v
-            im *= lobe_v
         return re * re + im * im
 
     def rho(self, wi, wo, wavelength_nm):
@@ -291,10 +289,10 @@ class NacreGrating(mi.BSDF):
 
     # ─── Sampling density of the lobe mixture ──────────────────────────────────────
 
-    def _lobe_pdf(self, wi, wo):
-        """Density (per solid angle) of the bin-and-Gaussian sampling at 555 nm."""
+    def _lobe_pdf(self, wi, wo, k):
+        """Density (per solid angle) of the bin-and-Gaussian sampling at wavenumber ``k``
+        (rad/µm)."""
         sp = self.spectra
-        k = 2.0 * math.pi / 0.555
         qx, qy = k * (-wi.x - wo.x), k * (-wi.y - wo.y)
         cx = mi.Int32(dr.round(qx / sp.dk[0]))
         cy = mi.Int32(dr.round(qy / sp.dk[1])) if sp.ny > 1 else mi.Int32(0)
@@ -332,7 +330,11 @@ class NacreGrating(mi.BSDF):
         value = mi.Spectrum(mi.UnpolarizedSpectrum(*lanes)) * (coverage * wo.z)
         if self.base is not None:
             value += self.base.eval(si, active) * (dr.inv_pi * wo.z)
-        pdf = (1.0 - P_COSINE) * self._lobe_pdf(wi, wo) + P_COSINE * dr.inv_pi * wo.z
+        lanes = len(si.wavelengths)
+        lobe = mi.Float(0.0)
+        for lane in range(lanes):
+            lobe += self._lobe_pdf(wi, wo, 2.0 * dr.pi / (si.wavelengths[lane] * 1e-3))
+        pdf = (1.0 - P_COSINE) * lobe / lanes + P_COSINE * dr.inv_pi * wo.z
         pdf *= 1.0 - _p_mirror(coverage)
         return dr.select(active, value, 0.0), dr.select(active, pdf, 0.0)
 
@@ -357,8 +359,16 @@ class NacreGrating(mi.BSDF):
         cosine = u1 < P_COSINE
         # A bin, then a Gaussian offset in q (Box–Muller on sample2).
         sp = self.spectra
-        k = 2.0 * math.pi / 0.555
-        j = self._sampler.sample(dr.clip((u1 - P_COSINE) / (1.0 - P_COSINE), 0.0, 0.999999))
+        # One of the path's wavelengths, uniformly, places the lobes (the density is the
+        # mixture over all of them, so every wavelength's orders are sampled).
+        lanes = len(si.wavelengths)
+        u2 = dr.clip((u1 - P_COSINE) / (1.0 - P_COSINE), 0.0, 0.999999) * lanes
+        lane = dr.floor(u2)
+        wavelength = si.wavelengths[0]
+        for i in range(1, lanes):
+            wavelength = dr.select(lane == i, si.wavelengths[i], wavelength)
+        k = 2.0 * dr.pi / (wavelength * 1e-3)
+        j = self._sampler.sample(dr.clip(u2 - lane, 0.0, 0.999999))
         jx = mi.Int32(j % sp.nx)
         jy = mi.Int32(j // sp.nx)
         jx = dr.select(jx >= (sp.nx + 1) // 2, jx - sp.nx, jx)
