@@ -7,10 +7,7 @@ environment (the bundled studio) and tone mapping — with nacre's BSDFs
 (:mod:`nacre.mitsuba`), spectrally. Besides the PNG it writes the linear radiance
 (``FILE.exr``) and the reference's own noise: the samples are rendered as two independent
 halves (different seeds), and the noise is the ΔE2000 between the halves' pictures
-divided by √2... see :func:`nacre.reference.compare.noise`.
-
-``grating-plane`` is not a scene of ``nacre render`` yet; it is defined here (a flat
-1200 lines/mm sinusoidal grating under a point light, :data:`SCENES`).
+halved: see :func:`nacre.reference.compare.noise`.
 """
 
 from __future__ import annotations

@@ -4,8 +4,8 @@ Geometry as the ray casters of ``nacre render``: the film scenes' sphere (centre
 radius 1) and plane y = 0 (to 1000 units), the CD's annulus 0.12 ≤ r ≤ 1 in y = 0 (grating
 for 0.38 ≤ r ≤ 0.98, tracks circular, a plain mirror elsewhere), the snake's cylinder patch
 y² + z² = 1, |x| ≤ 1.6, |φ| ≤ 1.31 with its domed diamond scales, per-scale ridge rotation and
-fan, and matt scale edges (``shaders/diffraction_scene.wgsl``), and grating-plane's 2 × 2
-square. The curved surfaces are fine triangle meshes (the CD's circles with 1024 segments,
+fan, and matt scale edges, and grating-plane's 2 × 2 square (``shaders/diffraction_scene.wgsl``).
+The curved surfaces are fine triangle meshes (the CD's circles with 1024 segments,
 a sagitta of 5·10⁻⁶ units); the BSDFs take their normals and grating frames from the
 analytic surfaces at each hit point.
 """
@@ -183,7 +183,8 @@ def _cd_frame(si):
 
 
 def _plane_frame(si):
-    return mi.Vector3f(0.0, 1.0, 0.0), mi.Vector3f(1.0, 0.0, 0.0), mi.Float(1.0)
+    """grating-plane: lines along x, t = z (shaders/diffraction_scene.wgsl)."""
+    return mi.Vector3f(0.0, 1.0, 0.0), mi.Vector3f(0.0, 0.0, 1.0), mi.Float(1.0)
 
 
 def _props(plugin: str, values: Dict[str, Any]) -> "mi.Properties":

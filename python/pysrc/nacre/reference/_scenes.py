@@ -2,8 +2,7 @@
 environment, geometry and materials (``crates/runtime/src/render/options.rs``,
 ``shaders/scene.wgsl``, ``crates/runtime/src/diffraction/scene.rs``,
 ``shaders/diffraction_scene.wgsl``, ``crates/runtime/src/environment.rs``,
-``crates/runtime/src/thickness_map.rs``), plus ``grating-plane``, which ``nacre render``
-does not have yet: a flat 1200 lines/mm sinusoidal grating under a point light.
+``crates/runtime/src/thickness_map.rs``).
 
 Each scene is a dict of plain numbers (:data:`SCENES`) and :func:`build` turns one into a
 Mitsuba scene; the pure-numpy parts (environment, thickness map, tone mapping) need no
@@ -78,15 +77,14 @@ SCENES: Dict[str, Scene] = {
         env_sun=False, env_intensity=0.5, tone_map="max_channel",
         surface=dict(kind="snake-skin", grating="sine:0.8:0.07", fresnel_ior=1.56),
     ),
-    # Not in `nacre render` yet (issue 37): a 1200 lines/mm sinusoidal grating (period
-    # 0.8333 µm, amplitude 0.07 µm) on a 2 × 2 plane in y = 0, lines along z, under a
-    # white point light of intensity 3 (W/sr) 1.5 units above and behind the camera's left.
+    # `nacre render --scene grating-plane` (table grating-1200): a 1200 lines/mm sinusoidal
+    # grating (period 0.833333 µm, amplitude 0.06 µm, F = 1) on the square |x|, |z| ≤ 1 of
+    # y = 0, lines along x, under a white directional light straight overhead.
     "grating-plane": Scene(
-        "grating-plane", eye=(0.0, 1.2, 2.2), target=(0.0, 0.0, 0.0), fov_y_deg=40.0,
-        light_direction=(0.0, 1.0, 0.0), light_colour=(1.0, 1.0, 1.0), light_intensity=0.0,
+        "grating-plane", eye=(0.0, 1.8, 2.0), target=(0.0, 0.0, 0.0), fov_y_deg=40.0,
+        light_direction=(0.0, 1.0, 0.0), light_colour=(1.0, 0.97, 0.92), light_intensity=3.0,
         env_sun=False, env_intensity=0.5, tone_map="max_channel",
-        surface=dict(kind="grating-plane", grating=f"sine:{1000.0 / 1200.0}:0.07", fresnel_ior=None),
-        point_light=(-0.6, 1.5, -1.2),
+        surface=dict(kind="grating-plane", grating="sine:0.833333:0.06", fresnel_ior=None),
     ),
 }
 
