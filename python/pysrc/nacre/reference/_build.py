@@ -274,9 +274,6 @@ def build(scene: Scene, width: int, height: int, max_depth: int = 8) -> Tuple["m
             "direction": [-x for x in _unit(scene.light_direction)],
             "irradiance": {"type": "rgb", "value": [c * scene.light_intensity for c in scene.light_colour]},
         }
-    if scene.point_light is not None:
-        emitters["point"] = {"type": "point", "position": list(scene.point_light),
-                             "intensity": {"type": "rgb", "value": [3.0, 3.0, 3.0]}}
     description = {
         "type": "scene",
         "integrator": {"type": "path", "max_depth": max_depth, "hide_emitters": False},

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, Dict, List, Optional, Tuple
+from typing import Any, Dict, Tuple
 
 import numpy as np
 
@@ -38,8 +38,6 @@ class Scene:
     #: "pbr_neutral" (film scenes) or "max_channel" (diffraction scenes).
     tone_map: str
     surface: Dict[str, Any] = field(default_factory=dict)
-    #: A point light instead of the directional one (position), for grating-plane.
-    point_light: Optional[Tuple[float, float, float]] = None
 
 
 _SUN = (-0.45, 0.70, 0.55)
