@@ -156,6 +156,22 @@ impl Renderer {
         self.technique
     }
 
+    /// Rebuilds the technique's group 1 (its tables' bind group and its buffers: the stack
+    /// of `film_stack`, the base of `film_spectral`) for new `options`, keeping the compiled
+    /// pipeline: the group's layout depends on the technique alone
+    /// ([`crate::bindings::table_layout`]), so an edited stack costs an upload, not a shader
+    /// compilation (the studio's sliders).
+    pub fn rebind(
+        &mut self,
+        ctx: &GpuContext,
+        tables: &TableSet,
+        options: &TechniqueOptions,
+    ) -> Result<()> {
+        let colorimeter = tables.colorimeter()?;
+        self.binding = TechniqueBinding::new(ctx, tables, self.technique, options, &colorimeter)?;
+        Ok(())
+    }
+
     /// Renders `options`, loading its environment and thickness map.
     pub fn render(
         &self,

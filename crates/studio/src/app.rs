@@ -1,0 +1,665 @@
+//! The studio's window: the stack editor (left), the live view (centre) and the plots
+//! (right). [`Studio::ui`] draws it all into any [`egui::Ui`], so the same code runs in the
+//! native window (`main.rs`, eframe) and in the UI tests (`egui_kittest`).
+//!
+//! An entry is applied when the stack it makes builds ([`StackDoc::build`], the CLI's
+//! parser); otherwise the error is shown beside the stack and the view, the plots and the
+//! exports keep the last stack that built.
+
+use crate::curves::{CurveWorker, Curves};
+use crate::doc::{Film, History, MAX_FILMS, PRESETS, SLIDER_MAX_NM, StackDoc};
+use crate::view::{Frame, Lighting, View, ViewSettings};
+use eframe::egui;
+use egui::{Color32, RichText, TextureHandle, TextureOptions};
+use nacre_format::atomic::write_atomic;
+use nacre_optics::Stack;
+use nacre_runtime::Technique;
+use nacre_runtime::render::SceneKind;
+use std::path::Path;
+
+/// The techniques the view offers.
+pub const TECHNIQUES: [Technique; 4] = [
+    Technique::Stack,
+    Technique::Spectral,
+    Technique::Fourier,
+    Technique::Lut,
+];
+
+/// The scenes the view offers.
+pub const SCENES: [SceneKind; 3] = [SceneKind::Sphere, SceneKind::Bubble, SceneKind::Plane];
+
+/// A scene's menu name.
+fn scene_name(scene: SceneKind) -> &'static str {
+    match scene {
+        SceneKind::Sphere => "sphere",
+        SceneKind::Bubble => "bubble",
+        SceneKind::Plane => "plane",
+    }
+}
+
+/// The studio's state.
+pub struct Studio {
+    /// The stack as edited (may not build).
+    pub doc: StackDoc,
+    /// The stack at the last undo step.
+    committed: StackDoc,
+    /// Undo and redo.
+    pub history: History,
+    /// The last stack that built, and its optics.
+    good: (StackDoc, Stack),
+    /// Why the edited stack does not build.
+    pub stack_error: Option<String>,
+    /// The typed thickness of each film, and its error.
+    thickness_text: Vec<(String, Option<String>)>,
+    /// What the view draws besides the stack.
+    pub settings: ViewSettings,
+    /// Whether the picture's size follows the window (the native window; tests fix it).
+    pub follow_panel: bool,
+    view: Result<View, String>,
+    texture: Option<TextureHandle>,
+    /// The last frame drawn.
+    pub frame: Option<Frame>,
+    /// Why the last frame failed.
+    pub view_error: Option<String>,
+    drawn: Option<(ViewSettings, StackDoc)>,
+    /// Frames drawn since the start.
+    pub frames_drawn: u64,
+    worker: CurveWorker,
+    /// The plots' data, and its request.
+    pub curves: Option<Curves>,
+    /// Why the plots' data failed.
+    pub curves_error: Option<String>,
+    asked: Option<(StackDoc, f64, u64)>,
+    /// The spectra's incidence angle, degrees.
+    pub spectrum_angle_deg: f64,
+    /// Where the recipe is saved or opened.
+    pub recipe_path: String,
+    /// Where the picture is saved.
+    pub picture_path: String,
+    /// The last export's outcome.
+    pub status: Option<Result<String, String>>,
+}
+
+impl Studio {
+    /// A studio drawing with `view` (its error is shown in place of the picture) at `size`.
+    pub fn new(view: Result<View, String>, doc: StackDoc, size: [u32; 2]) -> Studio {
+        let (doc, stack) = match doc.build() {
+            Ok(stack) => (doc, stack),
+            Err(_) => {
+                let d = StackDoc::default();
+                let s = d.build().expect("the default preset builds");
+                (d, s)
+            }
+        };
+        Studio {
+            committed: doc.clone(),
+            thickness_text: texts(&doc),
+            good: (doc.clone(), stack),
+            doc,
+            history: History::default(),
+            stack_error: None,
+            settings: ViewSettings::new(size),
+            follow_panel: false,
+            view,
+            texture: None,
+            frame: None,
+            view_error: None,
+            drawn: None,
+            frames_drawn: 0,
+            worker: CurveWorker::new(),
+            curves: None,
+            curves_error: None,
+            asked: None,
+            spectrum_angle_deg: 0.0,
+            recipe_path: "stack.toml".into(),
+            picture_path: "studio.png".into(),
+            status: None,
+        }
+    }
+
+    /// The last stack that built (what the view and the plots show).
+    pub fn stack(&self) -> &(StackDoc, Stack) {
+        &self.good
+    }
+
+    /// Replaces the stack (a preset, a recipe), as one undo step.
+    pub fn set_doc(&mut self, doc: StackDoc) {
+        self.commit();
+        self.history.record(self.doc.clone());
+        self.doc = doc;
+        self.committed = self.doc.clone();
+        self.thickness_text = texts(&self.doc);
+    }
+
+    /// Records the edits since the last step as one undo step.
+    fn commit(&mut self) {
+        if self.doc != self.committed {
+            self.history.record(self.committed.clone());
+            self.committed = self.doc.clone();
+        }
+    }
+
+    /// Undoes the last step.
+    pub fn undo(&mut self) {
+        self.commit();
+        if let Some(d) = self.history.undo(&self.doc) {
+            self.doc = d;
+            self.committed = self.doc.clone();
+            self.thickness_text = texts(&self.doc);
+        }
+    }
+
+    /// Redoes the last undone step.
+    pub fn redo(&mut self) {
+        if let Some(d) = self.history.redo(&self.doc) {
+            self.doc = d;
+            self.committed = self.doc.clone();
+            self.thickness_text = texts(&self.doc);
+        }
+    }
+
+    /// Builds the edited stack: applies it when it builds, else keeps the error.
+    fn apply(&mut self) {
+        if self.doc == self.good.0 {
+            self.stack_error = None;
+            return;
+        }
+        match self.doc.build() {
+            Ok(stack) => {
+                self.good = (self.doc.clone(), stack);
+                self.stack_error = None;
+            }
+            Err(e) => self.stack_error = Some(e.to_string()),
+        }
+    }
+
+    /// Writes the stack as a recipe to `path` (atomically); refused while an entry is in
+    /// error, so that the file always holds what the fields show.
+    pub fn export_recipe(&mut self, path: &Path) -> Result<(), String> {
+        if let Some(e) = &self.stack_error {
+            return Err(format!("the stack has an error, fix it first: {e}"));
+        }
+        self.good
+            .0
+            .write_recipe(path)
+            .map_err(|e| format!("{}: {e}", path.display()))
+    }
+
+    /// Opens a recipe (the CLI's reader) as the new stack.
+    pub fn open_recipe(&mut self, path: &Path) -> Result<(), String> {
+        let doc = StackDoc::read_recipe(path).map_err(|e| e.to_string())?;
+        doc.build().map_err(|e| e.to_string())?;
+        self.set_doc(doc);
+        Ok(())
+    }
+
+    /// Writes the view's last picture as a PNG to `path` (atomically).
+    pub fn save_picture(&self, path: &Path) -> Result<(), String> {
+        let frame = self.frame.as_ref().ok_or("no picture drawn yet")?;
+        let png = frame.image.encode_png().map_err(|e| e.to_string())?;
+        write_atomic(path, |w| w.write_all(&png)).map_err(|e| format!("{}: {e}", path.display()))
+    }
+
+    /// Draws the whole studio into `ui` (and the view's frame when anything changed).
+    pub fn ui(&mut self, ui: &mut egui::Ui) {
+        self.shortcuts(ui.ctx());
+        egui::Panel::top("studio toolbar").show(ui, |ui| self.toolbar(ui));
+        egui::Panel::left("studio stack")
+            .default_size(330.0)
+            .resizable(true)
+            .show(ui, |ui| {
+                egui::ScrollArea::vertical().show(ui, |ui| self.stack_editor(ui));
+            });
+        self.apply();
+        if !ui.ctx().input(|i| i.pointer.any_down()) && ui.ctx().memory(|m| m.focused().is_none()) {
+            self.commit();
+        }
+        self.poll_curves();
+        egui::Panel::right("studio plots")
+            .default_size(360.0)
+            .resizable(true)
+            .show(ui, |ui| self.plots(ui));
+        egui::CentralPanel::default().show(ui, |ui| self.view_ui(ui));
+    }
+
+    fn shortcuts(&mut self, ctx: &egui::Context) {
+        if ctx.memory(|m| m.focused().is_some()) {
+            return;
+        }
+        let (undo, redo) = ctx.input_mut(|i| {
+            let redo = i.consume_key(
+                egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
+                egui::Key::Z,
+            ) || i.consume_key(egui::Modifiers::COMMAND, egui::Key::Y);
+            (i.consume_key(egui::Modifiers::COMMAND, egui::Key::Z), redo)
+        });
+        if undo {
+            self.undo();
+        }
+        if redo {
+            self.redo();
+        }
+    }
+
+    fn toolbar(&mut self, ui: &mut egui::Ui) {
+        ui.horizontal_wrapped(|ui| {
+            ui.menu_button("Presets", |ui| {
+                for p in PRESETS {
+                    if ui.button(p.name).on_hover_text(p.description).clicked() {
+                        self.set_doc(p.doc());
+                        ui.close();
+                    }
+                }
+            });
+            if ui
+                .add_enabled(
+                    self.history.can_undo() || self.doc != self.committed,
+                    egui::Button::new("Undo"),
+                )
+                .clicked()
+            {
+                self.undo();
+            }
+            if ui
+                .add_enabled(self.history.can_redo(), egui::Button::new("Redo"))
+                .clicked()
+            {
+                self.redo();
+            }
+            ui.separator();
+            let label = ui.label("Recipe file");
+            ui.add(egui::TextEdit::singleline(&mut self.recipe_path).desired_width(140.0))
+                .labelled_by(label.id);
+            if ui.button("Save recipe").clicked() {
+                let path = self.recipe_path.clone();
+                self.status = Some(
+                    self.export_recipe(Path::new(&path))
+                        .map(|()| format!("saved {path}")),
+                );
+            }
+            if ui.button("Open recipe").clicked() {
+                let path = self.recipe_path.clone();
+                self.status = Some(
+                    self.open_recipe(Path::new(&path))
+                        .map(|()| format!("opened {path}")),
+                );
+            }
+            ui.separator();
+            let label = ui.label("Picture file");
+            ui.add(egui::TextEdit::singleline(&mut self.picture_path).desired_width(120.0))
+                .labelled_by(label.id);
+            if ui.button("Save picture").clicked() {
+                let path = self.picture_path.clone();
+                self.status = Some(
+                    self.save_picture(Path::new(&path))
+                        .map(|()| format!("saved {path}")),
+                );
+            }
+            match &self.status {
+                Some(Ok(text)) => {
+                    ui.label(text);
+                }
+                Some(Err(text)) => {
+                    ui.label(RichText::new(text).color(Color32::LIGHT_RED));
+                }
+                None => {}
+            }
+        });
+    }
+
+    fn stack_editor(&mut self, ui: &mut egui::Ui) {
+        ui.heading("Stack");
+        material_field(ui, "Ambient", &mut self.doc.ambient);
+        ui.separator();
+        let mut remove = None;
+        let mut swap = None;
+        let count = self.doc.films.len();
+        self.thickness_text.resize(count, (String::new(), None));
+        for j in 0..count {
+            let n = j + 1;
+            ui.label(RichText::new(format!("Film {n}")).strong());
+            material_field(
+                ui,
+                &format!("Film {n} material"),
+                &mut self.doc.films[j].material,
+            );
+            let film = &mut self.doc.films[j];
+            let (text, error) = &mut self.thickness_text[j];
+            ui.horizontal(|ui| {
+                let slider = ui.add(
+                    egui::Slider::new(&mut film.thickness_nm, 0.0..=SLIDER_MAX_NM)
+                        .clamping(egui::SliderClamping::Never)
+                        .show_value(false)
+                        .text(format!("Film {n} thickness")),
+                );
+                if slider.changed() {
+                    *text = format_nm(film.thickness_nm);
+                    *error = None;
+                }
+                let label = ui.label("nm:");
+                let typed = ui
+                    .add(egui::TextEdit::singleline(text).desired_width(70.0))
+                    .labelled_by(label.id);
+                typed.widget_info(|| {
+                    egui::WidgetInfo::text_edit(
+                        true,
+                        format!("Film {n} thickness (nm)"),
+                        text.as_str(),
+                        "",
+                    )
+                });
+                if typed.changed() {
+                    match nacre_bake::commands::grid::parse_thickness_nm(
+                        format!("studio film {n} thickness"),
+                        text,
+                    ) {
+                        Ok(d) => {
+                            film.thickness_nm = d;
+                            *error = None;
+                        }
+                        Err(e) => *error = Some(e.to_string()),
+                    }
+                } else if !typed.has_focus() && error.is_none() {
+                    *text = format_nm(film.thickness_nm);
+                }
+            });
+            if let Some(e) = error {
+                ui.label(RichText::new(e.as_str()).color(Color32::LIGHT_RED));
+            }
+            ui.add(
+                egui::Slider::new(&mut film.relative_nm, 0.0..=300.0)
+                    .text(format!("Film {n} relative (nm)")),
+            );
+            ui.horizontal(|ui| {
+                if ui.small_button("Remove").clicked() {
+                    remove = Some(j);
+                }
+                if j > 0 && ui.small_button("Up").clicked() {
+                    swap = Some(j - 1);
+                }
+                if j + 1 < count && ui.small_button("Down").clicked() {
+                    swap = Some(j);
+                }
+            });
+            ui.separator();
+        }
+        if let Some(j) = remove {
+            self.doc.films.remove(j);
+            self.thickness_text.remove(j);
+        }
+        if let Some(j) = swap {
+            self.doc.films.swap(j, j + 1);
+            self.thickness_text.swap(j, j + 1);
+        }
+        if ui
+            .add_enabled(count < MAX_FILMS, egui::Button::new("Add film"))
+            .clicked()
+        {
+            let film = Film::new("1.45", 100.0);
+            self.thickness_text
+                .push((format_nm(film.thickness_nm), None));
+            self.doc.films.push(film);
+        }
+        ui.separator();
+        material_field(ui, "Base", &mut self.doc.substrate);
+        ui.separator();
+        if let Some(e) = &self.stack_error {
+            ui.label(RichText::new(format!("Not applied: {e}")).color(Color32::LIGHT_RED));
+        } else {
+            ui.label("Materials: numbers (1.45, 0.27+2.9i), bundled names (bk7, mgf2, tio2, water, oil, au, ag, cu, al, cr, si), or files (.yml, .csv).");
+        }
+    }
+
+    fn view_ui(&mut self, ui: &mut egui::Ui) {
+        ui.horizontal_wrapped(|ui| {
+            let s = &mut self.settings;
+            egui::ComboBox::from_label("Technique")
+                .selected_text(s.technique.name())
+                .show_ui(ui, |ui| {
+                    for t in TECHNIQUES {
+                        ui.selectable_value(&mut s.technique, t, t.name());
+                    }
+                });
+            let scene = s.scene;
+            egui::ComboBox::from_label("Scene")
+                .selected_text(scene_name(scene))
+                .show_ui(ui, |ui| {
+                    for k in SCENES {
+                        ui.selectable_value(&mut s.scene, k, scene_name(k));
+                    }
+                });
+            if s.scene != scene {
+                s.orbit = crate::view::Orbit::for_scene(s.scene);
+            }
+            egui::ComboBox::from_label("Lighting")
+                .selected_text(s.lighting.name())
+                .show_ui(ui, |ui| {
+                    for l in Lighting::ALL {
+                        ui.selectable_value(&mut s.lighting, l, l.name());
+                    }
+                });
+            ui.add(egui::Slider::new(&mut s.exposure_ev, -4.0..=4.0).text("Exposure (EV)"));
+            ui.add(
+                egui::Slider::new(&mut s.roughness_alpha, 0.001..=1.0)
+                    .logarithmic(true)
+                    .text("Roughness α"),
+            );
+        });
+        if self.follow_panel {
+            let ppp = ui.ctx().pixels_per_point();
+            let avail = ui.available_size() * ppp;
+            // Multiples of 16 pixels, so that a resize re-renders only now and then.
+            let snap = |v: f32| ((v as u32) / 16 * 16).clamp(64, 4096);
+            self.settings.size = [snap(avail.x), snap(avail.y - 40.0 * ppp)];
+        }
+        self.draw_if_needed(ui.ctx());
+        if let Some(e) = &self.view_error {
+            ui.label(RichText::new(e.as_str()).color(Color32::LIGHT_RED));
+        }
+        if let Some(frame) = &self.frame {
+            for note in &frame.notes {
+                ui.label(RichText::new(format!("note: {note}")).weak());
+            }
+        }
+        if let Some(texture) = &self.texture {
+            let ppp = ui.ctx().pixels_per_point();
+            let [w, h] = texture.size();
+            let size = egui::vec2(w as f32, h as f32) / ppp;
+            let response = ui.add(
+                egui::Image::from_texture((texture.id(), size))
+                    .sense(egui::Sense::click_and_drag())
+                    .alt_text("Live view"),
+            );
+            if response.dragged() {
+                let d = response.drag_delta();
+                self.settings.orbit.drag(d.x, d.y);
+            }
+            if let Some(frame) = &self.frame {
+                ui.label(
+                    RichText::new(format!(
+                        "{}×{} · {} · frame {:.1} ms",
+                        frame.image.width,
+                        frame.image.height,
+                        self.view.as_ref().map_or(String::new(), |v| v.describe()),
+                        frame.seconds * 1e3
+                    ))
+                    .weak(),
+                );
+            }
+        }
+    }
+
+    /// Draws a new frame when the stack or the settings changed since the last one.
+    fn draw_if_needed(&mut self, ctx: &egui::Context) {
+        let key = (self.settings.clone(), self.good.0.clone());
+        if self.drawn.as_ref() == Some(&key) {
+            return;
+        }
+        let view = match &mut self.view {
+            Ok(v) => v,
+            Err(e) => {
+                self.view_error = Some(format!("no live view: {e}"));
+                return;
+            }
+        };
+        self.drawn = Some(key);
+        match view.render(&self.settings, &self.good.0, &self.good.1) {
+            Ok(frame) => {
+                let img = &frame.image;
+                let picture = egui::ColorImage::from_rgba_unmultiplied(
+                    [img.width as usize, img.height as usize],
+                    &img.pixels,
+                );
+                match &mut self.texture {
+                    Some(t) => t.set(picture, TextureOptions::LINEAR),
+                    None => {
+                        self.texture =
+                            Some(ctx.load_texture("live view", picture, TextureOptions::LINEAR));
+                    }
+                }
+                self.frame = Some(frame);
+                self.view_error = None;
+                self.frames_drawn += 1;
+            }
+            Err(e) => self.view_error = Some(e.to_string()),
+        }
+    }
+
+    /// Asks the worker for the current stack's curves when they are stale; takes its answer.
+    fn poll_curves(&mut self) {
+        if let Some((id, out)) = self.worker.take()
+            && id == self.worker.last_request()
+        {
+            match out {
+                Ok(c) => {
+                    self.curves = Some(c);
+                    self.curves_error = None;
+                }
+                Err(e) => self.curves_error = Some(e),
+            }
+        }
+        let stale = match &self.asked {
+            Some((doc, angle, _)) => *doc != self.good.0 || *angle != self.spectrum_angle_deg,
+            None => true,
+        };
+        if stale {
+            let id = self
+                .worker
+                .ask(self.good.1.clone(), self.spectrum_angle_deg);
+            self.asked = Some((self.good.0.clone(), self.spectrum_angle_deg, id));
+        }
+    }
+
+    /// Whether the plots show the current stack.
+    pub fn curves_current(&self) -> bool {
+        match (&self.curves, &self.asked) {
+            (Some(c), Some((doc, angle, _))) => {
+                *doc == self.good.0 && c.angle_deg == *angle && *angle == self.spectrum_angle_deg
+            }
+            _ => false,
+        }
+    }
+
+    fn plots(&mut self, ui: &mut egui::Ui) {
+        use egui_plot::{Legend, Line, Plot, PlotPoints};
+        ui.heading("Spectra");
+        ui.add(
+            egui::Slider::new(&mut self.spectrum_angle_deg, 0.0..=89.0).text("Spectrum angle (°)"),
+        );
+        if let Some(e) = &self.curves_error {
+            ui.label(RichText::new(e.as_str()).color(Color32::LIGHT_RED));
+        }
+        let Some(c) = &self.curves else {
+            ui.label("computing…");
+            ui.ctx().request_repaint();
+            return;
+        };
+        if !self.curves_current() {
+            ui.ctx().request_repaint();
+        }
+        let series = |values: &[f64]| -> PlotPoints<'static> {
+            c.wavelengths_nm
+                .iter()
+                .zip(values)
+                .map(|(&x, &y)| [x, y])
+                .collect()
+        };
+        let colours = [
+            Color32::from_rgb(90, 160, 255),
+            Color32::from_rgb(255, 140, 60),
+            Color32::from_gray(230),
+        ];
+        for (title, values, names) in [
+            ("Reflectance", &c.reflectance, ["R s", "R p", "R"]),
+            ("Transmittance", &c.transmittance, ["T s", "T p", "T"]),
+        ] {
+            ui.label(format!("{title} at {:.0}°", c.angle_deg));
+            Plot::new(title)
+                .height(150.0)
+                .legend(Legend::default())
+                .include_y(0.0)
+                .include_y(1.0)
+                .x_axis_label("wavelength (nm)")
+                .allow_scroll(false)
+                .show(ui, |p| {
+                    for k in 0..3 {
+                        p.line(
+                            Line::new(names[k], series(&values[k]))
+                                .color(colours[k])
+                                .width(if k == 2 { 2.0 } else { 1.2 }),
+                        );
+                    }
+                });
+        }
+        ui.label("Exact colour against angle, 0° to 89°");
+        let (rect, _) =
+            ui.allocate_exact_size(egui::vec2(ui.available_width(), 28.0), egui::Sense::hover());
+        let n = c.colour_by_angle.len().max(1);
+        let w = rect.width() / n as f32;
+        for (k, rgb) in c.colour_by_angle.iter().enumerate() {
+            let x = rect.left() + w * k as f32;
+            let r = egui::Rect::from_min_max(
+                egui::pos2(x, rect.top()),
+                egui::pos2(x + w + 0.5, rect.bottom()),
+            );
+            ui.painter().rect_filled(r, 0.0, srgb8(*rgb));
+        }
+    }
+}
+
+/// The thickness texts of `doc`'s films.
+fn texts(doc: &StackDoc) -> Vec<(String, Option<String>)> {
+    doc.films
+        .iter()
+        .map(|f| (format_nm(f.thickness_nm), None))
+        .collect()
+}
+
+/// A thickness as typed: up to two decimals, no trailing zeros.
+pub fn format_nm(d: f64) -> String {
+    let t = format!("{d:.2}");
+    t.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
+/// A labelled single-line material entry.
+fn material_field(ui: &mut egui::Ui, label: &str, text: &mut String) {
+    ui.horizontal(|ui| {
+        let l = ui.label(label);
+        ui.add(egui::TextEdit::singleline(text).desired_width(150.0))
+            .labelled_by(l.id);
+    });
+}
+
+/// Linear sRGB → an 8-bit sRGB-encoded colour (clipped to [0, 1]; IEC 61966-2-1).
+pub fn srgb8(rgb: [f64; 3]) -> Color32 {
+    let e = |c: f64| {
+        let c = c.clamp(0.0, 1.0);
+        let v = if c <= 0.003_130_8 {
+            12.92 * c
+        } else {
+            1.055 * c.powf(1.0 / 2.4) - 0.055
+        };
+        (v * 255.0).round() as u8
+    };
+    Color32::from_rgb(e(rgb[0]), e(rgb[1]), e(rgb[2]))
+}

@@ -1,0 +1,18 @@
+//! nacre studio: design a thin-film stack by eye. The stack editor (ambient, up to eight
+//! films, base; the CLI's material parser), the runtime's renderer drawing it live on a
+//! sphere, a bubble or a plane, its spectra and its exact colour against angle beside it,
+//! and the recipe TOML the CLI reads.
+//!
+//! Files: `doc.rs` (the stack as edited, presets, undo, the recipe), `view.rs` (the live
+//! view on the runtime's `Renderer`), `curves.rs` (spectra and colours for the plots, on a
+//! background thread), `app.rs` (the window's panels), `main.rs` (the `nacre-studio`
+//! binary: its flags, eframe, `--screenshot`).
+
+pub mod app;
+pub mod curves;
+pub mod doc;
+pub mod view;
+
+pub use app::Studio;
+pub use doc::StackDoc;
+pub use view::{View, ViewSettings};

@@ -1,0 +1,327 @@
+//! The live view: the runtime's scene renderer ([`nacre_runtime::render::Renderer`], the
+//! renderer of `nacre render`) drawing the designed stack on a sphere, a bubble or a plane,
+//! with an orbit camera.
+//!
+//! The renderer is compiled once per technique; a stack edit rebinds its group 1
+//! ([`Renderer::rebind`]: the stack's buffers, a new base) and changes the material
+//! uniform, so the picture follows a slider in the next frame without a shader
+//! compilation. Frames are read back as sRGB RGBA8 ([`Renderer::render_with`]) and shown
+//! as an egui texture: the same pixels `nacre render` writes to its PNG.
+
+use crate::doc::StackDoc;
+use nacre_format::set::resolve_table;
+use nacre_optics::Stack;
+use nacre_runtime::bindings::StackSetup;
+use nacre_runtime::render::{
+    DEFAULT_THICKNESS_MAP_SIZE, EnvironmentMap, RenderedImage, Renderer, SceneKind, SceneOptions,
+    ThicknessMap, ThicknessMapping, procedural_thickness_map,
+};
+use nacre_runtime::{GpuContext, TableSet, Technique};
+
+/// The tables the view loads: the sphere's film-lut (films of index 1.1–2.5 in air on a
+/// dielectric base) and the sRGB Fourier table.
+pub const TABLES: [&str; 2] = ["film-dielectric", "fourier-srgb"];
+
+/// The wavelength where the lut, fourier and spectral techniques take a film's single real
+/// index (they draw one film of real index; `film_stack` draws every film, dispersive and
+/// absorbing), nm.
+pub const INDEX_WAVELENGTH_NM: f64 = 550.0;
+
+/// How the scene is lit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Lighting {
+    /// `nacre render`'s default: the bundled studio environment and its sun.
+    Studio,
+    /// A uniform white sky of radiance 1 and no sun: a mirror-smooth film then shows its
+    /// own reflectance colour (the sphere's centre: `nacre color` at 0°, tone-mapped).
+    Uniform,
+}
+
+impl Lighting {
+    /// Every lighting, in menu order.
+    pub const ALL: [Lighting; 2] = [Lighting::Studio, Lighting::Uniform];
+
+    /// The menu name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Lighting::Studio => "studio environment",
+            Lighting::Uniform => "uniform white sky",
+        }
+    }
+}
+
+/// The orbit camera: angles about the scene's target, degrees, and the distance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Orbit {
+    /// Rotation about the vertical axis, degrees (0: looking along −z).
+    pub yaw_deg: f32,
+    /// Elevation, degrees (−89 to 89).
+    pub pitch_deg: f32,
+    /// Distance from the target, scene units.
+    pub distance: f32,
+}
+
+impl Orbit {
+    /// The orbit through `scene`'s default camera.
+    pub fn for_scene(scene: SceneKind) -> Orbit {
+        let c = SceneOptions::new(scene).camera;
+        let d: [f32; 3] = std::array::from_fn(|k| c.eye[k] - c.target[k]);
+        let distance = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        Orbit {
+            yaw_deg: d[0].atan2(d[2]).to_degrees(),
+            pitch_deg: (d[1] / distance).asin().to_degrees(),
+            distance,
+        }
+    }
+
+    /// Turns the orbit by a drag of (dx, dy) points (0.4° per point), the elevation kept
+    /// within ±89°.
+    pub fn drag(&mut self, dx: f32, dy: f32) {
+        self.yaw_deg = (self.yaw_deg - 0.4 * dx).rem_euclid(360.0);
+        self.pitch_deg = (self.pitch_deg + 0.4 * dy).clamp(-89.0, 89.0);
+    }
+
+    /// The eye position for `target`.
+    pub fn eye(&self, target: [f32; 3]) -> [f32; 3] {
+        let (yaw, pitch) = (self.yaw_deg.to_radians(), self.pitch_deg.to_radians());
+        [
+            target[0] + self.distance * pitch.cos() * yaw.sin(),
+            target[1] + self.distance * pitch.sin(),
+            target[2] + self.distance * pitch.cos() * yaw.cos(),
+        ]
+    }
+}
+
+/// Everything the view draws besides the stack.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ViewSettings {
+    /// The scene.
+    pub scene: SceneKind,
+    /// The technique.
+    pub technique: Technique,
+    /// The lighting.
+    pub lighting: Lighting,
+    /// The camera.
+    pub orbit: Orbit,
+    /// Exposure, EV.
+    pub exposure_ev: f32,
+    /// GGX roughness α of the film's surface (0.001 to 1).
+    pub roughness_alpha: f32,
+    /// The picture's size, pixels.
+    pub size: [u32; 2],
+}
+
+impl ViewSettings {
+    /// The sphere with `film_stack` under the studio environment, `size` pixels.
+    pub fn new(size: [u32; 2]) -> ViewSettings {
+        ViewSettings {
+            scene: SceneKind::Sphere,
+            technique: Technique::Stack,
+            lighting: Lighting::Studio,
+            orbit: Orbit::for_scene(SceneKind::Sphere),
+            exposure_ev: 0.0,
+            roughness_alpha: 0.06,
+            size,
+        }
+    }
+}
+
+/// A drawn frame and the notes about it (what the technique leaves out).
+pub struct Frame {
+    /// The picture.
+    pub image: RenderedImage,
+    /// What the technique draws differently from the stack (one film, one real index).
+    pub notes: Vec<String>,
+    /// Seconds the frame took (options, rebind, render and readback).
+    pub seconds: f64,
+}
+
+/// The GPU side of the view.
+pub struct View {
+    ctx: GpuContext,
+    tables: TableSet,
+    renderer: Option<Renderer>,
+    /// What the renderer's group 1 was built from: the stack and its relative thicknesses.
+    bound: Option<(Technique, StackDoc)>,
+    studio: EnvironmentMap,
+    uniform: EnvironmentMap,
+    thickness: ThicknessMap,
+}
+
+/// The view's errors: the runtime's, or a stack the technique cannot draw.
+#[derive(Debug, thiserror::Error)]
+pub enum ViewError {
+    /// From the runtime (GPU, tables, settings).
+    #[error(transparent)]
+    Runtime(#[from] nacre_runtime::Error),
+    /// From loading a table manifest.
+    #[error(transparent)]
+    Format(#[from] nacre_format::Error),
+    /// A material without an index at [`INDEX_WAVELENGTH_NM`].
+    #[error("{what}: {source}")]
+    Index {
+        /// The layer.
+        what: String,
+        /// Why.
+        source: nacre_optics::Error,
+    },
+}
+
+impl View {
+    /// A view on `ctx` (the window's device, or a headless one), loading [`TABLES`].
+    pub fn new(ctx: GpuContext) -> Result<View, ViewError> {
+        let mut tables = TableSet::default();
+        for name in TABLES {
+            tables.add(&ctx, &resolve_table(name))?;
+        }
+        Ok(View {
+            ctx,
+            tables,
+            renderer: None,
+            bound: None,
+            studio: EnvironmentMap::default_map()?,
+            uniform: EnvironmentMap {
+                width: 64,
+                height: 32,
+                rgb: vec![[1.0; 3]; 64 * 32],
+            },
+            thickness: procedural_thickness_map(DEFAULT_THICKNESS_MAP_SIZE),
+        })
+    }
+
+    /// The device description (adapter, backend).
+    pub fn describe(&self) -> String {
+        self.ctx.describe()
+    }
+
+    /// The scene options that draw `doc` (built as `stack`) with `settings`, and the notes on
+    /// what the technique leaves out.
+    pub fn options(
+        &self,
+        settings: &ViewSettings,
+        doc: &StackDoc,
+        stack: &Stack,
+    ) -> Result<(SceneOptions, Vec<String>), ViewError> {
+        let mut o = SceneOptions::new(settings.scene);
+        [o.width, o.height] = settings.size;
+        o.camera.eye = settings.orbit.eye(o.camera.target);
+        o.exposure_ev = settings.exposure_ev;
+        o.material.roughness_alpha = settings.roughness_alpha;
+        if settings.lighting == Lighting::Uniform {
+            o.light.intensity = 0.0;
+            o.material.base_colour = [0.0; 3];
+        }
+        let mut notes = Vec::new();
+        let index = |m: &nacre_optics::Material, what: &str| {
+            m.index_at(INDEX_WAVELENGTH_NM)
+                .map_err(|source| ViewError::Index {
+                    what: what.to_string(),
+                    source,
+                })
+        };
+        o.material.ambient_ior = index(stack.ambient(), "ambient")?.re as f32;
+        o.material.set_base(stack.substrate().clone());
+        o.material.drain_nm = 0.0;
+        let top = stack.layers().first();
+        let (thickness_nm, relative_nm) = doc
+            .films
+            .first()
+            .map_or((0.0, 0.0), |f| (f.thickness_nm, f.relative_nm));
+        o.material.thickness = ThicknessMapping::Svt {
+            average_nm: thickness_nm as f32,
+            relative_nm: relative_nm as f32,
+        };
+        match top {
+            Some(layer) => {
+                let n = index(&layer.material, "film 1")?;
+                o.material.film_ior = n.re as f32;
+                if settings.technique != Technique::Stack {
+                    if stack.layers().len() > 1 {
+                        notes.push(format!(
+                            "{} draws the top film only; `stack` draws all {}",
+                            settings.technique.name(),
+                            stack.layers().len()
+                        ));
+                    }
+                    if n.im != 0.0 || layer.material.index_at(450.0).ok() != Some(n) {
+                        notes.push(format!(
+                            "{} draws film 1 with the constant real index {:.3} (its index at {INDEX_WAVELENGTH_NM} nm)",
+                            settings.technique.name(),
+                            n.re
+                        ));
+                    }
+                }
+            }
+            None => {
+                // A bare interface: a film of zero thickness.
+                o.material.film_ior = o.material.ambient_ior.max(1.0);
+            }
+        }
+        o.stack = StackSetup {
+            stack: stack.clone(),
+            relative_nm: doc.relative_nm(),
+            channels: Vec::new(),
+            samples: None,
+        };
+        if settings.technique == Technique::Lut {
+            o.fit_to_tables(&self.tables)?;
+            notes.push(
+                "lut draws the film-dielectric table's ambient and base (n 1.5, black glaze)"
+                    .into(),
+            );
+        }
+        if settings.technique == Technique::Stack && stack.layers().is_empty() {
+            notes.push("a bare interface: the base alone".into());
+        }
+        Ok((o, notes))
+    }
+
+    /// Draws `doc` with `settings`: compiles the technique's pipeline when it changed,
+    /// rebinds its group 1 when the stack changed, renders and reads the picture back.
+    pub fn render(
+        &mut self,
+        settings: &ViewSettings,
+        doc: &StackDoc,
+        stack: &Stack,
+    ) -> Result<Frame, ViewError> {
+        let start = std::time::Instant::now();
+        let (options, notes) = self.options(settings, doc, stack)?;
+        let technique_options = options.technique_options();
+        let renderer = match self.renderer.take() {
+            Some(r) if r.technique() == settings.technique => r,
+            _ => {
+                self.bound = None;
+                Renderer::new(
+                    &self.ctx,
+                    &self.tables,
+                    settings.technique,
+                    &technique_options,
+                )?
+            }
+        };
+        let renderer = self.renderer.insert(renderer);
+        let key = (settings.technique, doc.clone());
+        if self.bound.as_ref() != Some(&key) {
+            // Drop the key first: a failed rebind leaves the renderer to be rebound.
+            self.bound = None;
+            renderer.rebind(&self.ctx, &self.tables, &technique_options)?;
+            self.bound = Some(key);
+        }
+        let environment = match settings.lighting {
+            Lighting::Studio => &self.studio,
+            Lighting::Uniform => &self.uniform,
+        };
+        let image = renderer.render_with(
+            &self.ctx,
+            &self.tables,
+            &options,
+            environment,
+            &self.thickness,
+        )?;
+        Ok(Frame {
+            image,
+            notes,
+            seconds: start.elapsed().as_secs_f64(),
+        })
+    }
+}
