@@ -41,8 +41,23 @@ step_rust() {
         echo "scripts/test.sh: installing glslang-tools (glslangValidator for the engine shader libraries)" >&2
         apt_install glslang-tools
     fi
+    # nacre studio's window test (crates/studio/tests/window.rs) runs `nacre-studio` under
+    # Xvfb: xvfb-run and xauth, and the X libraries winit opens at run time.
+    if ! command -v xvfb-run >/dev/null 2>&1 || ! command -v xauth >/dev/null 2>&1 \
+        || ! have_library libX11-xcb.so.1 || ! have_library libxkbcommon-x11.so.0 \
+        || ! have_library libXcursor.so.1 || ! have_library libXrandr.so.2 \
+        || ! have_library libXi.so.6; then
+        echo "scripts/test.sh: installing xvfb and X libraries (nacre studio's window test)" >&2
+        apt_install xvfb xauth libx11-xcb1 libxkbcommon-x11-0 libxcursor1 libxrandr2 libxi6
+    fi
     slangpy_venv
     cargo test --workspace --locked
+}
+
+# Whether the dynamic linker knows library $1 (grep reads to the end: an early exit would
+# fail the pipe under pipefail).
+have_library() {
+    { ldconfig -p 2>/dev/null || /sbin/ldconfig -p; } | grep -F "$1" >/dev/null
 }
 
 # Slang from PyPI's slangpy (pinned), in a virtual environment under target/ kept between runs,

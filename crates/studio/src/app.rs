@@ -326,29 +326,26 @@ impl Studio {
             let film = &mut self.doc.films[j];
             let (text, error) = &mut self.thickness_text[j];
             ui.horizontal(|ui| {
-                let slider = ui.add(
-                    egui::Slider::new(&mut film.thickness_nm, 0.0..=SLIDER_MAX_NM)
-                        .clamping(egui::SliderClamping::Never)
-                        .show_value(false)
-                        .text(format!("Film {n} thickness")),
-                );
-                if slider.changed() {
-                    *text = format_nm(film.thickness_nm);
-                    *error = None;
-                }
-                let label = ui.label("nm:");
+                let label = ui.label(format!("Film {n} thickness (nm)"));
                 let typed = ui
                     .add(egui::TextEdit::singleline(text).desired_width(70.0))
                     .labelled_by(label.id);
-                typed.widget_info(|| {
-                    egui::WidgetInfo::text_edit(
+                let slider = ui.add(
+                    egui::Slider::new(&mut film.thickness_nm, 0.0..=SLIDER_MAX_NM)
+                        .clamping(egui::SliderClamping::Never)
+                        .show_value(false),
+                );
+                slider.widget_info(|| {
+                    egui::WidgetInfo::slider(
                         true,
-                        format!("Film {n} thickness (nm)"),
-                        text.as_str(),
-                        "",
+                        film.thickness_nm,
+                        format!("Film {n} thickness slider"),
                     )
                 });
-                if typed.changed() {
+                if slider.changed() {
+                    *text = format_nm(film.thickness_nm);
+                    *error = None;
+                } else if typed.changed() {
                     match nacre_bake::commands::grid::parse_thickness_nm(
                         format!("studio film {n} thickness"),
                         text,
@@ -438,6 +435,9 @@ impl Studio {
                         ui.selectable_value(&mut s.lighting, l, l.name());
                     }
                 });
+        });
+        ui.horizontal_wrapped(|ui| {
+            let s = &mut self.settings;
             ui.add(egui::Slider::new(&mut s.exposure_ev, -4.0..=4.0).text("Exposure (EV)"));
             ui.add(
                 egui::Slider::new(&mut s.roughness_alpha, 0.001..=1.0)
@@ -450,7 +450,7 @@ impl Studio {
             let avail = ui.available_size() * ppp;
             // Multiples of 16 pixels, so that a resize re-renders only now and then.
             let snap = |v: f32| ((v as u32) / 16 * 16).clamp(64, 4096);
-            self.settings.size = [snap(avail.x), snap(avail.y - 40.0 * ppp)];
+            self.settings.size = [snap(avail.x), snap(avail.y - 24.0 * ppp)];
         }
         self.draw_if_needed(ui.ctx());
         if let Some(e) = &self.view_error {
