@@ -77,7 +77,8 @@ struct App {
     shot: Arc<Mutex<Option<Arc<egui::ColorImage>>>>,
     exit_code: Arc<Mutex<i32>>,
     spin: bool,
-    spin_seconds: Vec<f64>,
+    /// Per drawn frame: its seconds and its render pass's.
+    spin_seconds: Vec<(f64, f64)>,
 }
 
 impl eframe::App for App {
@@ -94,7 +95,7 @@ impl eframe::App for App {
                 eprintln!("first picture after {t:.2} s");
             }
             if let Some(f) = &self.studio.frame {
-                self.spin_seconds.push(f.seconds);
+                self.spin_seconds.push((f.seconds, f.image.gpu_seconds));
             }
         }
         self.frames += 1;
@@ -150,14 +151,21 @@ impl eframe::App for App {
         if self.spin && !self.spin_seconds.is_empty() {
             // The first frame compiles the pipeline: left out.
             let s = &self.spin_seconds[1.min(self.spin_seconds.len() - 1)..];
-            let mean = s.iter().sum::<f64>() / s.len() as f64;
+            let mean = |k: usize| {
+                s.iter()
+                    .map(|f| if k == 0 { f.0 } else { f.1 })
+                    .sum::<f64>()
+                    / s.len() as f64
+            };
             let frame = self.studio.frame.as_ref();
             eprintln!(
-                "view frames: {} at {}x{}, mean {:.2} ms (render, readback and upload)",
+                "view frames: {} at {}x{} ({}), mean {:.2} ms (render pass {:.2} ms; the rest: uniforms, environment upload, readback, texture upload)",
                 s.len(),
                 frame.map_or(0, |f| f.image.width),
                 frame.map_or(0, |f| f.image.height),
-                mean * 1e3
+                self.studio.settings.technique.name(),
+                mean(0) * 1e3,
+                mean(1) * 1e3
             );
         }
     }
