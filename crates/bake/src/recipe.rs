@@ -23,6 +23,10 @@ pub(crate) struct RawColour {
 pub(crate) struct RawLayer {
     pub(crate) material: Spanned<String>,
     pub(crate) thickness_nm: Spanned<f64>,
+    /// A thick slab whose reflections add in intensity ([`nacre_optics::incoherent`]);
+    /// `film-lut` only.
+    #[serde(default)]
+    pub(crate) incoherent: Option<Spanned<bool>>,
 }
 
 #[derive(Deserialize)]
@@ -132,6 +136,9 @@ pub(crate) struct RecipeStack {
     pub(crate) under: Vec<Layer>,
     /// `(material spec, thickness_nm)` of each layer under the film, as written.
     pub(crate) under_specs: Vec<(String, f64)>,
+    /// Per layer under the film: incoherent (`incoherent = true`, a thick slab). Empty when
+    /// every layer is coherent.
+    pub(crate) under_incoherent: Vec<bool>,
 }
 
 impl RecipeStack {
@@ -155,7 +162,20 @@ impl RecipeStack {
         let base = resolve(stack.base.get_ref(), at(stack.base.span()), base_dir)?;
         let mut under = Vec::new();
         let mut under_specs = Vec::new();
+        let mut under_incoherent = Vec::new();
         for l in &stack.under {
+            let incoherent = l.incoherent.as_ref().is_some_and(|i| *i.get_ref());
+            if incoherent && kind != "film-lut" {
+                let span = l.incoherent.as_ref().expect("set").span();
+                return Err(Error::recipe(
+                    path.to_path_buf(),
+                    line_of(text, span.start),
+                    format!(
+                        "incoherent = true: a {kind} takes coherent layers only; an incoherent slab under the film is a `film-lut`'s"
+                    ),
+                ));
+            }
+            under_incoherent.push(incoherent);
             let d = *l.thickness_nm.get_ref();
             if !(d >= 0.0 && d.is_finite()) {
                 return Err(Error::recipe(
@@ -170,12 +190,16 @@ impl RecipeStack {
             });
             under_specs.push((l.material.get_ref().clone(), d));
         }
+        if !under_incoherent.contains(&true) {
+            under_incoherent.clear();
+        }
         Ok(RecipeStack {
             ambient,
             ambient_index,
             base,
             under,
             under_specs,
+            under_incoherent,
         })
     }
 }

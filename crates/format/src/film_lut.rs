@@ -23,6 +23,16 @@
 //!   q_min → 0). Measured on the default tables, this mapping cuts the worst ΔE2000 of a
 //!   linear index axis with the same texel count by a factor of about 3.
 //!
+//! # Over a slab
+//!
+//! When a fixed layer is an incoherent slab (the manifest's `under_incoherent`: a lens or
+//! a window pane, its back face coated or bare, the base what lies behind the pane) the
+//! same channels hold the *whole pane's* colour: R(λ) is the front's reflectance plus every
+//! return from the slab's back face, summed in intensity (Byrnes, arXiv:1603.02720, §4;
+//! `nacre_optics::incoherent`), and T(λ) what leaves through the back. Axes and lookup are
+//! unchanged; a renderer draws the pane as one thin-walled surface, its back face already
+//! in the table.
+//!
 //! # Texel-centre convention (the same in `shaders/`)
 //!
 //! For an axis with `count` texels, texel i holds the value at t = i / (count − 1), so both

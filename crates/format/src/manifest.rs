@@ -268,6 +268,10 @@ pub struct Manifest {
     /// Fixed layers under the film: (material spec, thickness nm) (film-lut).
     #[serde(default)]
     pub under: Vec<(String, f64)>,
+    /// Per fixed layer: incoherent, a thick slab whose reflections add in intensity
+    /// (film-lut; absent when every fixed layer is coherent, [`crate::film_lut`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub under_incoherent: Vec<bool>,
     /// Base material spec (film-lut).
     #[serde(default, skip_serializing_if = "String::is_empty")]
     pub base: String,
@@ -322,6 +326,7 @@ impl Manifest {
             ambient: String::new(),
             film: String::new(),
             under: Vec::new(),
+            under_incoherent: Vec::new(),
             base: String::new(),
             axes: Vec::new(),
             record,

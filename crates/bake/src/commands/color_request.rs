@@ -149,6 +149,8 @@ pub fn prepare(stack: &Stack, method: Method, req: &ColorRequest) -> Result<Prep
         }
         (false, None) => {}
     }
+    // A method without slab physics says so before its table is checked against the stack.
+    color::refuse_incoherent(stack, &method)?;
     let (lut, colorimeter) = match &method {
         Method::RoughLut { path, alpha, .. } => {
             let table = nacre_format::load::LoadedRoughLut::load(path)?;

@@ -156,6 +156,7 @@ pub fn compare(
         },
         ambient: air,
         under: vec![],
+        under_incoherent: vec![],
         base,
         colorimeter: c.clone(),
         transmittance: false,

@@ -395,7 +395,14 @@ impl StackSpec {
             layers,
             substrate: from(&m.base, "base"),
             base_dir: path.parent().map(Path::to_path_buf),
-            incoherent: Vec::new(),
+            // The film is coherent; a slab under it keeps its flag (film-lut over a pane).
+            incoherent: if m.under_incoherent.contains(&true) {
+                std::iter::once(false)
+                    .chain((0..m.under.len()).map(|j| m.under_incoherent.get(j) == Some(&true)))
+                    .collect()
+            } else {
+                Vec::new()
+            },
         })
     }
 

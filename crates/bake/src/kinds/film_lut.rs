@@ -18,6 +18,9 @@
 //! film = "thin film"                # optional label; the film index is an axis
 //! base = "1.5"                      # any material spec (number, n+ki, bundled, file)
 //! under = [ { material = "water", thickness_nm = 50.0 } ]   # optional fixed layers under the film
+//! # a layer may be a thick incoherent slab, with coatings on both its faces:
+//! # under = [ { material = "bk7", thickness_nm = 2e6, incoherent = true },
+//! #           { material = "mgf2", thickness_nm = 99.0 } ]
 //!
 //! [axes]
 //! cos_theta_count = 32              # texels along cos θ (square mapping)
@@ -43,6 +46,18 @@
 //! ([`Stack::colours_over_thickness`]); where the ambient and the base are non-dispersive
 //! and no layers lie under the film (`film-dielectric`, `soap-film`) the same sums come from
 //! the film's Airy Fourier series ([`nacre_optics::film_series`], equal to ≈ 10⁻¹¹).
+//!
+//! # A coated or bare slab as the base
+//!
+//! A layer under the film marked `incoherent = true` is a thick slab (a 2 mm lens or window
+//! pane) whose back-face reflections add in intensity ([`nacre_optics::incoherent`]); the
+//! layers below it coat its back face and the base is what lies behind the pane (air). The
+//! table then holds the colour of the *whole pane*: its reflectance is the front coating's
+//! and every back-face return summed, its transmittance what leaves through the back. Each
+//! texel is one sweep of the exact intensity recurrence over the spectral rule of the
+//! coherent films (the slab adds no fringes: [`Stack::max_opd_nm`]), the film's thickness
+//! changed along a row ([`SpectrumSweep::set_thicknesses_nm`]). The channels, axes and the
+//! shader's rebuild are a film-lut's; the manifest lists the slab in `under_incoherent`.
 
 use crate::error::Result;
 use crate::kinds::{KindEntry, TableRecipe};
@@ -59,7 +74,7 @@ use nacre_optics::elementary;
 use nacre_optics::film_series::{
     RuleTransform, SingleFilm, non_dispersive_surround, series_extent,
 };
-use nacre_optics::{C64, Layer, Material, SpectralRule, Stack};
+use nacre_optics::{C64, FilmColours, Layer, Material, SpectralRule, SpectrumSweep, Stack};
 use rayon::prelude::*;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -139,6 +154,7 @@ impl FilmLutRecipe {
             base,
             under,
             under_specs,
+            under_incoherent,
         } = RecipeStack::parse(path, &text, &raw.stack, "film-lut")?;
         let ax = raw.axes.get_ref();
         let axes = FilmLutAxes {
@@ -166,6 +182,7 @@ impl FilmLutRecipe {
                 axes,
                 ambient,
                 under,
+                under_incoherent,
                 base,
                 colorimeter,
                 transmittance: output.transmittance,
@@ -256,11 +273,17 @@ pub fn bake_recipe(
         ambient: recipe.ambient_spec.clone(),
         film: recipe.film_label.clone(),
         under: recipe.under_specs.clone(),
+        under_incoherent: recipe.job.under_incoherent.clone(),
         base: recipe.base_spec.clone(),
         axes: axis_records(a),
         texel_centres: "texel i of an axis with count n holds t = i / (n - 1); a sampler reaches t at u = (t * (n - 1) + 0.5) / n; clamp to edge".into(),
         atlas: "width = count(cos_theta); height = count(opd_nm) * count(film_ior); slice k (film_ior index) occupies rows [k * count(opd_nm), (k + 1) * count(opd_nm)), row j of the slice is opd_nm index j, top row first (EXR, PNG); the KTX2 files hold the same texels as a 3-D RGBA16F texture, width = count(cos_theta), height = count(opd_nm), depth = count(film_ior), alpha 1".into(),
-        reconstruction: "cos_t = dot(N, V); opd = 2 d sqrt(n_f^2 - n0^2 (1 - cos_t^2)); q(n) = sqrt(n^2 - n0^2 (1 - cos_t^2)); t = (sqrt(cos_t), opd / opd_max, sqrt((q(n_f) - q(ior_min)) / (q(ior_max) - q(ior_min)))); colour = trilinear sample at u = (t (n - 1) + 0.5) / n per axis; specular = colour (replaces the Fresnel term)".into(),
+        reconstruction: "cos_t = dot(N, V); opd = 2 d sqrt(n_f^2 - n0^2 (1 - cos_t^2)); q(n) = sqrt(n^2 - n0^2 (1 - cos_t^2)); t = (sqrt(cos_t), opd / opd_max, sqrt((q(n_f) - q(ior_min)) / (q(ior_max) - q(ior_min)))); colour = trilinear sample at u = (t (n - 1) + 0.5) / n per axis; specular = colour (replaces the Fresnel term)".to_string()
+            + if recipe.job.under_incoherent.is_empty() {
+                ""
+            } else {
+                "; an incoherent slab lies under the film (under_incoherent): the colour is the whole pane's, its back-face reflections included (reflectance) or what leaves through its back (transmittance), so the pane is drawn as one thin-walled surface and its back face is not added again"
+            },
         files: Vec::new(),
         ..Manifest::for_recipe(
             KindRecord::FilmLut(a.clone()),
@@ -308,6 +331,8 @@ pub struct FilmLutJob {
     pub ambient: Material,
     /// Fixed layers under the film, top first.
     pub under: Vec<Layer>,
+    /// Per fixed layer: incoherent (a thick slab); empty when every layer is coherent.
+    pub under_incoherent: Vec<bool>,
     /// Base (substrate).
     pub base: Material,
     /// Colour conversion.
@@ -323,6 +348,11 @@ impl FilmLutJob {
         let a = &self.axes;
         let under_opd: f64 = {
             let probe = Stack::new(self.ambient.clone(), self.under.clone(), self.base.clone())?;
+            let probe = if self.under_incoherent.is_empty() {
+                probe
+            } else {
+                probe.with_incoherent(self.under_incoherent.clone())?
+            };
             probe.max_opd_nm(None)
         };
         let rule = SpectralRule::new(&self.colorimeter, a.opd_max_nm() + under_opd);
@@ -334,6 +364,18 @@ impl FilmLutJob {
                 .map(|y| a.texel_parameters(x, y, z).1)
                 .collect()
         };
+        if !self.under_incoherent.is_empty() {
+            let results = rows
+                .par_iter()
+                .map(|&(x, z)| {
+                    let (cos_theta, _, n) = a.texel_parameters(x, 0, z);
+                    let colours = self.slab_row(cos_theta, n, &rule, &thicknesses(x, z))?;
+                    progress();
+                    Ok(colours)
+                })
+                .collect::<Result<Vec<_>>>()?;
+            return Ok(self.assemble(&rows, &results));
+        }
         // A non-dispersive film between non-dispersive media: the same wavelength sums from
         // the film's Airy Fourier series (nacre_optics::film_series; rough_film_lut's
         // module docs, step 2).
@@ -397,11 +439,17 @@ impl FilmLutJob {
                 Ok(colours)
             })
             .collect::<Result<_>>()?;
+        Ok(self.assemble(&rows, &results))
+    }
+
+    /// The table from the colours of each row `rows[i]` = (x, z) over its thicknesses.
+    fn assemble(&self, rows: &[(usize, usize)], results: &[FilmColours]) -> FilmLut {
+        let a = &self.axes;
         let mut reflectance = Table3::new(a.cos_theta_count, a.opd_count, a.ior_count);
         let mut transmittance = self
             .transmittance
             .then(|| Table3::new(a.cos_theta_count, a.opd_count, a.ior_count));
-        for (&(x, z), colours) in rows.iter().zip(&results) {
+        for (&(x, z), colours) in rows.iter().zip(results) {
             for y in 0..a.opd_count {
                 reflectance.set(x, y, z, colours.reflectance[y].map(|v| v as f32));
                 if let Some(t) = transmittance.as_mut() {
@@ -409,11 +457,49 @@ impl FilmLutJob {
                 }
             }
         }
-        Ok(FilmLut {
+        FilmLut {
             axes: a.clone(),
             reflectance,
             transmittance,
-        })
+        }
+    }
+
+    /// One row of a table whose fixed layers hold an incoherent slab: the whole pane's
+    /// reflectance and transmittance colours at incidence cos θ = `cos_theta`, film index
+    /// `n`, for each film thickness of `thicknesses_nm`, by the intensity recurrence
+    /// ([`nacre_optics::incoherent`]) at the nodes of `rule` (unpolarised, R = (R_s + R_p)/2).
+    fn slab_row(
+        &self,
+        cos_theta: f64,
+        n: f64,
+        rule: &SpectralRule,
+        thicknesses_nm: &[f64],
+    ) -> Result<FilmColours> {
+        let film = Material::constant(format!("{n}"), C64::new(n, 0.0))?;
+        let mut layers = vec![Layer {
+            material: film,
+            thickness_nm: 0.0,
+        }];
+        layers.extend(self.under.iter().cloned());
+        let mut incoherent = vec![false];
+        incoherent.extend(&self.under_incoherent);
+        let stack = Stack::new(self.ambient.clone(), layers, self.base.clone())?
+            .with_incoherent(incoherent)?;
+        let angle_deg = elementary::acos(cos_theta).to_degrees();
+        let mut sweep = SpectrumSweep::new(&stack, &[angle_deg], rule.wavelengths_nm())?;
+        let mut d = stack.thicknesses_nm();
+        let mut out = FilmColours {
+            reflectance: Vec::with_capacity(thicknesses_nm.len()),
+            transmittance: Vec::with_capacity(thicknesses_nm.len()),
+        };
+        for &film_nm in thicknesses_nm {
+            d[0] = film_nm;
+            sweep.set_thicknesses_nm(&d)?;
+            let p = sweep.powers()?;
+            out.reflectance.push(rule.colour(p.iter().map(|p| p.R())));
+            out.transmittance.push(rule.colour(p.iter().map(|p| p.T())));
+        }
+        Ok(out)
     }
 }
 

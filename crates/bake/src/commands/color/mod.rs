@@ -427,14 +427,23 @@ pub fn check_stack_matches(m: &Manifest, path: &Path, stack: &Stack, method: &st
             ),
         ));
     }
-    for (l, (spec, d)) in layers[1..].iter().zip(&m.under) {
-        if !same(&l.material, spec)? || (l.thickness_nm - d).abs() > 1e-9 {
+    let slab = |incoherent: bool| if incoherent { ":incoherent" } else { "" };
+    for (j, (l, (spec, d))) in layers[1..].iter().zip(&m.under).enumerate() {
+        let theirs = m.under_incoherent.get(j) == Some(&true);
+        let ours = stack.is_incoherent(j + 2);
+        if !same(&l.material, spec)? || (l.thickness_nm - d).abs() > 1e-9 || ours != theirs {
             return Err(mismatch(
                 "fixed layer",
-                format!("{}@{}", l.material.name(), l.thickness_nm),
-                &format!("{spec}@{d}"),
+                format!("{}@{}{}", l.material.name(), l.thickness_nm, slab(ours)),
+                &format!("{spec}@{d}{}", slab(theirs)),
             ));
         }
+    }
+    if stack.is_incoherent(1) {
+        return Err(Error::invalid(
+            context,
+            "the table's film (layer 1) is coherent; this stack has it incoherent",
+        ));
     }
     Ok(())
 }
@@ -555,9 +564,7 @@ pub fn evaluate(
         }
         .into());
     }
-    if !stack.is_coherent() {
-        refuse_incoherent(stack, method)?;
-    }
+    refuse_incoherent(stack, method)?;
     // The stack technique's rules and indices, prepared once for the stack's own films (a
     // point that overrides the top film's index prepares its own).
     let stack_eval = match method {
@@ -815,17 +822,20 @@ pub fn undersampled(
     }
 }
 
-/// `Ok` when `method` takes a stack with incoherent layers (`spectral`, `rgb3`,
-/// `samples:N`: each integrates the stack's reflectance or transmittance spectrum, which
-/// [`Stack::sweep`] gives with the slabs added in intensity); otherwise an error that says
-/// why the method's physics does not apply.
-fn refuse_incoherent(stack: &Stack, method: &Method) -> Result<()> {
+/// `Ok` when `stack` is coherent or `method` takes a stack with incoherent layers
+/// (`spectral`, `rgb3`, `samples:N`: each integrates the stack's reflectance or
+/// transmittance spectrum, which [`Stack::sweep`] gives with the slabs added in intensity;
+/// `lut:` with a film-lut baked over the same slab, checked by [`LoadedLut::check_stack`]);
+/// otherwise an error that names the method and the slab and says why the method's
+/// physics does not apply.
+pub(crate) fn refuse_incoherent(stack: &Stack, method: &Method) -> Result<()> {
+    if stack.is_coherent() {
+        return Ok(());
+    }
     let (name, why) = match method {
         Method::Spectral | Method::Rgb3 | Method::Samples(_) => return Ok(()),
-        Method::Lut(_) => (
-            "lut",
-            "a film-lut holds one film over fixed coherent layers, baked without incoherent slabs",
-        ),
+        // A film-lut baked with the same slab under its film (checked by `check_stack`).
+        Method::Lut(_) => return Ok(()),
         Method::Fourier(..) => (
             "fourier",
             "the Fourier series in 1/λ describes one coherent film on a base; an incoherent slab below it has no such series",
@@ -853,7 +863,7 @@ fn refuse_incoherent(stack: &Stack, method: &Method) -> Result<()> {
     Err(Error::invalid(
         Param::Method.given(name),
         format!(
-            "layer {layer} is incoherent and {why}: use `spectral` (exact), `rgb3` or `samples:N`"
+            "layer {layer} is incoherent and {why}: use `spectral` (exact), `rgb3`, `samples:N` or `lut:` with a film-lut baked over the same slab"
         ),
     ))
 }

@@ -399,7 +399,15 @@ pub fn load_table_plot(name_or_path: &str, options: &TableOptions) -> Result<Tab
     let under: String = manifest
         .under
         .iter()
-        .map(|(m, d)| format!(" | {m} {d} nm"))
+        .enumerate()
+        .map(|(j, (m, d))| {
+            let slab = if manifest.under_incoherent.get(j) == Some(&true) {
+                " (incoherent)"
+            } else {
+                ""
+            };
+            format!(" | {m} {d} nm{slab}")
+        })
         .collect();
     let exposure = if options.exposure == 1.0 {
         String::new()

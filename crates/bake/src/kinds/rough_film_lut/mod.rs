@@ -534,6 +534,7 @@ impl RoughRecipe {
             base,
             under,
             under_specs,
+            under_incoherent: _,
         } = RecipeStack::parse(path, &text, &raw.stack, "rough-film-lut")?;
         let output = OutputSettings::parse(path, raw.output, &under, &base, false)?;
         let transmittance = output.transmittance;
