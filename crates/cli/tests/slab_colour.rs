@@ -87,7 +87,6 @@ fn spectral_rgb3_and_samples_give_the_whole_panes_reflected_and_transmitted_colo
 
 #[test]
 fn methods_without_slab_physics_refuse_it_with_exit_2() {
-    let dir = tempfile::tempdir().unwrap();
     for (method, extra, why) in [
         ("fourier", &[][..], "Fourier series"),
         ("fourier-exact:3", &[][..], "Fourier series"),

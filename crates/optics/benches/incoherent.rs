@@ -5,8 +5,9 @@
 //! dispersive materials, 90 angles × 401 wavelengths (380–780 nm at 1 nm), one thread:
 //!
 //! * `coherent pane`: the same five layers all coherent (the vectorised kernel, one pass);
-//! * `incoherent pane`: the slab incoherent (the kernel on the top coating forward and
-//!   backward and on the bottom coating forward, then the intensity recurrence);
+//! * `incoherent pane`: the slab incoherent (one kernel pass over the top coating giving
+//!   both sides, one over the bottom coating, the slab's single pass and the intensity
+//!   recurrence, row by row);
 //! * `coatings alone`: the four coating films on BK7 (the coherent stack without the slab).
 //!
 //! Run: `cargo bench -p nacre-optics --bench incoherent -- --warm-up-time 1 --measurement-time 5`.

@@ -19,6 +19,13 @@
 //! * R′_g, T′_g: the same for light incident from medium m_{g+1} (backward, the group
 //!   reversed), needed for every group but the last.
 //!
+//! Both come from one pass of the kernel per group ([`crate::multilayer`], "Both sides in
+//! one pass": the second column of the group's characteristic matrix gives r′ = −M₁₂/M₁₁
+//! and t′ = det M / M₁₁, Katsidis & Siapkas 2002, Eq. 5–7), so the square roots, sines
+//! and exponentials of each film are computed once for both sides. The groups' media and
+//! the slabs' −2 k₀ d are prepared once per sweep; each angle's row is then filled and run
+//! through the recurrence in one go (rows in parallel, the same bits on any thread count).
+//!
 //! Each group is computed as a stack of its own whose tangential component is that of the
 //! whole stack, β = n₀ sin θ₀ (Snell's law holds across incoherent slabs too); its first
 //! medium may absorb. Incoherent slab m_k (k = 1 … K) of thickness d and complex index ñ
@@ -52,7 +59,7 @@
 use crate::elementary;
 use crate::error::{Error, Result};
 use crate::fresnel::normal_component;
-use crate::multilayer::{Media, stack_powers};
+use crate::multilayer::{Media, stack_powers, stack_powers_both};
 use crate::power::{Power, wavenumber};
 use num_complex::Complex64 as C64;
 use rayon::prelude::*;
@@ -141,80 +148,200 @@ impl Groups {
 /// by [`crate::stack`] (its `Prepared`), for media outside the vectorised kernel's ranges.
 pub(crate) type Scalar = fn(&[C64], f64, f64, &[f64]) -> Power;
 
-/// Everything the recurrence needs at every (angle, wavelength): the groups' forward and
-/// backward powers and the slabs' single passes.
+/// A sweep's set-up, done once for all its (angle, wavelength) pairs: each coherent group's
+/// media for the vectorised kernel, and each slab's −2 k₀ d per wavelength.
+struct Plan<'a> {
+    groups: &'a Groups,
+    columns: &'a [Vec<C64>],
+    wavelengths_nm: &'a [f64],
+    thickness_nm: &'a [f64],
+    names: &'a [String],
+    scalar: Scalar,
+    /// Re ñ₀ per wavelength (β = Re ñ₀ sin θ₀).
+    beta_index: Vec<f64>,
+    /// Per group: its media for the kernel, or `None` (the scalar recurrence).
+    media: Vec<Option<Media>>,
+    /// Per slab k (medium m_k): −2 k₀ d per wavelength, so that P = exp(value · Im q).
+    slab_scale: Vec<Vec<f64>>,
+}
+
+/// Everything the recurrence needs at one angle: per group, its powers from above
+/// (forward) and, for every group but the last, from below (backward), and the slabs'
+/// single passes, each per wavelength.
 struct Terms {
     forward: Vec<Vec<Power>>,
     backward: Vec<Vec<Power>>,
-    /// [slab k − 1][element].
+    /// [slab k − 1][wavelength].
     passes: Vec<Vec<f64>>,
 }
 
-impl Terms {
+impl<'a> Plan<'a> {
     fn new(
-        groups: &Groups,
-        sines: &[f64],
-        columns: &[Vec<C64>],
-        wavelengths_nm: &[f64],
-        thickness_nm: &[f64],
-        names: &[String],
+        groups: &'a Groups,
+        columns: &'a [Vec<C64>],
+        wavelengths_nm: &'a [f64],
+        thickness_nm: &'a [f64],
+        names: &'a [String],
         scalar: Scalar,
-    ) -> Result<Self> {
+    ) -> Self {
         let beta_index: Vec<f64> = columns[0].iter().map(|n| n.re).collect();
-        let passes = groups.media[1..groups.media.len() - 1]
-            .iter()
-            .map(|&m| {
-                slab_passes(
-                    &columns[m],
-                    &beta_index,
-                    sines,
+        let media = (0..groups.count())
+            .map(|g| {
+                let (top, bottom) = (groups.media[g], groups.media[g + 1]);
+                Media::from_columns_beta(
+                    &columns[top..=bottom],
+                    Some(beta_index.as_slice()),
                     wavelengths_nm,
-                    thickness_nm[m - 1],
-                    m,
-                    &names[m - 1],
+                    &thickness_nm[top..bottom - 1],
                 )
             })
-            .collect::<Result<Vec<_>>>()?;
-        let last = groups.count() - 1;
-        let mut forward = Vec::with_capacity(groups.count());
-        let mut backward = Vec::with_capacity(last);
-        for g in 0..=last {
-            let (top, bottom) = (groups.media[g], groups.media[g + 1]);
-            let cols = &columns[top..=bottom];
-            let thick = &thickness_nm[top..bottom - 1];
-            forward.push(group_powers(
-                cols,
-                &beta_index,
-                sines,
-                wavelengths_nm,
-                thick,
-                scalar,
-            ));
-            if g < last {
-                let rev_cols: Vec<Vec<C64>> = cols.iter().rev().cloned().collect();
-                let rev_thick: Vec<f64> = thick.iter().rev().copied().collect();
-                backward.push(group_powers(
-                    &rev_cols,
-                    &beta_index,
-                    sines,
-                    wavelengths_nm,
-                    &rev_thick,
-                    scalar,
-                ));
-            }
+            .collect();
+        let slab_scale = groups.media[1..groups.media.len() - 1]
+            .iter()
+            .map(|&m| {
+                wavelengths_nm
+                    .iter()
+                    .map(|&wl| -2.0 * wavenumber(wl) * thickness_nm[m - 1])
+                    .collect()
+            })
+            .collect();
+        Plan {
+            groups,
+            columns,
+            wavelengths_nm,
+            thickness_nm,
+            names,
+            scalar,
+            beta_index,
+            media,
+            slab_scale,
         }
-        Ok(Terms {
-            forward,
-            backward,
-            passes,
-        })
     }
 
-    /// (R_g, T_g, R′_g, T′_g) of group g at element e, polarisation `pol` (0 s, 1 p); the
-    /// backward pair is (0, 0) for the last group.
+    /// Room for one angle's [`Terms`].
+    fn terms(&self) -> Terms {
+        let n = self.wavelengths_nm.len();
+        let groups = self.groups.count();
+        Terms {
+            forward: vec![vec![Power::default(); n]; groups],
+            backward: vec![vec![Power::default(); n]; groups - 1],
+            passes: vec![vec![0.0; n]; groups - 1],
+        }
+    }
+
+    /// Fills `terms` at incidence sin θ₀ = `sin_theta`: each group in one pass of the kernel
+    /// for both sides ([`stack_powers_both`]; the last group from above only), then the
+    /// slabs' passes. An opaque slab is reported with its slab index k − 1 (the first such
+    /// slab, at its first wavelength).
+    fn fill(&self, sin_theta: f64, terms: &mut Terms) -> std::result::Result<(), (usize, Error)> {
+        let last = self.groups.count() - 1;
+        for g in 0..=last {
+            let forward = &mut terms.forward[g];
+            let backward = terms.backward.get_mut(g);
+            match (&self.media[g], backward) {
+                (Some(media), Some(backward)) => {
+                    stack_powers_both(media, sin_theta, forward, backward, true)
+                }
+                (Some(media), None) => stack_powers(media, sin_theta, forward, true),
+                (None, backward) => self.scalar_group(g, sin_theta, forward, backward),
+            }
+        }
+        for (k, passes) in terms.passes.iter_mut().enumerate() {
+            let m = self.groups.media[k + 1];
+            let column = &self.columns[m];
+            for (w, p) in passes.iter_mut().enumerate() {
+                let n = column[w];
+                let q = normal_component(n, self.beta_index[w] * sin_theta);
+                let pass = elementary::exp(self.slab_scale[k][w] * q.im);
+                *p = if !(pass < OPAQUE_PASS) {
+                    pass
+                } else if n.im > 0.0 {
+                    let thickness_nm = self.thickness_nm[m - 1];
+                    return Err((
+                        k,
+                        Error::OpaqueSlab {
+                            layer: m,
+                            material: self.names[m - 1].to_string(),
+                            thickness_nm,
+                            wavelength_nm: self.wavelengths_nm[w],
+                            angle_deg: asin_deg(sin_theta),
+                            pass,
+                        },
+                    ));
+                } else {
+                    // A lossless slab beyond its critical angle: nothing crosses it.
+                    0.0
+                };
+            }
+        }
+        Ok(())
+    }
+
+    /// Group g's powers by the scalar recurrence (media outside the kernel's ranges): from
+    /// above, and from below into `backward` (the group upside down) where asked.
+    fn scalar_group(
+        &self,
+        g: usize,
+        sin_theta: f64,
+        forward: &mut [Power],
+        backward: Option<&mut Vec<Power>>,
+    ) {
+        let (top, bottom) = (self.groups.media[g], self.groups.media[g + 1]);
+        let cols = &self.columns[top..=bottom];
+        let thick = &self.thickness_nm[top..bottom - 1];
+        let rev_thick: Vec<f64> = thick.iter().rev().copied().collect();
+        let mut backward = backward;
+        for (w, &wl) in self.wavelengths_nm.iter().enumerate() {
+            let beta = self.beta_index[w] * sin_theta;
+            let mut indices: Vec<C64> = cols.iter().map(|c| c[w]).collect();
+            forward[w] = (self.scalar)(&indices, beta, wl, thick);
+            if let Some(b) = backward.as_deref_mut() {
+                indices.reverse();
+                b[w] = (self.scalar)(&indices, beta, wl, &rev_thick);
+            }
+        }
+    }
+
+    /// Runs `each(terms, sin θ₀, row)` over the angles' rows of `out` (angle-major, one
+    /// row per angle, in parallel) after filling the terms; the first error in the order
+    /// slab, angle.
+    fn rows<T: Send>(
+        &self,
+        sines: &[f64],
+        out: &mut [T],
+        each: impl Fn(&Terms, &mut [T]) + Sync,
+    ) -> Result<()> {
+        let per_angle = self.wavelengths_nm.len();
+        if per_angle == 0 {
+            return Ok(());
+        }
+        let errors: Vec<Option<(usize, Error)>> = out
+            .par_chunks_mut(per_angle)
+            .zip(sines)
+            .map_init(
+                || self.terms(),
+                |terms, (row, &sin_theta)| match self.fill(sin_theta, terms) {
+                    Ok(()) => {
+                        each(terms, row);
+                        None
+                    }
+                    Err(e) => Some(e),
+                },
+            )
+            .collect();
+        match errors.into_iter().flatten().min_by_key(|(k, _)| *k) {
+            Some((_, e)) => Err(e),
+            None => Ok(()),
+        }
+    }
+}
+
+impl Terms {
+    /// (R_g, T_g, R′_g, T′_g) of group g at wavelength w, polarisation `pol` (0 s, 1 p);
+    /// the backward pair is (0, 0) for the last group.
     #[inline]
-    fn group(&self, g: usize, e: usize, pol: usize) -> [f64; 4] {
-        let f = &self.forward[g][e];
+    fn group(&self, g: usize, w: usize, pol: usize) -> [f64; 4] {
+        let f = &self.forward[g][w];
         let (rf, tf) = if pol == 0 {
             (f.R_s, f.T_s)
         } else {
@@ -222,7 +349,7 @@ impl Terms {
         };
         match self.backward.get(g) {
             Some(b) => {
-                let b = &b[e];
+                let b = &b[w];
                 let (rb, tb) = if pol == 0 {
                     (b.R_s, b.T_s)
                 } else {
@@ -234,17 +361,17 @@ impl Terms {
         }
     }
 
-    /// X_g for g = 0 … K (reflectance below medium m_g seen from it) and Y₀ = T, at element
-    /// e, polarisation `pol`, written into `x`.
+    /// X_g for g = 0 … K (reflectance below medium m_g seen from it) and Y₀ = T, at
+    /// wavelength w, polarisation `pol`, written into `x`.
     #[inline]
-    fn recurrence(&self, e: usize, pol: usize, x: &mut [f64]) -> f64 {
+    fn recurrence(&self, w: usize, pol: usize, x: &mut [f64]) -> f64 {
         let last = self.forward.len() - 1;
-        let [rf, tf, _, _] = self.group(last, e, pol);
+        let [rf, tf, _, _] = self.group(last, w, pol);
         x[last] = rf;
         let mut y = tf;
         for g in (0..last).rev() {
-            let p = self.passes[g][e];
-            let [rf, tf, rb, tb] = self.group(g, e, pol);
+            let p = self.passes[g][w];
+            let [rf, tf, rb, tb] = self.group(g, w, pol);
             if p == 0.0 {
                 // An evanescent lossless slab: nothing crosses it.
                 x[g] = rf;
@@ -273,30 +400,23 @@ pub(crate) fn sweep(
     names: &[String],
     scalar: Scalar,
 ) -> Result<Vec<Power>> {
-    let terms = Terms::new(
-        groups,
-        sines,
-        columns,
-        wavelengths_nm,
-        thickness_nm,
-        names,
-        scalar,
-    )?;
-    let total = sines.len() * wavelengths_nm.len();
-    let mut x = vec![0.0; groups.count()];
-    Ok((0..total)
-        .map(|e| {
-            let t_s = terms.recurrence(e, 0, &mut x);
+    let plan = Plan::new(groups, columns, wavelengths_nm, thickness_nm, names, scalar);
+    let mut out = vec![Power::default(); sines.len() * wavelengths_nm.len()];
+    plan.rows(sines, &mut out, |terms, row| {
+        let mut x = vec![0.0; groups.count()];
+        for (w, slot) in row.iter_mut().enumerate() {
+            let t_s = terms.recurrence(w, 0, &mut x);
             let r_s = x[0];
-            let t_p = terms.recurrence(e, 1, &mut x);
-            Power {
+            let t_p = terms.recurrence(w, 1, &mut x);
+            *slot = Power {
                 R_s: r_s,
                 R_p: x[0],
                 T_s: t_s,
                 T_p: t_p,
-            }
-        })
-        .collect())
+            };
+        }
+    })?;
+    Ok(out)
 }
 
 /// [`sweep`] with the power absorbed in each part. Walking down from the ambient with
@@ -320,32 +440,29 @@ pub(crate) fn sweep_absorbed(
     names: &[String],
     scalar: Scalar,
 ) -> Result<Vec<Absorbed>> {
-    let terms = Terms::new(
-        groups,
-        sines,
-        columns,
-        wavelengths_nm,
-        thickness_nm,
-        names,
-        scalar,
-    )?;
-    let total = sines.len() * wavelengths_nm.len();
+    let plan = Plan::new(groups, columns, wavelengths_nm, thickness_nm, names, scalar);
     let last = groups.count() - 1;
-    let mut x = vec![0.0; groups.count()];
-    Ok((0..total)
-        .map(|e| {
+    let empty = Absorbed {
+        power: Power::default(),
+        parts_s: Vec::new(),
+        parts_p: Vec::new(),
+    };
+    let mut out = vec![empty; sines.len() * wavelengths_nm.len()];
+    plan.rows(sines, &mut out, |terms, row| {
+        let mut x = vec![0.0; groups.count()];
+        for (w, slot) in row.iter_mut().enumerate() {
             let mut pols = [(0.0, 0.0, Vec::new()), (0.0, 0.0, Vec::new())];
             for (pol, out) in pols.iter_mut().enumerate() {
-                let t = terms.recurrence(e, pol, &mut x);
+                let t = terms.recurrence(w, pol, &mut x);
                 let mut parts = Vec::with_capacity(2 * last + 1);
                 let mut incoming = 1.0;
                 for g in 0..=last {
-                    let [rf, tf, rb, tb] = terms.group(g, e, pol);
+                    let [rf, tf, rb, tb] = terms.group(g, w, pol);
                     if g == last {
                         parts.push(incoming * (1.0 - rf - tf));
                         break;
                     }
-                    let p = terms.passes[g][e];
+                    let p = terms.passes[g][w];
                     let below = x[g + 1];
                     let a = p * p * below;
                     let down = tf * incoming / (1.0 - rb * a);
@@ -357,7 +474,7 @@ pub(crate) fn sweep_absorbed(
                 *out = (x[0], t, parts);
             }
             let [(r_s, t_s, parts_s), (r_p, t_p, parts_p)] = pols;
-            Absorbed {
+            *slot = Absorbed {
                 power: Power {
                     R_s: r_s,
                     R_p: r_p,
@@ -366,47 +483,9 @@ pub(crate) fn sweep_absorbed(
                 },
                 parts_s,
                 parts_p,
-            }
-        })
-        .collect())
-}
-
-/// P = exp(−2 k₀ d Im q) of slab `medium` (index `column` per wavelength, thickness
-/// `thickness_nm`) at every (angle, wavelength), angle-major; an error where the slab
-/// absorbs and P < [`OPAQUE_PASS`]; exactly 0 where a lossless slab is evanescent and
-/// P underflows past it.
-fn slab_passes(
-    column: &[C64],
-    beta_index: &[f64],
-    sines: &[f64],
-    wavelengths_nm: &[f64],
-    thickness_nm: f64,
-    medium: usize,
-    name: &str,
-) -> Result<Vec<f64>> {
-    let mut out = Vec::with_capacity(sines.len() * wavelengths_nm.len());
-    for &sin_theta in sines {
-        for (w, &wl) in wavelengths_nm.iter().enumerate() {
-            let n = column[w];
-            let q = normal_component(n, beta_index[w] * sin_theta);
-            let p = elementary::exp(-2.0 * wavenumber(wl) * thickness_nm * q.im);
-            if p < OPAQUE_PASS {
-                if n.im > 0.0 {
-                    return Err(Error::OpaqueSlab {
-                        layer: medium,
-                        material: name.to_string(),
-                        thickness_nm,
-                        wavelength_nm: wl,
-                        angle_deg: asin_deg(sin_theta),
-                        pass: p,
-                    });
-                }
-                out.push(0.0);
-            } else {
-                out.push(p);
-            }
+            };
         }
-    }
+    })?;
     Ok(out)
 }
 
@@ -414,39 +493,4 @@ fn slab_passes(
 fn asin_deg(sin_theta: f64) -> f64 {
     let cos_theta = (1.0 - sin_theta * sin_theta).max(0.0).sqrt();
     elementary::atan2(sin_theta, cos_theta).to_degrees()
-}
-
-/// Powers of one coherent group (media `columns`, first to last, films `thickness_nm`) at
-/// every (angle, wavelength), angle-major, with β = `beta_index[w]` sin θ₀: the vectorised
-/// kernel of [`crate::multilayer`] where its ranges allow, else the scalar recurrence
-/// `scalar`.
-fn group_powers(
-    columns: &[Vec<C64>],
-    beta_index: &[f64],
-    sines: &[f64],
-    wavelengths_nm: &[f64],
-    thickness_nm: &[f64],
-    scalar: Scalar,
-) -> Vec<Power> {
-    let per_angle = wavelengths_nm.len();
-    let mut out = vec![Power::default(); sines.len() * per_angle];
-    if per_angle == 0 {
-        return out;
-    }
-    match Media::from_columns_beta(columns, Some(beta_index), wavelengths_nm, thickness_nm) {
-        Some(media) => out
-            .par_chunks_mut(per_angle)
-            .zip(sines)
-            .for_each(|(row, &sin_theta)| stack_powers(&media, sin_theta, row, true)),
-        None => out
-            .par_chunks_mut(per_angle)
-            .zip(sines)
-            .for_each(|(row, &sin_theta)| {
-                for (w, (slot, &wl)) in row.iter_mut().zip(wavelengths_nm).enumerate() {
-                    let indices: Vec<C64> = columns.iter().map(|c| c[w]).collect();
-                    *slot = scalar(&indices, beta_index[w] * sin_theta, wl, thickness_nm);
-                }
-            }),
-    }
-    out
 }

@@ -154,6 +154,15 @@ pub(super) fn interface<S: Simd>(s: S, i: &Medium<S>, j: &Medium<S>) -> Fraction
     }
 }
 
+/// |t′σ|² of the same interface crossed the other way, from medium `j` into medium `i`
+/// (α and β exchanged, σ unchanged): 4|q_j|² (s), 4|ñ_i ñ_j q_j|² (p).
+#[inline(always)]
+pub(super) fn reverse_t_sigma2<S: Simd>(s: S, i: &Medium<S>, j: &Medium<S>) -> [S::f64s; 2] {
+    let four_qj2 = s.mul_f64s(s.splat_f64s(4.0), norm_sqr(s, j.q));
+    let ninj2 = s.mul_f64s(i.n_abs2, j.n_abs2);
+    [four_qj2, s.mul_f64s(four_qj2, ninj2)]
+}
+
 /// Whether any lane of `v` is non-zero (NaN counts as zero).
 #[inline(always)]
 pub(super) fn any_nonzero<S: Simd>(s: S, v: S::f64s) -> bool {

@@ -78,6 +78,19 @@
 //!   T_p = U₀,p/|D₀,p|² · Re(ñ_f² conj q_f)/|ñ_f|² ÷ Re(ñ₀² conj q₀)/|ñ₀|² (Byrnes
 //!   Eq. 21–22: Re(ñ conj(cos θ)) = Re(ñ² conj q)/|ñ|²), one division for all four.
 //!
+//! * **Both sides in one pass** ([`stack_powers_both`], for the coherent groups between
+//!   incoherent slabs, [`crate::incoherent`]): (D, N) is the first column of the stack's
+//!   characteristic matrix in the kernel's scaling, M = A₀ P′₁ A₁ ⋯ A_N with
+//!   A_j = [[σ, ρ], [ρ, σ]] and P′ = diag(1, e^{2iδ}); the same steps carried from
+//!   (D₂, N₂) = (ρ_N, σ_N) give its second column. For light incident from the last medium
+//!   (Katsidis & Siapkas, Appl. Opt. 41, 3978, 2002, Eq. 5–7: r′ = −M₁₂/M₁₁,
+//!   t′ = det M / M₁₁), r′ = −D₂/D, and since det A_j = σ² − ρ² = 4αβ and
+//!   det P′ = e^{2iδ}, |t′|² = U′/|D|² with U′ the product of |t′σ|² = 16|αβ|²/|tσ|² (the
+//!   interface crossed upwards: 4|q_j|² for s, 4|ñ_i ñ_j q_j|² for p) and |e^{iδ}|², as U
+//!   is of |tσ|². The media's q and the films' e^{2iδ} — the square roots, sines and
+//!   exponentials — are shared by both sides; R′ = |D₂|²/|D|², T′ with the power factors of
+//!   the reversed direction (Re q₀/Re q_f, and Re(ñ₀² conj q₀)|ñ_f|² / (|ñ₀|² Re(ñ_f² conj q_f))).
+//!
 //! Against the scalar recurrence ([`crate::stack::Prepared`], which takes √ through
 //! `num_complex`'s polar form and e^{iδ} through `libm`) the powers agree to ~10⁻¹⁴ (tested:
 //! `vectorised_sweep_matches_the_recurrence`, 10⁻¹², over total internal reflection,
@@ -94,7 +107,9 @@ mod media;
 
 pub(crate) use media::{Column, Media};
 
-use lanes::{Cx, Medium, add, any_nonzero, interface, medium, mul, norm_sqr, sub};
+use lanes::{
+    Cx, Medium, add, any_nonzero, interface, medium, mul, norm_sqr, reverse_t_sigma2, sub,
+};
 
 /// The sign bit of an f64.
 const SIGN: u64 = 1 << 63;
@@ -107,7 +122,20 @@ pub(crate) fn stack_powers<T: PowerSlot>(
     row: &mut [T],
     vector: bool,
 ) {
-    row_powers::<T, true>(media, sin_theta, row, vector)
+    row_powers::<T, true>(media, sin_theta, row, None, vector)
+}
+
+/// [`stack_powers`] for light incident from the first medium (`forward`) and from the last
+/// (`backward`, the stack upside down) in one pass (module docs, "Both sides in one pass").
+pub(crate) fn stack_powers_both(
+    media: &Media,
+    sin_theta: f64,
+    forward: &mut [Power],
+    backward: &mut [Power],
+    vector: bool,
+) {
+    assert_eq!(backward.len(), forward.len());
+    row_powers::<Power, true>(media, sin_theta, forward, Some(backward), vector)
 }
 
 /// [`stack_powers`]; `SHORTCUTS = false` never skips an operation whose result is known
@@ -116,6 +144,7 @@ fn row_powers<T: PowerSlot, const SHORTCUTS: bool>(
     media: &Media,
     sin_theta: f64,
     row: &mut [T],
+    back: Option<&mut [Power]>,
     vector: bool,
 ) {
     assert_eq!(row.len(), media.wavelengths());
@@ -131,6 +160,7 @@ fn row_powers<T: PowerSlot, const SHORTCUTS: bool>(
             media,
             sin_theta,
             row,
+            back,
         };
         if vector {
             ARCH.dispatch(op)
@@ -145,6 +175,8 @@ struct RowOp<'a, T, const SHORTCUTS: bool> {
     media: &'a Media,
     sin_theta: f64,
     row: &'a mut [T],
+    /// The backward powers, when both sides are asked for.
+    back: Option<&'a mut [Power]>,
 }
 
 /// Wavelengths per block of the staging arrays (a multiple of every vector width).
@@ -226,6 +258,12 @@ struct Block {
     substrate: [[f64; BLOCK]; 3],
     /// R_s, R_p, T_s, T_p.
     out: [[f64; BLOCK]; 4],
+    /// The second column (D₂, N₂) and U′ ([`BOTH`]), as `num`, `den`, `u`.
+    num2: [[f64; BLOCK]; 4],
+    den2: [[f64; BLOCK]; 4],
+    u2: [[f64; BLOCK]; 2],
+    /// R′_s, R′_p, T′_s, T′_p ([`BOTH`]).
+    out2: [[f64; BLOCK]; 4],
 }
 
 /// What one stage of [`Block`] reads besides the block: the block's wavelengths of medium
@@ -272,9 +310,12 @@ const DECAY: u8 = 4;
 const RESCALE: u8 = 8;
 /// Medium j is known (a repeat, [`Slots`]): `FIRST` only adds the interface.
 const KNOWN: u8 = 16;
+/// Both sides: `FIRST`, `STEP` and `POWERS` also carry the second column
+/// ([`stack_powers_both`]).
+const BOTH: u8 = 32;
 
 /// Calls `$f::<F>` with `F` = `$flags` as a constant, for flags within `LOSSLESS | FORWARD |
-/// DECAY`, `DECAY | RESCALE` or `KNOWN`.
+/// DECAY`, `DECAY | RESCALE` or `KNOWN`, each with or without `BOTH`.
 macro_rules! with_flags {
     ($flags:expr, $f:ident, $($arg:expr),*) => {
         match $flags {
@@ -289,6 +330,14 @@ macro_rules! with_flags {
             8 => $f::<8>($($arg),*),
             12 => $f::<12>($($arg),*),
             16 => $f::<16>($($arg),*),
+            32 => $f::<32>($($arg),*),
+            33 => $f::<33>($($arg),*),
+            34 => $f::<34>($($arg),*),
+            35 => $f::<35>($($arg),*),
+            36 => $f::<36>($($arg),*),
+            40 => $f::<40>($($arg),*),
+            44 => $f::<44>($($arg),*),
+            48 => $f::<48>($($arg),*),
             _ => unreachable!(),
         }
     };
@@ -306,6 +355,10 @@ impl Block {
             u: [z; 2],
             substrate: [z; 3],
             out: [z; 4],
+            num2: [z; 4],
+            den2: [z; 4],
+            u2: [z; 2],
+            out2: [z; 4],
         }
     }
 
@@ -369,6 +422,55 @@ impl Block {
         *lane_mut::<S>(&mut self.u[pol], i) = u;
     }
 
+    /// [`Block::put`] of both columns: (N, D, U) and the second column's (N₂, D₂, U′), all
+    /// scaled by the power of two chosen from D (the same for both, so that D₂/D and
+    /// U′/|D|² are unchanged).
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn put_both<S: Simd>(
+        &mut self,
+        s: S,
+        i: usize,
+        pol: usize,
+        [n, d, n2, d2]: [Cx<S>; 4],
+        [u, u2]: [S::f64s; 2],
+        rescale: bool,
+    ) {
+        let (scale, scale2) = if rescale {
+            let scale = power_of_two_scale(s, s.add_f64s(s.abs_f64s(d.re), s.abs_f64s(d.im)));
+            (scale, s.mul_f64s(scale, scale))
+        } else {
+            (s.splat_f64s(1.0), s.splat_f64s(1.0))
+        };
+        let scaled = |c: Cx<S>| Cx::<S> {
+            re: s.mul_f64s(c.re, scale),
+            im: s.mul_f64s(c.im, scale),
+        };
+        let (n, d, n2, d2) = if rescale {
+            (scaled(n), scaled(d), scaled(n2), scaled(d2))
+        } else {
+            (n, d, n2, d2)
+        };
+        let (u, u2) = if rescale {
+            (s.mul_f64s(u, scale2), s.mul_f64s(u2, scale2))
+        } else {
+            (u, u2)
+        };
+        for (arrays, (n, d)) in [(0, (n, d)), (1, (n2, d2))] {
+            let (num, den) = if arrays == 0 {
+                (&mut self.num, &mut self.den)
+            } else {
+                (&mut self.num2, &mut self.den2)
+            };
+            *lane_mut::<S>(&mut num[2 * pol], i) = n.re;
+            *lane_mut::<S>(&mut num[2 * pol + 1], i) = n.im;
+            *lane_mut::<S>(&mut den[2 * pol], i) = d.re;
+            *lane_mut::<S>(&mut den[2 * pol + 1], i) = d.im;
+        }
+        *lane_mut::<S>(&mut self.u[pol], i) = u;
+        *lane_mut::<S>(&mut self.u2[pol], i) = u2;
+    }
+
     /// Medium j (the one `c` describes) for the lanes at `i`.
     #[inline(always)]
     fn medium_j<S: Simd, const F: u8>(&self, s: S, c: Ctx, i: usize) -> Medium<S> {
@@ -408,10 +510,21 @@ impl Block {
                 };
                 let below = self.media[c.below].load::<S>(i);
                 let f = interface(s, &above, &below);
-                for pol in 0..2 {
+                let back = if F & BOTH != 0 {
+                    reverse_t_sigma2(s, &above, &below)
+                } else {
+                    f.t_sigma2
+                };
+                for (pol, back) in back.into_iter().enumerate() {
                     let (alpha, beta) = (f.alpha[pol], f.beta[pol]);
                     let (rho, sigma) = (sub(s, alpha, beta), add(s, alpha, beta));
-                    self.put(s, i, pol, rho, sigma, f.t_sigma2[pol], true);
+                    if F & BOTH != 0 {
+                        // The second column: (D₂, N₂) = A_N (0, 1)ᵀ = (ρ, σ).
+                        let cols = [rho, sigma, sigma, rho];
+                        self.put_both(s, i, pol, cols, [f.t_sigma2[pol], back], true);
+                    } else {
+                        self.put(s, i, pol, rho, sigma, f.t_sigma2[pol], true);
+                    }
                 }
                 any_nonzero(s, above.q.im)
             }
@@ -450,7 +563,12 @@ impl Block {
                     re: ld(&self.phase[c.film][0]),
                     im: ld(&self.phase[c.film][1]),
                 };
-                for pol in 0..2 {
+                let back = if F & BOTH != 0 {
+                    reverse_t_sigma2(s, &above, &below)
+                } else {
+                    f.t_sigma2
+                };
+                for (pol, back) in back.into_iter().enumerate() {
                     let n = Cx::<S> {
                         re: ld(&self.num[2 * pol]),
                         im: ld(&self.num[2 * pol + 1]),
@@ -474,7 +592,30 @@ impl Block {
                     } else {
                         u
                     };
-                    self.put(s, i, pol, n_new, d_new, u, F & RESCALE != 0);
+                    if F & BOTH == 0 {
+                        self.put(s, i, pol, n_new, d_new, u, F & RESCALE != 0);
+                        continue;
+                    }
+                    // The second column through the same step, U′ with |t′σ|².
+                    let n2 = Cx::<S> {
+                        re: ld(&self.num2[2 * pol]),
+                        im: ld(&self.num2[2 * pol + 1]),
+                    };
+                    let d2 = Cx::<S> {
+                        re: ld(&self.den2[2 * pol]),
+                        im: ld(&self.den2[2 * pol + 1]),
+                    };
+                    let m2 = mul(s, n2, e2);
+                    let a2 = mul(s, alpha, add(s, d2, m2));
+                    let b2 = mul(s, beta, sub(s, d2, m2));
+                    let u2 = s.mul_f64s(back, ld(&self.u2[pol]));
+                    let u2 = if F & DECAY != 0 {
+                        s.mul_f64s(u2, ld(&self.phase[c.film][2]))
+                    } else {
+                        u2
+                    };
+                    let cols = [n_new, d_new, sub(s, a2, b2), add(s, a2, b2)];
+                    self.put_both(s, i, pol, cols, [u, u2], F & RESCALE != 0);
                 }
                 false
             }
@@ -516,6 +657,25 @@ impl Block {
                 for (k, v) in p.into_iter().enumerate() {
                     *lane_mut::<S>(&mut self.out[k], i) = v;
                 }
+                if F & BOTH != 0 {
+                    // Backwards: R′ = |D₂|²/|D|², T′ = U′/|D|² times Re q₀ / Re q_f (s) and
+                    // Re(ñ₀² conj q₀) |ñ_f|² / (|ñ₀|² Re(ñ_f² conj q_f)) (p) = y / (|ñ₀|² ·
+                    // Re(ñ_f² conj q_f)), one division for both.
+                    let re_qf = ld(&self.substrate[0]);
+                    let re_nf2_conj_qf = s.mul_f64s(ld(&self.substrate[1]), amb.n_abs2);
+                    let inv_f = s.div_f64s(s.splat_f64s(1.0), s.mul_f64s(re_qf, re_nf2_conj_qf));
+                    let back_s = s.mul_f64s(s.mul_f64s(x, re_nf2_conj_qf), inv_f);
+                    let back_p = s.mul_f64s(s.mul_f64s(y, re_qf), inv_f);
+                    let p2 = [
+                        s.mul_f64s(norm_sqr(s, cx(&self.den2, 0)), inv[0]),
+                        s.mul_f64s(norm_sqr(s, cx(&self.den2, 1)), inv[1]),
+                        s.mul_f64s(s.mul_f64s(ld(&self.u2[0]), inv[0]), back_s),
+                        s.mul_f64s(s.mul_f64s(ld(&self.u2[1]), inv[1]), back_p),
+                    ];
+                    for (k, v) in p2.into_iter().enumerate() {
+                        *lane_mut::<S>(&mut self.out2[k], i) = v;
+                    }
+                }
                 false
             }
             _ => unreachable!(),
@@ -551,6 +711,8 @@ impl<T: PowerSlot, const SHORTCUTS: bool> WithSimd for RowOp<'_, T, SHORTCUTS> {
         let media = self.media;
         let count = media.re.len();
         let b: &mut Block = self.block;
+        let mut back = self.back;
+        let both = if back.is_some() { BOTH } else { 0 };
         // Per media slot: whether a lane of the medium in it has Im q ≠ 0.
         let mut decays = [false; MEDIA_SLOTS];
         for (k, row) in self.row.chunks_mut(BLOCK).enumerate() {
@@ -614,9 +776,9 @@ impl<T: PowerSlot, const SHORTCUTS: bool> WithSimd for RowOp<'_, T, SHORTCUTS> {
                 if j == count - 2 {
                     // Γ_N = r_{N,N+1}, |τ_N|² = |t_{N,N+1}|².
                     if known {
-                        run!(FIRST, KNOWN, c);
+                        run!(FIRST, KNOWN | both, c);
                     } else {
-                        decays[c.above] = run!(FIRST, flags(j), c);
+                        decays[c.above] = run!(FIRST, flags(j) | both, c);
                     }
                     continue;
                 }
@@ -639,9 +801,13 @@ impl<T: PowerSlot, const SHORTCUTS: bool> WithSimd for RowOp<'_, T, SHORTCUTS> {
                 } else {
                     0
                 };
-                run!(STEP, rescale | decay, c);
+                run!(STEP, rescale | decay | both, c);
             }
-            b.run::<S, POWERS, 0>(s, ctx(0), n);
+            if both != 0 {
+                b.run::<S, POWERS, BOTH>(s, ctx(0), n);
+            } else {
+                b.run::<S, POWERS, 0>(s, ctx(0), n);
+            }
             for (k, slot) in row.iter_mut().enumerate() {
                 slot.put(Power {
                     R_s: b.out[0][k],
@@ -649,6 +815,19 @@ impl<T: PowerSlot, const SHORTCUTS: bool> WithSimd for RowOp<'_, T, SHORTCUTS> {
                     T_s: b.out[2][k],
                     T_p: b.out[3][k],
                 });
+            }
+            if let Some(back) = back.as_deref_mut() {
+                for (j, slot) in back[k * BLOCK..k * BLOCK + row.len()]
+                    .iter_mut()
+                    .enumerate()
+                {
+                    *slot = Power {
+                        R_s: b.out2[0][j],
+                        R_p: b.out2[1][j],
+                        T_s: b.out2[2][j],
+                        T_p: b.out2[3][j],
+                    };
+                }
             }
         }
     }
