@@ -296,6 +296,12 @@ pub const MAX_STACK_FILMS: usize = 8;
 /// material costs nothing per pixel); when no material is dispersive the interfaces'
 /// Fresnel coefficients are wavelength-invariant and the GPU computes them once per pixel
 /// (the thesis's precalculation, §4.3).
+///
+/// One film may be an incoherent slab ([`crate::Stack::with_incoherent`]): thin-walled coated
+/// glass, evaluated at each node by [`slab`]'s intensity recurrence (the GPU technique
+/// `film_glass`). It may be any film; it keeps its own thickness (neither the pixel's, even
+/// as the top film, nor the map's) and adds nothing to the rule's OPD (its fringes are
+/// averaged, not sampled). `film_stack`, which sums amplitudes only, refuses it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct StackEvaluation {
     rules: Vec<FewWavelengthRule>,
@@ -308,6 +314,8 @@ pub struct StackEvaluation {
     opd_factors: Vec<f64>,
     finesse: f64,
     dispersive: bool,
+    /// The incoherent slab: its 1-based medium index ([`slab`]).
+    slab: Option<usize>,
 }
 
 impl StackEvaluation {
@@ -346,6 +354,15 @@ impl StackEvaluation {
                 "one per film",
             ));
         }
+        let slabs = (1..=films).filter(|&j| stack.is_incoherent(j)).count();
+        if slabs > 1 {
+            return Err(out_of_range(
+                "incoherent slabs of a real-time stack",
+                slabs as f64,
+                "at most 1 (a coated pane: films, one slab, films)",
+            ));
+        }
+        let slab = (1..=films).find(|&j| stack.is_incoherent(j));
         if let Some(&r) = relative_nm.iter().find(|r| !(r.is_finite() && **r >= 0.0)) {
             return Err(out_of_range(
                 "relative thickness (nm)",
@@ -375,7 +392,11 @@ impl StackEvaluation {
         let opd_factors = stack
             .layers()
             .iter()
-            .map(|l| {
+            .enumerate()
+            .map(|(j, l)| {
+                if slab == Some(j + 1) {
+                    return 0.0;
+                }
                 2.0 * [380.0, 480.0, 580.0, 680.0, 780.0]
                     .iter()
                     .filter_map(|&wl| l.material.index_at(wl).ok())
@@ -401,6 +422,7 @@ impl StackEvaluation {
             opd_factors,
             finesse: finesse_factor(&at_550),
             dispersive,
+            slab,
         })
     }
 
@@ -442,6 +464,11 @@ impl StackEvaluation {
     /// True when some medium's index varies with wavelength.
     pub fn dispersive(&self) -> bool {
         self.dispersive
+    }
+
+    /// The incoherent slab's 1-based medium index (film j is medium j), if the stack has one.
+    pub fn slab(&self) -> Option<usize> {
+        self.slab
     }
 
     /// The same stack with film j's thickness following channel `channels[j]` of the
@@ -492,7 +519,11 @@ impl StackEvaluation {
         let s = variation.map(|v| if v.is_nan() { 0.0 } else { v.clamp(-1.0, 1.0) });
         (0..self.thickness_nm.len())
             .map(|j| {
-                if j == 0 {
+                if self.slab == Some(j + 1) {
+                    // The slab keeps its own thickness (millimetres: no 10⁶ nm clamp).
+                    let d = self.thickness_nm[j];
+                    if d > 0.0 && d.is_finite() { d } else { 0.0 }
+                } else if j == 0 {
                     clean(top_thickness_nm)
                 } else {
                     clean(self.thickness_nm[j] + self.relative_nm[j] * s[self.channels[j]])
@@ -551,9 +582,14 @@ impl StackEvaluation {
             .enumerate()
         {
             let idx = &self.indices[first + k];
-            let prepared = crate::Prepared::new(idx, idx[0].re * sin);
-            let p = prepared.power(&prepared.amplitudes(l, &d));
-            let (rv, tv) = (p.R(), p.T());
+            let (rv, tv) = match self.slab {
+                Some(s) => slab::slab_power(idx, idx[0].re * sin, l, &d, s),
+                None => {
+                    let prepared = crate::Prepared::new(idx, idx[0].re * sin);
+                    let p = prepared.power(&prepared.amplitudes(l, &d));
+                    (p.R(), p.T())
+                }
+            };
             for ch in 0..3 {
                 r[ch] += rv * w[ch];
                 t[ch] += tv * w[ch];
@@ -602,6 +638,8 @@ fn solve_spd(a: &[f64], b: &[[f64; 3]], n: usize) -> Vec<[f64; 3]> {
     }
     x
 }
+
+mod slab;
 
 #[cfg(test)]
 mod tests_support;
