@@ -305,6 +305,173 @@ fn film_stack_matches_its_cpu_twin() {
     }
 }
 
+/// `film_glass` against its CPU twin (`StackEvaluation` with an incoherent slab) over random
+/// pixels (incidence, top-film thickness, variations): a spectacle lens with a four-film AR
+/// coating on the front face and a three-film one on the back (dispersive, the slab N-BK7
+/// 2 mm), a window with a silver low-e
+/// coating on its back face, an absorbing slab first with a back coating, a slab in water
+/// with a titania front film, and a stack without a slab (then `film_glass` is `film_stack`):
+/// max |GPU − CPU| ≤ 1e-4 per channel, in reflection and transmission.
+#[test]
+fn film_glass_matches_its_cpu_twin() {
+    use nacre_format::materials;
+    use nacre_optics::few_wavelengths::StackEvaluation;
+    use nacre_optics::{Layer, Stack};
+    use nacre_runtime::bindings::StackSetup;
+    let ctx = ctx();
+    let tables = TableSet::load(ctx, &manifest("fourier-srgb")).unwrap();
+    let colorimeter = tables.colorimeter().unwrap();
+    let constant =
+        |n: f64, k: f64| Material::constant(format!("{n}+{k}i"), C64::new(n, k)).unwrap();
+    let bundled = |name: &str| materials::resolve(name, "test", None).unwrap();
+    let layer = |material: Material, thickness_nm: f64| Layer {
+        material,
+        thickness_nm,
+    };
+    let ar = |reversed: bool| {
+        let mut films = vec![
+            layer(bundled("mgf2"), 95.0),
+            layer(bundled("tio2"), 110.0),
+            layer(bundled("mgf2"), 30.0),
+            layer(bundled("tio2"), 12.0),
+        ];
+        if reversed {
+            // The back face: the first three films mirrored (eight films in all).
+            films.truncate(3);
+            films.reverse();
+        }
+        films
+    };
+    let slab = |films: Vec<Layer>, at: usize, ambient: Material, base: Material| {
+        let flags = (1..=films.len()).map(|j| j == at).collect();
+        Stack::new(ambient, films, base)
+            .unwrap()
+            .with_incoherent(flags)
+            .unwrap()
+    };
+    let spectacles = {
+        let mut films = ar(false);
+        films.push(layer(bundled("bk7"), 2e6));
+        films.extend(ar(true));
+        slab(films, 5, bundled("air"), bundled("air"))
+    };
+    let cases: Vec<(&str, Stack, Option<usize>)> = vec![
+        ("spectacle lens, AR on both faces", spectacles, None),
+        (
+            "window, silver low-e on the back",
+            slab(
+                vec![
+                    layer(constant(1.45, 0.0), 80.0),
+                    layer(bundled("bk7"), 4e6),
+                    layer(constant(2.0, 0.0), 35.0),
+                    layer(bundled("ag"), 10.0),
+                    layer(constant(2.0, 0.0), 35.0),
+                ],
+                2,
+                constant(1.0, 0.0),
+                constant(1.0, 0.0),
+            ),
+            None,
+        ),
+        (
+            "absorbing slab first, fixed 24 nodes",
+            slab(
+                vec![
+                    layer(constant(1.6, 2e-6), 1.5e6),
+                    layer(constant(2.3, 0.0), 70.0),
+                ],
+                1,
+                constant(1.0, 0.0),
+                constant(1.0, 0.0),
+            ),
+            Some(24),
+        ),
+        (
+            "slab in water",
+            slab(
+                vec![
+                    layer(bundled("tio2"), 60.0),
+                    layer(constant(1.52, 0.0), 3e6),
+                ],
+                2,
+                bundled("water"),
+                bundled("water"),
+            ),
+            None,
+        ),
+        (
+            "no slab",
+            Stack::new(
+                constant(1.0, 0.0),
+                vec![layer(constant(1.38, 0.0), 100.0), layer(bundled("cr"), 8.0)],
+                bundled("bk7"),
+            )
+            .unwrap(),
+            None,
+        ),
+    ];
+    for (name, stack, samples) in cases {
+        let films = stack.layers().len();
+        let relative_nm: Vec<f64> = (0..films).map(|j| 10.0 * j as f64).collect();
+        let eval = StackEvaluation::new(&colorimeter, &stack, &relative_nm, samples).unwrap();
+        let options = TechniqueOptions {
+            stack: StackSetup {
+                stack,
+                relative_nm,
+                channels: Vec::new(),
+                samples,
+            },
+            ..Default::default()
+        };
+        let binding =
+            TechniqueBinding::new(ctx, &tables, Technique::Glass, &options, &colorimeter).unwrap();
+        let mut rng = Lcg(31);
+        let inputs: Vec<FilmInput> = (0..400)
+            .map(|_| {
+                let (c, d, s) = (rng.next(), 300.0 * rng.next(), 2.0 * rng.next() - 1.0);
+                FilmInput {
+                    variation: s as f32,
+                    ..input(c, d, 1.5, 0.0, 1.0, C64::new(1.5, 0.0))
+                }
+            })
+            .collect();
+        let gpu = run_probe(ctx, &binding, &inputs).unwrap();
+        let cpu: Vec<([f64; 3], [f64; 3])> = inputs
+            .iter()
+            .map(|i| {
+                eval.colour(
+                    f64::from(i.cos_theta_i),
+                    f64::from(i.thickness_nm),
+                    [f64::from(i.variation), 0.0, 0.0],
+                )
+            })
+            .collect();
+        for (quantity, pick) in [("R", 0usize), ("T", 1)] {
+            let c: Vec<[f64; 3]> = cpu
+                .iter()
+                .map(|x| if pick == 0 { x.0 } else { x.1 })
+                .collect();
+            let g: Vec<[f32; 3]> = gpu
+                .iter()
+                .map(|o| {
+                    if pick == 0 {
+                        o.reflectance
+                    } else {
+                        o.transmittance
+                    }
+                })
+                .collect();
+            let (worst, at) = max_diff(&c, &g);
+            eprintln!("glass {name}: {quantity} max |GPU − CPU| = {worst:.2e}");
+            assert!(
+                worst <= 1e-4,
+                "{name} {quantity}: {worst:e} at {:?}",
+                inputs[at]
+            );
+        }
+    }
+}
+
 /// Every technique returns finite colours for every input a host engine might send: NaN,
 /// ±∞, negative, zero and huge values in every field, grazing and total internal reflection.
 #[test]

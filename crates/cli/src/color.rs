@@ -23,7 +23,8 @@ rough-mc[:N] with --roughness ALPHA (its Monte Carlo reference, N samples per po
 default 2^20; the largest standard error is printed on stderr), stack | stack:N (the GPU
 technique film_stack for any stack of 1 to 8 films: a few wavelengths uniform in
 wavenumber with weights fitted to the colour-matching functions, the count chosen from the
-stack's optical thickness, or N of them).
+stack's optical thickness, or N of them; a stack with one incoherent slab is the GPU
+technique film_glass: the films above and below the slab exact, the slab in intensity).
 
 Examples:
   # colour of a 400 nm soap film over angle, exact

@@ -168,9 +168,9 @@ pub struct RenderArgs {
 }
 
 /// Refuses a stack with an incoherent layer (`--layer bk7@2mm:incoherent`, or
-/// `incoherent = true` in `--recipe`): no render technique draws a slab whose reflections
-/// add in intensity (`film_stack` sums coherent amplitudes at a few wavelengths, and the
-/// other techniques draw their tables' film), so rendering it would be silently wrong.
+/// `incoherent = true` in `--recipe`) for every technique but `glass`: `film_stack` sums
+/// coherent amplitudes at a few wavelengths and the other techniques draw their tables'
+/// film, so rendering it with them would be silently wrong.
 fn refuse_slabs(spec: &StackSpec, args: &StackArgs) -> Result<()> {
     let Some(j) = spec.incoherent.iter().position(|&i| i) else {
         return Ok(());
@@ -184,7 +184,35 @@ fn refuse_slabs(spec: &StackSpec, args: &StackArgs) -> Result<()> {
         material.context.clone(),
         value,
         format!(
-            "layer {} is incoherent and `nacre render` draws no incoherent slab (the stack technique sums coherent amplitudes; the table techniques draw one film): compute its colour with `nacre color --method spectral`",
+            "layer {} is incoherent: only `--technique glass` draws an incoherent slab (the stack technique sums coherent amplitudes; the table techniques draw one film)",
+            j + 1
+        ),
+    )
+    .into())
+}
+
+/// Refuses a second incoherent layer for `--technique glass` (one pane: films, a slab, films).
+fn refuse_second_slab(spec: &StackSpec, args: &StackArgs) -> Result<()> {
+    let Some(j) = spec
+        .incoherent
+        .iter()
+        .enumerate()
+        .filter(|(_, i)| **i)
+        .nth(1)
+        .map(|(j, _)| j)
+    else {
+        return Ok(());
+    };
+    let (material, thickness_nm) = &spec.layers[j];
+    let value = match args.layers.get(j) {
+        Some(text) if args.recipe.is_none() => text.clone(),
+        _ => format!("{}@{}nm:incoherent", material.spec, thickness_nm),
+    };
+    Err(nacre_bake::Error::value(
+        material.context.clone(),
+        value,
+        format!(
+            "layer {} is a second incoherent slab: the glass technique draws one slab (films, one slab, films); compute a stack of several with `nacre color --method spectral`",
             j + 1
         ),
     )
@@ -218,16 +246,21 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         options.spectral_samples = n;
     }
     let s = &args.stack;
-    if technique != Technique::Stack && (!s.layers.is_empty() || s.recipe.is_some()) {
+    let stacked = matches!(technique, Technique::Stack | Technique::Glass);
+    if !stacked && (!s.layers.is_empty() || s.recipe.is_some()) {
         // The other techniques leave the stack flags unused; a slab among them is refused
         // all the same, rather than rendered as something else.
         if let Ok((spec, _, _)) = load_stack(s) {
             refuse_slabs(&spec, s)?;
         }
     }
-    if technique == Technique::Stack {
+    if stacked {
         let (spec, _, _) = load_stack(s)?;
-        refuse_slabs(&spec, s)?;
+        if technique == Technique::Stack {
+            refuse_slabs(&spec, s)?;
+        } else {
+            refuse_second_slab(&spec, s)?;
+        }
         let stack = spec.build()?;
         let relative = if args.relative.is_empty() {
             vec![0.0; stack.layers().len()]
@@ -235,8 +268,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             args.relative.clone()
         };
         if let (Some(top), Some(r)) = (stack.layers().first(), relative.first()) {
+            // A top slab keeps its own thickness (the glass technique ignores the pixel's).
+            let average_nm = if stack.is_incoherent(1) {
+                0.0
+            } else {
+                top.thickness_nm as f32
+            };
             options.material.thickness = nacre_runtime::render::ThicknessMapping::Svt {
-                average_nm: top.thickness_nm as f32,
+                average_nm,
                 relative_nm: *r as f32,
             };
             options.material.drain_nm = 0.0;

@@ -1361,8 +1361,32 @@ fn fixtures(d: &Path) -> Vec<Case> {
             &[
                 "--layer `bk7@2mm:incoherent`",
                 "layer 2 is incoherent",
-                "draws no incoherent slab",
-                "--method spectral",
+                "only `--technique glass` draws an incoherent slab",
+            ],
+        ),
+        case(
+            "flag: two slabs in render --technique glass",
+            &[
+                "render",
+                "--width",
+                "8",
+                "--height",
+                "8",
+                "--technique",
+                "glass",
+                "--layer",
+                "bk7@2mm:incoherent",
+                "--layer",
+                "mgf2@100nm",
+                "--layer",
+                "bk7@3mm:incoherent",
+                "-o",
+                "out.png",
+            ],
+            &[
+                "--layer `bk7@3mm:incoherent`",
+                "layer 3 is a second incoherent slab",
+                "one slab",
             ],
         ),
         case(
@@ -1378,7 +1402,10 @@ fn fixtures(d: &Path) -> Vec<Case> {
                 "-o",
                 "out.png",
             ],
-            &["--layer `bk7@2mm:incoherent`", "draws no incoherent slab"],
+            &[
+                "--layer `bk7@2mm:incoherent`",
+                "only `--technique glass` draws an incoherent slab",
+            ],
         ),
         case(
             "flag: a slab that absorbs everything",

@@ -10,7 +10,8 @@ use crate::technique::{BindInputs, Slot, Technique};
 use nacre_optics::colour::Colorimeter;
 
 pub use crate::technique::{
-    SpectralSetup, StackSetup, TechniqueOptions, spectral_samples, stack_buffers, stack_gpu,
+    GlassParams, SpectralSetup, StackSetup, TechniqueOptions, glass_gpu, spectral_samples,
+    stack_buffers, stack_gpu,
 };
 
 const STAGES: wgpu::ShaderStages = wgpu::ShaderStages::FRAGMENT.union(wgpu::ShaderStages::COMPUTE);

@@ -94,6 +94,17 @@ pub enum Error {
         /// The accepted range, in words.
         expected: String,
     },
+    /// A stack with an incoherent slab given to a technique that sums coherent amplitudes
+    /// only (`film_stack`).
+    #[error(
+        "technique `{technique}`: layer {layer} is incoherent and `{technique}` sums coherent amplitudes only: draw the coated glass with technique `glass`"
+    )]
+    IncoherentStack {
+        /// The technique.
+        technique: &'static str,
+        /// The incoherent film, 1-based.
+        layer: usize,
+    },
     /// A name that is not one of the choices (a scene, a film evaluation).
     #[error("{what} `{name}`: expected {expected}")]
     UnknownName {

@@ -107,14 +107,16 @@ impl ThicknessMap {
     }
 
     /// [`ThicknessMap::load`] for a scene rendered with `technique`: a colour map (one channel
-    /// per film) is for [`Technique::Stack`](crate::shaders::Technique::Stack) only.
+    /// per film) is for [`Technique::Stack`](crate::shaders::Technique::Stack) and
+    /// [`Technique::Glass`](crate::shaders::Technique::Glass) only.
     ///
     /// # Errors
     /// Those of [`ThicknessMap::load`]; [`Error::ThicknessMap`] for a colour map with another
     /// technique, which would read its R channel as if it were grey.
     pub fn load_for(path: &Path, technique: crate::shaders::Technique) -> Result<ThicknessMap> {
         let map = ThicknessMap::load(path)?;
-        if map.green_blue.is_some() && technique != crate::shaders::Technique::Stack {
+        use crate::shaders::Technique;
+        if map.green_blue.is_some() && !matches!(technique, Technique::Stack | Technique::Glass) {
             return Err(Error::ThicknessMap {
                 path: path.to_path_buf(),
                 problem: ThicknessMapProblem::ColourForTechnique(technique.name().to_string()),

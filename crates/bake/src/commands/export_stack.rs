@@ -76,6 +76,13 @@ pub fn stack_export(request: &StackExport) -> Result<serde_json::Value> {
             .with_channels(request.channels)
             .map_err(named(Param::LayerChannel))?;
     }
+    if let Some(j) = eval.slab() {
+        return Err(Error::value(
+            Param::Layer,
+            format!("layer {j}"),
+            "it is incoherent, and the engine libraries' stack technique sums coherent amplitudes only: export the stack without the slab".to_string(),
+        ));
+    }
     let gpu = StackGpu::new(&eval);
     let about = json!({
         "ambient": stack.ambient().name(),

@@ -17,12 +17,14 @@
 
 mod entry;
 mod fourier;
+mod glass;
 mod lut;
 mod options;
 mod spectral;
 mod stack;
 
 pub use entry::{BindInputs, Slot, TechniqueEntry};
+pub use glass::{GlassParams, glass_gpu};
 pub use options::{SpectralSetup, StackSetup, TechniqueOptions};
 pub use spectral::{SpectralParams, SpectralSample, spectral_samples};
 pub use stack::{StackGpu, StackNode, StackParams, stack_buffers, stack_gpu};
@@ -39,6 +41,8 @@ pub enum Technique {
     Spectral,
     /// `film_stack.wgsl`.
     Stack,
+    /// `film_glass.wgsl`.
+    Glass,
 }
 
 /// Every technique's entry, in [`Technique::ALL`] order (the command line's choices).
@@ -54,11 +58,12 @@ pub const REGISTRY: &[TechniqueEntry] = &{
 
 impl Technique {
     /// Every technique, in the order of the command line's choices.
-    pub const ALL: [Technique; 4] = [
+    pub const ALL: [Technique; 5] = [
         Technique::Lut,
         Technique::Fourier,
         Technique::Spectral,
         Technique::Stack,
+        Technique::Glass,
     ];
 
     /// Its entry (in its file of `technique/`).
@@ -68,6 +73,7 @@ impl Technique {
             Technique::Fourier => &fourier::ENTRY,
             Technique::Spectral => &spectral::ENTRY,
             Technique::Stack => &stack::ENTRY,
+            Technique::Glass => &glass::ENTRY,
         }
     }
 

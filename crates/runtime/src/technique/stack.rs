@@ -7,7 +7,7 @@
 use super::entry::{BindInputs, Slot, TechniqueEntry};
 use super::options::StackSetup;
 use crate::context::BufferInitExt;
-use crate::error::Result;
+use crate::error::{Error, Result};
 pub use nacre_format::gpu_params::{StackGpu, StackNode, StackParams};
 use nacre_optics::colour::Colorimeter;
 
@@ -63,12 +63,32 @@ pub fn stack_buffers(
 }
 
 /// What `film_stack` reads for `setup`, as [`StackGpu`].
+///
+/// # Errors
+/// [`Error::IncoherentStack`] for a stack with an incoherent slab (`film_stack` sums
+/// amplitudes only; `film_glass` draws it); the evaluation's errors.
 pub fn stack_gpu(colorimeter: &Colorimeter, setup: &StackSetup) -> Result<StackGpu> {
+    let eval = evaluation(colorimeter, setup)?;
+    if let Some(layer) = eval.slab() {
+        return Err(Error::IncoherentStack {
+            technique: ENTRY.name,
+            layer,
+        });
+    }
+    Ok(StackGpu::new(&eval))
+}
+
+/// The evaluation of `setup` (its stack, relative thicknesses, map channels and rule), which
+/// `film_stack` and `film_glass` upload and the CPU twin evaluates.
+pub(super) fn evaluation(
+    colorimeter: &Colorimeter,
+    setup: &StackSetup,
+) -> Result<nacre_optics::few_wavelengths::StackEvaluation> {
     use nacre_optics::few_wavelengths::StackEvaluation;
     let mut eval =
         StackEvaluation::new(colorimeter, &setup.stack, &setup.relative_nm, setup.samples)?;
     if !setup.channels.is_empty() {
         eval = eval.with_channels(&setup.channels)?;
     }
-    Ok(StackGpu::new(&eval))
+    Ok(eval)
 }

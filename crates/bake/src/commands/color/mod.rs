@@ -825,7 +825,8 @@ pub fn undersampled(
 /// `Ok` when `stack` is coherent or `method` takes a stack with incoherent layers
 /// (`spectral`, `rgb3`, `samples:N`: each integrates the stack's reflectance or
 /// transmittance spectrum, which [`Stack::sweep`] gives with the slabs added in intensity;
-/// `lut:` with a film-lut baked over the same slab, checked by [`LoadedLut::check_stack`]);
+/// `lut:` with a film-lut baked over the same slab, checked by [`LoadedLut::check_stack`];
+/// `stack`, the real-time technique's twin, with one slab: [`StackEvaluation`] refuses more);
 /// otherwise an error that names the method and the slab and says why the method's
 /// physics does not apply.
 pub(crate) fn refuse_incoherent(stack: &Stack, method: &Method) -> Result<()> {
@@ -833,7 +834,7 @@ pub(crate) fn refuse_incoherent(stack: &Stack, method: &Method) -> Result<()> {
         return Ok(());
     }
     let (name, why) = match method {
-        Method::Spectral | Method::Rgb3 | Method::Samples(_) => return Ok(()),
+        Method::Spectral | Method::Rgb3 | Method::Samples(_) | Method::Stack(_) => return Ok(()),
         // A film-lut baked with the same slab under its film (checked by `check_stack`).
         Method::Lut(_) => return Ok(()),
         Method::Fourier(..) => (
@@ -851,10 +852,6 @@ pub(crate) fn refuse_incoherent(stack: &Stack, method: &Method) -> Result<()> {
         Method::RoughMonteCarlo { .. } => (
             "rough-mc",
             "the microfacet model reflects from one rough interface; light returning through an incoherent slab behind it leaves at other points and angles",
-        ),
-        Method::Stack(_) => (
-            "stack",
-            "the real-time technique sums coherent amplitudes at a few wavelengths; it has no incoherent slab",
         ),
     };
     let layer = (1..=stack.layers().len())
