@@ -35,7 +35,9 @@
 //! P_k = |e^{iδ}|² = exp(−2 Im δ) = exp(−4π d Im(ñ cos θ) / λ),    δ = k₀ q d, q = ñ cos θ
 //! ```
 //!
-//! at its internal (complex) angle, the same for s and p (Byrnes §4, `P_list`). From the
+//! at its internal (complex) angle, the same for s and p (Byrnes §4, `P_list`), computed
+//! wavelengths-as-lanes with the kernel's own root and e^{−a}
+//! ([`crate::multilayer::slab_passes`]). From the
 //! substrate up, X_g and Y_g being the reflectance and transmittance of everything below
 //! medium m_g seen from inside it, X_K = R_K, Y_K = T_K (the last group), and for
 //! g = K−1 … 0
@@ -58,8 +60,7 @@
 
 use crate::elementary;
 use crate::error::{Error, Result};
-use crate::fresnel::normal_component;
-use crate::multilayer::{Media, stack_powers, stack_powers_both};
+use crate::multilayer::{Media, SlabArrays, slab_passes, stack_powers, stack_powers_both};
 use crate::power::{Power, wavenumber};
 use num_complex::Complex64 as C64;
 use rayon::prelude::*;
@@ -161,8 +162,8 @@ struct Plan<'a> {
     beta_index: Vec<f64>,
     /// Per group: its media for the kernel, or `None` (the scalar recurrence).
     media: Vec<Option<Media>>,
-    /// Per slab k (medium m_k): −2 k₀ d per wavelength, so that P = exp(value · Im q).
-    slab_scale: Vec<Vec<f64>>,
+    /// Per slab k (medium m_k): its arrays for [`slab_passes`].
+    slabs: Vec<SlabArrays>,
 }
 
 /// Everything the recurrence needs at one angle: per group, its powers from above
@@ -196,14 +197,10 @@ impl<'a> Plan<'a> {
                 )
             })
             .collect();
-        let slab_scale = groups.media[1..groups.media.len() - 1]
+        let k0_per_nm: Vec<f64> = wavelengths_nm.iter().map(|&wl| wavenumber(wl)).collect();
+        let slabs = groups.media[1..groups.media.len() - 1]
             .iter()
-            .map(|&m| {
-                wavelengths_nm
-                    .iter()
-                    .map(|&wl| -2.0 * wavenumber(wl) * thickness_nm[m - 1])
-                    .collect()
-            })
+            .map(|&m| SlabArrays::new(&columns[m], &beta_index, &k0_per_nm, thickness_nm[m - 1]))
             .collect();
         Plan {
             groups,
@@ -214,7 +211,7 @@ impl<'a> Plan<'a> {
             scalar,
             beta_index,
             media,
-            slab_scale,
+            slabs,
         }
     }
 
@@ -225,7 +222,7 @@ impl<'a> Plan<'a> {
         Terms {
             forward: vec![vec![Power::default(); n]; groups],
             backward: vec![vec![Power::default(); n]; groups - 1],
-            passes: vec![vec![0.0; n]; groups - 1],
+            passes: self.slabs.iter().map(|a| vec![0.0; a.padded()]).collect(),
         }
     }
 
@@ -249,10 +246,10 @@ impl<'a> Plan<'a> {
         for (k, passes) in terms.passes.iter_mut().enumerate() {
             let m = self.groups.media[k + 1];
             let column = &self.columns[m];
-            for (w, p) in passes.iter_mut().enumerate() {
+            slab_passes(&self.slabs[k], sin_theta, passes);
+            for (w, p) in passes.iter_mut().take(column.len()).enumerate() {
                 let n = column[w];
-                let q = normal_component(n, self.beta_index[w] * sin_theta);
-                let pass = elementary::exp(self.slab_scale[k][w] * q.im);
+                let pass = *p;
                 *p = if !(pass < OPAQUE_PASS) {
                     pass
                 } else if n.im > 0.0 {

@@ -98,6 +98,7 @@
 
 use crate::power::{Power, PowerSlot};
 use crate::simd::{ARCH, exp_neg_with, lane, lane_mut, madd, sin_cos_bounded_with};
+use num_complex::Complex64 as C64;
 use pulp::{Simd, WithSimd};
 use std::cell::RefCell;
 
@@ -136,6 +137,74 @@ pub(crate) fn stack_powers_both(
 ) {
     assert_eq!(backward.len(), forward.len());
     row_powers::<Power, true>(media, sin_theta, forward, Some(backward), vector)
+}
+
+/// The arrays of one incoherent slab for [`slab_passes`], per wavelength and padded with
+/// copies of the last to a whole number of [`PAD`]-lane vectors: ñ² (re, im), |ñ|², the
+/// ambient's Re ñ₀ (β = Re ñ₀ sin θ₀) and the slab's −2 k₀ d.
+pub(crate) struct SlabArrays {
+    n2_re: Vec<f64>,
+    n2_im: Vec<f64>,
+    n_abs2: Vec<f64>,
+    n0_re: Vec<f64>,
+    scale: Vec<f64>,
+}
+
+impl SlabArrays {
+    /// The padded length: what [`slab_passes`] writes.
+    pub(crate) fn padded(&self) -> usize {
+        self.scale.len()
+    }
+
+    /// The arrays of a slab of index `column[w]` and thickness `thickness_nm` at the
+    /// vacuum wavenumbers `k0_per_nm[w]`, with the ambient's real index `n0_re[w]`.
+    pub(crate) fn new(column: &[C64], n0_re: &[f64], k0_per_nm: &[f64], thickness_nm: f64) -> Self {
+        let padded = column.len().next_multiple_of(PAD);
+        let pad = |v: Vec<f64>| -> Vec<f64> {
+            let last = v.last().copied().unwrap_or(0.0);
+            let mut v = v;
+            v.resize(padded, last);
+            v
+        };
+        SlabArrays {
+            n2_re: pad(column.iter().map(|n| n.re * n.re - n.im * n.im).collect()),
+            n2_im: pad(column.iter().map(|n| 2.0 * n.re * n.im).collect()),
+            n_abs2: pad(column.iter().map(|n| n.re * n.re + n.im * n.im).collect()),
+            n0_re: pad(n0_re.to_vec()),
+            scale: pad(k0_per_nm
+                .iter()
+                .map(|k0| -2.0 * k0 * thickness_nm)
+                .collect()),
+        }
+    }
+}
+
+/// A slab's single-pass transmission P = |e^{iδ}|² = e^{−2 k₀ d Im q} at every wavelength
+/// for incidence sin θ₀ = `sin_theta` (Byrnes §4, [`crate::incoherent`]), into `out`
+/// (at least as long as the padded arrays): q by the kernel's own root on its forward
+/// branch ([`medium`], the general formula), e^{−a} by [`crate::simd::exp_neg_with`] — the
+/// same bits on every vector width.
+pub(crate) fn slab_passes(slab: &SlabArrays, sin_theta: f64, out: &mut [f64]) {
+    struct Op<'a>(&'a SlabArrays, f64, &'a mut [f64]);
+    impl WithSimd for Op<'_> {
+        type Output = ();
+        #[inline(always)]
+        fn with_simd<S: Simd>(self, s: S) {
+            let Op(a, sin_theta, out) = self;
+            let lanes = S::F64_LANES;
+            for i in (0..a.scale.len()).step_by(lanes) {
+                let beta = s.mul_f64s(lane::<S>(&a.n0_re, i), s.splat_f64s(sin_theta));
+                let n2 = Cx::<S> {
+                    re: lane::<S>(&a.n2_re, i),
+                    im: lane::<S>(&a.n2_im, i),
+                };
+                let m = medium::<S, 0>(s, lane::<S>(&a.n_abs2, i), n2, s.mul_f64s(beta, beta));
+                let decay = s.neg_f64s(s.mul_f64s(lane::<S>(&a.scale, i), m.q.im));
+                *lane_mut::<S>(out, i) = exp_neg_with::<S, true>(s, decay);
+            }
+        }
+    }
+    ARCH.dispatch(Op(slab, sin_theta, out))
 }
 
 /// [`stack_powers`]; `SHORTCUTS = false` never skips an operation whose result is known
