@@ -57,9 +57,9 @@ fn color(method: &str, quantity: &str, extra: &[&str], dir: &Path) -> Output {
 }
 
 #[test]
-fn spectral_rgb3_and_samples_give_the_whole_panes_reflected_and_transmitted_colour() {
+fn spectral_rgb3_samples_and_stack_give_the_whole_panes_reflected_and_transmitted_colour() {
     let dir = tempfile::tempdir().unwrap();
-    for method in ["spectral", "rgb3", "samples:16"] {
+    for method in ["spectral", "rgb3", "samples:16", "stack"] {
         let r = color(method, "r", &[], dir.path());
         let t = color(method, "t", &[], dir.path());
         for o in [&r, &t] {
@@ -91,7 +91,6 @@ fn methods_without_slab_physics_refuse_it_with_exit_2() {
         ("fourier", &[][..], "Fourier series"),
         ("fourier-exact:3", &[][..], "Fourier series"),
         ("gaussian", &[][..], "Gaussian fit"),
-        ("stack", &[][..], "real-time technique"),
         (
             "rough-lut:rough-film-dielectric",
             &["--roughness", "0.3"][..],
