@@ -96,7 +96,9 @@ pub fn unpolarised<'py>(
 /// Reflectance and transmittance of `stack` over angle × wavelength (× thickness of film
 /// `layer` when `thickness_nm` is given): one array of shape (angles, wavelengths[,
 /// thicknesses], 4) holding R_s, R_p, T_s, T_p (the sweep's own memory, not copied). The computation of `nacre spectrum`
-/// ([`spectrum_cmd::compute`], [`spectrum_cmd::compute_thickness`]).
+/// ([`spectrum_cmd::compute`], [`spectrum_cmd::compute_thickness`]). With it, the warnings
+/// `nacre spectrum` prints: the coherent films whose fringes the wavelength grid cannot
+/// follow ([`nacre_optics::Stack::undersampled_films`]; not for a thickness sweep).
 #[pyfunction]
 #[pyo3(signature = (stack, angles_deg, wavelengths_nm, thickness_nm=None, layer=1))]
 pub fn spectrum<'py>(
@@ -106,7 +108,7 @@ pub fn spectrum<'py>(
     wavelengths_nm: PyReadonlyArray1<'py, f64>,
     thickness_nm: Option<PyReadonlyArray1<'py, f64>>,
     layer: usize,
-) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+) -> PyResult<(Bound<'py, PyArrayDyn<f64>>, Vec<String>)> {
     let angles = vec_of(&angles_deg);
     let wavelengths = vec_of(&wavelengths_nm);
     let thicknesses = thickness_nm.as_ref().map(vec_of);
@@ -116,39 +118,60 @@ pub fn spectrum<'py>(
         shape.push(d.len());
     }
     shape.push(4);
-    let powers = py
+    let (powers, warnings) = py
         .detach(|| -> Result<_> {
-            let powers = match &thicknesses {
-                None => spectrum_cmd::compute(&s, &angles, &wavelengths)?,
-                Some(d) => spectrum_cmd::compute_thickness(&s, layer, &angles, &wavelengths, d)?,
+            let (powers, warnings) = match &thicknesses {
+                None => (
+                    spectrum_cmd::compute(&s, &angles, &wavelengths)?,
+                    undersampled(&s, &wavelengths),
+                ),
+                Some(d) => (
+                    spectrum_cmd::compute_thickness(&s, layer, &angles, &wavelengths, d)?,
+                    Vec::new(),
+                ),
             };
-            Ok(powers_as_floats(powers))
+            Ok((powers_as_floats(powers), warnings))
         })
         .map_err(bake_err)?;
-    Ok(array(py, &shape, powers))
+    Ok((array(py, &shape, powers), warnings))
+}
+
+/// The texts of `nacre spectrum`'s undersampling warnings for `stack` on `wavelengths_nm`.
+fn undersampled(stack: &nacre_optics::Stack, wavelengths_nm: &[f64]) -> Vec<String> {
+    stack
+        .undersampled_films(wavelengths_nm)
+        .iter()
+        .map(ToString::to_string)
+        .collect()
 }
 
 /// [`spectrum`] with the exact derivatives of the powers by every film's thickness (the
 /// computation of `nacre spectrum --jacobian`, [`spectrum_cmd::compute_jacobian`]): the powers,
 /// shape (angles, wavelengths, 4), and ∂R_s, ∂R_p, ∂T_s, ∂T_p per nm of each film's thickness
-/// (top film first), shape (angles, wavelengths, films, 4).
+/// (top film first), shape (angles, wavelengths, films, 4); and the undersampling warnings.
 #[pyfunction]
+#[allow(clippy::type_complexity)]
 pub fn spectrum_jacobian<'py>(
     py: Python<'py>,
     stack: &PyStack,
     angles_deg: PyReadonlyArray1<'py, f64>,
     wavelengths_nm: PyReadonlyArray1<'py, f64>,
-) -> PyResult<(Bound<'py, PyArrayDyn<f64>>, Bound<'py, PyArrayDyn<f64>>)> {
+) -> PyResult<(
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    Vec<String>,
+)> {
     let angles = vec_of(&angles_deg);
     let wavelengths = vec_of(&wavelengths_nm);
     let s = stack.stack.clone();
     let films = s.layers().len();
-    let (powers, d_thickness) = py
+    let (powers, d_thickness, warnings) = py
         .detach(|| -> Result<_> {
             let (powers, jacobian) = spectrum_cmd::compute_jacobian(&s, &angles, &wavelengths)?;
             Ok((
                 powers_as_floats(powers),
                 powers_as_floats(jacobian.d_thickness),
+                undersampled(&s, &wavelengths),
             ))
         })
         .map_err(bake_err)?;
@@ -156,6 +179,7 @@ pub fn spectrum_jacobian<'py>(
     Ok((
         array(py, &[na, nw, 4], powers),
         array(py, &[na, nw, films, 4], d_thickness),
+        warnings,
     ))
 }
 
@@ -191,8 +215,8 @@ fn points(
 /// The colour of `stack` at each point by `method` (every method of `nacre color`), through
 /// [`request::prepare`] and [`request::compute`]. Returns `(xyz, rgb, thickness_nm,
 /// film_ior, monte_carlo)`: XYZ and output-space colours (n, 3), the first film's thickness
-/// and real index at each point (the CSV's columns), and for `rough-mc` the samples per
-/// point and the largest standard error.
+/// and real index at each point (the CSV's columns), for `rough-mc` the samples per point
+/// and the largest standard error, and the undersampling warnings `nacre color` prints.
 #[pyfunction]
 #[pyo3(signature = (stack, angles_deg, thickness_nm=None, film_ior=None, method="spectral", quantity="r", observer=None, illuminant=None, space=None, roughness=None, fourier_table=None))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
@@ -215,13 +239,14 @@ pub fn color<'py>(
     Bound<'py, PyArrayDyn<f64>>,
     Bound<'py, PyArrayDyn<f64>>,
     Option<(usize, f64)>,
+    Vec<String>,
 )> {
     let angles = vec_of(&angles_deg);
     let thickness = thickness_nm.as_ref().map(vec_of);
     let film_ior = film_ior.as_ref().map(vec_of);
     let fourier_table = fourier_table.map(|p| p.to_string_lossy().into_owned());
     let s = stack.stack.clone();
-    let (xyz, rgb, d, n, mc) = py
+    let (xyz, rgb, d, n, mc, warnings) = py
         .detach(|| -> Result<_> {
             let quantity = match quantity.trim().to_ascii_lowercase().as_str() {
                 "r" | "reflectance" => Quantity::Reflectance,
@@ -262,7 +287,8 @@ pub fn color<'py>(
                 d.push(dp);
                 n.push(np);
             }
-            Ok((xyz, rgb, d, n, out.monte_carlo))
+            let warnings = out.undersampled.iter().map(ToString::to_string).collect();
+            Ok((xyz, rgb, d, n, out.monte_carlo, warnings))
         })
         .map_err(bake_err)?;
     let len = d.len();
@@ -272,6 +298,7 @@ pub fn color<'py>(
         array(py, &[len], d),
         array(py, &[len], n),
         mc,
+        warnings,
     ))
 }
 

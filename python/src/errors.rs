@@ -47,6 +47,7 @@ pub fn python_name(param: Param) -> &'static str {
         Param::FilmIors => "film_ior",
         Param::Table => "name_or_manifest",
         Param::Output => "out_dir",
+        Param::Distinct => "distinct_nm",
         other => other.name(),
     }
 }

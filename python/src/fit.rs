@@ -1,21 +1,27 @@
-//! `fit_spectrum` and `fit_gltf`: the computations of `nacre fit spectrum` and `nacre fit
-//! gltf` ([`fit_spectrum_cmd`], [`fit_gltf_cmd`]) with numpy arrays instead of CSV files.
+//! `fit_spectrum`, `fit_color` and `fit_gltf`: the computations of `nacre fit spectrum`,
+//! `nacre fit color` and `nacre fit gltf` ([`fit_spectrum_cmd`], [`fit_color_cmd`],
+//! [`fit_gltf_cmd`]) with numpy arrays instead of CSV files.
 //! The template is read by the command line's own parser (`--layer sio2@50:400` texts, or
 //! a template recipe); many spectra are fitted in parallel by [`fit_spectrum_cmd::fit_all`]
 //! with the GIL released, each fit alone, so the results are the same whatever the thread
-//! count. The public API and its docs are `fit_spectrum`/`fit_gltf` in
-//! `pysrc/nacre/__init__.py`.
+//! count. A colour design runs [`fit_color_cmd::design`], the command's own function, on
+//! target rows made by [`fit_color_cmd::target_row`], the targets file's own conversion. The
+//! public API and its docs are `fit_spectrum`/`fit_color`/`fit_gltf` in
+//! `pysrc/nacre/_fit.py`.
 
 use crate::errors::{Result, bake_err};
 use crate::stack::{PyStack, database_of};
+use nacre_bake::commands::color_request::{ColourSettings as ColourNames, colorimeter};
+use nacre_bake::commands::fit_color as fit_color_cmd;
 use nacre_bake::commands::fit_gltf as fit_gltf_cmd;
 use nacre_bake::commands::fit_spectrum as fit_spectrum_cmd;
 use nacre_bake::commands::fit_template::FitTemplate;
 use nacre_bake::commands::stack_spec::TemplateSpec;
 use nacre_bake::error::{Error, Param};
 use nacre_optics::fit::gltf::{Errors, GltfBase, GltfFilm};
-use nacre_optics::fit::{FreeKind, Measurement, Quantity, Settings};
+use nacre_optics::fit::{ColourSettings, FreeKind, Measurement, Quantity, Settings};
 use numpy::ndarray::Array2;
+use numpy::ndarray::Array3;
 use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -190,11 +196,7 @@ pub fn fit_spectrum<'py>(
     );
     let computed = py.detach(move || -> Result<_> {
         let template = template(layers, ambient, substrate, recipe, material_db)?;
-        let quantity = match quantity.trim() {
-            "r" | "R" => Quantity::Reflectance,
-            "t" | "T" => Quantity::Transmittance,
-            other => return Err(Error::value(Param::Quantity, other, "expected r or t")),
-        };
+        let quantity = quantity_of(&quantity)?;
         let request = fit_spectrum_cmd::Request {
             settings: Settings {
                 scale: fit_spectrum_cmd::parse_baseline(Param::Scale, &scale)?,
@@ -283,6 +285,239 @@ pub fn fit_spectrum<'py>(
             .collect::<Vec<_>>(),
     )?;
     d.set_item("recipes", recipes)?;
+    Ok(d)
+}
+
+/// The quantity of `--quantity r|t`.
+fn quantity_of(text: &str) -> Result<Quantity> {
+    match text.trim() {
+        "r" | "R" => Ok(Quantity::Reflectance),
+        "t" | "T" => Ok(Quantity::Transmittance),
+        other => Err(Error::value(Param::Quantity, other, "expected r or t")),
+    }
+}
+
+/// The target rows of `targets` (rows × 3, the colour as `given`, named `given_name` in
+/// messages), `angles_deg` and `weights` (one per row), checked and converted as
+/// `nacre fit color` reads its targets file ([`fit_color_cmd::target_row`]); a problem
+/// names the argument and row.
+fn target_rows(
+    targets: &Array2<f64>,
+    given: fit_color_cmd::Given,
+    given_name: &str,
+    angles_deg: &[f64],
+    weights: Option<&[f64]>,
+    colorimeter: &nacre_optics::colour::Colorimeter,
+) -> Result<Vec<fit_color_cmd::TargetRow>> {
+    let n = targets.nrows();
+    if n == 0 {
+        return Err(Error::value(
+            given_name,
+            "no rows",
+            "expected one target colour per row",
+        ));
+    }
+    for (what, len) in [
+        ("angles_deg", Some(angles_deg.len())),
+        ("weights", weights.map(<[f64]>::len)),
+    ] {
+        if let Some(len) = len
+            && len != n
+        {
+            return Err(Error::value(
+                what,
+                format!("{len} values"),
+                format!("expected one per target row: {n}"),
+            ));
+        }
+    }
+    let finite = |name: String, v: f64| {
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(Error::value(
+                name,
+                format!("{v}"),
+                "expected a finite number",
+            ))
+        }
+    };
+    (0..n)
+        .map(|i| {
+            let angle = finite(format!("angles_deg[{i}]"), angles_deg[i])?;
+            let weight = match weights {
+                Some(w) => finite(format!("weights[{i}]"), w[i])?,
+                None => 1.0,
+            };
+            let mut v = [0.0; 3];
+            for (k, slot) in v.iter_mut().enumerate() {
+                *slot = finite(format!("{given_name}[{i}, {k}]"), targets[[i, k]])?;
+            }
+            fit_color_cmd::target_row(i + 1, angle, given, v, weight, colorimeter).map_err(|bad| {
+                let name = match bad.field {
+                    "angle_deg" => format!("angles_deg[{i}]"),
+                    "weight" => format!("weights[{i}]"),
+                    _ => format!("{given_name}[{i}, 0]"),
+                };
+                Error::value(name, format!("{}", bad.value), bad.requirement)
+            })
+        })
+        .collect()
+}
+
+/// Designs the template's free thicknesses and indices for the target colours `targets`
+/// (rows × 3: linear R, G, B in `space`, X, Y, Z or L, a, b as `given` says) seen at
+/// `angles_deg`, weighted by `weights`: `nacre fit color` through its own
+/// [`fit_color_cmd::design`]. Returns a dict: `params`, per solution (best first) `x`
+/// (solutions × params), `colour` and `lab` (solutions × rows × 3, by `nacre color`'s
+/// spectral method), `delta_e` (solutions × rows), `iterations`, `recipes` (the TOML the
+/// command writes with `-o`, naming the targets `targets_name`), `summary` (the lines the
+/// command prints, a row named `lab[1]` instead of `line 4`), and `target_lab`, `target_colour` (rows × 3), `samples`, `starts`,
+/// `reached_delta_e`.
+#[pyfunction]
+#[pyo3(signature = (targets, given, angles_deg, weights, layers, ambient, substrate, recipe, material_db, quantity, observer, illuminant, space, solutions, distinct_nm, starts, targets_name))]
+#[allow(clippy::too_many_arguments)]
+pub fn fit_color<'py>(
+    py: Python<'py>,
+    targets: PyReadonlyArray2<'py, f64>,
+    given: &str,
+    angles_deg: PyReadonlyArray1<'py, f64>,
+    weights: Option<PyReadonlyArray1<'py, f64>>,
+    layers: Option<Vec<String>>,
+    ambient: Option<String>,
+    substrate: Option<String>,
+    recipe: Option<PathBuf>,
+    material_db: Option<PathBuf>,
+    quantity: &str,
+    observer: Option<String>,
+    illuminant: Option<String>,
+    space: Option<String>,
+    solutions: usize,
+    distinct_nm: f64,
+    starts: usize,
+    targets_name: String,
+) -> PyResult<Bound<'py, PyDict>> {
+    let targets = targets.as_array().to_owned();
+    let angles = angles_deg.as_array().to_vec();
+    let weights = weights.map(|w| w.as_array().to_vec());
+    let (given, given_name) = match given {
+        "rgb" => (fit_color_cmd::Given::Rgb, "rgb"),
+        "xyz" => (fit_color_cmd::Given::Xyz, "xyz"),
+        "lab" => (fit_color_cmd::Given::Lab, "lab"),
+        other => {
+            return Err(bake_err(Error::value(
+                "given",
+                other,
+                "expected rgb, xyz or lab",
+            )));
+        }
+    };
+    if targets.ncols() != 3 {
+        return Err(bake_err(Error::value(
+            given_name,
+            format!("{} columns", targets.ncols()),
+            "expected three per row",
+        )));
+    }
+    let quantity = quantity.to_string();
+    let computed = py.detach(move || -> Result<_> {
+        let colorimeter = colorimeter(&ColourNames {
+            observer: observer.as_deref(),
+            illuminant: illuminant.as_deref(),
+            space: space.as_deref(),
+        })?;
+        let settings = ColourSettings {
+            quantity: quantity_of(&quantity)?,
+            starts: starts.max(1),
+            solutions: fit_color_cmd::parse_solutions(solutions)?,
+            distinct_nm: fit_color_cmd::check_distinct(distinct_nm)?,
+            ..ColourSettings::default()
+        };
+        let template = template(layers, ambient, substrate, recipe, material_db)?;
+        let rows = target_rows(
+            &targets,
+            given,
+            given_name,
+            &angles,
+            weights.as_deref(),
+            &colorimeter,
+        )?;
+        let design = fit_color_cmd::design(&template, &rows, &colorimeter, &settings)?;
+        let recipes = (0..design.solutions.len())
+            .map(|k| {
+                fit_color_cmd::recipe_toml(
+                    &template,
+                    &design,
+                    k,
+                    &rows,
+                    &colorimeter,
+                    &targets_name,
+                )
+            })
+            .collect::<Result<Vec<_>>>()?;
+        // A row is named as its argument's: `lab[1]`.
+        let place = |r: &fit_color_cmd::TargetRow| format!("{given_name}[{}]", r.line - 1);
+        let summary = fit_color_cmd::describe(&template, &design, &rows, &place);
+        Ok((template, rows, design, recipes, summary))
+    });
+    let (template, rows, design, recipes, summary) = computed.map_err(bake_err)?;
+    let (k, n, p) = (design.solutions.len(), rows.len(), template.free().len());
+    let per_row = |f: &dyn Fn(&fit_color_cmd::Achieved) -> &Vec<[f64; 3]>| {
+        let flat: Vec<f64> = design
+            .solutions
+            .iter()
+            .flat_map(|s| f(s).iter().flatten().copied())
+            .collect();
+        Array3::from_shape_vec((k, n, 3), flat)
+            .expect("every solution has a colour per row")
+            .into_pyarray(py)
+    };
+    let rows_of = |f: &dyn Fn(&fit_color_cmd::TargetRow) -> [f64; 3]| {
+        let flat: Vec<f64> = rows.iter().flat_map(f).collect();
+        Array2::from_shape_vec((n, 3), flat)
+            .expect("three values per row")
+            .into_pyarray(py)
+    };
+    let flat_x: Vec<f64> = design.solutions.iter().flat_map(|s| s.x.clone()).collect();
+    let flat_e: Vec<f64> = design
+        .solutions
+        .iter()
+        .flat_map(|s| s.delta_e.clone())
+        .collect();
+    let d = PyDict::new(py);
+    d.set_item(
+        "params",
+        template.free().iter().map(param_name).collect::<Vec<_>>(),
+    )?;
+    d.set_item(
+        "x",
+        Array2::from_shape_vec((k, p), flat_x)
+            .expect("every solution has the template's parameters")
+            .into_pyarray(py),
+    )?;
+    d.set_item("colour", per_row(&|s| &s.colour))?;
+    d.set_item("lab", per_row(&|s| &s.lab))?;
+    d.set_item(
+        "delta_e",
+        Array2::from_shape_vec((k, n), flat_e)
+            .expect("every solution has a ΔE2000 per row")
+            .into_pyarray(py),
+    )?;
+    d.set_item(
+        "iterations",
+        design
+            .solutions
+            .iter()
+            .map(|s| s.iterations)
+            .collect::<Vec<_>>(),
+    )?;
+    d.set_item("target_lab", rows_of(&|r| r.lab))?;
+    d.set_item("target_colour", rows_of(&|r| r.colour))?;
+    d.set_item("samples", design.samples)?;
+    d.set_item("starts", design.starts)?;
+    d.set_item("reached_delta_e", nacre_optics::fit::color::REACHED_DELTA_E)?;
+    d.set_item("recipes", recipes)?;
+    d.set_item("summary", summary)?;
     Ok(d)
 }
 

@@ -29,6 +29,7 @@ fn _nacre(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(compute::bake, m)?)?;
     m.add_function(wrap_pyfunction!(compute::conformance, m)?)?;
     m.add_function(wrap_pyfunction!(fit::fit_spectrum, m)?)?;
+    m.add_function(wrap_pyfunction!(fit::fit_color, m)?)?;
     m.add_function(wrap_pyfunction!(fit::fit_gltf, m)?)?;
     m.add_function(wrap_pyfunction!(bundled_materials, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

@@ -109,6 +109,10 @@ COLOR_ANGLES = "0:85:5"
 # line). `{out}` is the output folder (for a second output file).
 FIT_MEASURED = "python/tests/fixtures/fit-measured.csv"
 FIT_WIDE = "python/tests/fixtures/fit-wide.csv"
+# `nacre fit color` targets: the linear sRGB look of 137 nm of TiO2 on BK7 at 0-60 degrees
+# as `nacre color` wrote it, and a CIELAB look with weights that no film on BK7 reaches.
+FIT_LOOK = "python/tests/fixtures/fit-color-look.csv"
+FIT_LOOK_LAB = "python/tests/fixtures/fit-color-look-lab.csv"
 FIT_CASES: Dict[str, List[str]] = {
     "fit-spectrum.toml": ["fit", "spectrum", FIT_MEASURED, "--layer", "sio2@10:2000", "--substrate", "si",
                           "--residuals", "{out}/fit-spectrum-residuals.csv"],
@@ -117,6 +121,11 @@ FIT_CASES: Dict[str, List[str]] = {
     "fit-spectrum-wide.csv": ["fit", "spectrum", FIT_WIDE, "--layer", "sio2@10:2000", "--substrate", "si", "--scale", "free"],
     "fit-gltf.json": ["fit", "gltf", "--ambient", "air", "--layer", "tio2@120", "--layer", "sio2@180", "--substrate", "bk7"],
     "fit-gltf-range.json": ["fit", "gltf", "--layer", "1.33@400", "--substrate", "1.5", "--thicknesses", "200:600"],
+    "fit-color.toml": ["fit", "color", FIT_LOOK, "--layer", "tio2@20:300", "--substrate", "bk7",
+                       "--report", "{out}/fit-color-report.csv"],
+    "fit-color-lab.toml": ["fit", "color", FIT_LOOK_LAB, "--layer", "1.3:2.4@20:300", "--substrate", "bk7",
+                           "--quantity", "r", "--illuminant", "d50", "--space", "rec2020", "--solutions", "2",
+                           "--distinct", "20", "--starts", "8", "--report", "{out}/fit-color-lab-report.csv"],
 }
 
 
@@ -165,7 +174,8 @@ def run_all(nacre: str, out: pathlib.Path) -> List[str]:
 
 def run_fit(nacre: str, out: pathlib.Path) -> List[str]:
     """Runs every `nacre fit` case, writing into `out`; returns the files written (the second
-    outputs too), and for `fit gltf` cases `NAME.txt` with the errors the command prints."""
+    outputs and further solutions too), and for `fit gltf` and `fit color` cases `NAME.txt`
+    with what the command prints (the errors; the designs' summary lines)."""
     out.mkdir(parents=True, exist_ok=True)
     files = []
     for name, args in FIT_CASES.items():
@@ -173,7 +183,11 @@ def run_fit(nacre: str, out: pathlib.Path) -> List[str]:
         stderr = _run(nacre, args, out / name)
         files.append(name)
         files += [pathlib.Path(a).name for a in args if a.startswith(str(out.resolve()))]
-        if args[1] == "gltf":
+        if args[1] == "color":
+            # Solutions 2, 3, … beside the first (NAME-2.toml, …), and the lines printed.
+            stem = name.rsplit(".", 1)[0]
+            files += sorted(p.name for p in out.glob(f"{stem}-[0-9]*.toml"))
+        if args[1] in ("gltf", "color"):
             txt = name.rsplit(".", 1)[0] + ".txt"
             (out / txt).write_text(stderr)
             files.append(txt)

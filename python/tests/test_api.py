@@ -230,7 +230,8 @@ def test_incoherent_layers_take_the_cli_syntax_or_a_flag():
         assert np.array_equal(a[key], b[key]), key
     # incoherent: no 2 mm fringes from one nanometre to the next
     assert np.ptp(a.R[0]) < 1e-3
-    coherent = nacre.spectrum(nacre.Stack("air", ["mgf2@99.75nm", "bk7@2mm", "mgf2@99.75"], "air"), 0, [500, 501, 502])
+    with pytest.warns(nacre.UndersamplingWarning, match=r"layer 2 \(`bk7`, 2000000 nm\) is coherent"):
+        coherent = nacre.spectrum(nacre.Stack("air", ["mgf2@99.75nm", "bk7@2mm", "mgf2@99.75"], "air"), 0, [500, 501, 502])
     assert np.ptp(coherent.R[0]) > 1e-2
     assert nacre.Stack(1.0, [(1.33, 400.0, False)], 1.0).incoherent == [False]
     with pytest.raises(nacre.NacreError, match=r"layers\[1\].*bk7@2mm:incoherant.*unknown suffix"):

@@ -304,7 +304,7 @@ fn color(args: &FitColorArgs) -> Result<()> {
         }
         None => None,
     };
-    for line in fit_color::describe(&template, &design, &rows) {
+    for line in fit_color::describe(&template, &design, &rows, &fit_color::file_line) {
         eprintln!("{line}");
     }
     let mut table = Vec::new();

@@ -75,6 +75,7 @@ pub fn run(args: &SpectrumArgs) -> Result<()> {
     let stack = spec.build()?;
     if args.jacobian {
         let (powers, jacobian) = spectrum::compute_jacobian(&stack, &angles, &wavelengths)?;
+        crate::error::warn(&stack.undersampled_films(&wavelengths));
         return Ok(write_atomic(&args.output, |w| {
             spectrum::write_csv_jacobian(w, &angles, &wavelengths, &powers, &jacobian)
         })?);

@@ -403,10 +403,22 @@ impl Stack {
     /// (λ₂ − λ₁)/Δm (≈ λ²/(2 Re ñ d) for fine fringes), is reported against the step. Such
     /// a film's spectrum aliases; a slab that thick should be marked incoherent. Films
     /// whose index is unknown somewhere on the grid are skipped (the sweep reports that).
+    ///
+    /// A constant-index film whose order at the shortest wavelength is at most
+    /// [`UNDERSAMPLED_MIN_ORDER`] is passed over without a walk of the grid (the order only
+    /// falls with λ), so the check costs one pass for the grid's minimum on thin stacks.
     pub fn undersampled_films(&self, wavelengths_nm: &[f64]) -> Vec<Undersampled> {
         let mut out = Vec::new();
+        let shortest_nm = wavelengths_nm.iter().copied().fold(f64::INFINITY, f64::min);
         for (j, layer) in self.layers.iter().enumerate() {
             if self.is_incoherent(j + 1) || layer.thickness_nm == 0.0 {
+                continue;
+            }
+            if layer.material.is_constant()
+                && layer.material.index_at(shortest_nm).is_ok_and(|n| {
+                    2.0 * n.re.abs() * layer.thickness_nm / shortest_nm <= UNDERSAMPLED_MIN_ORDER
+                })
+            {
                 continue;
             }
             let mut worst: Option<(f64, f64, f64)> = None;

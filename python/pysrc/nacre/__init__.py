@@ -9,7 +9,8 @@ computations as the ``nacre`` command line, returning arrays instead of CSV file
 * :func:`color` — XYZ and RGB by every method of ``nacre color``;
 * :class:`Table` — a baked table, its texels and the CPU lookup that reproduces a GPU's;
 * :func:`fit_spectrum` — a template's free thicknesses and indices fitted to measured
-  spectra (many in parallel); :func:`fit_gltf` — the closest glTF iridescence material;
+  spectra (many in parallel); :func:`fit_color` — a stack designed for target colours over
+  angles; :func:`fit_gltf` — the closest glTF iridescence material;
 * :func:`bake`, :func:`conformance`, :func:`materials`.
 
 Conventions (those of ``nacre spectrum``; Byrnes' ``tmm``): R = (R_s + R_p)/2, T is the
@@ -35,12 +36,13 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _nacre
 from ._nacre import MaterialError, NacreError, ParseError, Stack, TableError
-from ._fit import GltfFilm, GltfFit, SpectrumFit, fit_gltf, fit_spectrum
+from ._fit import ColourDesign, GltfFilm, GltfFit, SpectrumFit, fit_color, fit_gltf, fit_spectrum
 
 __version__: str = _nacre.__version__
 
 __all__ = [
     "Colour",
+    "ColourDesign",
     "GltfFilm",
     "GltfFit",
     "MaterialError",
@@ -51,9 +53,11 @@ __all__ = [
     "Stack",
     "Table",
     "TableError",
+    "UndersamplingWarning",
     "bake",
     "color",
     "conformance",
+    "fit_color",
     "fit_gltf",
     "fit_spectrum",
     "materials",
@@ -67,6 +71,21 @@ __all__ = [
 Material = Union[float, complex, str, "os.PathLike[str]"]
 
 FloatArray = NDArray[np.float64]
+
+
+class UndersamplingWarning(UserWarning):
+    """A coherent film whose interference fringes the wavelength sampling cannot follow (its
+    spectrum aliases): the warning ``nacre spectrum`` and ``nacre color`` print, with the
+    same text. A layer that thick adds its reflections in intensity: mark it incoherent
+    (``(material, thickness_nm, True)`` or ``"bk7@2mm:incoherent"``)."""
+
+
+def _warn(texts: Sequence[str]) -> None:
+    """Each library warning as an :class:`UndersamplingWarning` at the caller's caller."""
+    import warnings
+
+    for text in texts:
+        warnings.warn(text, UndersamplingWarning, stacklevel=3)
 
 
 def _axis(values: ArrayLike, name: str) -> FloatArray:
@@ -215,6 +234,11 @@ def spectrum(
     ``nacre spectrum``): :attr:`Spectrum.d_thickness`, shape (angles, wavelengths, films, 4)
     for ∂R_s, ∂R_p, ∂T_s, ∂T_p, and :attr:`Spectrum.dR_dd`, :attr:`Spectrum.dT_dd`, shape
     (angles, wavelengths, films), for the unpolarised R and T.
+
+    A coherent film far thicker than the wavelength grid can follow (its fringes finer than
+    the step, more than 20 orders thick) emits an :class:`UndersamplingWarning` with the
+    text ``nacre spectrum`` prints (not for a ``thickness_nm`` sweep); mark such a slab
+    incoherent.
     """
     a = _axis(angles_deg, "angles_deg")
     w = _axis(wavelengths_nm, "wavelengths_nm")
@@ -225,9 +249,11 @@ def spectrum(
         if d is not None:
             raise NacreError("jacobian=True: derivatives are by the stack's own thicknesses, "
                              "not with thickness_nm")
-        powers, d_thickness = _nacre.spectrum_jacobian(stack, a, w)
+        powers, d_thickness, warned = _nacre.spectrum_jacobian(stack, a, w)
+        _warn(warned)
         return Spectrum(a, w, None, powers, d_thickness)
-    powers = _nacre.spectrum(stack, a, w, d, int(layer))
+    powers, warned = _nacre.spectrum(stack, a, w, d, int(layer))
+    _warn(warned)
     return Spectrum(a, w, d, powers)
 
 
@@ -310,9 +336,10 @@ def color(
     table = None if fourier_table is None else os.fspath(fourier_table)
     if roughness is not None:
         roughness = float(roughness)
-    xyz, rgb, dd, nn, mc = _nacre.color(
+    xyz, rgb, dd, nn, mc, warned = _nacre.color(
         stack, a, d, n, method, quantity, observer, illuminant, space, roughness, table
     )
+    _warn(warned)
     return Colour(
         angle_deg=a.reshape(shape),
         thickness_nm=dd.reshape(shape),

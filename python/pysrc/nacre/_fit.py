@@ -1,5 +1,6 @@
-"""``fit_spectrum`` and ``fit_gltf``: the computations of ``nacre fit spectrum`` and
-``nacre fit gltf`` with numpy arrays (re-exported by :mod:`nacre`)."""
+"""``fit_spectrum``, ``fit_color`` and ``fit_gltf``: the computations of ``nacre fit
+spectrum``, ``nacre fit color`` and ``nacre fit gltf`` with numpy arrays (re-exported by
+:mod:`nacre`)."""
 
 from __future__ import annotations
 
@@ -260,6 +261,195 @@ def fit_spectrum(
         fitted=r["fitted"],
         warnings=[list(w) for w in r["warnings"]],
         recipe=list(r["recipes"]),
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class ColourDesign:
+    """The result of :func:`fit_color`: up to ``solutions`` distinct stacks, best first, each
+    with the colour it achieves at every target row and the CIEDE2000 to the target there.
+
+    The same numbers as ``nacre fit color`` (its recipes, ``--report`` rows and the lines it
+    prints): the achieved colours are recomputed by ``nacre color``'s ``spectral`` method on
+    the designed stack, so ``nacre.color(Stack.from_recipe(...), angles)`` shows them too."""
+
+    params: List[str]
+    """The free parameters, in the order of ``x``: ``layer1_thickness_nm``,
+    ``layer2_index``, … (films top first, a film's index before its thickness)."""
+    x: FloatArray
+    """The designed values, shape (solutions, params): thicknesses rounded to 0.001 nm and
+    indices to 10⁻⁵, as the recipe writes them."""
+    colour: FloatArray
+    """The achieved colour, linear in ``space`` (or XYZ), shape (solutions, rows, 3)."""
+    lab: FloatArray
+    """The achieved CIELAB under the illuminant, shape (solutions, rows, 3)."""
+    delta_e: FloatArray
+    """CIEDE2000 between target and achieved colour, shape (solutions, rows)."""
+    iterations: List[int]
+    """Levenberg–Marquardt iterations of each solution's polish."""
+    target_lab: FloatArray
+    """The targets in CIELAB, shape (rows, 3)."""
+    target_colour: FloatArray
+    """The targets as linear colours in ``space``, shape (rows, 3)."""
+    samples: int
+    """Samples of the global search over the bounds."""
+    starts: int
+    """Local polishes from the best samples."""
+    reached_delta_e: float
+    """A solution reaches the look when its largest ΔE2000 is at most this (1)."""
+    recipes: List[str]
+    """Each solution as the recipe ``nacre fit color -o FIT.toml`` writes (the designed stack
+    and a ``[fit]`` table); ``Stack.from_recipe`` reads it."""
+    summary: List[str]
+    """The lines ``nacre fit color`` prints, one per solution: its values, ΔE2000 mean and
+    max, and whether it reaches the look or how far the closest stack stays (at which row:
+    ``lab[1]`` where the command names the file's line)."""
+    weights: FloatArray
+    """The rows' weights."""
+
+    @property
+    def mean_delta_e(self) -> FloatArray:
+        """Per solution: the weighted mean ΔE2000 over the rows."""
+        return (self.delta_e @ self.weights) / self.weights.sum()  # type: ignore[no-any-return]
+
+    @property
+    def max_delta_e(self) -> FloatArray:
+        """Per solution: the largest ΔE2000 over the rows."""
+        return self.delta_e.max(axis=1)  # type: ignore[no-any-return]
+
+    @property
+    def reached(self) -> List[bool]:
+        """Per solution: whether every row is within ``reached_delta_e``."""
+        return [bool(m <= self.reached_delta_e) for m in self.max_delta_e]
+
+    def __getitem__(self, param: str) -> FloatArray:
+        """The designed value of a parameter by name, one per solution:
+        ``design["layer1_thickness_nm"]``."""
+        try:
+            k = self.params.index(param)
+        except ValueError:
+            raise KeyError(param) from None
+        return self.x[:, k]  # type: ignore[no-any-return]
+
+    def as_dict(self) -> Dict[str, Any]:
+        """The fields as a dict."""
+        return {f: getattr(self, f) for f in self.__dataclass_fields__}
+
+
+def _whole(v: Any, name: str) -> int:
+    if isinstance(v, bool) or not isinstance(v, (int, np.integer)):
+        raise NacreError(f"{name}: expected a whole number, got {v!r}")
+    return int(v)
+
+
+def fit_color(
+    angles_deg: ArrayLike,
+    layers: Optional[Sequence[TemplateLayer]] = None,
+    *,
+    rgb: Optional[ArrayLike] = None,
+    xyz: Optional[ArrayLike] = None,
+    lab: Optional[ArrayLike] = None,
+    weights: Optional[ArrayLike] = None,
+    ambient: Any = None,
+    substrate: Any = None,
+    recipe: Optional[Union[str, "os.PathLike[str]"]] = None,
+    quantity: str = "r",
+    observer: Optional[str] = None,
+    illuminant: Optional[str] = None,
+    space: Optional[str] = None,
+    solutions: int = 1,
+    distinct_nm: float = 10.0,
+    starts: int = 16,
+    material_db: Optional[Union[str, "os.PathLike[str]"]] = None,
+    targets_name: str = "targets",
+) -> ColourDesign:
+    """Designs a stack's free thicknesses and indices for target colours seen at angles,
+    globally over the bounds: ``nacre fit color``.
+
+    The targets, one row per angle of ``angles_deg`` (incidence in the ambient, degrees),
+    given as exactly one of ``rgb`` (linear R, G, B in ``space``, as :func:`color` returns
+    them in ``Colour.rgb``), ``xyz`` (under the illuminant, perfect reflector Y = 1) or
+    ``lab`` (CIELAB under the illuminant), each of shape (rows, 3); ``weights`` (> 0, one
+    per row, default 1). ``quantity``: the reflected (``"r"``) or transmitted (``"t"``)
+    colour. ``observer`` (``"1931"``, ``"1964"``), ``illuminant`` (``"d65"``, ``"d50"``,
+    ``"a"``, ``"e"``) and ``space`` (``"srgb"``, ``"rec2020"``, ``"p3"``, ``"acescg"``,
+    ``"xyz"``) as in :func:`color` (default 1931, d65, srgb).
+
+    The template as in :func:`fit_spectrum`: ``layers`` with ranges for the free values
+    (``"tio2@20:300"``, ``("sio2", (20, 300))``, ``((1.3, 1.7), (100, 600))``), ``ambient``
+    and ``substrate``, or a template ``recipe``.
+
+    The objective is the weighted sum of squared CIEDE2000 over the rows; the search samples
+    the whole box and polishes the ``starts`` best samples with Levenberg–Marquardt on the
+    exact ΔE2000 gradient. ``solutions``: up to K (1–100) distinct stacks, best first (two
+    differ when a free thickness differs by more than ``distinct_nm``). A look out of reach
+    still gets its closest stack; ``ColourDesign.summary`` says how far it stays. The GIL is
+    released while it runs. ``targets_name`` is what the recipes name the targets (the
+    command names the file).
+    """
+    given = [(k, v) for k, v in (("rgb", rgb), ("xyz", xyz), ("lab", lab)) if v is not None]
+    if len(given) != 1:
+        raise NacreError(
+            "rgb, xyz, lab: give the target colours as exactly one of them, "
+            f"got {', '.join(k for k, _ in given) or 'none'}"
+        )
+    kind, values = given[0]
+    t = np.asarray(values, dtype=np.float64)
+    if t.ndim == 1 and t.shape[0] == 3:
+        t = t.reshape(1, 3)
+    if t.ndim != 2 or t.shape[1] != 3:
+        raise NacreError(f"{kind}: expected one colour of three values per row, shape (rows, 3), got shape {t.shape}")
+    a = np.asarray(angles_deg, dtype=np.float64)
+    if a.ndim == 0:
+        a = np.full(t.shape[0], float(a))
+    if a.ndim != 1:
+        raise NacreError(f"angles_deg: expected a number or a 1-D sequence, got shape {a.shape}")
+    w = None if weights is None else np.ascontiguousarray(np.asarray(weights, dtype=np.float64).reshape(-1))
+    if recipe is not None and (layers is not None or ambient is not None or substrate is not None):
+        raise NacreError("recipe: give either a template recipe or layers/ambient/substrate, not both")
+    texts = None if layers is None else [_layer_text(i, l) for i, l in enumerate(layers)]
+    amb = None if ambient is None else _material_text(ambient, "ambient")
+    sub = None if substrate is None else _material_text(substrate, "substrate")
+    n_solutions = _whole(solutions, "solutions")
+    if n_solutions < 0:
+        raise NacreError(f"solutions `{n_solutions}`: expected 1 to 100 stacks")
+    n_starts = _whole(starts, "starts")
+    if isinstance(distinct_nm, bool) or not isinstance(distinct_nm, numbers.Real):
+        raise NacreError(f"distinct_nm: expected a thickness in nm, got {distinct_nm!r}")
+    r = _nacre.fit_color(
+        np.ascontiguousarray(t),
+        kind,
+        np.ascontiguousarray(a),
+        w,
+        texts,
+        amb,
+        sub,
+        None if recipe is None else os.fspath(recipe),
+        None if material_db is None else os.fspath(material_db),
+        quantity,
+        observer,
+        illuminant,
+        space,
+        n_solutions,
+        float(distinct_nm),
+        max(n_starts, 0),
+        str(targets_name),
+    )
+    return ColourDesign(
+        params=list(r["params"]),
+        x=r["x"],
+        colour=r["colour"],
+        lab=r["lab"],
+        delta_e=r["delta_e"],
+        iterations=list(r["iterations"]),
+        target_lab=r["target_lab"],
+        target_colour=r["target_colour"],
+        samples=int(r["samples"]),
+        starts=int(r["starts"]),
+        reached_delta_e=float(r["reached_delta_e"]),
+        recipes=list(r["recipes"]),
+        summary=list(r["summary"]),
+        weights=np.ones(t.shape[0]) if w is None else w,
     )
 
 

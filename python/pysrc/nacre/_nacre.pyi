@@ -70,12 +70,12 @@ def spectrum(
     wavelengths_nm: NDArray[np.float64],
     thickness_nm: Optional[NDArray[np.float64]] = None,
     layer: int = 1,
-) -> NDArray[np.float64]: ...
+) -> Tuple[NDArray[np.float64], List[str]]: ...
 def spectrum_jacobian(
     stack: Stack,
     angles_deg: NDArray[np.float64],
     wavelengths_nm: NDArray[np.float64],
-) -> Tuple[NDArray[np.float64], NDArray[np.float64]]: ...
+) -> Tuple[NDArray[np.float64], NDArray[np.float64], List[str]]: ...
 def unpolarised(
     powers: NDArray[np.float64],
 ) -> List[NDArray[np.float64]]: ...
@@ -97,6 +97,7 @@ def color(
     NDArray[np.float64],
     NDArray[np.float64],
     Optional[Tuple[int, float]],
+    List[str],
 ]: ...
 def bake(recipes: Sequence[str], out_dir: str) -> List[str]: ...
 def conformance(grid: str = "default") -> Dict[str, Any]: ...
@@ -118,5 +119,24 @@ def fit_spectrum(
     loss: str,
     starts: int,
     names: List[str],
+) -> Dict[str, Any]: ...
+def fit_color(
+    targets: NDArray[np.float64],
+    given: str,
+    angles_deg: NDArray[np.float64],
+    weights: Optional[NDArray[np.float64]],
+    layers: Optional[List[str]],
+    ambient: Optional[str],
+    substrate: Optional[str],
+    recipe: Optional[str],
+    material_db: Optional[str],
+    quantity: str,
+    observer: Optional[str],
+    illuminant: Optional[str],
+    space: Optional[str],
+    solutions: int,
+    distinct_nm: float,
+    starts: int,
+    targets_name: str,
 ) -> Dict[str, Any]: ...
 def fit_gltf(stack: Stack, thicknesses: Optional[str] = None) -> Dict[str, Any]: ...

@@ -43,6 +43,85 @@ pub struct TargetRow {
     pub weight: f64,
 }
 
+/// How a target's colour is given.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Given {
+    /// Linear R, G, B in the colorimeter's output space (as `nacre color` writes them).
+    Rgb,
+    /// CIE XYZ under the illuminant (perfect reflector Y = 1).
+    Xyz,
+    /// CIELAB under the illuminant.
+    Lab,
+}
+
+/// A target row's value outside what it may hold: `{field} {value} {requirement}`
+/// (`angle_deg 90 must lie strictly between -90 and 90`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BadTarget {
+    /// `angle_deg`, `weight` or `L`.
+    pub field: &'static str,
+    /// The value given.
+    pub value: f64,
+    /// What it must be.
+    pub requirement: &'static str,
+}
+
+impl std::fmt::Display for BadTarget {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} {} {}", self.field, self.value, self.requirement)
+    }
+}
+
+/// One target row from finite numbers: the angle (strictly inside ±90°), the colour `v` as
+/// `given` (L of CIELAB in 0–100) and the weight (> 0), with its CIELAB and output-space
+/// colour under `colorimeter`. The one conversion of the targets file and of Python's
+/// `nacre.fit_color` arrays.
+pub fn target_row(
+    line: usize,
+    angle_deg: f64,
+    given: Given,
+    v: [f64; 3],
+    weight: f64,
+    colorimeter: &Colorimeter,
+) -> std::result::Result<TargetRow, BadTarget> {
+    if !(angle_deg > -90.0 && angle_deg < 90.0) {
+        return Err(BadTarget {
+            field: "angle_deg",
+            value: angle_deg,
+            requirement: "must lie strictly between -90 and 90",
+        });
+    }
+    if weight <= 0.0 {
+        return Err(BadTarget {
+            field: "weight",
+            value: weight,
+            requirement: "must be positive",
+        });
+    }
+    let white = colorimeter.white_xyz();
+    let (lab, colour) = match given {
+        Given::Rgb => (xyz_to_lab(colorimeter.xyz_from_output(v), white), v),
+        Given::Xyz => (xyz_to_lab(v, white), colorimeter.output_from_xyz(v)),
+        Given::Lab => {
+            if !(0.0..=100.0).contains(&v[0]) {
+                return Err(BadTarget {
+                    field: "L",
+                    value: v[0],
+                    requirement: "must lie in 0–100",
+                });
+            }
+            (v, colorimeter.output_from_xyz(lab_to_xyz(v, white)))
+        }
+    };
+    Ok(TargetRow {
+        line,
+        angle_deg,
+        lab,
+        colour,
+        weight,
+    })
+}
+
 /// Reads the targets of `path` for `colorimeter` (see the module docs).
 pub fn read_targets(path: &Path, colorimeter: &Colorimeter) -> Result<Vec<TargetRow>> {
     let text = std::fs::read_to_string(path).map_err(|source| nacre_format::Error::Io {
@@ -103,12 +182,6 @@ pub fn parse_targets(path: &Path, text: &str, colorimeter: &Colorimeter) -> Resu
         (Some(x), Some(y), Some(z)) => Some([x, y, z]),
         _ => None,
     };
-    #[derive(Clone, Copy)]
-    enum Given {
-        Rgb,
-        Xyz,
-        Lab,
-    }
     let (given, cols) = match (
         triple("R", "G", "B"),
         triple("X", "Y", "Z"),
@@ -127,7 +200,6 @@ pub fn parse_targets(path: &Path, text: &str, colorimeter: &Colorimeter) -> Resu
             ));
         }
     };
-    let white = colorimeter.white_xyz();
     let mut out = Vec::new();
     for row in rows {
         let row = row?;
@@ -153,38 +225,14 @@ pub fn parse_targets(path: &Path, text: &str, colorimeter: &Colorimeter) -> Resu
             }
         };
         let angle_deg = num(angle)?;
-        if !(angle_deg > -90.0 && angle_deg < 90.0) {
-            return Err(at(
-                row.line,
-                format!("angle_deg {angle_deg} must lie strictly between -90 and 90"),
-            ));
-        }
         let w = match weight {
             Some(i) => num(i)?,
             None => 1.0,
         };
-        if w <= 0.0 {
-            return Err(at(row.line, format!("weight {w} must be positive")));
-        }
         let v = [num(cols[0])?, num(cols[1])?, num(cols[2])?];
-        let (lab, colour) = match given {
-            Given::Rgb => (xyz_to_lab(colorimeter.xyz_from_output(v), white), v),
-            Given::Xyz => (xyz_to_lab(v, white), colorimeter.output_from_xyz(v)),
-            Given::Lab => {
-                if !(0.0..=100.0).contains(&v[0]) {
-                    return Err(at(row.line, format!("L {} must lie in 0–100", v[0])));
-                }
-                let xyz = lab_to_xyz(v, white);
-                (v, colorimeter.output_from_xyz(xyz))
-            }
-        };
-        out.push(TargetRow {
-            line: row.line,
-            angle_deg,
-            lab,
-            colour,
-            weight: w,
-        });
+        let target = target_row(row.line, angle_deg, given, v, w, colorimeter)
+            .map_err(|bad| at(row.line, bad.to_string()))?;
+        out.push(target);
     }
     if out.is_empty() {
         return Err(at(header_line, "no target rows below the header".into()));
@@ -479,8 +527,14 @@ pub fn report_csv(
 }
 
 /// One line per solution for standard error: its free values and ΔE2000, and whether it
-/// reaches the look.
-pub fn describe(template: &FitTemplate, design: &Design, rows: &[TargetRow]) -> Vec<String> {
+/// reaches the look (if not, the worst row named by `place`: `line 4` for the targets
+/// file, [`file_line`]).
+pub fn describe(
+    template: &FitTemplate,
+    design: &Design,
+    rows: &[TargetRow],
+    place: &dyn Fn(&TargetRow) -> String,
+) -> Vec<String> {
     design
         .solutions
         .iter()
@@ -504,8 +558,10 @@ pub fn describe(template: &FitTemplate, design: &Design, rows: &[TargetRow]) -> 
                 "reached".to_string()
             } else {
                 format!(
-                    "not reached: the closest stack stays ΔE2000 {:.2} away at {}° (line {})",
-                    worst.1, rows[worst.0].angle_deg, rows[worst.0].line
+                    "not reached: the closest stack stays ΔE2000 {:.2} away at {}° ({})",
+                    worst.1,
+                    rows[worst.0].angle_deg,
+                    place(&rows[worst.0])
                 )
             };
             format!(
@@ -517,6 +573,11 @@ pub fn describe(template: &FitTemplate, design: &Design, rows: &[TargetRow]) -> 
             )
         })
         .collect()
+}
+
+/// A target row's place in its file: `line 4`.
+pub fn file_line(row: &TargetRow) -> String {
+    format!("line {}", row.line)
 }
 
 /// The picture of a design: per target row, the target swatch over each solution's, as
