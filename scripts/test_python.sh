@@ -36,8 +36,12 @@ export NACRE_REQUIRE_MITSUBA=1
 # bookworm's 14/15 (their instruction selection lacks fminimum: "LLVM ERROR: Cannot select");
 # the Rust toolchain's libLLVM (22 with Rust 1.95) serves, unless DRJIT_LIBLLVM_PATH is set.
 if [ -z "${DRJIT_LIBLLVM_PATH:-}" ]; then
-    for lib in "$(rustc --print sysroot)"/lib/libLLVM*.so*; do
-        if [ -f "$lib" ]; then export DRJIT_LIBLLVM_PATH="$lib"; break; fi
+    # Only a real shared object: the toolchain's libLLVM-*.so beside it is a 42-byte linker
+    # script (INPUT(...)) that dlopen refuses.
+    for lib in "$(rustc --print sysroot)"/lib/libLLVM.so.* "$(rustc --print sysroot)"/lib/libLLVM*.so*; do
+        if [ -f "$lib" ] && [ "$(head -c 4 "$lib" | tail -c 3)" = "ELF" ]; then
+            export DRJIT_LIBLLVM_PATH="$lib"; break
+        fi
     done
 fi
 installed=$(date +%s)
