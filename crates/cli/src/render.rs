@@ -172,33 +172,36 @@ pub struct RenderArgs {
 /// coherent amplitudes at a few wavelengths and the other techniques draw their tables'
 /// film, so rendering it with them would be silently wrong.
 fn refuse_slabs(spec: &StackSpec, args: &StackArgs) -> Result<()> {
-    let Some(j) = spec.incoherent.iter().position(|&i| i) else {
-        return Ok(());
-    };
-    let (material, thickness_nm) = &spec.layers[j];
-    let value = match args.layers.get(j) {
-        Some(text) if args.recipe.is_none() => text.clone(),
-        _ => format!("{}@{}nm:incoherent", material.spec, thickness_nm),
-    };
-    Err(nacre_bake::Error::value(
-        material.context.clone(),
-        value,
+    refuse_slab(spec, args, 0, |j| {
         format!(
-            "layer {} is incoherent: only `--technique glass` draws an incoherent slab (the stack technique sums coherent amplitudes; the table techniques draw one film)",
-            j + 1
-        ),
-    )
-    .into())
+            "layer {j} is incoherent: only `--technique glass` draws an incoherent slab (the stack technique sums coherent amplitudes; the table techniques draw one film)"
+        )
+    })
 }
 
 /// Refuses a second incoherent layer for `--technique glass` (one pane: films, a slab, films).
 fn refuse_second_slab(spec: &StackSpec, args: &StackArgs) -> Result<()> {
+    refuse_slab(spec, args, 1, |j| {
+        format!(
+            "layer {j} is a second incoherent slab: the glass technique draws one slab (films, one slab, films); compute a stack of several with `nacre color --method spectral`"
+        )
+    })
+}
+
+/// The error naming the stack's `nth` incoherent layer (0: the first) as the user wrote it,
+/// `why(layer number, 1-based)` its reason; none when the stack has no such layer.
+fn refuse_slab(
+    spec: &StackSpec,
+    args: &StackArgs,
+    nth: usize,
+    why: impl Fn(usize) -> String,
+) -> Result<()> {
     let Some(j) = spec
         .incoherent
         .iter()
         .enumerate()
         .filter(|(_, i)| **i)
-        .nth(1)
+        .nth(nth)
         .map(|(j, _)| j)
     else {
         return Ok(());
@@ -208,15 +211,7 @@ fn refuse_second_slab(spec: &StackSpec, args: &StackArgs) -> Result<()> {
         Some(text) if args.recipe.is_none() => text.clone(),
         _ => format!("{}@{}nm:incoherent", material.spec, thickness_nm),
     };
-    Err(nacre_bake::Error::value(
-        material.context.clone(),
-        value,
-        format!(
-            "layer {} is a second incoherent slab: the glass technique draws one slab (films, one slab, films); compute a stack of several with `nacre color --method spectral`",
-            j + 1
-        ),
-    )
-    .into())
+    Err(nacre_bake::Error::value(material.context.clone(), value, why(j + 1)).into())
 }
 
 pub fn run(args: &RenderArgs) -> Result<()> {

@@ -333,27 +333,5 @@ impl View {
 /// tone mapping and the sRGB transfer function (`shaders/output.wgsl`), as 8-bit values.
 pub fn uniform_sky_pixel(rgb: [f64; 3], roughness_alpha: f64) -> [u8; 3] {
     let scale = (1.0 - 0.55 * roughness_alpha.sqrt()).clamp(0.0, 1.0);
-    let mut c = rgb.map(|v| v.max(0.0) * scale);
-    let start_compression = 0.8 - 0.04;
-    let desaturation = 0.15;
-    let x = c[0].min(c[1]).min(c[2]);
-    let offset = if x < 0.08 { x - 6.25 * x * x } else { 0.04 };
-    c = c.map(|v| v - offset);
-    let peak = c[0].max(c[1]).max(c[2]);
-    if peak >= start_compression {
-        let d = 1.0 - start_compression;
-        let new_peak = 1.0 - d * d / (peak + d - start_compression);
-        c = c.map(|v| v * new_peak / peak);
-        let g = 1.0 - 1.0 / (desaturation * (peak - new_peak) + 1.0);
-        c = c.map(|v| v + (new_peak - v) * g);
-    }
-    c.map(|v| {
-        let v = v.clamp(0.0, 1.0);
-        let e = if v <= 0.003_130_8 {
-            12.92 * v
-        } else {
-            1.055 * v.powf(1.0 / 2.4) - 0.055
-        };
-        (e * 255.0).round() as u8
-    })
+    nacre_runtime::rough_reference::display_colour(rgb.map(|v| v.max(0.0) * scale))
 }
