@@ -95,7 +95,7 @@ GL_TESTS=(
     # crates/runtime/tests (diffraction: 18 s on GL here)
     diffraction diffraction_integrated gltf gltf_basisu gltf_samples ktx2_load lost_device render rough
     # tests/tests
-    engine_shaders_gpu gpu_probe
+    engine_shaders_gpu gpu_probe grating_equation
     # crates/cli/tests that render (gltf_sweep: the 48 Khronos samples under ../shared, one
     # `nacre render` child each; 38 s on GL here)
     bad_input cli gltf_sweep render_rough
