@@ -462,12 +462,17 @@ fn sweep_matches_points_with_dispersion() {
     assert!(worst <= 1e-12, "kernel against scalar: {worst:e}");
 }
 
-/// The smallest row scale of [`kernel_error`], per nm: where every derivative of an output
-/// vanishes (R = 1 under total internal reflection into a lossless stack), both sweeps
-/// return rounding noise of order ε k₀ |q| |N| (up to ~10⁻¹⁶ per nm behind an evanescent
-/// film), so 10⁻¹² of it is an absolute 10⁻¹⁵ per nm there (the dual-number check allows
-/// 10⁻¹³, [`FLOOR`] × [`TOL`]).
-const KERNEL_FLOOR: f64 = 1e-3;
+/// The smallest row scale of [`kernel_error`], per nm: the size of a thickness derivative
+/// where it does not vanish (R and T swing by O(1) over a fringe of 2π/(2 k₀ n) nm, so their
+/// slopes reach ~2 k₀ n ≈ 0.03–0.1 per nm over 380–780 nm). Where every derivative of an
+/// output vanishes (R = 1 under total internal reflection into a lossless stack, or R = 1 −
+/// 10⁻⁹ under frustrated total internal reflection through deep evanescent films) both
+/// sweeps return rounding noise: the forward R itself is good only to ~10⁻¹¹ there (central
+/// differences with steps of 10⁻² and 5 × 10⁻³ nm disagree at 10⁻⁹ per nm), and the two
+/// sweeps' derivatives, 5 × 10⁻⁸ per nm each, differ by 2 × 10⁻⁹. Measured against this
+/// floor, such rows are held to what the arithmetic can give, not to a relative error of a
+/// quantity that is itself noise.
+const KERNEL_FLOOR: f64 = 0.1;
 
 /// The largest difference between the kernel's thickness derivatives and `scalar`'s (same
 /// layout), relative to the largest |derivative| of the same output and element over the
@@ -496,10 +501,13 @@ proptest! {
     /// (`point_jacobian`, itself checked against dual numbers and finite differences above)
     /// over random stacks: absorbing films and substrates, up to 9 films, normal to grazing
     /// incidence, total internal reflection; its powers are `Stack::sweep`'s, bit for bit,
-    /// and its bits do not depend on the thread count. Over 1000 cases the relative
-    /// difference was 3.6 × 10⁻¹⁵ (median), 1.8 × 10⁻¹⁴ (90 %), 7 × 10⁻¹³ (99 %) and at worst
-    /// 7 × 10⁻¹²: frustrated total internal reflection through several evanescent films,
-    /// whose growing and decaying waves cancel (both sweeps round there); held to 10⁻¹¹.
+    /// and its bits do not depend on the thread count. Over 300 000 random cases (this
+    /// strategy, [`kernel_error`] with the floor above) the worst difference was 3 × 10⁻⁸
+    /// and fewer than 1 in 10⁵ exceeded 10⁻⁹: every one frustrated total internal reflection
+    /// through lossless films 4–18 evanescent decay lengths deep, where the forward R is
+    /// 1 − 10⁻⁹ and both sweeps round (see [`KERNEL_FLOOR`]); the next worst were below 10⁻⁹.
+    /// Held to 10⁻⁹: a wrong term in the kernel is an O(1) difference. (An earlier floor of
+    /// 10⁻³ per nm held such rows to 10⁻¹⁴ per nm absolute, and CI drew one at 2 × 10⁻¹⁰.)
     #[test]
     fn kernel_jacobian_matches_the_scalar_one(
         n0 in 1.0..2.0f64,
@@ -519,7 +527,7 @@ proptest! {
             sweep_jacobian(&stack, &angles, &wavelengths, Wrt::ThicknessAndIndex).unwrap();
         prop_assert_eq!(&kernel.power, &stack.sweep(&angles, &wavelengths).unwrap());
         let worst = kernel_error(&kernel, &scalar.d_thickness);
-        prop_assert!(worst <= 1e-11, "kernel against scalar: {:e}", worst);
+        prop_assert!(worst <= 1e-9, "kernel against scalar: {:e}", worst);
         let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
         let serial =
             one.install(|| sweep_jacobian(&stack, &angles, &wavelengths, Wrt::Thickness).unwrap());
