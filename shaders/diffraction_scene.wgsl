@@ -13,8 +13,9 @@
 //
 // Radiance leaving a grating point towards the eye:
 //
-//   L = Σ_k I_k · Σ_λ ρ(F ω_k, F ω_r, λ) u(λ)              light + environment samples
+//   L = Σ_k I_k · Σ_λ ρ(F ω_k, F ω_r, λ) u(λ)              light (+ environment samples)
 //     + L_env(reflect(−ω_r, n)) ⊙ Σ_λ F² |P_DC(k w)|² u(λ)  the specular order of the environment
+//     + Σ_λ u(λ) ⊙ Σ_c F² G/w² η_c(k w_c) L_env(ω_c(λ))     the environment through the lobes
 //     + base (snake skin only: a dark diffuse layer, albedo × (n·ω_0 E_0 + ambient))
 //
 // I_k = E_k · (σ_s k₀)²/π is the radiance of source k's mirror image spread over the
@@ -22,13 +23,18 @@
 // CPU, `nacre_runtime::diffraction::lobe_gain`): a flat mirror's lobe |P̃|² integrates to
 // π/(σ_s k)² over (u, v), so ρ · I is the reflected radiance (Stam's k² included at 555 nm).
 //
-// The environment enters twice, as a documented approximation: its mirror image through the
-// zeroth order (exact for an extended source: the order keeps |P_DC|² of the radiance), and
-// the K brightest texels of a 32 × 16 downsampled copy as directional samples
-// (`DiffractionLights.samples`, chosen on the CPU at least 25° apart above the horizon, each
-// with E_k = L_texel · Ω_texel) whose diffracted orders are evaluated like the light's:
-// extended sources are thus diffracted as if they were points (thin rainbow lines, with the
-// right total power, instead of wide smeared bands).
+// The environment enters through its mirror image in the zeroth order (exact for an extended
+// source: the order keeps |P_DC|² of the radiance) and, with a "terms" table, through the
+// table's lobes c (`nacre_runtime::diffraction::lobes`, which derives it): the integral
+// ∫ L_env ρ (σ_s k)²/π du dv of Stam's BRDF against the whole environment, per wavelength a
+// sum over the lobes of F² G/w² η_c(kw) times the environment averaged over the lobe, read
+// where the grating equation puts it (ω_c,t = −ω_r,t − κ_c/k) from the environment's mip
+// chain at the level of the lobe's angular size (`scene_env_diffracted`). Otherwise
+// (an "integrated" table, which keeps no bins, or `--env-samples K`) the K brightest texels
+// of a 32 × 16 downsampled copy are directional samples (`DiffractionLights.samples`,
+// chosen on the CPU at least 25° apart above the horizon, each with E_k = L_texel · Ω_texel)
+// diffracted like the light: extended sources as if they were points (thin rainbow lines
+// instead of wide bands).
 //
 // Scenes (ViewParams.scene):
 //   0 cd-disc     an annulus in the plane y = 0 centred at the origin: a clear hub
@@ -56,25 +62,38 @@
 // irradiance at normal incidence, and view.scene = 0 cd-disc, 1 snake-skin, 2 bench,
 // 3 grating-plane.
 //
-// Group 2, the lights as the gratings see them (272 bytes, uniform;
-// `nacre_runtime::diffraction::DiffractionLightsUniform` mirrors it):
+// Group 2, the lights as the gratings see them (binding 0: 288 bytes, uniform;
+// `nacre_runtime::diffraction::DiffractionLightsUniform` mirrors it; bindings 1–3:
+// `nacre_runtime::diffraction::LobeData`):
 //
 //   offset size field
 //        0    4 light_radiance: f32         I_0 = E_0 (σ_s k₀)²/π
 //        4    4 sample_count: u32           environment samples used (≤ 8)
-//        8    8 _pad0, _pad1: f32
+//        8    4 lobe_count: u32             environment lobes (0: none)
+//       12    4 lobe_wavelength_count: u32  wavelengths of lobe_spectrum
 //       16  128 samples: array<vec4<f32>, 8>          direction xyz (unit), w unused
 //      144  128 sample_radiance: array<vec4<f32>, 8>  I_k rgb (× env_intensity on the CPU)
+//      272   16 lobe_kw: vec4<f32>          (kw_min, samples per unit kw, Δλ µm, 0)
 struct DiffractionLights {
     light_radiance: f32,
     sample_count: u32,
-    _pad0: f32,
-    _pad1: f32,
+    lobe_count: u32,
+    lobe_wavelength_count: u32,
     samples: array<vec4<f32>, 8>,
     sample_radiance: array<vec4<f32>, 8>,
+    lobe_kw: vec4<f32>,
 }
 
 @group(2) @binding(0) var<uniform> lights: DiffractionLights;
+// Per lobe (κ_x, κ_y rad/µm in the grating frame, variance per axis of q (rad/µm)², 0).
+@group(2) @binding(1) var<storage, read> lobes: array<vec4<f32>>;
+// η_c(kw) at SCENE_LOBE_SAMPLES points per lobe, kw = kw_min … 0.
+@group(2) @binding(2) var<storage, read> lobe_efficiency: array<f32>;
+// (λ nm, u_R, u_G, u_B) per wavelength of the lobe sum.
+@group(2) @binding(3) var<storage, read> lobe_spectrum: array<vec4<f32>>;
+
+// Efficiency samples per lobe (`nacre_runtime::diffraction::lobes::LOBE_KW_SAMPLES`).
+const SCENE_LOBE_SAMPLES: u32 = 64u;
 
 const SCENE_PI: f32 = 3.14159265358979;
 
@@ -215,6 +234,60 @@ fn snake_skin(origin: vec3<f32>, dir: vec3<f32>) -> Surface {
     return s;
 }
 
+// η_c(kw) of lobe `l`, linear between its samples (clamped to its range; 0 past the buffer).
+fn scene_lobe_efficiency(l: u32, kw: f32) -> f32 {
+    let x = clamp((kw - lights.lobe_kw.x) * lights.lobe_kw.y, 0.0, f32(SCENE_LOBE_SAMPLES - 1u));
+    let i = min(u32(floor(x)), SCENE_LOBE_SAMPLES - 2u);
+    let base = l * SCENE_LOBE_SAMPLES + i;
+    if base + 1u >= arrayLength(&lobe_efficiency) || !diffraction_finite(x) {
+        return 0.0;
+    }
+    return mix(lobe_efficiency[base], lobe_efficiency[base + 1u], x - f32(i));
+}
+
+// The environment diffracted towards ω_r (grating frame, unit) through the lobes (header):
+// Σ_λ u(λ) ⊙ Σ_c F²(θ_h) G/w² η_c(k w) L_env(ω_c), ω_c,t = −ω_r,t − κ_c/k. A lobe of
+// variance σ_q² per axis spans σ_q/k in (u, v), and the band of one wavelength step Δλ
+// sweeps it by |κ_c| Δλ/2π (a uniform spread, variance /12); divided by cos θ_c that is its
+// angular size σ, read at the mip level log₂(2.5 σ/texel₀) of the environment's box chain.
+fn scene_env_diffracted(frame: mat3x3<f32>, wr: vec3<f32>) -> vec3<f32> {
+    let count = min(lights.lobe_count, arrayLength(&lobes));
+    let wavelengths = min(lights.lobe_wavelength_count, arrayLength(&lobe_spectrum));
+    if count == 0u || wavelengths == 0u || !(wr.z > 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let texel = SCENE_PI / f32(max(textureDimensions(env_map, 0).y, 1u));
+    let to_world = transpose(frame);
+    var sum = vec3<f32>(0.0);
+    for (var i = 0u; i < wavelengths; i++) {
+        let s = lobe_spectrum[i];
+        let k = 2.0 * SCENE_PI / (s.x * 1e-3);
+        var band = vec3<f32>(0.0);
+        for (var l = 0u; l < count; l++) {
+            let lobe = lobes[l];
+            let t = -wr.xy - lobe.xy / k;
+            let t2 = dot(t, t);
+            if !(t2 < 1.0) {
+                continue;
+            }
+            let wi = vec3<f32>(t, sqrt(1.0 - t2));
+            let g = diffraction_geometry_over_w2(wi, wr);
+            if !(g > 0.0) {
+                continue;
+            }
+            let uvw = -wi - wr;
+            let cos_h = -dot(wi, uvw) * inverseSqrt(dot(uvw, uvw));
+            let eta = scene_lobe_efficiency(l, k * uvw.z);
+            let sweep = length(lobe.xy) * lights.lobe_kw.z / (2.0 * SCENE_PI);
+            let sigma = sqrt(lobe.z / (k * k) + sweep * sweep / 12.0) / max(wi.z, 0.05);
+            let lod = clamp(log2(max(2.5 * sigma / texel, 1.0)), 0.0, view.env_lod_max);
+            band += (diffraction_fresnel(cos_h) * g * eta) * scene_env(to_world * wi, lod);
+        }
+        sum += band * s.yzw;
+    }
+    return select(vec3<f32>(0.0), sum, diffraction_finite3(sum));
+}
+
 // World direction into the grating frame of the surface.
 fn scene_shade(s: Surface, to_eye: vec3<f32>) -> vec3<f32> {
     let frame = diffraction_frame(s.normal, s.across);
@@ -228,6 +301,7 @@ fn scene_shade(s: Surface, to_eye: vec3<f32>) -> vec3<f32> {
         for (var k = 0u; k < count; k++) {
             diffracted += diffraction_colour(frame * lights.samples[k].xyz, wr) * lights.sample_radiance[k].rgb;
         }
+        diffracted += scene_env_diffracted(frame, wr);
         radiance += s.grating * diffracted;
     }
     // The environment through the specular order (the clear parts: a plain mirror, F² only).

@@ -64,7 +64,7 @@ fn lit_pixels(
     }
     (options.width, options.height) = (width, height);
     options.env_intensity = 0.0;
-    options.env_samples = 0;
+    options.env_samples = Some(0);
     options.technique.wavelength_step_nm = None;
     let image = render_diffraction_scene(ctx(), table, &options).unwrap();
     let out = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!(

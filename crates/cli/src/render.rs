@@ -159,9 +159,12 @@ pub struct RenderArgs {
     /// (an integrated table's sum is fixed at bake time) [default: 10].
     #[arg(long, value_name = "NM")]
     wavelength_step: Option<f64>,
-    /// Diffraction scenes: brightest environment directions diffracted like the light (0 to 8).
-    #[arg(long, value_name = "K", default_value_t = 4)]
-    env_samples: usize,
+    /// Diffraction scenes: diffract the environment's K brightest directions like the light
+    /// (0 to 8; 0: only its mirror image) instead of the default, the whole environment
+    /// integrated through a "terms" table's lobes (an "integrated" table, which has none,
+    /// diffracts 4 directions by default).
+    #[arg(long, value_name = "K")]
+    env_samples: Option<usize>,
     /// Output PNG file.
     #[arg(short = 'o', long = "output", value_name = "FILE.png")]
     output: PathBuf,

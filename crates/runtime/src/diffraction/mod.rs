@@ -47,19 +47,23 @@
 //! * `terms.rs`: layout "terms" ([`DiffractionTable`], [`DiffractionBinding`], [`run_probe`]);
 //! * [`integrated`]: layout "integrated" (also reachable as `nacre_runtime::diffraction_integrated`);
 //! * `tables.rs`: either layout ([`DiffractionTables`]);
+//! * [`lobes`]: the environment diffracted through a "terms" table's lobes (the integral of
+//!   Stam's BRDF against the whole environment, [`EnvironmentLobes`]);
 //! * `scene.rs`: the scenes and the scene pass ([`render_diffraction_scene`], [`ScenePass`]).
 
 mod common;
 pub mod integrated;
+pub mod lobes;
 mod scene;
 mod tables;
 mod terms;
 
 pub use common::{DIFFRACTION_COMMON, DiffractionLayout};
+pub use lobes::EnvironmentLobes;
 pub use scene::{
-    DIFFRACTION_SCENE, DiffractionLightsUniform, DiffractionScene, DiffractionSceneOptions,
-    LOBE_REFERENCE_NM, MAX_ENV_SAMPLES, ScenePass, environment_samples, lobe_gain,
-    render_diffraction_scene,
+    DEFAULT_ENV_SAMPLES, DIFFRACTION_SCENE, DiffractionLightsUniform, DiffractionScene,
+    DiffractionSceneOptions, LOBE_REFERENCE_NM, LobeData, MAX_ENV_SAMPLES, ScenePass,
+    environment_samples, lobe_gain, render_diffraction_scene, render_diffraction_scene_in,
 };
 pub use tables::DiffractionTables;
 pub use terms::{

@@ -3,8 +3,12 @@
 //! with a table of either layout.
 
 use super::integrated;
+use super::lobes::{EnvironmentLobes, LOBE_KW_SAMPLES};
 use super::tables::DiffractionTables;
-use super::terms::{DiffractionBinding, DiffractionOptions, LLVMPIPE_LOOP_LIMIT, composition};
+use super::terms::{
+    DiffractionBinding, DiffractionOptions, LLVMPIPE_LOOP_LIMIT, composition, spectrum_weights,
+    wavelength_grid,
+};
 use crate::context::{BufferInitExt, GpuContext};
 use crate::environment::EnvironmentMap;
 use crate::error::{Error, Result};
@@ -17,7 +21,7 @@ use bytemuck::{Pod, Zeroable};
 use nacre_format::diffraction::DiffractionRecord;
 use nacre_format::msg;
 use nacre_format::param::Param;
-use nacre_optics::diffraction::FresnelTerm;
+use nacre_optics::diffraction::{FresnelTerm, SpectralGrid};
 use std::path::PathBuf;
 use std::str::FromStr;
 
@@ -26,6 +30,10 @@ pub const DIFFRACTION_SCENE: &str = include_str!("../../../../shaders/diffractio
 
 /// Most environment samples of a scene (`DiffractionLights.samples`).
 pub const MAX_ENV_SAMPLES: usize = 8;
+
+/// Environment samples of a scene with an "integrated" table when none are asked for (the
+/// "terms" layout integrates the whole environment instead: [`super::lobes`]).
+pub const DEFAULT_ENV_SAMPLES: usize = 4;
 
 /// The diffraction scenes of `nacre render` (`shaders/diffraction_scene.wgsl`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -173,8 +181,12 @@ pub struct DiffractionSceneOptions {
     pub environment: Option<PathBuf>,
     /// Environment multiplier (default 0.5: a dim room, so that the rainbows stand out).
     pub env_intensity: f32,
-    /// Environment samples diffracted like the light (0 to [`MAX_ENV_SAMPLES`]).
-    pub env_samples: usize,
+    /// How the environment diffracts. `None` (the default): a "terms" table integrates the
+    /// whole environment through its lobes ([`super::lobes`]), an "integrated" table (which
+    /// keeps no bins) diffracts its [`DEFAULT_ENV_SAMPLES`] brightest texels like the light.
+    /// `Some(K)`: the K brightest texels (0 to [`MAX_ENV_SAMPLES`], [`environment_samples`])
+    /// with either layout, and no lobes (0: only the environment's mirror image remains).
+    pub env_samples: Option<usize>,
     /// The directional light; `intensity` is its irradiance E₀ at normal incidence (the
     /// grating sees the radiance E₀ (σ_s k₀)²/π of its mirror image, [`lobe_gain`]).
     pub light: Light,
@@ -186,7 +198,8 @@ pub struct DiffractionSceneOptions {
 }
 
 impl DiffractionSceneOptions {
-    /// The defaults of `scene`: 800 × 600, 4 environment samples, 10 nm wavelength step,
+    /// The defaults of `scene`: 800 × 600, the environment integrated (or, for an integrated
+    /// table, [`DEFAULT_ENV_SAMPLES`] samples), 10 nm wavelength step,
     /// the scene's [`DiffractionScene::fresnel`].
     pub fn new(scene: DiffractionScene) -> DiffractionSceneOptions {
         DiffractionSceneOptions {
@@ -196,7 +209,7 @@ impl DiffractionSceneOptions {
             camera: scene.camera(),
             environment: None,
             env_intensity: 0.5,
-            env_samples: 4,
+            env_samples: None,
             light: scene.light(),
             exposure_ev: 0.0,
             technique: DiffractionOptions {
@@ -246,10 +259,10 @@ impl DiffractionSceneOptions {
                 "≥ 0".into(),
             );
         }
-        if self.env_samples > MAX_ENV_SAMPLES {
+        if let Some(k) = self.env_samples.filter(|k| *k > MAX_ENV_SAMPLES) {
             return bad(
                 "environment samples",
-                self.env_samples as f64,
+                k as f64,
                 "",
                 format!("0 to {MAX_ENV_SAMPLES}"),
             );
@@ -271,8 +284,10 @@ impl DiffractionSceneOptions {
     }
 }
 
-/// Mirror of `DiffractionLights` (shaders/diffraction_scene.wgsl, group 2, 272 bytes): the
-/// light and the environment samples as the gratings see them. The camera, the exposure, the
+/// Mirror of `DiffractionLights` (shaders/diffraction_scene.wgsl, group 2 binding 0, 288
+/// bytes): the light, the environment samples and the environment lobes' settings as the
+/// gratings see them (the lobes, their efficiencies and the spectrum are bindings 1–3,
+/// [`LobeData`]). The camera, the exposure, the
 /// light's direction, colour and irradiance E₀ and the environment are every scene's group 0
 /// ([`ViewUniform`], `shaders/view.wgsl`).
 #[repr(C)]
@@ -282,12 +297,80 @@ pub struct DiffractionLightsUniform {
     pub light_radiance: f32,
     /// Environment samples used.
     pub sample_count: u32,
-    /// Padding.
-    pub pad: [f32; 2],
+    /// Environment lobes (0: none; [`super::lobes`]).
+    pub lobe_count: u32,
+    /// Wavelengths of the lobes' spectrum.
+    pub lobe_wavelength_count: u32,
     /// Sample directions (xyz unit, w 0).
     pub samples: [[f32; 4]; MAX_ENV_SAMPLES],
     /// Sample radiance I_k (rgb, × env_intensity; w 0).
     pub sample_radiance: [[f32; 4]; MAX_ENV_SAMPLES],
+    /// (kw_min, (S − 1)/(−kw_min), Δλ µm, 0): the efficiency samples' first kw and their
+    /// density (S = [`LOBE_KW_SAMPLES`]), and the step of the lobes' wavelength grid.
+    pub lobe_kw: [f32; 4],
+}
+
+/// Bindings 1–3 of the scenes' group 2: the environment lobes of a "terms" table
+/// ([`EnvironmentLobes`]) as the shader reads them, and the spectrum they are summed over.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LobeData {
+    /// Per lobe (κ_x, κ_y rad/µm, variance per axis (rad/µm)², 0).
+    pub lobes: Vec<[f32; 4]>,
+    /// η(kw) of lobe l at `l · S + s` (S = [`LOBE_KW_SAMPLES`]).
+    pub efficiency: Vec<f32>,
+    /// (λ nm, u_R, u_G, u_B) per wavelength (the technique's grid and CIE weights).
+    pub spectrum: Vec<[f32; 4]>,
+    /// `DiffractionLights.lobe_kw`.
+    pub kw: [f32; 4],
+}
+
+impl LobeData {
+    /// The lobes of `lobes` summed over the wavelength grid of `record` at `step_nm` (the
+    /// scene technique's: [`wavelength_grid`]) with the CIE weights of `colorimeter`.
+    ///
+    /// # Errors
+    /// The grid's errors ([`wavelength_grid`], [`SpectralGrid::new`]).
+    pub fn new(
+        lobes: &EnvironmentLobes,
+        record: &DiffractionRecord,
+        colorimeter: &nacre_optics::colour::Colorimeter,
+        step_nm: Option<f64>,
+    ) -> Result<LobeData> {
+        let wavelengths = wavelength_grid(record, step_nm)?;
+        let step_um = (wavelengths[1] - wavelengths[0]) * 1e-3;
+        let grid = SpectralGrid::new(colorimeter, &wavelengths)?;
+        Ok(LobeData {
+            lobes: lobes
+                .lobes
+                .iter()
+                .map(|l| {
+                    [
+                        l.centre_per_um[0] as f32,
+                        l.centre_per_um[1] as f32,
+                        l.variance_per_um2 as f32,
+                        0.0,
+                    ]
+                })
+                .collect(),
+            efficiency: lobes
+                .lobes
+                .iter()
+                .flat_map(|l| l.efficiency.iter().map(|&e| e as f32))
+                .collect(),
+            spectrum: spectrum_weights(&grid, colorimeter),
+            kw: [
+                lobes.kw_min as f32,
+                ((LOBE_KW_SAMPLES - 1) as f64 / -lobes.kw_min) as f32,
+                step_um as f32,
+                0.0,
+            ],
+        })
+    }
+
+    /// Per-pixel loop iterations of the lobe sum (lobes × wavelengths).
+    pub fn iterations(&self) -> u64 {
+        (self.lobes.len() * self.spectrum.len()) as u64
+    }
 }
 
 /// The `count` brightest texels (by luminance 0.2126 R + 0.7152 G + 0.0722 B) of the 32 × 16
@@ -352,6 +435,7 @@ fn scene_groups(
     ctx: &GpuContext,
     view: &ViewUniform,
     lights: &DiffractionLightsUniform,
+    lobes: &LobeData,
     env: &EnvironmentMap,
 ) -> Result<SceneGroups> {
     let textures = EnvironmentTextures::new(ctx, env, FilmEval::Classic, None)?;
@@ -364,22 +448,70 @@ fn scene_groups(
             "diffraction view",
             bytemuck::bytes_of(view),
         );
+        let storage = |binding: u32| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only: true },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
         let lights_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("diffraction lights"),
-            entries: &[crate::gpu::uniform_entry(0)],
+            entries: &[
+                crate::gpu::uniform_entry(0),
+                storage(1),
+                storage(2),
+                storage(3),
+            ],
         });
         let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("DiffractionLights"),
             contents: bytemuck::bytes_of(lights),
             usage: wgpu::BufferUsages::UNIFORM,
         });
+        // A storage binding may not be empty: one zero element stands for none (the
+        // uniform's counts say how many are read).
+        let store = |label: &str, bytes: &[u8]| {
+            let zero = [0u8; 16];
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: if bytes.is_empty() { &zero } else { bytes },
+                usage: wgpu::BufferUsages::STORAGE,
+            })
+        };
+        let lobe_buffer = store("diffraction lobes", bytemuck::cast_slice(&lobes.lobes));
+        let efficiency = store(
+            "diffraction lobe efficiency",
+            bytemuck::cast_slice(&lobes.efficiency),
+        );
+        let spectrum = store(
+            "diffraction lobe spectrum",
+            bytemuck::cast_slice(&lobes.spectrum),
+        );
         let lights = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("diffraction lights"),
             layout: &lights_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: buffer.as_entire_binding(),
-            }],
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: lobe_buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: efficiency.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: spectrum.as_entire_binding(),
+                },
+            ],
         });
         SceneGroups {
             view_layout,
@@ -420,6 +552,7 @@ impl ScenePass {
         technique: &DiffractionOptions,
         view: &ViewUniform,
         lights: &DiffractionLightsUniform,
+        lobes: &LobeData,
         env: &EnvironmentMap,
     ) -> Result<ScenePass> {
         let (technique, source) = match table {
@@ -448,7 +581,7 @@ impl ScenePass {
             SceneTechnique::Terms(b) => &b.layout,
             SceneTechnique::Integrated { layout, .. } => layout,
         };
-        let groups = scene_groups(ctx, view, lights, env)?;
+        let groups = scene_groups(ctx, view, lights, lobes, env)?;
         let device = &ctx.device;
         let module = shaders::create_module(ctx, "diffraction scene", &source)?;
         let pipeline = ctx.checked("building the diffraction pipeline", || {
@@ -506,13 +639,22 @@ impl ScenePass {
             height: 1,
             rgb: vec![[0.0; 3]],
         };
-        let pass = ScenePass::new(ctx, table, technique, &view, &lights, &env)?;
-        pass.check_loop_cap(ctx, 1, "bench")?;
+        let pass = ScenePass::new(
+            ctx,
+            table,
+            technique,
+            &view,
+            &lights,
+            &LobeData::default(),
+            &env,
+        )?;
+        pass.check_loop_cap(ctx, 1, 0, "bench")?;
         Ok(pass)
     }
 
     /// On llvmpipe, refuses a terms-layout pass whose per-pixel loops — `diffracted` calls of
-    /// `diffraction_colour` plus the specular order — could run past
+    /// `diffraction_colour`, the specular order and `lobe_iterations` of the environment's
+    /// lobe sum ([`LobeData::iterations`]) — could run past
     /// [`LLVMPIPE_LOOP_LIMIT`], which would silently cut them short. The estimate counts
     /// the sums' own loops; llvmpipe's count runs ~20 % higher (cd-disc went wrong from 56
     /// wavelengths on, an estimate of 54,824), so the pass is refused above three quarters of
@@ -520,13 +662,19 @@ impl ScenePass {
     ///
     /// # Errors
     /// [`Error::Refused`] naming the way out (a coarser step, fewer samples, the fast layout).
-    pub fn check_loop_cap(&self, ctx: &GpuContext, diffracted: u64, what: &str) -> Result<()> {
+    pub fn check_loop_cap(
+        &self,
+        ctx: &GpuContext,
+        diffracted: u64,
+        lobe_iterations: u64,
+        what: &str,
+    ) -> Result<()> {
         let Some(binding) = self.technique() else {
             return Ok(());
         };
         let u = &binding.uniform;
         let specular = u64::from(u.wavelength_count) * (u64::from(u.order) + 3);
-        let needed = diffracted * binding.loop_iterations_per_colour() + specular;
+        let needed = diffracted * binding.loop_iterations_per_colour() + specular + lobe_iterations;
         if ctx.info.name.contains("llvmpipe") && needed > LLVMPIPE_LOOP_LIMIT * 3 / 4 {
             return Err(Error::Refused {
                 context: format!("the diffraction {what} pass on {}", ctx.info.name),
@@ -596,7 +744,8 @@ fn unit(v: [f32; 3]) -> [f32; 3] {
 }
 
 /// Renders a diffraction scene with `table` (either layout) and reads it back as
-/// sRGB-encoded RGBA8.
+/// sRGB-encoded RGBA8: [`render_diffraction_scene_in`] under `options.environment` (or the
+/// default studio without its sun).
 ///
 /// # Errors
 /// [`Error::Invalid`] for bad options (and an integrated table loaded with another F² than
@@ -614,6 +763,22 @@ pub fn render_diffraction_scene(
             crate::environment::procedural_environment_with(w, h, false)
         }
     };
+    render_diffraction_scene_in(ctx, table, options, &env)
+}
+
+/// Renders a diffraction scene under `env` (`options.environment` unused): the light, the
+/// environment's mirror image through the specular order, and the environment diffracted
+/// through the table's lobes or as samples ([`DiffractionSceneOptions::env_samples`]).
+///
+/// # Errors
+/// As [`render_diffraction_scene`].
+pub fn render_diffraction_scene_in(
+    ctx: &GpuContext,
+    table: &DiffractionTables,
+    options: &DiffractionSceneOptions,
+    env: &EnvironmentMap,
+) -> Result<RenderedImage> {
+    options.validate()?;
     let (width, height) = (options.width, options.height);
     let gain = lobe_gain(table.record());
     let view = ViewUniform {
@@ -631,10 +796,31 @@ pub fn render_diffraction_scene(
         env_lod_max: env.mip_chain().len().saturating_sub(1) as f32,
         ..ViewUniform::zeroed()
     };
-    let samples = environment_samples(&env, options.env_samples);
+    // The whole environment through the lobes (terms tables), or its brightest texels.
+    let lobes = match (table, options.env_samples) {
+        (DiffractionTables::Terms(t), None) => {
+            let lobes = EnvironmentLobes::new(&t.terms, &t.record)?;
+            LobeData::new(
+                &lobes,
+                &t.record,
+                &t.colorimeter()?,
+                options.technique.wavelength_step_nm,
+            )?
+        }
+        _ => LobeData::default(),
+    };
+    let sample_count = match (table, options.env_samples) {
+        (_, Some(k)) => k,
+        (DiffractionTables::Terms(_), None) => 0,
+        (DiffractionTables::Integrated(_), None) => DEFAULT_ENV_SAMPLES,
+    };
+    let samples = environment_samples(env, sample_count);
     let mut lights = DiffractionLightsUniform {
         light_radiance: options.light.intensity * gain,
         sample_count: samples.len() as u32,
+        lobe_count: lobes.lobes.len() as u32,
+        lobe_wavelength_count: lobes.spectrum.len() as u32,
+        lobe_kw: lobes.kw,
         ..DiffractionLightsUniform::zeroed()
     };
     for (k, (d, l)) in samples.iter().enumerate() {
@@ -642,9 +828,14 @@ pub fn render_diffraction_scene(
         lights.sample_radiance[k] =
             [l[0], l[1], l[2], 0.0].map(|x| x * options.env_intensity * gain);
     }
-    let pass = ScenePass::new(ctx, table, &options.technique, &view, &lights, &env)?;
-    // The light and every environment sample are diffracted.
-    pass.check_loop_cap(ctx, 1 + samples.len() as u64, options.scene.name())?;
+    let pass = ScenePass::new(ctx, table, &options.technique, &view, &lights, &lobes, env)?;
+    // The light and every environment sample are diffracted; the lobes add their sum.
+    pass.check_loop_cap(
+        ctx,
+        1 + samples.len() as u64,
+        lobes.iterations(),
+        options.scene.name(),
+    )?;
     let device = &ctx.device;
     let target = ctx.checked("creating the diffraction target", || {
         gpu::render_target(
