@@ -446,12 +446,14 @@ fn scene_settings_are_checked() {
 /// On llvmpipe (lavapipe), a terms-layout scene whose per-pixel loops would run past the
 /// driver's 65,535-iteration cap (which silently cuts them short) is refused with the way
 /// out; the integrated table of the same surface renders, and so does the default step. On
-/// other adapters the fine step renders.
+/// other adapters the fine step renders. The environment as four samples (each a full
+/// `diffraction_colour`): the lobes' sum fits the cap at 5 nm (about 20,000 iterations).
 #[test]
 fn scenes_beyond_llvmpipes_loop_cap_are_refused_there() {
     let ctx = ctx();
     let mut options = DiffractionSceneOptions::new(DiffractionScene::CdDisc);
     (options.width, options.height) = (16, 12);
+    options.env_samples = Some(DEFAULT_ENV_SAMPLES);
     let default_step = render_diffraction_scene(ctx, tables("cd-tracks"), &options);
     assert!(default_step.is_ok(), "{:?}", default_step.err());
     options.technique.wavelength_step_nm = Some(5.0);
