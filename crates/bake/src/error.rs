@@ -52,6 +52,11 @@ pub enum Error {
         /// The largest accepted value.
         high: f64,
     },
+    /// A bake stopped because its caller cancelled it (nothing was written).
+    Cancelled {
+        /// The table being baked.
+        table: String,
+    },
 }
 
 impl Error {
@@ -127,6 +132,12 @@ impl Render for Error {
                 "{} `{value}`: expected {low} to {high}",
                 naming.name(*param)
             ),
+            Error::Cancelled { table } => {
+                write!(
+                    f,
+                    "the bake of `{table}` was cancelled: nothing was written"
+                )
+            }
         }
     }
 }

@@ -6,6 +6,8 @@
 //! parser); otherwise the error is shown beside the stack and the view, the plots and the
 //! exports keep the last stack that built.
 
+use crate::bake::{BakeJob, BakeOutcome, BakeSettings};
+use crate::compare::{DEFAULT_SCALE_MAX, DeltaE, REFERENCE, delta_e, scale_colour};
 use crate::curves::{CurveWorker, Curves};
 use crate::doc::{Film, History, MAX_FILMS, PRESETS, SLIDER_MAX_NM, StackDoc};
 use crate::view::{Frame, Lighting, View, ViewSettings};
@@ -15,7 +17,7 @@ use nacre_format::atomic::write_atomic;
 use nacre_optics::Stack;
 use nacre_runtime::Technique;
 use nacre_runtime::render::SceneKind;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// The techniques the view offers.
 pub const TECHNIQUES: [Technique; 4] = [
@@ -61,7 +63,7 @@ pub struct Studio {
     pub frame: Option<Frame>,
     /// Why the last frame failed.
     pub view_error: Option<String>,
-    drawn: Option<(ViewSettings, StackDoc)>,
+    drawn: Option<(ViewSettings, StackDoc, bool)>,
     /// Frames drawn since the start.
     pub frames_drawn: u64,
     worker: CurveWorker,
@@ -76,8 +78,36 @@ pub struct Studio {
     pub recipe_path: String,
     /// Where the picture is saved.
     pub picture_path: String,
+    /// The glTF file the model field names.
+    pub model_path: String,
+    /// Why the last model did not open.
+    pub model_error: Option<String>,
     /// The last export's outcome.
     pub status: Option<Result<String, String>>,
+    /// What the export panel bakes.
+    pub bake: BakeSettings,
+    /// The bake running, if any.
+    pub bake_job: Option<BakeJob>,
+    /// How the last bake ended (or why it did not start).
+    pub bake_status: Option<Result<String, String>>,
+    /// Times the studio was drawn (every UI frame, whether the view redrew or not).
+    pub ui_frames: u64,
+    /// Whether the view shows the ΔE2000 map against the exact technique beside the picture.
+    pub compare: bool,
+    /// The top of the ΔE2000 colour scale.
+    pub delta_e_max: f32,
+    /// The last comparison: the ΔE2000 map of the picture against [`REFERENCE`]'s.
+    pub delta_e: Option<DeltaE>,
+    /// The reference picture of the last comparison.
+    pub reference: Option<Frame>,
+    delta_e_texture: Option<(TextureHandle, f32)>,
+    /// Where the session (the stack, as a recipe) is saved on every committed change and
+    /// restored from on start; None: no session.
+    pub session_path: Option<PathBuf>,
+    /// The stack the session file holds (nothing is written until the stack differs).
+    saved_session: Option<StackDoc>,
+    /// Why the session could not be restored or saved, if it could not.
+    pub session_error: Option<String>,
 }
 
 impl Studio {
@@ -113,7 +143,68 @@ impl Studio {
             spectrum_angle_deg: 0.0,
             recipe_path: "stack.toml".into(),
             picture_path: "studio.png".into(),
+            model_path: String::new(),
+            model_error: None,
             status: None,
+            bake: BakeSettings::default(),
+            bake_job: None,
+            bake_status: None,
+            ui_frames: 0,
+            compare: false,
+            delta_e_max: DEFAULT_SCALE_MAX,
+            delta_e: None,
+            reference: None,
+            delta_e_texture: None,
+            session_path: None,
+            saved_session: None,
+            session_error: None,
+        }
+    }
+
+    /// A studio whose session lives at `path`: the stack it holds is restored (a missing
+    /// file starts from `doc`; an unreadable one too, its error shown and the file left as
+    /// it is until the stack changes), and every committed change is written back
+    /// atomically as a recipe ([`StackDoc::write_recipe`]).
+    pub fn with_session(
+        view: Result<View, String>,
+        doc: StackDoc,
+        size: [u32; 2],
+        path: PathBuf,
+    ) -> Studio {
+        let (doc, error) = match restore_session(&path) {
+            Ok(Some(restored)) => (restored, None),
+            Ok(None) => (doc, None),
+            Err(e) => (doc, Some(e)),
+        };
+        let mut studio = Studio::new(view, doc, size);
+        studio.saved_session = Some(studio.good.0.clone());
+        studio.session_path = Some(path);
+        studio.session_error = error;
+        studio
+    }
+
+    /// Writes the session file when the committed stack builds and differs from what it
+    /// holds (called every frame once the edits are committed, and on exit).
+    pub fn save_session(&mut self) {
+        let Some(path) = &self.session_path else {
+            return;
+        };
+        if self.stack_error.is_some()
+            || self.doc != self.committed
+            || self.saved_session.as_ref() == Some(&self.good.0)
+        {
+            return;
+        }
+        match self.good.0.write_recipe(path) {
+            Ok(()) => {
+                self.saved_session = Some(self.good.0.clone());
+                self.session_error = None;
+            }
+            Err(e) => {
+                // Tried once per stack: the error stays shown until the next change.
+                self.saved_session = Some(self.good.0.clone());
+                self.session_error = Some(format!("session {}: {e}", path.display()));
+            }
         }
     }
 
@@ -193,6 +284,44 @@ impl Studio {
         Ok(())
     }
 
+    /// Opens the glTF file at `path` (`.gltf` or `.glb`) as the view's model: the stack's
+    /// top film goes on its materials and the orbit starts at the fitted camera's
+    /// direction. A file that does not load leaves the view as it was.
+    pub fn open_model(&mut self, path: &Path) -> Result<(), String> {
+        let view = self
+            .view
+            .as_mut()
+            .map_err(|e| format!("no live view: {e}"))?;
+        view.load_model(path)
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+        self.settings.model = Some(path.to_path_buf());
+        self.settings.orbit.yaw_deg = 0.0;
+        self.settings.orbit.pitch_deg = nacre_runtime::mesh::DEFAULT_PITCH_DEG as f32;
+        self.model_path = path.display().to_string();
+        Ok(())
+    }
+
+    /// Back to the analytic scene.
+    pub fn close_model(&mut self) {
+        if self.settings.model.take().is_some() {
+            self.settings.orbit = crate::view::Orbit::for_scene(self.settings.scene);
+        }
+    }
+
+    /// Opens the first `.gltf`/`.glb` file dropped on the window, if any.
+    fn take_dropped_model(&mut self, ctx: &egui::Context) {
+        let dropped = ctx.input(|i| {
+            i.raw
+                .dropped_files
+                .iter()
+                .map(|f| f.path().to_path_buf())
+                .find(|p| is_gltf(p))
+        });
+        if let Some(path) = dropped {
+            self.model_error = self.open_model(&path).err();
+        }
+    }
+
     /// Writes the view's last picture as a PNG to `path` (atomically).
     pub fn save_picture(&self, path: &Path) -> Result<(), String> {
         let frame = self.frame.as_ref().ok_or("no picture drawn yet")?;
@@ -202,8 +331,11 @@ impl Studio {
 
     /// Draws the whole studio into `ui` (and the view's frame when anything changed).
     pub fn ui(&mut self, ui: &mut egui::Ui) {
+        self.ui_frames += 1;
         self.shortcuts(ui.ctx());
+        self.take_dropped_model(ui.ctx());
         egui::Panel::top("studio toolbar").show(ui, |ui| self.toolbar(ui));
+        egui::Panel::bottom("studio export").show(ui, |ui| self.export_panel(ui));
         egui::Panel::left("studio stack")
             .default_size(330.0)
             .resizable(true)
@@ -213,6 +345,7 @@ impl Studio {
         self.apply();
         if !ui.ctx().input(|i| i.pointer.any_down()) && ui.ctx().memory(|m| m.focused().is_none()) {
             self.commit();
+            self.save_session();
         }
         self.poll_curves();
         egui::Panel::right("studio plots")
@@ -296,6 +429,107 @@ impl Studio {
                 );
             }
             match &self.status {
+                Some(Ok(text)) => {
+                    ui.label(text);
+                }
+                Some(Err(text)) => {
+                    ui.label(RichText::new(text).color(Color32::LIGHT_RED));
+                }
+                None => {}
+            }
+        });
+    }
+
+    /// Starts baking the last stack that built into [`Studio::bake`]'s folder (refused while
+    /// an entry is in error or a bake runs).
+    pub fn start_bake(&mut self) {
+        if self.bake_job.is_some() {
+            return;
+        }
+        self.bake_status = Some(match &self.stack_error {
+            Some(e) => Err(format!("the stack has an error, fix it first: {e}")),
+            None => match BakeJob::start(&self.good.0, &self.bake) {
+                Ok(job) => {
+                    self.bake_job = Some(job);
+                    Ok("baking…".into())
+                }
+                Err(e) => Err(e),
+            },
+        });
+    }
+
+    /// Whether a bake is running.
+    pub fn baking(&self) -> bool {
+        self.bake_job.is_some()
+    }
+
+    /// Takes a finished bake's outcome.
+    fn poll_bake(&mut self) {
+        let Some(job) = &mut self.bake_job else {
+            return;
+        };
+        let Some(outcome) = job.poll() else {
+            return;
+        };
+        self.bake_status = Some(match outcome {
+            BakeOutcome::Baked(path) => Ok(format!("baked {}", path.display())),
+            BakeOutcome::Cancelled => {
+                Err(format!("bake of {} cancelled: nothing written", job.name))
+            }
+            BakeOutcome::Failed(e) => Err(format!("bake failed: {e}")),
+        });
+        self.bake_job = None;
+    }
+
+    /// The export panel: a table set baked from the stack, with its progress and a cancel
+    /// button.
+    fn export_panel(&mut self, ui: &mut egui::Ui) {
+        self.poll_bake();
+        ui.horizontal_wrapped(|ui| {
+            ui.strong("Export");
+            let running = self.bake_job.is_some();
+            ui.add_enabled_ui(!running, |ui| {
+                let b = &mut self.bake;
+                let label = ui.label("Table folder");
+                ui.add(egui::TextEdit::singleline(&mut b.folder).desired_width(160.0))
+                    .labelled_by(label.id);
+                let label = ui.label("Table name");
+                ui.add(egui::TextEdit::singleline(&mut b.name).desired_width(110.0))
+                    .labelled_by(label.id);
+                for (text, value, max) in [
+                    ("cos θ texels", &mut b.cos_theta_count, 256),
+                    ("thickness texels", &mut b.opd_count, 2048),
+                    ("index texels", &mut b.film_ior_count, 128),
+                ] {
+                    let label = ui.label(text);
+                    ui.add(egui::DragValue::new(value).range(2..=max))
+                        .labelled_by(label.id);
+                }
+            });
+            if ui
+                .add_enabled(!running, egui::Button::new("Bake tables"))
+                .clicked()
+            {
+                self.start_bake();
+            }
+            if let Some(job) = &self.bake_job {
+                let (done, total) = job.progress();
+                ui.add(
+                    egui::ProgressBar::new(done as f32 / total.max(1) as f32)
+                        .desired_width(180.0)
+                        .text(format!("{done}/{total} rows")),
+                );
+                if ui
+                    .add_enabled(!job.cancelling(), egui::Button::new("Cancel bake"))
+                    .clicked()
+                {
+                    job.cancel();
+                }
+                // Keep drawing while the thread works: the bar moves and the outcome shows.
+                ui.ctx()
+                    .request_repaint_after(std::time::Duration::from_millis(50));
+            }
+            match &self.bake_status {
                 Some(Ok(text)) => {
                     ui.label(text);
                 }
@@ -400,6 +634,9 @@ impl Studio {
         ui.separator();
         material_field(ui, "Base", &mut self.doc.substrate);
         ui.separator();
+        if let Some(e) = &self.session_error {
+            ui.label(RichText::new(e.as_str()).color(Color32::LIGHT_RED));
+        }
         if let Some(e) = &self.stack_error {
             ui.label(RichText::new(format!("Not applied: {e}")).color(Color32::LIGHT_RED));
         } else {
@@ -435,6 +672,17 @@ impl Studio {
                         ui.selectable_value(&mut s.lighting, l, l.name());
                     }
                 });
+            ui.checkbox(
+                &mut self.compare,
+                format!("ΔE2000 against {}", REFERENCE.name()),
+            );
+            if self.compare {
+                ui.add(
+                    egui::Slider::new(&mut self.delta_e_max, 0.5..=20.0)
+                        .logarithmic(true)
+                        .text("ΔE scale max"),
+                );
+            }
         });
         ui.horizontal_wrapped(|ui| {
             let s = &mut self.settings;
@@ -445,12 +693,40 @@ impl Studio {
                     .text("Roughness α"),
             );
         });
+        ui.horizontal_wrapped(|ui| {
+            let label = ui.label("Model file");
+            ui.add(egui::TextEdit::singleline(&mut self.model_path).desired_width(220.0))
+                .labelled_by(label.id)
+                .on_hover_text("a .gltf or .glb file (or drop one on the window)");
+            if ui.button("Open model").clicked() {
+                let path = PathBuf::from(self.model_path.trim());
+                self.model_error = self.open_model(&path).err();
+            }
+            if ui
+                .add_enabled(
+                    self.settings.model.is_some(),
+                    egui::Button::new("Close model"),
+                )
+                .clicked()
+            {
+                self.close_model();
+            }
+            ui.checkbox(&mut self.settings.film_on_all, "Film on every material");
+            if let Some(e) = &self.model_error {
+                ui.label(RichText::new(e.as_str()).color(Color32::LIGHT_RED));
+            }
+        });
         if self.follow_panel {
             let ppp = ui.ctx().pixels_per_point();
             let avail = ui.available_size() * ppp;
             // Multiples of 16 pixels, so that a resize re-renders only now and then.
             let snap = |v: f32| ((v as u32) / 16 * 16).clamp(64, 4096);
-            self.settings.size = [snap(avail.x), snap(avail.y - 24.0 * ppp)];
+            let (width, below) = if self.compare {
+                (avail.x / 2.0 - 8.0 * ppp, 84.0 * ppp)
+            } else {
+                (avail.x, 24.0 * ppp)
+            };
+            self.settings.size = [snap(width), snap(avail.y - below)];
         }
         self.draw_if_needed(ui.ctx());
         if let Some(e) = &self.view_error {
@@ -465,14 +741,34 @@ impl Studio {
             let ppp = ui.ctx().pixels_per_point();
             let [w, h] = texture.size();
             let size = egui::vec2(w as f32, h as f32) / ppp;
-            let response = ui.add(
-                egui::Image::from_texture((texture.id(), size))
-                    .sense(egui::Sense::click_and_drag())
-                    .alt_text("Live view"),
-            );
+            let response = ui
+                .horizontal(|ui| {
+                    let response = ui.add(
+                        egui::Image::from_texture((texture.id(), size))
+                            .sense(egui::Sense::click_and_drag())
+                            .alt_text("Live view"),
+                    );
+                    if self.compare
+                        && let Some((map, _)) = &self.delta_e_texture
+                    {
+                        let [w, h] = map.size();
+                        ui.add(
+                            egui::Image::from_texture((
+                                map.id(),
+                                egui::vec2(w as f32, h as f32) / ppp,
+                            ))
+                            .alt_text("ΔE2000 map"),
+                        );
+                    }
+                    response
+                })
+                .inner;
             if response.dragged() {
                 let d = response.drag_delta();
                 self.settings.orbit.drag(d.x, d.y);
+            }
+            if self.compare {
+                self.delta_e_legend(ui);
             }
             if let Some(frame) = &self.frame {
                 ui.label(
@@ -491,8 +787,9 @@ impl Studio {
 
     /// Draws a new frame when the stack or the settings changed since the last one.
     fn draw_if_needed(&mut self, ctx: &egui::Context) {
-        let key = (self.settings.clone(), self.good.0.clone());
+        let key = (self.settings.clone(), self.good.0.clone(), self.compare);
         if self.drawn.as_ref() == Some(&key) {
+            self.update_delta_e_texture(ctx);
             return;
         }
         let view = match &mut self.view {
@@ -521,8 +818,100 @@ impl Studio {
                 self.view_error = None;
                 self.frames_drawn += 1;
             }
-            Err(e) => self.view_error = Some(e.to_string()),
+            Err(e) => {
+                self.view_error = Some(e.to_string());
+                return;
+            }
         }
+        self.delta_e = None;
+        self.reference = None;
+        if !self.compare {
+            return;
+        }
+        let mut settings = self.settings.clone();
+        settings.technique = REFERENCE;
+        match view.render(&settings, &self.good.0, &self.good.1) {
+            Ok(reference) => {
+                self.delta_e = self
+                    .frame
+                    .as_ref()
+                    .and_then(|f| delta_e(&f.image, &reference.image));
+                self.reference = Some(reference);
+            }
+            Err(e) => {
+                self.view_error = Some(format!("the {} reference: {e}", REFERENCE.name()));
+            }
+        }
+        self.delta_e_texture = None;
+        self.update_delta_e_texture(ctx);
+    }
+
+    /// Paints the ΔE2000 map's texture when the map or the scale changed.
+    fn update_delta_e_texture(&mut self, ctx: &egui::Context) {
+        let Some(d) = &self.delta_e else {
+            self.delta_e_texture = None;
+            return;
+        };
+        if self
+            .delta_e_texture
+            .as_ref()
+            .is_some_and(|(_, max)| *max == self.delta_e_max)
+        {
+            return;
+        }
+        let picture = egui::ColorImage::from_rgba_unmultiplied(
+            [d.width as usize, d.height as usize],
+            &d.map_rgba(self.delta_e_max),
+        );
+        match &mut self.delta_e_texture {
+            Some((t, max)) => {
+                t.set(picture, TextureOptions::NEAREST);
+                *max = self.delta_e_max;
+            }
+            None => {
+                self.delta_e_texture = Some((
+                    ctx.load_texture("ΔE2000 map", picture, TextureOptions::NEAREST),
+                    self.delta_e_max,
+                ));
+            }
+        }
+    }
+
+    /// The ΔE2000 map's colour scale and statistics.
+    fn delta_e_legend(&self, ui: &mut egui::Ui) {
+        let Some(d) = &self.delta_e else {
+            return;
+        };
+        ui.horizontal(|ui| {
+            ui.label("ΔE2000 0");
+            let (rect, _) = ui.allocate_exact_size(egui::vec2(200.0, 14.0), egui::Sense::hover());
+            let steps = 64;
+            for k in 0..steps {
+                let t = k as f32 / (steps - 1) as f32;
+                let [r, g, b] = scale_colour(t * self.delta_e_max, self.delta_e_max);
+                let x = rect.left() + rect.width() * k as f32 / steps as f32;
+                ui.painter().rect_filled(
+                    egui::Rect::from_min_max(
+                        egui::pos2(x, rect.top()),
+                        egui::pos2(x + rect.width() / steps as f32 + 0.5, rect.bottom()),
+                    ),
+                    0.0,
+                    Color32::from_rgb(r, g, b),
+                );
+            }
+            ui.label(format!("≥ {:.1}", self.delta_e_max));
+        });
+        ui.label(format!(
+            "ΔE2000 {} against {}: mean {:.2}, p95 {:.2}, max {:.2} over the picture; {} pixels differ (mean {:.2}, p95 {:.2})",
+            self.settings.technique.name(),
+            REFERENCE.name(),
+            d.mean,
+            d.p95,
+            d.max,
+            d.differing,
+            d.mean_differing,
+            d.p95_differing
+        ));
     }
 
     /// Asks the worker for the current stack's curves when they are stale; takes its answer.
@@ -625,6 +1014,25 @@ impl Studio {
             ui.painter().rect_filled(r, 0.0, srgb8(*rgb));
         }
     }
+}
+
+/// Whether `path` names a glTF file (`.gltf` or `.glb`, any case).
+pub fn is_gltf(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"))
+}
+
+/// The stack a session file holds: None when there is no file; an error (its message)
+/// when it cannot be read or does not build.
+pub fn restore_session(path: &Path) -> Result<Option<StackDoc>, String> {
+    if !path.exists() {
+        return Ok(None);
+    }
+    let doc = StackDoc::read_recipe(path).map_err(|e| format!("session not restored: {e}"))?;
+    doc.build()
+        .map_err(|e| format!("session not restored: {}: {e}", path.display()))?;
+    Ok(Some(doc))
 }
 
 /// The thickness texts of `doc`'s films.

@@ -20,9 +20,18 @@ use std::time::Instant;
 #[derive(Parser)]
 #[command(name = "nacre-studio", version)]
 struct Args {
-    /// Start from this stack recipe (the TOML `nacre color --recipe` reads).
+    /// Start from this stack recipe (the TOML `nacre color --recipe` reads) instead of the
+    /// last session's stack.
     #[arg(long, value_name = "FILE.toml")]
     recipe: Option<PathBuf>,
+    /// The session file: the stack, saved as a recipe on every change and restored on
+    /// start [default: $XDG_STATE_HOME/nacre/studio-session.toml, else
+    /// ~/.local/state/nacre/studio-session.toml; none with --screenshot].
+    #[arg(long, value_name = "FILE.toml", conflicts_with = "no_session")]
+    session: Option<PathBuf>,
+    /// Neither restore nor save a session.
+    #[arg(long)]
+    no_session: bool,
     /// Draw --frames frames, save the window's picture to this PNG and exit.
     #[arg(long, value_name = "FILE.png")]
     screenshot: Option<PathBuf>,
@@ -51,6 +60,19 @@ struct Args {
 fn bad(flag: &str, message: impl std::fmt::Display) -> ! {
     eprintln!("error: {flag}: {message}");
     std::process::exit(2);
+}
+
+/// The default session file (`--session`), if a home or state folder is known.
+fn default_session() -> Option<PathBuf> {
+    let state = std::env::var_os("XDG_STATE_HOME")
+        .filter(|v| !v.is_empty())
+        .map(PathBuf::from)
+        .or_else(|| {
+            std::env::var_os("HOME")
+                .filter(|v| !v.is_empty())
+                .map(|h| PathBuf::from(h).join(".local/state"))
+        })?;
+    Some(state.join("nacre").join("studio-session.toml"))
 }
 
 fn size(flag: &str, text: &str) -> [u32; 2] {
@@ -148,6 +170,7 @@ impl eframe::App for App {
     }
 
     fn on_exit(&mut self) {
+        self.studio.save_session();
         if self.spin && !self.spin_seconds.is_empty() {
             // The first frame compiles the pipeline: left out.
             let s = &self.spin_seconds[1.min(self.spin_seconds.len() - 1)..];
@@ -212,6 +235,27 @@ fn main() {
     {
         bad("--screenshot", format!("{} is a folder", path.display()));
     }
+    let session = if args.no_session {
+        None
+    } else if args.session.is_some() {
+        args.session.clone()
+    } else if args.screenshot.is_some() {
+        // A screenshot draws what its flags say, never a session's stack.
+        None
+    } else {
+        default_session()
+    };
+    if let Some(path) = &session {
+        if path.is_dir() {
+            bad("--session", format!("{} is a folder", path.display()));
+        }
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty())
+            && let Err(e) = std::fs::create_dir_all(dir)
+        {
+            bad("--session", format!("{}: {e}", dir.display()));
+        }
+    }
+    let from_recipe = args.recipe.is_some();
     let exit_code = Arc::new(Mutex::new(0));
     let setup = WgpuSetupCreateNew {
         device_descriptor: Arc::new(|adapter| wgpu::DeviceDescriptor {
@@ -248,7 +292,15 @@ fn main() {
                 None => Err("eframe started without wgpu".to_string()),
             };
             let size = view_size.unwrap_or([800, 600]);
-            let mut studio = Studio::new(view, doc, size);
+            let mut studio = match session {
+                Some(path) if !from_recipe => Studio::with_session(view, doc, size, path),
+                Some(path) => {
+                    let mut s = Studio::new(view, doc, size);
+                    s.session_path = Some(path);
+                    s
+                }
+                None => Studio::new(view, doc, size),
+            };
             studio.follow_panel = view_size.is_none();
             studio.settings.technique = technique;
             studio.settings.lighting = lighting;

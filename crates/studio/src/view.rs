@@ -12,11 +12,14 @@ use crate::doc::StackDoc;
 use nacre_format::set::resolve_table;
 use nacre_optics::Stack;
 use nacre_runtime::bindings::StackSetup;
+use nacre_runtime::gltf_scene::GltfScene;
+use nacre_runtime::mesh::{Orbit as MeshOrbit, ViewPoint};
 use nacre_runtime::render::{
     DEFAULT_THICKNESS_MAP_SIZE, EnvironmentMap, RenderedImage, Renderer, SceneKind, SceneOptions,
     ThicknessMap, ThicknessMapping, procedural_thickness_map,
 };
 use nacre_runtime::{GpuContext, TableSet, Technique};
+use std::path::{Path, PathBuf};
 
 /// The tables the view loads: the sphere's film-lut (films of index 1.1–2.5 in air on a
 /// dielectric base) and the sRGB Fourier table.
@@ -109,6 +112,11 @@ pub struct ViewSettings {
     pub roughness_alpha: f32,
     /// The picture's size, pixels.
     pub size: [u32; 2],
+    /// A glTF file drawn instead of `scene` ([`View::load_model`] loads it).
+    pub model: Option<PathBuf>,
+    /// With a model: the stack's film on every material (true) or on the materials that
+    /// have `KHR_materials_iridescence` only (false, the default).
+    pub film_on_all: bool,
 }
 
 impl ViewSettings {
@@ -122,6 +130,8 @@ impl ViewSettings {
             exposure_ev: 0.0,
             roughness_alpha: 0.06,
             size,
+            model: None,
+            film_on_all: false,
         }
     }
 }
@@ -140,12 +150,14 @@ pub struct Frame {
 pub struct View {
     ctx: GpuContext,
     tables: TableSet,
-    renderer: Option<Renderer>,
-    /// What the renderer's group 1 was built from: the stack and its relative thicknesses.
-    bound: Option<(Technique, StackDoc)>,
+    /// Compiled renderers, the most recently used last (at most [`KEPT_RENDERERS`]), each
+    /// with the stack its group 1 was built from.
+    renderers: Vec<(Renderer, Option<StackDoc>)>,
     studio: EnvironmentMap,
     uniform: EnvironmentMap,
     thickness: ThicknessMap,
+    /// The loaded glTF model.
+    model: Option<GltfScene>,
 }
 
 /// The view's errors: the runtime's, or a stack the technique cannot draw.
@@ -157,6 +169,9 @@ pub enum ViewError {
     /// From loading a table manifest.
     #[error(transparent)]
     Format(#[from] nacre_format::Error),
+    /// A model is chosen but none is loaded.
+    #[error("no glTF model is loaded: open one")]
+    NoModel,
     /// A material without an index at [`INDEX_WAVELENGTH_NM`].
     #[error("{what}: {source}")]
     Index {
@@ -177,8 +192,7 @@ impl View {
         Ok(View {
             ctx,
             tables,
-            renderer: None,
-            bound: None,
+            renderers: Vec::new(),
             studio: EnvironmentMap::default_map()?,
             uniform: EnvironmentMap {
                 width: 64,
@@ -186,6 +200,7 @@ impl View {
                 rgb: vec![[1.0; 3]; 64 * 32],
             },
             thickness: procedural_thickness_map(DEFAULT_THICKNESS_MAP_SIZE),
+            model: None,
         })
     }
 
@@ -276,36 +291,123 @@ impl View {
         Ok((o, notes))
     }
 
-    /// Draws `doc` with `settings`: compiles the technique's pipeline when it changed,
-    /// rebinds its group 1 when the stack changed, renders and reads the picture back.
-    pub fn render(
+    /// Loads the glTF file at `path` (the runtime's loader, [`GltfScene::load`]) as the
+    /// model the view draws when [`ViewSettings::model`] names it.
+    pub fn load_model(&mut self, path: &Path) -> Result<(), ViewError> {
+        self.model = Some(GltfScene::load(path)?);
+        Ok(())
+    }
+
+    /// The loaded model's path, if any.
+    pub fn model_path(&self) -> Option<&Path> {
+        self.model.as_ref().map(|m| m.path.as_path())
+    }
+
+    /// Draws the loaded model with `settings` and the stack's top film on its materials
+    /// ([`film_on_model`]), through the runtime's glTF renderer
+    /// ([`nacre_runtime::mesh::render`], that of `nacre render --gltf`), the orbit camera
+    /// fitted to the model's bounds at the view's yaw and pitch.
+    fn render_model(
         &mut self,
         settings: &ViewSettings,
         doc: &StackDoc,
         stack: &Stack,
     ) -> Result<Frame, ViewError> {
         let start = std::time::Instant::now();
+        let Some(model) = &self.model else {
+            return Err(ViewError::NoModel);
+        };
+        let mut notes = Vec::new();
+        let (scene, filmed) = film_on_model(model, doc, stack, settings.film_on_all)?;
+        let whose = if settings.film_on_all {
+            "every material"
+        } else {
+            "the iridescent ones"
+        };
+        match stack.layers().first() {
+            Some(layer) => notes.push(format!(
+                "film 1 (index {:.3} at {INDEX_WAVELENGTH_NM} nm, {} nm) on {filmed} of {} materials ({whose}); each material keeps its own base and the ambient is air",
+                index_of(&layer.material, "film 1")?.re,
+                format_range(doc),
+                model.materials.len(),
+            )),
+            None => notes.push("a bare interface: no film on the model".into()),
+        }
+        if stack.layers().len() > 1 {
+            notes.push(format!(
+                "a glTF material holds one film: films 2 to {} are not drawn",
+                stack.layers().len()
+            ));
+        }
+        let technique = if settings.technique == Technique::Stack {
+            notes.push(
+                "the glTF renderer draws one film per material: `stack` is drawn with spectral"
+                    .into(),
+            );
+            Technique::Spectral
+        } else {
+            settings.technique
+        };
+        let mut o = SceneOptions::new(SceneKind::Sphere);
+        [o.width, o.height] = settings.size;
+        o.exposure_ev = settings.exposure_ev;
+        if settings.lighting == Lighting::Uniform {
+            o.light.intensity = 0.0;
+        }
+        let environment = match settings.lighting {
+            Lighting::Studio => self.studio.clone(),
+            Lighting::Uniform => self.uniform.clone(),
+        };
+        let view = ViewPoint::Orbit(MeshOrbit {
+            yaw_deg: f64::from(settings.orbit.yaw_deg),
+            pitch_deg: f64::from(settings.orbit.pitch_deg),
+            distance: None,
+        });
+        let inputs =
+            nacre_runtime::mesh::RenderInputs::with_environment(&scene, &o, view, environment)?;
+        let out = nacre_runtime::mesh::render(&self.ctx, &self.tables, technique, &inputs)?;
+        notes.extend(out.notes.iter().map(|n| n.to_string()));
+        Ok(Frame {
+            image: out.image,
+            notes,
+            seconds: start.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// Draws `doc` with `settings`: compiles the technique's pipeline when none is kept for
+    /// it, rebinds its group 1 when the stack changed, renders and reads the picture back.
+    pub fn render(
+        &mut self,
+        settings: &ViewSettings,
+        doc: &StackDoc,
+        stack: &Stack,
+    ) -> Result<Frame, ViewError> {
+        if settings.model.is_some() {
+            return self.render_model(settings, doc, stack);
+        }
+        let start = std::time::Instant::now();
         let (options, notes) = self.options(settings, doc, stack)?;
         let technique_options = options.technique_options();
-        let renderer = match self.renderer.take() {
-            Some(r) if r.technique() == settings.technique => r,
-            _ => {
-                self.bound = None;
+        let kept = self
+            .renderers
+            .iter()
+            .position(|(r, _)| r.technique() == settings.technique);
+        let (mut renderer, mut bound) = match kept {
+            Some(k) => self.renderers.remove(k),
+            None => (
                 Renderer::new(
                     &self.ctx,
                     &self.tables,
                     settings.technique,
                     &technique_options,
-                )?
-            }
+                )?,
+                None,
+            ),
         };
-        let renderer = self.renderer.insert(renderer);
-        let key = (settings.technique, doc.clone());
-        if self.bound.as_ref() != Some(&key) {
-            // Drop the key first: a failed rebind leaves the renderer to be rebound.
-            self.bound = None;
+        if bound.as_ref() != Some(doc) {
+            // A failed rebind drops the renderer: the next frame builds it anew.
             renderer.rebind(&self.ctx, &self.tables, &technique_options)?;
-            self.bound = Some(key);
+            bound = Some(doc.clone());
         }
         let environment = match settings.lighting {
             Lighting::Studio => &self.studio,
@@ -317,14 +419,89 @@ impl View {
             &options,
             environment,
             &self.thickness,
-        )?;
+        );
+        self.renderers.push((renderer, bound));
+        if self.renderers.len() > KEPT_RENDERERS {
+            self.renderers.remove(0);
+        }
         Ok(Frame {
-            image,
+            image: image?,
             notes,
             seconds: start.elapsed().as_secs_f64(),
         })
     }
 }
+
+/// A material's index at [`INDEX_WAVELENGTH_NM`], its error naming `what`.
+fn index_of(m: &nacre_optics::Material, what: &str) -> Result<nacre_optics::C64, ViewError> {
+    m.index_at(INDEX_WAVELENGTH_NM)
+        .map_err(|source| ViewError::Index {
+            what: what.to_string(),
+            source,
+        })
+}
+
+/// The top film's thickness as drawn on a model: `d` or `d − r to d + r`, nm.
+fn format_range(doc: &StackDoc) -> String {
+    match doc.films.first() {
+        Some(f) if f.relative_nm > 0.0 => format!(
+            "{} to {}",
+            (f.thickness_nm - f.relative_nm).max(0.0),
+            f.thickness_nm + f.relative_nm
+        ),
+        Some(f) => format!("{}", f.thickness_nm),
+        None => "0".into(),
+    }
+}
+
+/// `model` with the stack's top film on its materials: on those with
+/// `KHR_materials_iridescence` (`all` false) or on every one (`all` true, a factor of 1
+/// where a material had none). The film's index is its real index at
+/// [`INDEX_WAVELENGTH_NM`] (`iridescenceIor`); its thickness spans `d − r` to `d + r`
+/// (`iridescenceThicknessMinimum`/`Maximum`: a thickness texture, where the material has
+/// one, varies it between them; without one the extension draws the maximum, so both
+/// are d when r = 0). A bare interface (no film) sets the factors to 0. Returns the scene
+/// and how many materials carry the film.
+pub fn film_on_model(
+    model: &GltfScene,
+    doc: &StackDoc,
+    stack: &Stack,
+    all: bool,
+) -> Result<(GltfScene, usize), ViewError> {
+    let mut scene = model.clone();
+    let film = match (stack.layers().first(), doc.films.first()) {
+        (Some(layer), Some(f)) => Some((index_of(&layer.material, "film 1")?.re, f)),
+        _ => None,
+    };
+    let mut filmed = 0;
+    for m in &mut scene.materials {
+        if m.iridescence.is_none() && all {
+            m.iridescence = Some(nacre_runtime::gltf_scene::Iridescence {
+                factor: 1.0,
+                ..Default::default()
+            });
+        }
+        let Some(i) = &mut m.iridescence else {
+            continue;
+        };
+        match film {
+            Some((n, f)) => {
+                i.ior = n as f32;
+                i.thickness_min_nm = (f.thickness_nm - f.relative_nm).max(0.0) as f32;
+                i.thickness_max_nm = (f.thickness_nm + f.relative_nm) as f32;
+                if i.factor > 0.0 {
+                    filmed += 1;
+                }
+            }
+            None => i.factor = 0.0,
+        }
+    }
+    Ok((scene, filmed))
+}
+
+/// How many compiled renderers the view keeps (the chosen technique and the comparison's
+/// reference, [`crate::compare::REFERENCE`], and one more to switch back without a compile).
+pub const KEPT_RENDERERS: usize = 3;
 
 /// The pixel the view shows where a film of reflectance colour `rgb` (linear, the output
 /// space of `nacre color`) faces the camera under [`Lighting::Uniform`] (radiance 1, no

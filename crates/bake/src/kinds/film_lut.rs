@@ -59,7 +59,7 @@
 //! changed along a row ([`SpectrumSweep::set_thicknesses_nm`]). The channels, axes and the
 //! shader's rebuild are a film-lut's; the manifest lists the slab in `under_incoherent`.
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::kinds::{KindEntry, TableRecipe};
 use crate::recipe::{
     OutputSettings, RawColour, RawOutput, RawStack, RecipeStack, line_of, parse_colour, table_name,
@@ -78,6 +78,7 @@ use nacre_optics::{C64, FilmColours, Layer, Material, SpectralRule, SpectrumSwee
 use rayon::prelude::*;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use toml::Spanned;
 
 #[derive(Deserialize)]
@@ -251,7 +252,27 @@ pub fn bake_recipe(
     out_dir: &Path,
     progress: &(dyn Fn() + Sync),
 ) -> Result<PathBuf> {
-    let lut: FilmLut = recipe.job.bake(progress)?;
+    bake_recipe_cancellable(recipe, out_dir, progress, &AtomicBool::new(false))
+}
+
+/// [`bake_recipe`] that stops with [`Error::Cancelled`] when `cancel` is set before the
+/// table is computed: rows not started yet are skipped, and nothing is written (the output
+/// folder is not even created). Once the table is computed its files are written and
+/// committed whatever `cancel` says, so the folder holds the whole table or none of it.
+pub fn bake_recipe_cancellable(
+    recipe: &FilmLutRecipe,
+    out_dir: &Path,
+    progress: &(dyn Fn() + Sync),
+    cancel: &AtomicBool,
+) -> Result<PathBuf> {
+    let lut: FilmLut = recipe
+        .job
+        .bake_cancellable(progress, cancel, &recipe.name)?;
+    if cancel.load(Ordering::Relaxed) {
+        return Err(Error::Cancelled {
+            table: recipe.name.clone(),
+        });
+    }
     // Every file goes to a staging folder first; `commit` moves them in, the manifest last.
     let stage = nacre_format::stage::StagedTable::new(out_dir)?;
     let mut stale = Vec::new();
@@ -345,6 +366,27 @@ impl FilmLutJob {
     /// Bakes the table: rows of constant (cos θ, n) in parallel, each a thickness sweep
     /// integrated spectrally; `progress` is called once per finished row.
     pub fn bake(&self, progress: &(dyn Fn() + Sync)) -> Result<FilmLut> {
+        self.bake_cancellable(progress, &AtomicBool::new(false), "film-lut")
+    }
+
+    /// [`FilmLutJob::bake`] that stops with [`Error::Cancelled`] (naming `table`) when
+    /// `cancel` is set: every row checks it before it starts. The rows' values do not
+    /// depend on it, so a bake that is not cancelled gives the same bytes.
+    pub fn bake_cancellable(
+        &self,
+        progress: &(dyn Fn() + Sync),
+        cancel: &AtomicBool,
+        table: &str,
+    ) -> Result<FilmLut> {
+        let check = || {
+            if cancel.load(Ordering::Relaxed) {
+                Err(Error::Cancelled {
+                    table: table.to_string(),
+                })
+            } else {
+                Ok(())
+            }
+        };
         let a = &self.axes;
         let under_opd: f64 = {
             let probe = Stack::new(self.ambient.clone(), self.under.clone(), self.base.clone())?;
@@ -368,6 +410,7 @@ impl FilmLutJob {
             let results = rows
                 .par_iter()
                 .map(|&(x, z)| {
+                    check()?;
                     let (cos_theta, _, n) = a.texel_parameters(x, 0, z);
                     let colours = self.slab_row(cos_theta, n, &rule, &thicknesses(x, z))?;
                     progress();
@@ -418,6 +461,7 @@ impl FilmLutJob {
             .par_iter()
             .enumerate()
             .map(|(i, &(x, z))| {
+                check()?;
                 let (cos_theta, _, n) = a.texel_parameters(x, 0, z);
                 let thicknesses = thicknesses(x, z);
                 if let (Some(films), Some(transform)) = (&films, &transform)
