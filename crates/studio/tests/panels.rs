@@ -371,13 +371,10 @@ fn a_gltf_model_opens_and_wears_the_stacks_film() {
     let changed = pixel_difference(&water_380, &water_650);
     // The same model without any film, for scale.
     let doc = h.state().stack().0.clone();
-    let (bare, filmed) = {
-        let scene = nacre_runtime::gltf_scene::GltfScene::load(&path).unwrap();
-        let mut no_film = doc.clone();
-        no_film.films.clear();
-        let (s, n) = film_on_model(&scene, &no_film, &no_film.build().unwrap(), false).unwrap();
-        (s, n)
-    };
+    let scene = nacre_runtime::gltf_scene::GltfScene::load(&path).unwrap();
+    let mut no_film = doc.clone();
+    no_film.films.clear();
+    let (bare, filmed) = film_on_model(&scene, &no_film, &no_film.build().unwrap(), false).unwrap();
     assert_eq!(filmed, 0);
     assert!(
         bare.materials
@@ -395,7 +392,6 @@ fn a_gltf_model_opens_and_wears_the_stacks_film() {
     // iridescent already, so the picture stays).
     h.get_by_label("Film on every material").click();
     settle(&mut h);
-    let scene = nacre_runtime::gltf_scene::GltfScene::load(&path).unwrap();
     let (_, all) = film_on_model(&scene, &doc, &doc.build().unwrap(), true).unwrap();
     assert_eq!(all, scene.materials.len());
     let notes = h.state().frame.as_ref().unwrap().notes.join("\n");
