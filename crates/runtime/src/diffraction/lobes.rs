@@ -170,7 +170,7 @@ impl EnvironmentLobes {
             .chain(sharp.iter().map(|&i| kappa(i)))
             .collect();
         let mut group = vec![usize::MAX; power0.len()];
-        for i in 0..power0.len() {
+        for (i, slot) in group.iter_mut().enumerate() {
             if i == dc || sharp.contains(&i) {
                 continue;
             }
@@ -182,7 +182,7 @@ impl EnvironmentLobes {
                     best = (d, a);
                 }
             }
-            group[i] = best.1;
+            *slot = best.1;
         }
         // Efficiencies: |P_j(kw)|² at every sample, summed per lobe (lobe index: sharp
         // bins 0 … S − 1, halos S … 2S).
@@ -228,7 +228,7 @@ impl EnvironmentLobes {
             // Power-weighted centroid and per-axis variance of the group at s₀.
             let members: Vec<usize> = (0..power0.len()).filter(|&i| group[i] == a).collect();
             let w: f64 = members.iter().map(|&i| power0[i]).sum();
-            if !(w > 0.0) {
+            if w.is_nan() || w <= 0.0 {
                 continue;
             }
             let mut c = [0.0, 0.0];
