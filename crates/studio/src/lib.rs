@@ -5,7 +5,7 @@
 //!
 //! Files: `bake.rs` (the export panel's table bake on a background thread), `compare.rs` (the ΔE2000 map against the exact technique), `doc.rs` (the stack as edited, presets, undo, the recipe), `view.rs` (the live
 //! view on the runtime's `Renderer`), `curves.rs` (spectra and colours for the plots, on a
-//! background thread), `app.rs` (the window's panels), `main.rs` (the `nacre-studio`
+//! background thread), `app/` (the window's panels, one file each), `main.rs` (the `nacre-studio`
 //! binary: its flags, eframe, `--screenshot`).
 
 pub mod app;
