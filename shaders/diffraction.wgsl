@@ -61,7 +61,8 @@ const DIFFRACTION_TWO_PI: f32 = 6.28318530717959;
 //       40    4 wavelength_count: u32    entries of diffraction_spectrum
 //       44    4 fresnel_kind: u32        0: F² = 1; 1: Fresnel of fresnel_ior
 //       48    8 fresnel_ior: vec2<f32>   (n, κ) of the bulk material (fresnel_kind 1)
-//       56    8 _pad: vec2<f32>
+//       56    8 filter_radius: vec2<i32> largest R per axis the footprint filter may grow to
+//                                        (−1, −1: the filter is off)
 struct DiffractionParams {
     size: vec2<u32>,
     dc: vec2<i32>,
@@ -72,7 +73,7 @@ struct DiffractionParams {
     wavelength_count: u32,
     fresnel_kind: u32,
     fresnel_ior: vec2<f32>,
-    _pad: vec2<f32>,
+    filter_radius: vec2<i32>,
 }
 
 @group(1) @binding(0) var<uniform> diffraction: DiffractionParams;
@@ -144,6 +145,182 @@ fn diffraction_transform(k_per_um: f32, uvw: vec3<f32>) -> vec2<f32> {
         }
     }
     return sum;
+}
+
+// ─── Footprint filter (issue 37, item 3: no aliasing) ─────────────────────────────────────
+//
+// A pixel sees a spread of (u, v), not one point: the view direction and the grating frame
+// (the CD's tracks curve) change across it. |P̃|² varies on the scale 1/σ_s in q = k (u, v)
+// (the coherence lobe), finer than a pixel's footprint for a grating far away, so a point
+// sample per pixel is noise. The filtered intensity is the mean of |P̃(q)|² over a Gaussian
+// footprint q ~ N(q̄, diag(s_x², s_y²)), s = k σ_uv with σ_uv the footprint's standard deviation
+// in (u, v) per axis of the grating frame (the scenes take it from ray differentials: the
+// neighbouring pixels' rays, a box pixel's variance 1/12 of the difference²). Exactly, with
+// g(q − κ) = exp(−σ_s² |q − κ|²/2) the window and A = 1 + 2 σ_s² s² per axis:
+//
+//   E|P̃|² = Σ_{j, j′} Re(P_j P_{j′}*) W(j, j′),   W = Π_axes E[g(q − κ_j) g(q − κ_{j′})]
+//   E[g(q − a) g(q − b)] = A^{−½} exp(−σ_s² (a − b)²/4 − σ_s² (q̄ − (a + b)/2)²/A)      (1-D)
+//
+// (the product of two Gaussians is a Gaussian at their midpoint; its mean over a Gaussian is
+// the convolution of two Gaussians). At s = 0, W = g g and the sum is |Σ_j P_j g_j|², the
+// unfiltered P̃. The shader evaluates it as the unfiltered coherent sum plus the correction
+// (W − g g) of the pairs at most one bin apart per axis (the diagonal and the 8 neighbours):
+// exact at s = 0 and for an isolated order; the pairs ≥ 2 bins apart keep their unfiltered
+// weight g g ≤ exp(−(σ_s Δκ)²) (0.085 of a bin's amplitude² for the CD tables, σ_s Δκ = π/2),
+// so their speckle is what the filter leaves. The neighbourhood grows with the footprint,
+// R_f = ⌈(R + ½) √A − ½⌉ per axis, capped by the uniform's filter_radius (the host keeps it
+// within llvmpipe's loop budget); a footprint wider than the cap would lose the bins past
+// it, so the result is then scaled by Σ_all exp(−σ_s² (q̄ − κ)²/A) / Σ_window (the Gaussian's
+// sum over every bin, √(π A)/(σ_s Δκ), over the part the window holds) per axis — the
+// energy is kept, not the detail. Only the Taylor sums load texels: the neighbourhood's cost
+// is (2R_f + 1)² Taylor sums per wavelength, the pairs are arithmetic on values kept in two
+// rows.
+
+// Largest filter radius the shader holds (its row buffers; `MAX_FILTER_RADIUS` on the host).
+const DIFFRACTION_MAX_FILTER_RADIUS: i32 = 8;
+
+// Per-axis weights of the footprint filter at window offset i (j = first + i): the window g,
+// the diagonal mean E[g²] (both as in the header), and the pair mean E[g_j g_{j+1}].
+struct DiffractionAxisWeights {
+    g: array<f32, 17>,
+    diag: array<f32, 17>,
+    next: array<f32, 17>,
+    // Σ_all / Σ_window of the diagonal weights when the cap cut the window, else 1.
+    renorm: f32,
+}
+
+fn diffraction_axis_weights(q: f32, dk: f32, first: i32, count: i32, a: f32, s2: f32, cut: bool) -> DiffractionAxisWeights {
+    var w: DiffractionAxisWeights;
+    let inv_sqrt_a = inverseSqrt(a);
+    var held = 0.0;
+    for (var i = 0; i < count; i++) {
+        let d = q - f32(first + i) * dk;
+        w.g[i] = exp(-0.5 * s2 * d * d);
+        let e = exp(-s2 * d * d / a);
+        held += e;
+        w.diag[i] = inv_sqrt_a * e;
+        let m = q - (f32(first + i) + 0.5) * dk;
+        w.next[i] = inv_sqrt_a * exp(-0.25 * s2 * dk * dk - s2 * m * m / a);
+    }
+    w.renorm = 1.0;
+    if cut && held > 0.0 {
+        let all = sqrt(3.14159265358979 * a / s2) / dk;
+        w.renorm = max(1.0, all / held);
+    }
+    return w;
+}
+
+// E|P̃|² over the footprint (above) for wave number k (rad/µm), (u, v, w) at the pixel's
+// centre and σ_uv ≥ 0 the footprint's standard deviation in (u, v) per axis.
+fn diffraction_filtered_intensity(k_per_um: f32, uvw: vec3<f32>, sigma_uv: vec2<f32>) -> f32 {
+    var c: array<vec2<f32>, 32>;
+    let kw = k_per_um * uvw.z;
+    var term = 1.0;
+    let order = min(diffraction.order, DIFFRACTION_MAX_ORDER);
+    for (var n = 0u; n <= order; n++) {
+        if n > 0u {
+            term *= kw / f32(n);
+        }
+        if (n & 1u) == 0u {
+            c[n / 2u].x = term;
+        } else {
+            c[n / 2u].y = term;
+        }
+    }
+    let q = k_per_um * uvw.xy;
+    let s = k_per_um * max(sigma_uv, vec2<f32>(0.0));
+    let s2 = diffraction.sigma_s_um * diffraction.sigma_s_um;
+    let a = vec2<f32>(1.0) + 2.0 * s2 * s * s;
+    let size = vec2<i32>(diffraction.size);
+    let lo = -diffraction.dc;
+    let hi = lo + size - vec2<i32>(1);
+    let dk = diffraction.dk_per_um;
+    let j_real = q / dk;
+    let r = diffraction.radius;
+    let cap = clamp(diffraction.filter_radius, r, vec2<i32>(DIFFRACTION_MAX_FILTER_RADIUS));
+    let need = ceil((vec2<f32>(r) + 0.5) * sqrt(a) - 0.5);
+    let rf = vec2<i32>(clamp(need, vec2<f32>(r), vec2<f32>(cap)));
+    let reach = vec2<f32>(lo - rf) - 0.5;
+    let reach_hi = vec2<f32>(hi + rf) + 0.5;
+    if any(j_real < reach) || any(j_real > reach_hi) || !diffraction_finite(j_real.x) || !diffraction_finite(j_real.y) || !diffraction_finite(a.x) || !diffraction_finite(a.y) {
+        return 0.0;
+    }
+    let j0 = vec2<i32>(round(j_real));
+    let first = j0 - rf;
+    let count = 2 * rf + vec2<i32>(1);
+    // The cap cut the window (and the table has bins past it on that axis).
+    let cut = (need > vec2<f32>(rf)) & (size > count);
+    let wx = diffraction_axis_weights(q.x, dk.x, first.x, count.x, a.x, s2, cut.x);
+    let wy = diffraction_axis_weights(q.y, dk.y, first.y, count.y, a.y, s2, cut.y);
+    var prev: array<vec2<f32>, 17>;
+    var cur: array<vec2<f32>, 17>;
+    var coherent_sum = vec2<f32>(0.0);
+    var correction = 0.0;
+    for (var iy = 0; iy < count.y; iy++) {
+        let jy = first.y + iy;
+        let gy = wy.g[iy];
+        let gy_prev = select(0.0, wy.g[max(iy - 1, 0)], iy > 0);
+        let wyd = wy.diag[iy];
+        let wyn = select(0.0, wy.next[max(iy - 1, 0)], iy > 0);
+        for (var ix = 0; ix < count.x; ix++) {
+            let jx = first.x + ix;
+            var p = vec2<f32>(0.0);
+            if jx >= lo.x && jx <= hi.x && jy >= lo.y && jy <= hi.y {
+                p = diffraction_taylor_sum(vec2<i32>(jx, jy) + diffraction.dc, &c);
+            }
+            cur[ix] = p;
+            let gx = wx.g[ix];
+            coherent_sum += p * (gx * gy);
+            correction += dot(p, p) * (wx.diag[ix] * wyd - gx * gx * gy * gy);
+            if ix > 0 {
+                let g_left = wx.g[ix - 1];
+                correction += 2.0 * dot(p, cur[ix - 1]) * (wx.next[ix - 1] * wyd - gx * g_left * gy * gy);
+            }
+            if iy > 0 {
+                correction += 2.0 * dot(p, prev[ix]) * (wx.diag[ix] * wyn - gx * gx * gy * gy_prev);
+                if ix > 0 {
+                    let g_left = wx.g[ix - 1];
+                    correction += 2.0 * dot(p, prev[ix - 1]) * (wx.next[ix - 1] * wyn - gx * g_left * gy * gy_prev);
+                }
+                if ix + 1 < count.x {
+                    let g_right = wx.g[ix + 1];
+                    correction += 2.0 * dot(p, prev[ix + 1]) * (wx.next[ix] * wyn - gx * g_right * gy * gy_prev);
+                }
+            }
+        }
+        prev = cur;
+    }
+    let e = (dot(coherent_sum, coherent_sum) + correction) * wx.renorm * wy.renorm;
+    return select(0.0, max(e, 0.0), diffraction_finite(e));
+}
+
+// The colour Σ_λ F² G/w² E|P̃|² u(λ) of `diffraction_colour` filtered over a pixel's
+// footprint of standard deviation σ_uv in (u, v) per axis of the grating frame (the filter
+// above); σ_uv = 0 is `diffraction_colour` (up to rounding). A table whose own radius R
+// exceeds the shader's row buffers (DIFFRACTION_MAX_FILTER_RADIUS), and every table when the
+// host turned the filter off (filter_radius −1), is evaluated unfiltered.
+// Always finite.
+fn diffraction_colour_footprint(wi_in: vec3<f32>, wr_in: vec3<f32>, sigma_uv: vec2<f32>) -> vec3<f32> {
+    if any(diffraction.radius > vec2<i32>(DIFFRACTION_MAX_FILTER_RADIUS)) || diffraction.filter_radius.x < 0 {
+        return diffraction_colour(wi_in, wr_in);
+    }
+    let wi = diffraction_unit(wi_in);
+    let wr = diffraction_unit(wr_in);
+    let g = diffraction_geometry_over_w2(wi, wr);
+    if !(g > 0.0) || !diffraction_finite(g) || !diffraction_finite(sigma_uv.x) || !diffraction_finite(sigma_uv.y) {
+        return vec3<f32>(0.0);
+    }
+    let uvw = -wi - wr;
+    let cos_h = -dot(wi, uvw) * inverseSqrt(dot(uvw, uvw));
+    let fresnel = diffraction_fresnel(cos_h);
+    var colour = vec3<f32>(0.0);
+    let count = min(diffraction.wavelength_count, arrayLength(&diffraction_spectrum));
+    for (var i = 0u; i < count; i++) {
+        let sp = diffraction_spectrum[i];
+        let k = DIFFRACTION_TWO_PI / (sp.x * 1e-3);
+        colour += (fresnel * g * diffraction_filtered_intensity(k, uvw, sigma_uv)) * sp.yzw;
+    }
+    return select(vec3<f32>(0.0), colour, diffraction_finite3(colour));
 }
 
 // Relative reflectance ρ(ω_i, ω_r, λ) = F² G/w² |P̃|² for unit directions in the grating frame.

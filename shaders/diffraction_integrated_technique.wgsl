@@ -10,6 +10,8 @@
 // (the host's `FresnelTerm`, as the terms technique's uniform carries it).
 //
 //   diffraction_colour(ω_i, ω_r)              = diffraction_integrated_colour(ω_i, ω_r, F²)
+//   diffraction_colour_footprint(ω_i, ω_r, σ_uv) = diffraction_colour(ω_i, ω_r): the integrated
+//                                               tables are not filtered over the footprint
 //   diffraction_specular_order_colour(cos θ)  = diffraction_integrated_specular_colour(cos θ, F²)
 //                                               (the mirror-lobe peak; see its comment)
 //   diffraction_fresnel(cos θ)                = diffraction_fresnel_of(cos θ, the uniform's F²)
@@ -21,6 +23,10 @@ fn diffraction_fresnel(cos_theta: f32) -> f32 {
 
 fn diffraction_colour(wi: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
     return diffraction_integrated_colour(wi, wr, diffraction_integrated.fresnel_kind, diffraction_integrated.fresnel_ior);
+}
+
+fn diffraction_colour_footprint(wi: vec3<f32>, wr: vec3<f32>, sigma_uv: vec2<f32>) -> vec3<f32> {
+    return diffraction_colour(wi, wr);
 }
 
 fn diffraction_specular_order_colour(cos_theta: f32) -> vec3<f32> {

@@ -18,6 +18,10 @@
 //     + Σ_λ u(λ) ⊙ Σ_c F² G/w² η_c(k w_c) L_env(ω_c(λ))     the environment through the lobes
 //     + base (snake skin only: a dark diffuse layer, albedo × (n·ω_0 E_0 + ambient))
 //
+// where each Σ_λ ρ u is filtered over the pixel's footprint (diffraction_colour_footprint,
+// issue 37: the footprint's σ_uv from the neighbouring pixels' rays, scene_footprint below;
+// the integrated layout's adapter point-samples).
+//
 // I_k = E_k · (σ_s k₀)²/π is the radiance of source k's mirror image spread over the
 // coherence lobe (E_k its irradiance at normal incidence, k₀ = 2π/555 nm; computed on the
 // CPU, `nacre_runtime::diffraction::lobe_gain`): a flat mirror's lobe |P̃|² integrates to
@@ -288,18 +292,94 @@ fn scene_env_diffracted(frame: mat3x3<f32>, wr: vec3<f32>) -> vec3<f32> {
     return select(vec3<f32>(0.0), sum, diffraction_finite3(sum));
 }
 
-// World direction into the grating frame of the surface.
-fn scene_shade(s: Surface, to_eye: vec3<f32>) -> vec3<f32> {
+// A neighbouring pixel's view of the surface (a ray differential, issue 37): its grating
+// frame and its direction to the eye in that frame; `ok` false when its ray misses.
+struct Neighbour {
+    ok: bool,
+    frame: mat3x3<f32>,
+    wr: vec3<f32>,
+}
+
+// The camera ray through framebuffer position `pixel` (y down), as (origin, unit direction).
+fn scene_ray(pixel: vec2<f32>) -> array<vec3<f32>, 2> {
+    let ndc = vec2<f32>(
+        pixel.x / view.resolution.x * 2.0 - 1.0,
+        1.0 - pixel.y / view.resolution.y * 2.0,
+    );
+    let near = view.inv_view_proj * vec4<f32>(ndc, 0.0, 1.0);
+    let far = view.inv_view_proj * vec4<f32>(ndc, 1.0, 1.0);
+    let origin = near.xyz / near.w;
+    return array<vec3<f32>, 2>(origin, normalize(far.xyz / far.w - origin));
+}
+
+fn scene_hit(origin: vec3<f32>, dir: vec3<f32>) -> Surface {
+    if view.scene == 0u {
+        return cd_disc(origin, dir);
+    } else if view.scene == 3u {
+        return grating_plane(origin, dir);
+    }
+    return snake_skin(origin, dir);
+}
+
+// The surface seen one pixel away, at framebuffer position `pixel` + `step`.
+fn scene_neighbour(pixel: vec2<f32>, step: vec2<f32>) -> Neighbour {
+    var n: Neighbour;
+    let ray = scene_ray(pixel + step);
+    let s = scene_hit(ray[0], ray[1]);
+    n.ok = s.hit;
+    if s.hit {
+        n.frame = diffraction_frame(s.normal, s.across);
+        n.wr = n.frame * -ray[1];
+    }
+    return n;
+}
+
+// The change of (u, v) = −(F ω_i + F ω_r)_xy towards one neighbour along an axis of the
+// screen: the smaller of the two sides' (a pixel on an edge — the snake's scales, the
+// disc's rim — takes the side that sees its own surface); 0 when both miss.
+fn scene_uv_step(l: vec3<f32>, uv: vec2<f32>, plus: Neighbour, minus: Neighbour) -> vec2<f32> {
+    var best = vec2<f32>(0.0);
+    var best_len = -1.0;
+    if plus.ok {
+        best = -(plus.frame * l + plus.wr).xy - uv;
+        best_len = dot(best, best);
+    }
+    if minus.ok {
+        let d = uv + (minus.frame * l + minus.wr).xy;
+        if best_len < 0.0 || dot(d, d) < best_len {
+            best = d;
+        }
+    }
+    return best;
+}
+
+// The pixel's footprint in (u, v) for light from `l` (world): σ_uv per axis of the grating
+// frame, from the differences of (u, v) to the neighbouring pixels' (in their own frames:
+// the CD's tracks turn across a distant pixel), a box pixel's variance (Δ_x² + Δ_y²)/12,
+// at most 0.25 (a pixel spanning a large part of the hemisphere). n: the neighbours at
+// +x, −x, +y, −y.
+fn scene_footprint(l: vec3<f32>, frame: mat3x3<f32>, wr: vec3<f32>, n: array<Neighbour, 4>) -> vec2<f32> {
+    let uv = -(frame * l + wr).xy;
+    let dx = scene_uv_step(l, uv, n[0], n[1]);
+    let dy = scene_uv_step(l, uv, n[2], n[3]);
+    let sigma = sqrt((dx * dx + dy * dy) / 12.0);
+    return select(vec2<f32>(0.0), min(sigma, vec2<f32>(0.25)), diffraction_finite(sigma.x) && diffraction_finite(sigma.y));
+}
+
+// World direction into the grating frame of the surface; around: the neighbouring pixels' views
+// at +x, −x, +y, −y (the footprint filter of diffraction_colour_footprint).
+fn scene_shade(s: Surface, to_eye: vec3<f32>, around: array<Neighbour, 4>) -> vec3<f32> {
     let frame = diffraction_frame(s.normal, s.across);
     let wr = frame * to_eye;
     var radiance = vec3<f32>(0.0);
     let light = normalize(view.light_direction);
     let light_radiance = view.light_colour * lights.light_radiance;
     if s.grating > 0.0 {
-        var diffracted = diffraction_colour(frame * light, wr) * light_radiance;
+        var diffracted = diffraction_colour_footprint(frame * light, wr, scene_footprint(light, frame, wr, around)) * light_radiance;
         let count = min(lights.sample_count, 8u);
         for (var k = 0u; k < count; k++) {
-            diffracted += diffraction_colour(frame * lights.samples[k].xyz, wr) * lights.sample_radiance[k].rgb;
+            let l = lights.samples[k].xyz;
+            diffracted += diffraction_colour_footprint(frame * l, wr, scene_footprint(l, frame, wr, around)) * lights.sample_radiance[k].rgb;
         }
         diffracted += scene_env_diffracted(frame, wr);
         radiance += s.grating * diffracted;
@@ -349,26 +429,19 @@ fn diffraction_scene_fs(@builtin(position) position: vec4<f32>) -> @location(0) 
     if view.scene == 2u {
         return scene_display(scene_bench(position.xy));
     }
-    let ndc = vec2<f32>(
-        position.x / view.resolution.x * 2.0 - 1.0,
-        1.0 - position.y / view.resolution.y * 2.0,
-    );
-    let near = view.inv_view_proj * vec4<f32>(ndc, 0.0, 1.0);
-    let far = view.inv_view_proj * vec4<f32>(ndc, 1.0, 1.0);
-    let origin = near.xyz / near.w;
-    let dir = normalize(far.xyz / far.w - origin);
-    var s: Surface;
-    if view.scene == 0u {
-        s = cd_disc(origin, dir);
-    } else if view.scene == 3u {
-        s = grating_plane(origin, dir);
-    } else {
-        s = snake_skin(origin, dir);
-    }
+    let ray = scene_ray(position.xy);
+    let dir = ray[1];
+    let s = scene_hit(ray[0], dir);
     if !s.hit {
         return scene_display(scene_env(dir, 0.0));
     }
-    return scene_display(scene_shade(s, -dir));
+    let n = array<Neighbour, 4>(
+        scene_neighbour(position.xy, vec2<f32>(1.0, 0.0)),
+        scene_neighbour(position.xy, vec2<f32>(-1.0, 0.0)),
+        scene_neighbour(position.xy, vec2<f32>(0.0, 1.0)),
+        scene_neighbour(position.xy, vec2<f32>(0.0, -1.0)),
+    );
+    return scene_display(scene_shade(s, -dir, n));
 }
 
 // ─── GPU = CPU probe (compute) ──────────────────────────────────────────────────────────

@@ -63,11 +63,13 @@ pub use lobes::EnvironmentLobes;
 pub use scene::{
     DEFAULT_ENV_SAMPLES, DIFFRACTION_SCENE, DiffractionLightsUniform, DiffractionScene,
     DiffractionSceneOptions, LOBE_REFERENCE_NM, LobeData, MAX_ENV_SAMPLES, ScenePass,
-    environment_samples, lobe_gain, render_diffraction_scene, render_diffraction_scene_in,
+    environment_samples, llvmpipe_filter_radius, lobe_gain, render_diffraction_scene,
+    render_diffraction_scene_in,
 };
 pub use tables::DiffractionTables;
 pub use terms::{
     DIFFRACTION, DiffractionBinding, DiffractionOptions, DiffractionTable, DiffractionUniform,
-    LLVMPIPE_LOOP_LIMIT, MAX_RADIUS, MAX_TAYLOR_ORDER, MAX_WAVELENGTHS, ProbeOutput, compose,
-    composition, run_probe, spectrum_weights, wavelength_grid,
+    LLVMPIPE_LOOP_LIMIT, MAX_FILTER_RADIUS, MAX_RADIUS, MAX_TAYLOR_ORDER, MAX_WAVELENGTHS,
+    ProbeOutput, compose, composition, filter_radius, filtered_iterations, run_probe,
+    spectrum_weights, wavelength_grid,
 };

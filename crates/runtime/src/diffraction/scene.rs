@@ -6,8 +6,8 @@ use super::integrated;
 use super::lobes::{EnvironmentLobes, LOBE_KW_SAMPLES};
 use super::tables::DiffractionTables;
 use super::terms::{
-    DiffractionBinding, DiffractionOptions, LLVMPIPE_LOOP_LIMIT, composition, spectrum_weights,
-    wavelength_grid,
+    DiffractionBinding, DiffractionOptions, DiffractionTable, LLVMPIPE_LOOP_LIMIT, composition,
+    filter_radius, filtered_iterations, spectrum_weights, wavelength_grid,
 };
 use crate::context::{BufferInitExt, GpuContext};
 use crate::environment::EnvironmentMap;
@@ -648,13 +648,14 @@ impl ScenePass {
             &LobeData::default(),
             &env,
         )?;
-        pass.check_loop_cap(ctx, 1, 0, "bench")?;
+        pass.check_loop_cap(ctx, 1, false, 0, "bench")?;
         Ok(pass)
     }
 
     /// On llvmpipe, refuses a terms-layout pass whose per-pixel loops — `diffracted` calls of
-    /// `diffraction_colour`, the specular order and `lobe_iterations` of the environment's
-    /// lobe sum ([`LobeData::iterations`]) — could run past
+    /// `diffraction_colour` (`diffraction_colour_footprint` when `filtered`: the scenes), the
+    /// specular order and `lobe_iterations` of the environment's lobe sum
+    /// ([`LobeData::iterations`]) — could run past
     /// [`LLVMPIPE_LOOP_LIMIT`], which would silently cut them short. The estimate counts
     /// the sums' own loops; llvmpipe's count runs ~20 % higher (cd-disc went wrong from 56
     /// wavelengths on, an estimate of 54,824), so the pass is refused above three quarters of
@@ -666,6 +667,7 @@ impl ScenePass {
         &self,
         ctx: &GpuContext,
         diffracted: u64,
+        filtered: bool,
         lobe_iterations: u64,
         what: &str,
     ) -> Result<()> {
@@ -674,7 +676,12 @@ impl ScenePass {
         };
         let u = &binding.uniform;
         let specular = u64::from(u.wavelength_count) * (u64::from(u.order) + 3);
-        let needed = diffracted * binding.loop_iterations_per_colour() + specular + lobe_iterations;
+        let per_colour = if filtered {
+            binding.loop_iterations_per_filtered_colour()
+        } else {
+            binding.loop_iterations_per_colour()
+        };
+        let needed = diffracted * per_colour + specular + lobe_iterations;
         if ctx.info.name.contains("llvmpipe") && needed > LLVMPIPE_LOOP_LIMIT * 3 / 4 {
             return Err(Error::Refused {
                 context: format!("the diffraction {what} pass on {}", ctx.info.name),
@@ -718,6 +725,42 @@ impl ScenePass {
             SceneTechnique::Integrated { .. } => None,
         }
     }
+}
+
+/// The footprint filter's radius cap for a scene pass of `table` on llvmpipe: the largest
+/// cap, at most `technique.filter_radius`, whose per-pixel loops (`diffracted` filtered
+/// colours, the specular order and `lobe_iterations` of the environment's lobes) stay within three quarters of [`LLVMPIPE_LOOP_LIMIT`]
+/// (the margin of [`ScenePass::check_loop_cap`]); 0 (the table's own radius) when none does,
+/// which that check then refuses; `None` when the filter is off. The filter keeps its weights at any cap; a smaller one
+/// loses the detail of the widest footprints, not their energy (`shaders/diffraction.wgsl`).
+///
+/// # Errors
+/// [`Error::Invalid`] for a bad window tolerance or wavelength step.
+pub fn llvmpipe_filter_radius(
+    table: &DiffractionTable,
+    technique: &DiffractionOptions,
+    diffracted: u64,
+    lobe_iterations: u64,
+) -> Result<Option<i32>> {
+    let radius = table.radius(technique.window_tolerance)?;
+    let wavelengths = wavelength_grid(&table.record, technique.wavelength_step_nm)?.len() as u32;
+    let order = table.terms.order() as u32;
+    let specular = u64::from(wavelengths) * (u64::from(order) + 3);
+    let size = [table.record.nx, table.record.ny];
+    let Some(wanted) = technique.filter_radius else {
+        return Ok(None);
+    };
+    let top = wanted.clamp(0, super::terms::MAX_FILTER_RADIUS);
+    Ok((0..=top)
+        .rev()
+        .find(|&cap| {
+            let needed = diffracted
+                * filtered_iterations(order, wavelengths, filter_radius(radius, size, cap))
+                + specular
+                + lobe_iterations;
+            needed <= LLVMPIPE_LOOP_LIMIT * 3 / 4
+        })
+        .or(Some(0)))
 }
 
 /// Reference wavelength of [`lobe_gain`], nm.
@@ -828,11 +871,21 @@ pub fn render_diffraction_scene_in(
         lights.sample_radiance[k] =
             [l[0], l[1], l[2], 0.0].map(|x| x * options.env_intensity * gain);
     }
-    let pass = ScenePass::new(ctx, table, &options.technique, &view, &lights, &lobes, env)?;
-    // The light and every environment sample are diffracted; the lobes add their sum.
+    // The light and every environment sample are diffracted, filtered over the footprint;
+    // the lobes add their sum.
+    let diffracted = 1 + samples.len() as u64;
+    let mut technique = options.technique;
+    if let DiffractionTables::Terms(t) = table
+        && ctx.info.name.contains("llvmpipe")
+    {
+        technique.filter_radius =
+            llvmpipe_filter_radius(t, &technique, diffracted, lobes.iterations())?;
+    }
+    let pass = ScenePass::new(ctx, table, &technique, &view, &lights, &lobes, env)?;
     pass.check_loop_cap(
         ctx,
-        1 + samples.len() as u64,
+        diffracted,
+        true,
         lobes.iterations(),
         options.scene.name(),
     )?;

@@ -31,6 +31,9 @@ pub const DIFFRACTION: &str = concat!(
 pub const MAX_TAYLOR_ORDER: usize = 63;
 /// Largest neighbourhood radius R, bins per side.
 pub const MAX_RADIUS: i32 = 16;
+/// Largest neighbourhood radius, bins per side, the footprint filter grows to
+/// (`DIFFRACTION_MAX_FILTER_RADIUS` in the WGSL: its row buffers hold 2 · 8 + 1 bins).
+pub const MAX_FILTER_RADIUS: i32 = 8;
 /// Most wavelengths of the spectral sum.
 pub const MAX_WAVELENGTHS: usize = 4096;
 
@@ -209,6 +212,14 @@ pub struct DiffractionOptions {
     /// Largest window weight the neighbourhood may drop (default 10⁻³; module docs). Layout
     /// "terms" only.
     pub window_tolerance: f64,
+    /// The footprint filter of the scenes (`diffraction_colour_footprint`,
+    /// `shaders/diffraction.wgsl`): the largest neighbourhood radius per axis, bins, it may
+    /// grow to as a pixel's footprint widens (default [`MAX_FILTER_RADIUS`]; at least the
+    /// table's own radius R, at most [`MAX_FILTER_RADIUS`] and the table's half-size; 0 keeps
+    /// R: the filter's weights without the wider neighbourhood). `None`: no filter, one point
+    /// sample of the BRDF per pixel (what the scenes drew before issue 37). Layout "terms"
+    /// only.
+    pub filter_radius: Option<i32>,
 }
 
 impl Default for DiffractionOptions {
@@ -217,6 +228,7 @@ impl Default for DiffractionOptions {
             wavelength_step_nm: None,
             fresnel: FresnelTerm::Unity,
             window_tolerance: 1e-3,
+            filter_radius: Some(MAX_FILTER_RADIUS),
         }
     }
 }
@@ -285,8 +297,9 @@ pub struct DiffractionUniform {
     pub fresnel_kind: u32,
     /// (n, κ) of the bulk material.
     pub fresnel_ior: [f32; 2],
-    /// Padding.
-    pub pad: [f32; 2],
+    /// Largest radius per axis the footprint filter grows the neighbourhood to, bins
+    /// ([`DiffractionOptions::filter_radius`] within its bounds); (−1, −1): no filter.
+    pub filter_radius: [i32; 2],
 }
 
 /// Group 1 of the technique: the table, its uniform and the spectral weights.
@@ -320,6 +333,19 @@ impl DiffractionBinding {
         let rows = 2 * u64::from(u.radius[1].unsigned_abs()) + 1;
         let bins = 2 * u64::from(u.radius[0].unsigned_abs()) + 1;
         u64::from(u.wavelength_count) * (1 + (order + 1) + rows * (1 + bins * (1 + layers)))
+    }
+
+    /// An upper bound on the loop iterations of one `diffraction_colour_footprint` call:
+    /// per wavelength, one of the colour loop, N + 1 Taylor coefficients, two axes of
+    /// 2R_f + 1 weights, and 2R_f,y + 1 rows of 2R_f,x + 1 bins of ⌈(N + 1)/2⌉ layer loads
+    /// each, R_f the uniform's `filter_radius`.
+    /// Without a filter (`filter_radius` −1), [`Self::loop_iterations_per_colour`].
+    pub fn loop_iterations_per_filtered_colour(&self) -> u64 {
+        let u = &self.uniform;
+        if u.filter_radius[0] < 0 {
+            return self.loop_iterations_per_colour();
+        }
+        filtered_iterations(u.order, u.wavelength_count, u.filter_radius)
     }
 
     /// Builds the technique's group 1 for `table`.
@@ -362,7 +388,10 @@ impl DiffractionBinding {
             wavelength_count: spectrum.len() as u32,
             fresnel_kind,
             fresnel_ior,
-            pad: [0.0; 2],
+            filter_radius: match options.filter_radius {
+                Some(cap) => filter_radius(radius, [r.nx, r.ny], cap),
+                None => [-1, -1],
+            },
         };
         let device = &ctx.device;
         let (layout, bind_group) = ctx.checked("binding a diffraction table", || {
@@ -444,6 +473,26 @@ impl DiffractionBinding {
             grid,
         })
     }
+}
+
+/// The footprint filter's radius cap per axis: `wanted` (≥ 0) within the table's own
+/// `radius` and the smaller of [`MAX_FILTER_RADIUS`] and (n − 1)/2 (a wider window than the
+/// table only adds empty bins).
+pub fn filter_radius(radius: [i32; 2], size: [usize; 2], wanted: i32) -> [i32; 2] {
+    [0, 1].map(|a| {
+        let half = i32::try_from((size[a].max(1) - 1) / 2).unwrap_or(i32::MAX);
+        wanted.clamp(0, MAX_FILTER_RADIUS).min(half).max(radius[a])
+    })
+}
+
+/// [`DiffractionBinding::loop_iterations_per_filtered_colour`] for Taylor order `order`,
+/// `wavelengths` wavelengths and the cap `filter_radius`.
+pub fn filtered_iterations(order: u32, wavelengths: u32, filter_radius: [i32; 2]) -> u64 {
+    let order = u64::from(order);
+    let layers = (order + 2) / 2;
+    let rows = 2 * u64::from(filter_radius[1].unsigned_abs()) + 1;
+    let bins = 2 * u64::from(filter_radius[0].unsigned_abs()) + 1;
+    u64::from(wavelengths) * (1 + (order + 1) + rows + bins + rows * (1 + bins * (1 + layers)))
 }
 
 /// One probe result.
