@@ -179,35 +179,97 @@ fn diffraction_transform(k_per_um: f32, uvw: vec3<f32>) -> vec2<f32> {
 // Largest filter radius the shader holds (its row buffers; `MAX_FILTER_RADIUS` on the host).
 const DIFFRACTION_MAX_FILTER_RADIUS: i32 = 8;
 
-// Per-axis weights of the footprint filter at window offset i (j = first + i): the window g,
-// the diagonal mean E[g²] (both as in the header), and the pair mean E[g_j g_{j+1}].
+// Per-axis weights of the footprint filter, stored at window offset i + 2 (j = first + i;
+// two zero entries on each side, so that a pair reaching past the window reads 0): the
+// window g, and the pair means E[g_j g_{j+d}] for d = 0, 1, 2 (the header's 1-D mean).
 struct DiffractionAxisWeights {
-    g: array<f32, 17>,
-    diag: array<f32, 17>,
-    next: array<f32, 17>,
+    g: array<f32, 21>,
+    w0: array<f32, 21>,
+    w1: array<f32, 21>,
+    w2: array<f32, 21>,
     // Σ_all / Σ_window of the diagonal weights when the cap cut the window, else 1.
     renorm: f32,
 }
 
+// The 1-D pair mean E[g(q − κ_a) g(q − κ_b)] of the header, a = (first + i) Δκ,
+// b = a + d Δκ; σ_s² = s2, A = a_fp.
+fn diffraction_pair_mean(q: f32, dk: f32, j: i32, d: i32, a_fp: f32, s2: f32) -> f32 {
+    let m = q - (f32(j) + 0.5 * f32(d)) * dk;
+    let gap = f32(d) * dk;
+    return inverseSqrt(a_fp) * exp(-0.25 * s2 * gap * gap - s2 * m * m / a_fp);
+}
+
 fn diffraction_axis_weights(q: f32, dk: f32, first: i32, count: i32, a: f32, s2: f32, cut: bool) -> DiffractionAxisWeights {
     var w: DiffractionAxisWeights;
-    let inv_sqrt_a = inverseSqrt(a);
     var held = 0.0;
     for (var i = 0; i < count; i++) {
-        let d = q - f32(first + i) * dk;
-        w.g[i] = exp(-0.5 * s2 * d * d);
-        let e = exp(-s2 * d * d / a);
-        held += e;
-        w.diag[i] = inv_sqrt_a * e;
-        let m = q - (f32(first + i) + 0.5) * dk;
-        w.next[i] = inv_sqrt_a * exp(-0.25 * s2 * dk * dk - s2 * m * m / a);
+        let j = first + i;
+        let d = q - f32(j) * dk;
+        w.g[i + 2] = exp(-0.5 * s2 * d * d);
+        w.w0[i + 2] = diffraction_pair_mean(q, dk, j, 0, a, s2);
+        held += w.w0[i + 2];
+        w.w1[i + 2] = select(0.0, diffraction_pair_mean(q, dk, j, 1, a, s2), i + 1 < count);
+        w.w2[i + 2] = select(0.0, diffraction_pair_mean(q, dk, j, 2, a, s2), i + 2 < count);
     }
     w.renorm = 1.0;
     if cut && held > 0.0 {
-        let all = sqrt(3.14159265358979 * a / s2) / dk;
+        let all = inverseSqrt(a) * sqrt(3.14159265358979 * a / s2) / dk;
         w.renorm = max(1.0, all / held);
     }
     return w;
+}
+
+// The pair weight E[g_a g_b] per axis for window offsets i and i + d, |d| ≤ 2 (stored
+// offsets: i + 2).
+fn diffraction_axis_pair(w: ptr<function, DiffractionAxisWeights>, i: i32, d: i32) -> f32 {
+    let lo = min(i, i + d) + 2;
+    switch abs(d) {
+        case 0: {
+            return (*w).w0[lo];
+        }
+        case 1: {
+            return (*w).w1[lo];
+        }
+        default: {
+            return (*w).w2[lo];
+        }
+    }
+}
+
+// The correction 2 Re(P_a P_b*) (W_x W_y − g_a g_b) of one pair to the coherent sum: bin
+// a at (ix, iy) with amplitude p, bin b at (ix + dx, iy − dy) with amplitude p_b.
+fn diffraction_pair_correction(
+    p: vec2<f32>,
+    p_b: vec2<f32>,
+    wx: ptr<function, DiffractionAxisWeights>,
+    wy: ptr<function, DiffractionAxisWeights>,
+    ix: i32,
+    iy: i32,
+    dx: i32,
+    dy: i32,
+) -> f32 {
+    let w = diffraction_axis_pair(wx, ix, dx) * diffraction_axis_pair(wy, iy, -dy);
+    let gg = (*wx).g[ix + 2] * (*wx).g[ix + dx + 2] * (*wy).g[iy + 2] * (*wy).g[iy - dy + 2];
+    return 2.0 * dot(p, p_b) * (w - gg);
+}
+
+// The corrections of bin (ix, iy), amplitude p, with the bins of `row` (dy rows back, window
+// offsets stored at + 2) from dx = −2 to 2: straight-line code, no loop (llvmpipe counts
+// loop iterations against its cap).
+fn diffraction_row_corrections(
+    p: vec2<f32>,
+    row: ptr<function, array<vec2<f32>, 21>>,
+    wx: ptr<function, DiffractionAxisWeights>,
+    wy: ptr<function, DiffractionAxisWeights>,
+    ix: i32,
+    iy: i32,
+    dy: i32,
+) -> f32 {
+    return diffraction_pair_correction(p, (*row)[ix], wx, wy, ix, iy, -2, dy)
+        + diffraction_pair_correction(p, (*row)[ix + 1], wx, wy, ix, iy, -1, dy)
+        + diffraction_pair_correction(p, (*row)[ix + 2], wx, wy, ix, iy, 0, dy)
+        + diffraction_pair_correction(p, (*row)[ix + 3], wx, wy, ix, iy, 1, dy)
+        + diffraction_pair_correction(p, (*row)[ix + 4], wx, wy, ix, iy, 2, dy);
 }
 
 // E|P̃|² over the footprint (above) for wave number k (rad/µm), (u, v, w) at the pixel's
@@ -250,45 +312,36 @@ fn diffraction_filtered_intensity(k_per_um: f32, uvw: vec3<f32>, sigma_uv: vec2<
     let count = 2 * rf + vec2<i32>(1);
     // The cap cut the window (and the table has bins past it on that axis).
     let cut = (need > vec2<f32>(rf)) & (size > count);
-    let wx = diffraction_axis_weights(q.x, dk.x, first.x, count.x, a.x, s2, cut.x);
-    let wy = diffraction_axis_weights(q.y, dk.y, first.y, count.y, a.y, s2, cut.y);
-    var prev: array<vec2<f32>, 17>;
-    var cur: array<vec2<f32>, 17>;
+    var wx = diffraction_axis_weights(q.x, dk.x, first.x, count.x, a.x, s2, cut.x);
+    var wy = diffraction_axis_weights(q.y, dk.y, first.y, count.y, a.y, s2, cut.y);
+    // Rows of amplitudes at window offset + 2 (zero past the window): this row, one and two
+    // rows back.
+    var cur: array<vec2<f32>, 21>;
+    var back1: array<vec2<f32>, 21>;
+    var back2: array<vec2<f32>, 21>;
     var coherent_sum = vec2<f32>(0.0);
     var correction = 0.0;
     for (var iy = 0; iy < count.y; iy++) {
         let jy = first.y + iy;
-        let gy = wy.g[iy];
-        let gy_prev = select(0.0, wy.g[max(iy - 1, 0)], iy > 0);
-        let wyd = wy.diag[iy];
-        let wyn = select(0.0, wy.next[max(iy - 1, 0)], iy > 0);
+        let gy = wy.g[iy + 2];
         for (var ix = 0; ix < count.x; ix++) {
             let jx = first.x + ix;
             var p = vec2<f32>(0.0);
             if jx >= lo.x && jx <= hi.x && jy >= lo.y && jy <= hi.y {
                 p = diffraction_taylor_sum(vec2<i32>(jx, jy) + diffraction.dc, &c);
             }
-            cur[ix] = p;
-            let gx = wx.g[ix];
+            cur[ix + 2] = p;
+            let gx = wx.g[ix + 2];
             coherent_sum += p * (gx * gy);
-            correction += dot(p, p) * (wx.diag[ix] * wyd - gx * gx * gy * gy);
-            if ix > 0 {
-                let g_left = wx.g[ix - 1];
-                correction += 2.0 * dot(p, cur[ix - 1]) * (wx.next[ix - 1] * wyd - gx * g_left * gy * gy);
-            }
-            if iy > 0 {
-                correction += 2.0 * dot(p, prev[ix]) * (wx.diag[ix] * wyn - gx * gx * gy * gy_prev);
-                if ix > 0 {
-                    let g_left = wx.g[ix - 1];
-                    correction += 2.0 * dot(p, prev[ix - 1]) * (wx.next[ix - 1] * wyn - gx * g_left * gy * gy_prev);
-                }
-                if ix + 1 < count.x {
-                    let g_right = wx.g[ix + 1];
-                    correction += 2.0 * dot(p, prev[ix + 1]) * (wx.next[ix] * wyn - gx * g_right * gy * gy_prev);
-                }
-            }
+            // The bin with itself (counted once) and with the two before it in its row.
+            correction += dot(p, p) * (wx.w0[ix + 2] * wy.w0[iy + 2] - gx * gx * gy * gy);
+            correction += diffraction_pair_correction(p, cur[ix + 1], &wx, &wy, ix, iy, -1, 0);
+            correction += diffraction_pair_correction(p, cur[ix], &wx, &wy, ix, iy, -2, 0);
+            correction += diffraction_row_corrections(p, &back1, &wx, &wy, ix, iy, 1);
+            correction += diffraction_row_corrections(p, &back2, &wx, &wy, ix, iy, 2);
         }
-        prev = cur;
+        back2 = back1;
+        back1 = cur;
     }
     let e = (dot(coherent_sum, coherent_sum) + correction) * wx.renorm * wy.renorm;
     return select(0.0, max(e, 0.0), diffraction_finite(e));

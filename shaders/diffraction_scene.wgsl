@@ -252,9 +252,12 @@ fn scene_lobe_efficiency(l: u32, kw: f32) -> f32 {
 // The environment diffracted towards ω_r (grating frame, unit) through the lobes (header):
 // Σ_λ u(λ) ⊙ Σ_c F²(θ_h) G/w² η_c(k w) L_env(ω_c), ω_c,t = −ω_r,t − κ_c/k. A lobe of
 // variance σ_q² per axis spans σ_q/k in (u, v), and the band of one wavelength step Δλ
-// sweeps it by |κ_c| Δλ/2π (a uniform spread, variance /12); divided by cos θ_c that is its
-// angular size σ, read at the mip level log₂(2.5 σ/texel₀) of the environment's box chain.
-fn scene_env_diffracted(frame: mat3x3<f32>, wr: vec3<f32>) -> vec3<f32> {
+// sweeps it by |κ_c| Δλ/2π (a uniform spread, variance /12); the pixel's footprint adds the
+// spread σ_fp of ω_r,t across the pixel (ray differentials, `scene_footprint` with no light:
+// ω_c,t follows −ω_r,t), the variances adding as for independent spreads; divided by cos θ_c
+// that is its angular size σ, read at the mip level log₂(2.5 σ/texel₀) of the environment's
+// box chain.
+fn scene_env_diffracted(frame: mat3x3<f32>, wr: vec3<f32>, sigma_fp: f32) -> vec3<f32> {
     let count = min(lights.lobe_count, arrayLength(&lobes));
     let wavelengths = min(lights.lobe_wavelength_count, arrayLength(&lobe_spectrum));
     if count == 0u || wavelengths == 0u || !(wr.z > 0.0) {
@@ -283,7 +286,8 @@ fn scene_env_diffracted(frame: mat3x3<f32>, wr: vec3<f32>) -> vec3<f32> {
             let cos_h = -dot(wi, uvw) * inverseSqrt(dot(uvw, uvw));
             let eta = scene_lobe_efficiency(l, k * uvw.z);
             let sweep = length(lobe.xy) * lights.lobe_kw.z / (2.0 * SCENE_PI);
-            let sigma = sqrt(lobe.z / (k * k) + sweep * sweep / 12.0) / max(wi.z, 0.05);
+            let spread2 = lobe.z / (k * k) + sweep * sweep / 12.0 + sigma_fp * sigma_fp;
+            let sigma = sqrt(spread2) / max(wi.z, 0.05);
             let lod = clamp(log2(max(2.5 * sigma / texel, 1.0)), 0.0, view.env_lod_max);
             band += (diffraction_fresnel(cos_h) * g * eta) * scene_env(to_world * wi, lod);
         }
@@ -381,7 +385,9 @@ fn scene_shade(s: Surface, to_eye: vec3<f32>, around: array<Neighbour, 4>) -> ve
             let l = lights.samples[k].xyz;
             diffracted += diffraction_colour_footprint(frame * l, wr, scene_footprint(l, frame, wr, around)) * lights.sample_radiance[k].rgb;
         }
-        diffracted += scene_env_diffracted(frame, wr);
+        // The view direction's own spread over the pixel (u, v) = −ω_r,t: its larger axis.
+        let fp = scene_footprint(vec3<f32>(0.0), frame, wr, around);
+        diffracted += scene_env_diffracted(frame, wr, max(fp.x, fp.y));
         radiance += s.grating * diffracted;
     }
     // The environment through the specular order (the clear parts: a plain mirror, F² only).
