@@ -161,20 +161,29 @@ fn diffraction_transform(k_per_um: f32, uvw: vec3<f32>) -> vec2<f32> {
 //   E|P̃|² = Σ_{j, j′} Re(P_j P_{j′}*) W(j, j′),   W = Π_axes E[g(q − κ_j) g(q − κ_{j′})]
 //   E[g(q − a) g(q − b)] = A^{−½} exp(−σ_s² (a − b)²/4 − σ_s² (q̄ − (a + b)/2)²/A)      (1-D)
 //
-// (the product of two Gaussians is a Gaussian at their midpoint; its mean over a Gaussian is
-// the convolution of two Gaussians). At s = 0, W = g g and the sum is |Σ_j P_j g_j|², the
-// unfiltered P̃. The shader evaluates it as the unfiltered coherent sum plus the correction
-// (W − g g) of the pairs at most one bin apart per axis (the diagonal and the 8 neighbours):
-// exact at s = 0 and for an isolated order; the pairs ≥ 2 bins apart keep their unfiltered
-// weight g g ≤ exp(−(σ_s Δκ)²) (0.085 of a bin's amplitude² for the CD tables, σ_s Δκ = π/2),
-// so their speckle is what the filter leaves. The neighbourhood grows with the footprint,
-// R_f = ⌈(R + ½) √A − ½⌉ per axis, capped by the uniform's filter_radius (the host keeps it
-// within llvmpipe's loop budget); a footprint wider than the cap would lose the bins past
-// it, so the result is then scaled by Σ_all exp(−σ_s² (q̄ − κ)²/A) / Σ_window (the Gaussian's
-// sum over every bin, √(π A)/(σ_s Δκ), over the part the window holds) per axis — the
-// energy is kept, not the detail. Only the Taylor sums load texels: the neighbourhood's cost
-// is (2R_f + 1)² Taylor sums per wavelength, the pairs are arithmetic on values kept in two
-// rows.
+// (the product of two Gaussians g(q − a) g(q − b) = exp(−σ_s² (a − b)²/4) ·
+// exp(−σ_s² (q − m)²), m = (a + b)/2, is a Gaussian at their midpoint; its mean over
+// q ~ N(q̄, s²) is the convolution of two Gaussians, variances 1/(2σ_s²) and s² adding:
+// (1 + 2σ_s² s²)^{−½} exp(−σ_s² (q̄ − m)²/(1 + 2σ_s² s²))). The footprint averages
+// intensities, not amplitudes: P̃'s own mean over the footprint would cancel its speckle
+// into darkness, which is why no mip chain of the terms can stand in for it. At s = 0,
+// W = g g and the sum is |Σ_j P_j g_j|², the unfiltered P̃. The shader evaluates it as the
+// unfiltered coherent sum plus the correction (W − g g) of the pairs at most two bins apart
+// per axis (the diagonal and the 24 neighbours, each pair once): exact at s = 0 and for an
+// isolated order; the pairs ≥ 3 bins apart keep their unfiltered weight g g ≤
+// exp(−9 (σ_s Δκ)²/4) = 0.004 of a bin's amplitude² for the default tables (σ_s Δκ = π/2).
+// The neighbourhood grows with the footprint, R_f = ⌈(R + ½) √A − ½⌉ per axis, capped by
+// the uniform's filter_radius (the host keeps it within llvmpipe's loop budget); a footprint
+// wider than the cap would lose the bins past it, so the result is then scaled by
+// Σ_all W(j, j) / Σ_window W(j, j) per axis (the Gaussian's sum over every bin,
+// A^{−½} √(π A)/(σ_s Δκ), over the part the window holds) — the energy is kept, not the
+// detail. Only the Taylor sums load texels: the neighbourhood's cost is (2R_f + 1)² Taylor
+// sums per wavelength; the pairs are arithmetic on amplitudes kept in three rows, written
+// out without loops (llvmpipe counts loop iterations against its cap).
+//
+// The footprint itself comes from ray differentials (Igehy, "Tracing ray differentials",
+// SIGGRAPH 1999), taken as finite differences: the scenes trace the neighbouring pixels'
+// rays (`scene_footprint`, shaders/diffraction_scene.wgsl).
 
 // Largest filter radius the shader holds (its row buffers; `MAX_FILTER_RADIUS` on the host).
 const DIFFRACTION_MAX_FILTER_RADIUS: i32 = 8;

@@ -296,8 +296,10 @@ fn scene_env_diffracted(frame: mat3x3<f32>, wr: vec3<f32>, sigma_fp: f32) -> vec
     return select(vec3<f32>(0.0), sum, diffraction_finite3(sum));
 }
 
-// A neighbouring pixel's view of the surface (a ray differential, issue 37): its grating
-// frame and its direction to the eye in that frame; `ok` false when its ray misses.
+// A neighbouring pixel's view of the surface (a ray differential, issue 37; Igehy, "Tracing
+// ray differentials", SIGGRAPH 1999, here as the finite difference to the next pixel's ray,
+// which also carries the change of the grating frame): its grating frame and its direction
+// to the eye in that frame; `ok` false when its ray misses.
 struct Neighbour {
     ok: bool,
     frame: mat3x3<f32>,
