@@ -447,8 +447,13 @@ fn material_film_input(cos_theta: f32, thickness_nm: f32, sigma_thickness_nm: f3
 // coated surface (film_weight < 1). The base is the lobe's (`base_ior`, `base_kappa`: the
 // dielectric's or the metal's), and for the metal lobe of a two-lobe point (`schlick`) the
 // bare reflectance is glTF's F_schlick(F0, v·h) with F0 the metal index's normal-incidence
-// reflectance (glTF 2.0 Appendix B, conductor_fresnel).
-fn material_base_reflectance(cos_theta: f32, schlick: bool, base_ior: vec3<f32>, base_kappa: vec3<f32>) -> vec3<f32> {
+// reflectance (glTF 2.0 Appendix B, conductor_fresnel). With `pane` (SurfaceMaterial.bare_pane)
+// the base is a clear pane of that index in the ambient, its two faces' reflections summed
+// in intensity, per polarisation (the incoherent slab of film_glass.wgsl with P = 1 and
+// R′ = R_B = R, T = 1 − R: Byrnes, arXiv:1603.02720 §4):
+//
+//   R_pane = R + (1 − R)² R / (1 − R²) = 2R / (1 + R)
+fn material_base_reflectance(cos_theta: f32, schlick: bool, base_ior: vec3<f32>, base_kappa: vec3<f32>, pane: bool) -> vec3<f32> {
     let p = material_params;
     let c = clamp(finite_or(cos_theta, 1.0), 1e-6, 1.0);
     if schlick {
@@ -463,19 +468,25 @@ fn material_base_reflectance(cos_theta: f32, schlick: bool, base_ior: vec3<f32>,
     for (var j = 0; j < 3; j++) {
         let nk = sanitize_base_index(base_ior[j], base_kappa[j]);
         let f = fresnel_interface(c_real(n1), q0, nk, normal_component_cos(nk, n1, c));
-        r[j] = clamp(0.5 * (c_abs2(f.r_s) + c_abs2(f.r_p)), 0.0, 1.0);
+        let r_s = clamp(c_abs2(f.r_s), 0.0, 1.0);
+        let r_p = clamp(c_abs2(f.r_p), 0.0, 1.0);
+        if pane {
+            r[j] = 0.5 * (2.0 * r_s / (1.0 + r_s) + 2.0 * r_p / (1.0 + r_p));
+        } else {
+            r[j] = 0.5 * (r_s + r_p);
+        }
     }
     return r;
 }
 
 // The film's output blended with the bare base (index n + iκ) for a film weight w < 1 (see
 // the header); w ≥ 1 (or NaN) returns the film unchanged.
-fn material_weight_film(film: FilmOutput, cos_theta: f32, weight: f32, schlick: bool, base_ior: vec3<f32>, base_kappa: vec3<f32>) -> FilmOutput {
+fn material_weight_film(film: FilmOutput, cos_theta: f32, weight: f32, schlick: bool, base_ior: vec3<f32>, base_kappa: vec3<f32>, pane: bool) -> FilmOutput {
     let w = clamp(finite_or(weight, 1.0), 0.0, 1.0);
     if w >= 1.0 {
         return film;
     }
-    let f_base = material_base_reflectance(cos_theta, schlick, base_ior, base_kappa);
+    let f_base = material_base_reflectance(cos_theta, schlick, base_ior, base_kappa, pane);
     var out: FilmOutput;
     out.reflectance = mix(f_base, film.reflectance, w);
     out.transmittance = mix(vec3<f32>(1.0) - f_base, film.transmittance, w);
@@ -485,7 +496,7 @@ fn material_weight_film(film: FilmOutput, cos_theta: f32, weight: f32, schlick: 
 // E_f(μ_o, α, d, n₂): the iridescent GGX lobe's directional albedo from the rough-film-lut
 // (two trilinear fetches, rough_lut_sample), blended for a film weight w < 1 with the bare
 // base's F_base(n·v) E₁(n·v, α) (base index n + iκ).
-fn material_rough_film_albedo(n_dot_v: f32, alpha: f32, thickness_nm: f32, weight: f32, schlick: bool, base_ior: vec3<f32>, base_kappa: vec3<f32>) -> vec3<f32> {
+fn material_rough_film_albedo(n_dot_v: f32, alpha: f32, thickness_nm: f32, weight: f32, schlick: bool, base_ior: vec3<f32>, base_kappa: vec3<f32>, pane: bool) -> vec3<f32> {
     let p = material_params;
     let e = rough_lut_sample(env_rough_lut, env_lut_sampler, env_rough_lut_params, n_dot_v, alpha, thickness_nm, p.film_ior);
     let e_film = select(vec3<f32>(0.0), clamp(e, vec3<f32>(0.0), vec3<f32>(1.0)), vec3_is_finite(e));
@@ -493,7 +504,7 @@ fn material_rough_film_albedo(n_dot_v: f32, alpha: f32, thickness_nm: f32, weigh
     if w >= 1.0 {
         return e_film;
     }
-    return mix(material_base_reflectance(n_dot_v, schlick, base_ior, base_kappa) * ggx_albedo(n_dot_v, alpha), e_film, w);
+    return mix(material_base_reflectance(n_dot_v, schlick, base_ior, base_kappa, pane) * ggx_albedo(n_dot_v, alpha), e_film, w);
 }
 
 // ─── Shading ─────────────────────────────────────────────────────────────────────────────
@@ -565,6 +576,11 @@ struct SurfaceMaterial {
     // 1 the metal only, 2 both (their shares 1 − m and m). (A per-point choice made
     // lavapipe's LLVM back end of Mesa 22 crash.)
     lobes: u32,
+    // 1: the film-free share (w < 1) of the dielectric lobe is an uncoated clear pane of the
+    // dielectric's index in the ambient, both faces summed in intensity (the technique
+    // `film_glass` drawing a glTF glass: crates/runtime/src/mesh/materials.rs glass_setup);
+    // 0: one interface, the bare base.
+    bare_pane: u32,
 }
 
 // The uniform's material at every point: one lobe, dielectric or metal (base_kind), the
@@ -586,6 +602,7 @@ fn material_surface() -> SurfaceMaterial {
     m.occlusion = 1.0;
     m.specular_colour = vec3<f32>(1.0);
     m.lobes = select(0u, 1u, metal);
+    m.bare_pane = 0u;
     return m;
 }
 
@@ -711,7 +728,7 @@ fn material_shade_with(s: SurfacePoint, mat: SurfaceMaterial) -> ShadeResult {
             let density = PI * f32(MATERIAL_LOBE_SAMPLES) * ggx_distribution(m.z, alpha);
             lobe_alpha = MATERIAL_LOBE_FIS_SCALE * sqrt(wo.z * (1.0 + lambda_o) / max(density, 1e-30));
         }
-        let film = material_weight_film(film_colour(material_film_input(cos_theta, s.thickness_nm, s.sigma_thickness_nm, s.variation, base_ior, base_kappa)), cos_theta, mat.film_weight, lobe == 1u && lobe_count == 2u, base_ior, base_kappa);
+        let film = material_weight_film(film_colour(material_film_input(cos_theta, s.thickness_nm, s.sigma_thickness_nm, s.variation, base_ior, base_kappa)), cos_theta, mat.film_weight, lobe == 1u && lobe_count == 2u, base_ior, base_kappa, lobe == 0u && mat.bare_pane != 0u);
         if k == 0u {
             if lobe == 0u {
                 film_v_d = film;
@@ -755,8 +772,8 @@ fn material_shade_with(s: SurfacePoint, mat: SurfaceMaterial) -> ShadeResult {
         var e_spec = reflectance_v * e_one;
         var mean_reflectance = film_v_d.reflectance * specular_scale;
         if mode == MATERIAL_FILM_EVAL_EXACT {
-            let e_d = material_rough_film_albedo(n_dot_v, alpha, s.thickness_nm, mat.film_weight, false, mat.dielectric_ior, mat.dielectric_kappa);
-            let e_m = material_rough_film_albedo(n_dot_v, alpha, s.thickness_nm, mat.film_weight, lobe_count == 2u, mat.metal_ior, mat.metal_kappa);
+            let e_d = material_rough_film_albedo(n_dot_v, alpha, s.thickness_nm, mat.film_weight, false, mat.dielectric_ior, mat.dielectric_kappa, mat.bare_pane != 0u);
+            let e_m = material_rough_film_albedo(n_dot_v, alpha, s.thickness_nm, mat.film_weight, lobe_count == 2u, mat.metal_ior, mat.metal_kappa, false);
             e_spec = e_d * spec_d + e_m * w_m;
             mean_reflectance = e_d * specular_scale / max(e_one, 1e-4);
         }

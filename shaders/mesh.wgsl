@@ -58,6 +58,14 @@
 // shows nothing). Neither the picture's blur by roughness nor transmissive surfaces behind
 // transmissive ones are modelled.
 //
+// Coated glass (technique `glass`, crates/runtime/src/mesh/materials.rs glass_setup): a
+// transmissive dielectric material is drawn by film_glass.wgsl with its own stack — air |
+// the iridescence film (iridescenceIor, d from the thickness mapping) | an incoherent clear
+// slab of index `ior` (thicknessFactor thick; thin-walled: 0) | air — so that R and T of the
+// film_colour call are the whole pane's, both faces summed in intensity; the film-free share
+// of w < 1 is the uncoated pane (MESH_FLAG_GLASS). mesh_behind then refracts and attenuates
+// (attenuationColor over the path inside the volume) as for every transmissive material.
+//
 // Double-sided: the shading normal faces the viewer (a back face's normal and tangent frame
 // are reversed, as glTF prescribes); single-sided materials are culled by the pipeline.
 //
@@ -148,6 +156,9 @@ const MESH_FLAG_LINEAR_OUTPUT: u32 = 2u;
 const MESH_FLAG_BEHIND: u32 = 4u;
 // KHR_materials_unlit: the colour is base colour × texture × COLOR_0, unlit, without film.
 const MESH_FLAG_UNLIT: u32 = 8u;
+// Drawn by film_glass as a coated pane (crates/runtime/src/mesh/materials.rs glass_setup): the
+// film-free share of a film weight w < 1 is the uncoated pane (SurfaceMaterial.bare_pane).
+const MESH_FLAG_GLASS: u32 = 16u;
 // Set by the pipeline (mesh/pipeline.rs Raster) for lines and points without normals: drawn
 // unlit in their base colour, as KHR_materials_unlit draws (a line or point has no surface).
 override MESH_PRIMITIVE_UNLIT: bool = false;
@@ -432,6 +443,7 @@ fn mesh_fs(in: MeshVertexOut, @builtin(front_facing) front: bool) -> @location(0
     mat.transmission = clamp(finite_or(q.transmission, 0.0), 0.0, 1.0);
     mat.occlusion = clamp(1.0 + finite_or(q.occlusion_strength, 1.0) * (occlusion_tex.r - 1.0), 0.0, 1.0);
     mat.specular_colour = clamp(q.specular * specular_tex.a * q.specular_colour * specular_colour_tex.rgb, vec3<f32>(0.0), vec3<f32>(1.0));
+    mat.bare_pane = select(0u, 1u, (q.flags & MESH_FLAG_GLASS) != 0u);
 
     var surface: SurfacePoint;
     surface.position = in.world;

@@ -9,7 +9,9 @@ use nacre_format::{Manifest, Param, set};
 pub const EXAMPLES: &str = "\
 Every pass shades each pixel of a WIDTHxHEIGHT target with the same GGX microfacet material
 (shaders/bench.wgsl); only the Fresnel term differs: Schlick (plain), film_lut, film_fourier
-(--harmonics M, by default automatic, then M = 3) or film_spectral (N wavelengths). A last pass times the diffraction technique
+(--harmonics M, by default automatic, then M = 3) or film_spectral (N wavelengths), then
+film_stack with 2, 4 and 8 films and film_glass with a coated pane (those 2 films on each
+face of a 2 mm slab). A last pass times the diffraction technique
 at the same resolution (one directional light per pixel, the --diffraction table: layout
 \"terms\" sums over the --diffraction-step grid, layout \"integrated\" reads the sum baked into
 the table). Times are GPU timestamps of the render pass where the adapter supports them,
@@ -142,6 +144,7 @@ pub fn run(args: &BenchGpuArgs) -> Result<()> {
         BenchPass::Stack(2),
         BenchPass::Stack(4),
         BenchPass::Stack(8),
+        BenchPass::Glass,
         BenchPass::Diffraction,
     ];
     let results = run_bench_with_diffraction(

@@ -51,7 +51,11 @@ minimum, maximum, g) with g the thickness texture's green channel (PNG; g = 1 wi
 iridescenceFactor → film weight, ior → dielectric base,
 metallicFactor ≥ 0.5 → a metal whose index reproduces the base colour at normal incidence
 (Gulbrandsen 2014). With --technique lut a material whose base, film index or thickness the
-film-lut table cannot represent is drawn with fourier instead (a note on stderr says so).";
+film-lut table cannot represent is drawn with fourier instead (a note on stderr says so).
+With --technique glass a transmissive dielectric material (KHR_materials_transmission,
+metallic 0) is drawn as a coated pane: air | its iridescence film | an incoherent slab of
+its ior, KHR_materials_volume's thickness (0: thin-walled) | air; every other material with
+fourier.";
 
 #[derive(Args)]
 pub struct RenderArgs {

@@ -39,6 +39,9 @@ pub enum BenchPass {
     /// `film_stack` with a dielectric stack of this many films
     /// ([`StackSetup::alternating`]), the rule ladder.
     Stack(usize),
+    /// `film_glass` with a coated pane ([`StackSetup::coated_pane`]: two films on each face
+    /// of a 2 mm slab), the rule ladder.
+    Glass,
 }
 
 impl BenchPass {
@@ -54,6 +57,7 @@ impl BenchPass {
             BenchPass::Stack(4) => "film_stack, 4 films",
             BenchPass::Stack(8) => "film_stack, 8 films",
             BenchPass::Stack(_) => "film_stack, N films",
+            BenchPass::Glass => "film_glass, 2+slab+2",
         }
     }
 }
@@ -264,6 +268,19 @@ pub fn run_bench_with_diffraction(
                     &colorimeter,
                 )?)
             }
+            BenchPass::Glass => {
+                let technique = TechniqueOptions {
+                    stack: StackSetup::coated_pane()?,
+                    ..options.technique.clone()
+                };
+                Some(TechniqueBinding::new(
+                    ctx,
+                    tables,
+                    Technique::Glass,
+                    &technique,
+                    &colorimeter,
+                )?)
+            }
         };
         let (source, table_layout, table_group) = match (&binding, pass) {
             (Some(b), BenchPass::Film(t)) => (
@@ -278,6 +295,11 @@ pub fn run_bench_with_diffraction(
             ),
             (Some(b), BenchPass::Stack(_)) => (
                 shaders::film_pipeline(Technique::Stack.module(), &["bench"])?,
+                &b.layout,
+                &b.bind_group,
+            ),
+            (Some(b), BenchPass::Glass) => (
+                shaders::film_pipeline(Technique::Glass.module(), &["bench"])?,
                 &b.layout,
                 &b.bind_group,
             ),

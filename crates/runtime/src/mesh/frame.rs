@@ -21,8 +21,8 @@ use super::materials;
 use super::pipeline::{Passes, PipelineState, Raster, transmits};
 use super::textures::{GltfTextures, MipDown, Samplers, mesh_group_layout};
 use super::{
-    BEHIND_FORMAT, DEPTH_FORMAT, FLAG_BEHIND, FLAG_LINEAR_OUTPUT, MeshRender, MeshUniform,
-    vertex_data,
+    BEHIND_FORMAT, DEPTH_FORMAT, FLAG_BEHIND, FLAG_GLASS, FLAG_LINEAR_OUTPUT, MeshRender,
+    MeshUniform, vertex_data,
 };
 use crate::context::{BufferInitExt, GpuContext};
 use crate::error::Result;
@@ -77,6 +77,7 @@ pub(super) fn draw(
         &plan.colorimeter,
         scene,
         &plan.drawn,
+        &plan.glass,
         &plan.used,
         [&layouts[0], &layouts[1], &layouts[2]],
     )?;
@@ -84,7 +85,7 @@ pub(super) fn draw(
     let resources = Resources::upload(ctx, tables, inputs, &plan, passes.behind_needed)?;
 
     let (target, submitted) = ctx.checked("rendering the glTF scene", || {
-        let bound = Bound::new(device, inputs, &plan.used, &resources, &layouts);
+        let bound = Bound::new(device, inputs, &plan, &resources, &layouts);
         let targets = Targets::new(device, (width, height), passes.behind_needed);
         let frame = Frame {
             device,
@@ -132,6 +133,8 @@ struct Plan {
     used: Vec<usize>,
     /// Per material of the file: nacre's options and the technique that draws it.
     drawn: Vec<(MaterialOptions, Technique)>,
+    /// Per material of the file: the pane of those drawn with `glass`.
+    glass: Vec<Option<crate::technique::StackSetup>>,
     /// The colorimeter of the tables.
     colorimeter: nacre_optics::colour::Colorimeter,
     /// The notes of [`MeshRender::notes`].
@@ -172,6 +175,7 @@ fn plan(tables: &TableSet, technique: Technique, inputs: &RenderInputs) -> Resul
     Ok(Plan {
         used,
         drawn: choice.drawn,
+        glass: choice.glass,
         colorimeter,
         notes,
     })
@@ -277,17 +281,20 @@ struct Bound<'r> {
     geometry: Vec<Geometry>,
     /// The used materials.
     used: &'r [usize],
+    /// Per material of the file: drawn by `film_glass` as a pane ([`FLAG_GLASS`]).
+    glass: Vec<bool>,
 }
 
 impl<'r> Bound<'r> {
     fn new(
         device: &wgpu::Device,
         inputs: &RenderInputs,
-        used: &'r [usize],
+        plan: &'r Plan,
         resources: &Resources,
         layouts: &[wgpu::BindGroupLayout; 3],
     ) -> Bound<'r> {
         let scene = inputs.scene;
+        let used = &plan.used;
         let view_group = resources.env.bind_group(
             device,
             &layouts[0],
@@ -337,6 +344,7 @@ impl<'r> Bound<'r> {
             samplers,
             geometry,
             used,
+            glass: plan.glass.iter().map(Option::is_some).collect(),
         }
     }
 
@@ -360,6 +368,9 @@ impl<'r> Bound<'r> {
             }
             let mut uniform = MeshUniform::new(inputs.camera.view_proj, gm);
             uniform.flags |= extra_flags;
+            if self.glass.get(i) == Some(&true) {
+                uniform.flags |= FLAG_GLASS;
+            }
             let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("mesh material (glTF)"),
                 contents: bytemuck::bytes_of(&uniform),

@@ -3,7 +3,8 @@
 //! material uniform per primitive, the camera fitted to the scene's bounds.
 //!
 //! Techniques per primitive: `fourier` and `spectral` take any base (the material's index goes
-//! to the shader). A `film-lut` table bakes its base, ambient and index range, so with the
+//! to the shader); `glass` draws a transmissive dielectric as a coated pane, the material's own
+//! stack in its own pass ([`glass_setup`]), and every other material with `fourier`. A `film-lut` table bakes its base, ambient and index range, so with the
 //! `lut` technique a primitive is drawn with the table only when its material matches it —
 //! a dielectric of the table's base index (film-dielectric: 1.5), or a gold-coloured metal
 //! ([`crate::gltf_scene::is_gold_like`]) with a gold table (film-gold, whose baked base replaces the
@@ -35,6 +36,7 @@ pub use camera::{
 };
 pub use inputs::{RenderInputs, TableFile, load_environment};
 pub use lights::scene_lights;
+pub use materials::{NM_PER_WORLD_UNIT, glass_setup};
 pub use textures::{COAT_SLOT_NONE, CoatSlots, coat_slots, rgba8_mip_chain};
 
 use crate::context::GpuContext;
@@ -83,7 +85,7 @@ pub struct MeshUniform {
     /// 0 OPAQUE, 1 MASK, 2 BLEND.
     pub alpha_mode: u32,
     /// Bit 0: a normal texture is bound; [`FLAG_LINEAR_OUTPUT`], [`FLAG_BEHIND`],
-    /// [`FLAG_UNLIT`].
+    /// [`FLAG_UNLIT`], [`FLAG_GLASS`].
     pub flags: u32,
     /// `transmissionFactor`.
     pub transmission: f32,
@@ -119,6 +121,11 @@ pub const FLAG_BEHIND: u32 = 4;
 /// [`MeshUniform::flags`]: the material is `KHR_materials_unlit` (`shaders/mesh.wgsl`
 /// MESH_FLAG_UNLIT).
 pub const FLAG_UNLIT: u32 = 8;
+
+/// [`MeshUniform::flags`]: the material is drawn by `film_glass` as a coated pane
+/// ([`glass_setup`]); its film-free share is the uncoated pane (`shaders/mesh.wgsl`
+/// MESH_FLAG_GLASS).
+pub const FLAG_GLASS: u32 = 16;
 
 /// Format of the picture of the opaque scene that transmissive surfaces refract.
 pub const BEHIND_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;

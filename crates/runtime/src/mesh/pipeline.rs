@@ -8,6 +8,7 @@ use crate::gltf_scene::{AlphaMode, GltfMaterial, GltfPrimitive, GltfScene, Topol
 use crate::render::{MaterialOptions, TARGET_FORMAT};
 use crate::shaders::{self, Technique};
 use crate::tables::TableSet;
+use crate::technique::StackSetup;
 use nacre_optics::colour::Colorimeter;
 use std::collections::BTreeMap;
 
@@ -83,7 +84,8 @@ pub(super) fn transmits(gm: &GltfMaterial) -> bool {
 
 /// The passes of a glTF render: one per technique, except `film_spectral`, whose group-1
 /// samples hold the base index per wavelength: one pass (binding and pipelines) per distinct
-/// base. Each pass has a pipeline per [`PipelineState`] its materials need.
+/// base, and `film_glass`, whose group 1 holds the material's own pane: one pass per material
+/// drawn with it. Each pass has a pipeline per [`PipelineState`] its materials need.
 pub(super) struct Passes {
     /// Per pass, its group 1.
     pub bindings: Vec<TechniqueBinding>,
@@ -97,7 +99,8 @@ pub(super) struct Passes {
 
 impl Passes {
     /// The passes that draw the materials `used` of `scene` as `drawn` says (per material:
-    /// options and technique); `layouts` are groups 0, 2 and 3.
+    /// options and technique; `glass`, the pane of those drawn with `glass`); `layouts` are
+    /// groups 0, 2 and 3.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn new(
         ctx: &GpuContext,
@@ -106,6 +109,7 @@ impl Passes {
         colorimeter: &Colorimeter,
         scene: &GltfScene,
         drawn: &[(MaterialOptions, Technique)],
+        glass: &[Option<StackSetup>],
         used: &[usize],
         layouts: [&wgpu::BindGroupLayout; 3],
     ) -> Result<Passes> {
@@ -113,6 +117,8 @@ impl Passes {
             let (m, t) = &drawn[i];
             if *t == Technique::Spectral {
                 (*t, m.base.name().to_string())
+            } else if *t == Technique::Glass {
+                (*t, format!("material {i}"))
             } else {
                 (*t, String::new())
             }
@@ -127,6 +133,9 @@ impl Passes {
             let mut options = technique_options.clone();
             if let Some(&i) = used.iter().find(|&&i| key_of(i) == *key) {
                 options.spectral.base = drawn[i].0.base.clone();
+                if let Some(Some(pane)) = glass.get(i) {
+                    options.stack = pane.clone();
+                }
             }
             let binding = TechniqueBinding::new(ctx, tables, key.0, &options, colorimeter)?;
             let mut states: Vec<PipelineState> = Vec::new();

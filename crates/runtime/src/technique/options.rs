@@ -96,6 +96,41 @@ impl StackSetup {
     }
 }
 
+impl StackSetup {
+    /// A coated pane in air: [`StackSetup::alternating`]'s two films (n 1.38, 100 nm over
+    /// n 2.3, 60 nm) on the front face of a clear incoherent slab of n 1.5, 2 mm thick, and
+    /// the same two films mirrored on its back face — the pane `nacre bench-gpu` times with
+    /// `film_glass` beside the four coherent films alone with `film_stack`.
+    ///
+    /// # Errors
+    /// None in practice (the stack is valid); the stack's own errors otherwise.
+    pub fn coated_pane() -> Result<StackSetup> {
+        let constant = |n: f64| {
+            nacre_optics::Material::constant(format!("{n}"), nacre_optics::C64::new(n, 0.0))
+                .expect("a real index above zero is a valid material")
+        };
+        let layer = |n: f64, thickness_nm: f64| nacre_optics::Layer {
+            material: constant(n),
+            thickness_nm,
+        };
+        let layers = vec![
+            layer(1.38, 100.0),
+            layer(2.3, 60.0),
+            layer(1.5, 2e6),
+            layer(2.3, 60.0),
+            layer(1.38, 100.0),
+        ];
+        let stack = nacre_optics::Stack::new(constant(1.0), layers, constant(1.0))?
+            .with_incoherent(vec![false, false, true, false, false])?;
+        Ok(StackSetup {
+            stack,
+            relative_nm: vec![0.0, 20.0, 0.0, 20.0, 20.0],
+            channels: Vec::new(),
+            samples: None,
+        })
+    }
+}
+
 /// Options of a technique's group-1 bind group.
 #[derive(Clone, Debug)]
 pub struct TechniqueOptions {
