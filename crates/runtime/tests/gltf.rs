@@ -1434,7 +1434,9 @@ fn glass_materials_match_the_cpu_coated_pane() {
         o.film_eval = FilmEval::Classic;
         let r = render_gltf(ctx(), &tables, Technique::Glass, &scene, &o).unwrap();
         assert!(
-            r.notes.iter().all(|n| !n.to_string().contains("instead of")),
+            r.notes
+                .iter()
+                .all(|n| !n.to_string().contains("instead of")),
             "a glass material fell back: {:?}",
             r.notes.iter().map(|n| n.to_string()).collect::<Vec<_>>()
         );
@@ -1474,9 +1476,11 @@ fn glass_materials_match_the_cpu_coated_pane() {
         let mu = n[0] * v[0] + n[1] * v[1] + n[2] * v[2];
         let gm = &scene.materials[k];
         let setup = nacre_runtime::mesh::glass_setup(gm).unwrap();
-        let eval = StackEvaluation::new(&colorimeter, &setup.stack, &setup.relative_nm, None)
-            .unwrap();
-        let d_nm = gm.iridescence.map_or(0.0, |i| f64::from(i.thickness_max_nm));
+        let eval =
+            StackEvaluation::new(&colorimeter, &setup.stack, &setup.relative_nm, None).unwrap();
+        let d_nm = gm
+            .iridescence
+            .map_or(0.0, |i| f64::from(i.thickness_max_nm));
         let (film_r, film_t) = eval.colour(mu, d_nm, [1.0; 3]);
         let (pane_r, pane_t) = eval.colour(mu, 0.0, [1.0; 3]);
         let w = gm.iridescence.map_or(0.0, |i| f64::from(i.factor));
