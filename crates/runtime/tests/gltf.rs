@@ -1475,7 +1475,7 @@ fn glass_materials_match_the_cpu_coated_pane() {
         };
         let mu = n[0] * v[0] + n[1] * v[1] + n[2] * v[2];
         let gm = &scene.materials[k];
-        let setup = nacre_runtime::mesh::glass_setup(gm).unwrap();
+        let setup = nacre_runtime::mesh::glass_setup(&scene, k).unwrap();
         let eval =
             StackEvaluation::new(&colorimeter, &setup.stack, &setup.relative_nm, None).unwrap();
         let d_nm = gm

@@ -156,6 +156,33 @@ impl GltfError {
 }
 
 impl GltfScene {
+    /// The least and greatest metallic value material `material` takes: its
+    /// [`GltfMaterial::metallic_range`], narrowed by the decoded `metallicRoughnessTexture`'s
+    /// blue channel (glTF 2.0 §3.9.2: metallic = `metallicFactor` × B), so that a texture
+    /// whose B is 0 everywhere (IridescentDishWithOlives' `glassCover`) makes a dielectric.
+    /// Without the texture's texels (skipped at load) the material's own bound stands.
+    pub fn metallic_range(&self, material: usize) -> (f32, f32) {
+        let Some(gm) = self.materials.get(material) else {
+            return (0.0, 1.0);
+        };
+        let (lo, hi) = gm.metallic_range();
+        let texels = gm
+            .textures
+            .metallic_roughness
+            .and_then(|r| self.textures.get(r.texture))
+            .filter(|t| !t.rgba.is_empty());
+        match texels {
+            Some(t) => {
+                let (b_min, b_max) = t
+                    .rgba
+                    .chunks_exact(4)
+                    .fold((u8::MAX, 0u8), |(a, b), px| (a.min(px[2]), b.max(px[2])));
+                (hi * f32::from(b_min) / 255.0, hi * f32::from(b_max) / 255.0)
+            }
+            None => (lo, hi),
+        }
+    }
+
     /// Reads a `.gltf` (JSON, buffers embedded as `data:` URIs or in files beside it) or a
     /// `.glb` file.
     pub fn load(path: &Path) -> Result<GltfScene> {

@@ -3,7 +3,7 @@
 //! transmissive dielectric ([`glass_setup`]), `fourier` otherwise.
 
 use crate::error::{Error, Result};
-use crate::gltf_scene::{GltfMaterial, GltfScene, is_gold_like};
+use crate::gltf_scene::{GltfScene, is_gold_like};
 use crate::render::{BaseKind, MaterialOptions, check_film_lut};
 use crate::shaders::Technique;
 use crate::tables::TableSet;
@@ -38,14 +38,20 @@ pub const NM_PER_WORLD_UNIT: f64 = 1e9;
 /// share R′R_B ≈ 0.2 % of the light, go unattenuated). A material without iridescence has
 /// film weight 0: the uncoated pane (`SurfaceMaterial.bare_pane`).
 ///
+/// Metallic 0 everywhere is judged by [`GltfScene::metallic_range`], the metallic texture's
+/// texels included.
+///
 /// # Errors
-/// The reason, for the renderer's fallback note: the material does not transmit, has a metal
-/// lobe, or a value makes no stack.
-pub fn glass_setup(gm: &GltfMaterial) -> std::result::Result<StackSetup, Msg> {
+/// The reason, for the renderer's fallback note: `material` is not in the scene, does not
+/// transmit, has a metal lobe, or a value makes no stack.
+pub fn glass_setup(scene: &GltfScene, material: usize) -> std::result::Result<StackSetup, Msg> {
+    let Some(gm) = scene.materials.get(material) else {
+        return Err(format!("material {material} is not in the scene").into());
+    };
     if !(gm.transmission.is_finite() && gm.transmission > 0.0) {
         return Err("it does not transmit (KHR_materials_transmission): glass draws a pane".into());
     }
-    let (_, metallic_max) = gm.metallic_range();
+    let (_, metallic_max) = scene.metallic_range(material);
     if metallic_max > 0.0 {
         return Err(format!(
             "its metallic value reaches {metallic_max} (a factor or texture): a metal lobe has no pane"
@@ -172,12 +178,12 @@ pub(super) fn choose(
                 )));
             }
         }
-        let (lo, hi) = gm.metallic_range();
+        let (lo, hi) = scene.metallic_range(i);
         let one_lobe = hi <= 0.0 || lo >= 1.0;
         let mut t = technique;
         let mut pane = None;
         if technique == Technique::Glass {
-            match glass_setup(gm) {
+            match glass_setup(scene, i) {
                 Ok(setup) => pane = Some(setup),
                 Err(why) => {
                     if used.contains(&i) {
