@@ -1515,3 +1515,51 @@ fn glass_materials_match_the_cpu_coated_pane() {
         }
     }
 }
+
+/// Metallic 0 everywhere is read from the `metallicRoughnessTexture`'s texels (glTF 2.0
+/// §3.9.2: metallic = `metallicFactor` × B): a transmissive material whose factor is 1 but
+/// whose texture's blue channel is 0 in every texel is glass (IridescentDishWithOlives'
+/// cover); one texel of B = 51 makes the range reach 0.2 and the material no pane.
+#[test]
+fn a_metallic_texture_without_metal_makes_glass() {
+    use nacre_runtime::gltf_scene::{
+        GltfMaterial, GltfTexture, IDENTITY_TRANSFORM, SamplerSpec, TextureRef,
+    };
+    let texels = |b: [u8; 4]| GltfTexture {
+        name: "texture 0".into(),
+        width: 2,
+        height: 2,
+        rgba: b.iter().flat_map(|&b| [255, 26, b, 255]).collect(),
+        srgb: false,
+        sampler: SamplerSpec::default(),
+    };
+    let mut material = GltfMaterial {
+        transmission: 1.0,
+        metallic: 1.0,
+        ..GltfMaterial::default()
+    };
+    material.textures.metallic_roughness = Some(TextureRef {
+        texture: 0,
+        tex_coord: 0,
+        transform: IDENTITY_TRANSFORM,
+    });
+    let mut scene = GltfScene {
+        materials: vec![material.clone()],
+        textures: vec![texels([0; 4])],
+        ..GltfScene::default()
+    };
+    assert_eq!(material.metallic_range(), (0.0, 1.0));
+    assert_eq!(scene.metallic_range(0), (0.0, 0.0));
+    assert!(nacre_runtime::mesh::glass_setup(&scene, 0).is_ok());
+
+    scene.textures = vec![texels([0, 0, 51, 0])];
+    assert_eq!(scene.metallic_range(0), (0.0, 0.2));
+    let why = nacre_runtime::mesh::glass_setup(&scene, 0).unwrap_err();
+    assert!(
+        why.to_string().contains("metallic value reaches 0.2"),
+        "{why}"
+    );
+    // Without texels (the loader skipped the texture) the factor's bound stands.
+    scene.textures.clear();
+    assert_eq!(scene.metallic_range(0), (0.0, 1.0));
+}
