@@ -226,6 +226,17 @@ impl MaterialDb {
         }
     }
 
+    /// Every page the database's catalog (`catalog-nk.yml`) lists, in its order (see
+    /// [`catalog_pages`]): what a front end offers to browse and search.
+    pub fn pages(&self) -> Result<Vec<CatalogPage>> {
+        let catalog = self.root().join("catalog-nk.yml");
+        let text = std::fs::read_to_string(&catalog).map_err(|source| Error::Io {
+            path: catalog,
+            source,
+        })?;
+        Ok(catalog_pages(&text))
+    }
+
     /// The data file of page `shelf/book/page`, and every path tried (in order) when
     /// there is none.
     pub fn locate(&self, shelf: &str, book: &str, page: &str) -> (Option<PathBuf>, Vec<PathBuf>) {
@@ -316,10 +327,32 @@ impl MaterialDb {
     }
 }
 
-/// The `data:` path of `shelf/book/page` in a `catalog-nk.yml` text. The catalog is a YAML
-/// list of `- SHELF:`, `- BOOK:`, `- PAGE:` entries, each page with a `data:` line; a line
-/// scan suffices for the file the database generates.
-fn catalog_lookup(text: &str, shelf: &str, book: &str, page: &str) -> Option<String> {
+/// One page of the database's catalog (`catalog-nk.yml`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct CatalogPage {
+    /// The shelf (`main`).
+    pub shelf: String,
+    /// The book (`Au`).
+    pub book: String,
+    /// The page (`Johnson`).
+    pub page: String,
+    /// The page's title in the catalog (`Johnson and Christy 1972: n,k 0.188–1.94 µm`).
+    pub name: String,
+    /// Its data file, relative to the data folder (`main/Au/nk/Johnson.yml`).
+    pub data: String,
+}
+
+impl CatalogPage {
+    /// The page as a material specification: `shelf/book/page`.
+    pub fn spec(&self) -> String {
+        format!("{}/{}/{}", self.shelf, self.book, self.page)
+    }
+}
+
+/// Every page of a `catalog-nk.yml` text that names a data file, in the catalog's order.
+/// The catalog is read line by line (its `SHELF`/`BOOK`/`PAGE`, `name` and `data` keys), not
+/// as general YAML.
+pub fn catalog_pages(text: &str) -> Vec<CatalogPage> {
     fn value<'a>(line: &'a str, key: &str) -> Option<&'a str> {
         let v = line.strip_prefix(key)?.strip_prefix(':')?.trim();
         let v = v
@@ -329,23 +362,38 @@ fn catalog_lookup(text: &str, shelf: &str, book: &str, page: &str) -> Option<Str
             .unwrap_or(v);
         Some(v)
     }
-    let (mut s, mut b, mut p) = ("", "", "");
+    let (mut s, mut b, mut p, mut name) = ("", "", "", "");
+    let mut pages = Vec::new();
     for line in text.lines() {
         let t = line.trim();
         let t = t.strip_prefix("- ").unwrap_or(t).trim_start();
         if let Some(v) = value(t, "SHELF") {
-            (s, b, p) = (v, "", "");
+            (s, b, p, name) = (v, "", "", "");
         } else if let Some(v) = value(t, "BOOK") {
-            (b, p) = (v, "");
+            (b, p, name) = (v, "", "");
         } else if let Some(v) = value(t, "PAGE") {
-            p = v;
-        } else if let Some(v) = value(t, "data")
-            && (s, b, p) == (shelf, book, page)
-        {
-            return Some(v.to_string());
+            (p, name) = (v, "");
+        } else if let Some(v) = value(t, "name") {
+            name = v;
+        } else if let Some(v) = value(t, "data") {
+            pages.push(CatalogPage {
+                shelf: s.to_string(),
+                book: b.to_string(),
+                page: p.to_string(),
+                name: name.to_string(),
+                data: v.to_string(),
+            });
         }
     }
-    None
+    pages
+}
+
+/// The data path the catalog gives page `shelf/book/page`, if any.
+fn catalog_lookup(text: &str, shelf: &str, book: &str, page: &str) -> Option<String> {
+    catalog_pages(text)
+        .into_iter()
+        .find(|c| (c.shelf.as_str(), c.book.as_str(), c.page.as_str()) == (shelf, book, page))
+        .map(|c| c.data)
 }
 
 /// Resolves a material specification (see module docs) with the database set by
@@ -516,6 +564,18 @@ mod tests {
                     "{spec}: {i}"
                 );
             }
+            // The catalog lists its pages with their titles and data files.
+            assert_eq!(
+                db.pages().unwrap(),
+                vec![CatalogPage {
+                    shelf: "main".into(),
+                    book: "BeAl2O4".into(),
+                    page: "Walling-α".into(),
+                    name: "Walling et al. 1980".into(),
+                    data: "main/BeAl2O4/Walling-alpha.yml".into(),
+                }]
+            );
+            assert_eq!(db.pages().unwrap()[0].spec(), "main/BeAl2O4/Walling-α");
             // Bundled names, numbers and paths come first.
             let au = resolve_with("au", Param::Substrate, None, Some(&db)).unwrap();
             assert_eq!(au.name(), "au");

@@ -9,7 +9,9 @@ use clap::Parser;
 use eframe::egui;
 use eframe::egui_wgpu::{WgpuConfiguration, WgpuSetup, WgpuSetupCreateNew};
 use nacre_format::atomic::write_atomic;
+use nacre_format::materials::{MaterialDb, set_database};
 use nacre_runtime::{GpuContext, Technique};
+use nacre_studio::material_db;
 use nacre_studio::view::Lighting;
 use nacre_studio::{StackDoc, Studio, View};
 use std::path::PathBuf;
@@ -219,6 +221,14 @@ fn main() {
             format!("`{other}` (expected studio or uniform)"),
         ),
     };
+    // The material database `shelf/book/page` materials are read from (recipes, the
+    // session, the browser): NACRE_MATERIAL_DB, else ../shared beside the repository.
+    let db_origin = if std::env::var_os(material_db::DB_ENV).is_some_and(|v| !v.is_empty()) {
+        material_db::DB_ENV
+    } else {
+        "the shared material database folder"
+    };
+    set_database(material_db::default_folder().map(|d| MaterialDb::new(d, db_origin)));
     // Read the recipe before opening the window: bad input fails fast.
     let doc = match &args.recipe {
         Some(path) => {

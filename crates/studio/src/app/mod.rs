@@ -3,7 +3,7 @@
 //! native window (`main.rs`, eframe) and in the UI tests (`egui_kittest`).
 //!
 //! Each panel is its own file: `stack_editor.rs` (left), `view_panel.rs` (centre: the
-//! picture, the model, the ΔE2000 map), `plots.rs` (right), `export.rs` (bottom: the table
+//! picture, the model, the ΔE2000 map), `material_browser.rs` (under the stack), `plots.rs` (right), `export.rs` (bottom: the table
 //! bake). This file holds the state they share, undo, the session, the recipe and the
 //! toolbar.
 //!
@@ -12,10 +12,12 @@
 //! exports keep the last stack that built.
 
 mod export;
+mod material_browser;
 mod plots;
 mod stack_editor;
 mod view_panel;
 
+pub use material_browser::{MAX_RESULTS, MaterialBrowser, MaterialTarget};
 pub use view_panel::is_gltf;
 
 use crate::bake::{BakeJob, BakeSettings};
@@ -111,6 +113,8 @@ pub struct Studio {
     saved_session: Option<StackDoc>,
     /// Why the session could not be restored or saved, if it could not.
     pub session_error: Option<String>,
+    /// The material database browser.
+    pub materials: MaterialBrowser,
 }
 
 impl Studio {
@@ -161,6 +165,7 @@ impl Studio {
             session_path: None,
             saved_session: None,
             session_error: None,
+            materials: MaterialBrowser::default(),
         }
     }
 

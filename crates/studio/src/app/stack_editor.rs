@@ -100,13 +100,15 @@ impl Studio {
         ui.separator();
         material_field(ui, "Base", &mut self.doc.substrate);
         ui.separator();
+        self.material_browser(ui);
+        ui.separator();
         if let Some(e) = &self.session_error {
             ui.label(RichText::new(e.as_str()).color(Color32::LIGHT_RED));
         }
         if let Some(e) = &self.stack_error {
             ui.label(RichText::new(format!("Not applied: {e}")).color(Color32::LIGHT_RED));
         } else {
-            ui.label("Materials: numbers (1.45, 0.27+2.9i), bundled names (bk7, mgf2, tio2, water, oil, au, ag, cu, al, cr, si), or files (.yml, .csv).");
+            ui.label("Materials: numbers (1.45, 0.27+2.9i), bundled names (bk7, mgf2, tio2, water, oil, au, ag, cu, al, cr, si), files (.yml, .csv), or refractiveindex.info pages (main/Au/Johnson) from the material database.");
         }
     }
 }
