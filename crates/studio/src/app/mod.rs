@@ -4,7 +4,7 @@
 //!
 //! Each panel is its own file: `stack_editor.rs` (left), `view_panel.rs` (centre: the
 //! picture, the model, the ΔE2000 map), `material_browser.rs` (under the stack), `plots.rs` (right), `export.rs` (bottom: the table
-//! bake). This file holds the state they share, undo, the session, the recipe and the
+//! bake and the engine export). This file holds the state they share, undo, the session, the recipe and the
 //! toolbar.
 //!
 //! An entry is applied when the stack it makes builds ([`StackDoc::build`], the CLI's
@@ -24,6 +24,7 @@ use crate::bake::{BakeJob, BakeSettings};
 use crate::compare::{DEFAULT_SCALE_MAX, DeltaE};
 use crate::curves::{CurveWorker, Curves};
 use crate::doc::{History, PRESETS, StackDoc};
+use crate::engine::{EngineExport, EngineJob};
 use crate::view::{Frame, View, ViewSettings};
 use eframe::egui;
 use egui::{Color32, RichText, TextureHandle};
@@ -115,6 +116,12 @@ pub struct Studio {
     pub session_error: Option<String>,
     /// The material database browser.
     pub materials: MaterialBrowser,
+    /// The last engine export prepared (the closest glTF film, the stack JSON, snippets).
+    pub engine: Option<EngineExport>,
+    /// The engine export being prepared, if any.
+    pub engine_job: Option<EngineJob>,
+    /// How the last engine export or write went.
+    pub engine_status: Option<Result<String, String>>,
 }
 
 impl Studio {
@@ -166,6 +173,9 @@ impl Studio {
             saved_session: None,
             session_error: None,
             materials: MaterialBrowser::default(),
+            engine: None,
+            engine_job: None,
+            engine_status: None,
         }
     }
 
@@ -305,7 +315,10 @@ impl Studio {
         self.shortcuts(ui.ctx());
         self.take_dropped_model(ui.ctx());
         egui::Panel::top("studio toolbar").show(ui, |ui| self.toolbar(ui));
-        egui::Panel::bottom("studio export").show(ui, |ui| self.export_panel(ui));
+        egui::Panel::bottom("studio export").show(ui, |ui| {
+            self.export_panel(ui);
+            self.engine_panel(ui);
+        });
         egui::Panel::left("studio stack")
             .default_size(330.0)
             .resizable(true)
