@@ -1,7 +1,10 @@
 //! What the plots beside the view show, computed by the CLI's library calls: the stack's
 //! reflectance and transmittance spectra at one angle (s, p, unpolarised;
 //! `nacre spectrum`'s [`nacre_bake::commands::spectrum::compute`]) and its exact colour
-//! against the angle (`nacre color`'s spectral method, [`exact_colours`]).
+//! against the angle (`nacre color`'s spectral method, [`exact_colours`]); the unpolarised
+//! spectra at a family of angles ([`FAMILY_ANGLES_DEG`]); the exact colour at 0° against the
+//! top film's thickness ([`THICKNESS_SWEEP_NM`]); and the chromaticity trajectories (CIE 1931
+//! xy = (X, Y)/(X + Y + Z), D65) as the angle and as the thickness vary.
 
 use nacre_bake::commands::color::{Method, Point, Quantity};
 use nacre_bake::commands::color_request::{self, ColorRequest, ColourSettings};
@@ -13,6 +16,12 @@ pub const WAVELENGTHS_NM: (f64, f64, f64) = (380.0, 780.0, 2.0);
 
 /// The angles of the colour-against-angle strip, degrees (0 to 89 every degree).
 pub const STRIP_ANGLES_DEG: usize = 90;
+
+/// The angles of the spectra family, degrees.
+pub const FAMILY_ANGLES_DEG: [f64; 4] = [0.0, 30.0, 60.0, 75.0];
+
+/// The top film's thickness sweep, nm: from, to, step.
+pub const THICKNESS_SWEEP_NM: (f64, f64, f64) = (0.0, 1000.0, 5.0);
 
 /// Spectra at one angle and colours against angle.
 #[derive(Clone, Debug, PartialEq)]
@@ -27,6 +36,36 @@ pub struct Curves {
     pub transmittance: [Vec<f64>; 3],
     /// The exact reflectance colour (linear sRGB, D65, CIE 1931) at 0°, 1°, … 89°.
     pub colour_by_angle: Vec<[f64; 3]>,
+    /// R (unpolarised) per wavelength at each of [`FAMILY_ANGLES_DEG`].
+    pub family_reflectance: Vec<Vec<f64>>,
+    /// T (unpolarised) per wavelength at each of [`FAMILY_ANGLES_DEG`].
+    pub family_transmittance: Vec<Vec<f64>>,
+    /// The top film's thicknesses of the sweep, nm (empty without a film).
+    pub thicknesses_nm: Vec<f64>,
+    /// The exact reflectance colour (linear sRGB) at 0° at each of `thicknesses_nm`.
+    pub colour_by_thickness: Vec<[f64; 3]>,
+    /// CIE 1931 xy of the reflected colour at 0°, 1°, … 89°.
+    pub xy_by_angle: Vec<[f64; 2]>,
+    /// CIE 1931 xy of the reflected colour at 0° at each of `thicknesses_nm`.
+    pub xy_by_thickness: Vec<[f64; 2]>,
+}
+
+/// The thicknesses of [`THICKNESS_SWEEP_NM`].
+pub fn thicknesses() -> Vec<f64> {
+    let (lo, hi, step) = THICKNESS_SWEEP_NM;
+    let n = ((hi - lo) / step).round() as usize;
+    (0..=n).map(|k| lo + step * k as f64).collect()
+}
+
+/// xy = (X, Y)/(X + Y + Z); a black colour (X + Y + Z = 0) has the white point's (D65:
+/// 0.3127, 0.3290).
+pub fn chromaticity(xyz: [f64; 3]) -> [f64; 2] {
+    let sum = xyz[0] + xyz[1] + xyz[2];
+    if sum > 0.0 {
+        [xyz[0] / sum, xyz[1] / sum]
+    } else {
+        [0.3127, 0.3290]
+    }
 }
 
 /// The wavelengths of [`WAVELENGTHS_NM`].
@@ -47,17 +86,34 @@ pub fn exact_colours(stack: &Stack, angles_deg: &[f64]) -> nacre_bake::Result<Ve
             film_ior: None,
         })
         .collect();
+    exact_colours_at(stack, &points, None)
+}
+
+/// The exact (spectral) reflectance colour of `stack` at `points` (angle, and the top
+/// film's thickness) in `space` (None: linear sRGB; `Some("xyz")`: CIE XYZ), D65, CIE 1931:
+/// `nacre color --method spectral --space SPACE`.
+pub fn exact_colours_at(
+    stack: &Stack,
+    points: &[Point],
+    space: Option<&str>,
+) -> nacre_bake::Result<Vec<[f64; 3]>> {
+    if points.is_empty() {
+        return Ok(Vec::new());
+    }
     let prepared = color_request::prepare(
         stack,
         Method::Spectral,
         &ColorRequest {
             method: "spectral",
             roughness: None,
-            colour: ColourSettings::default(),
+            colour: ColourSettings {
+                space,
+                ..ColourSettings::default()
+            },
             fourier_table: None,
         },
     )?;
-    let out = color_request::compute(stack, &points, &prepared, Quantity::Reflectance)?;
+    let out = color_request::compute(stack, points, &prepared, Quantity::Reflectance)?;
     Ok(out.colours)
 }
 
@@ -70,12 +126,41 @@ pub fn compute(stack: &Stack, angle_deg: f64) -> nacre_bake::Result<Curves> {
     let transmittance = [pick(&|p| p.T_s), pick(&|p| p.T_p), pick(&|p| p.T())];
     let angles: Vec<f64> = (0..STRIP_ANGLES_DEG).map(|a| a as f64).collect();
     let colour_by_angle = exact_colours(stack, &angles)?;
+    let mut family_reflectance = Vec::new();
+    let mut family_transmittance = Vec::new();
+    for a in FAMILY_ANGLES_DEG {
+        let powers = nacre_bake::commands::spectrum::compute(stack, &[a], &wavelengths_nm)?;
+        family_reflectance.push(powers.iter().map(|p| p.R()).collect());
+        family_transmittance.push(powers.iter().map(|p| p.T()).collect());
+    }
+    let at = |angle_deg: f64, thickness_nm: Option<f64>| Point {
+        angle_deg,
+        thickness_nm,
+        film_ior: None,
+    };
+    let thicknesses_nm = if stack.layers().is_empty() {
+        Vec::new()
+    } else {
+        thicknesses()
+    };
+    let by_thickness: Vec<Point> = thicknesses_nm.iter().map(|&d| at(0.0, Some(d))).collect();
+    let colour_by_thickness = exact_colours_at(stack, &by_thickness, None)?;
+    let by_angle: Vec<Point> = angles.iter().map(|&a| at(a, None)).collect();
+    let xy = |xyz: Vec<[f64; 3]>| xyz.into_iter().map(chromaticity).collect::<Vec<_>>();
+    let xy_by_angle = xy(exact_colours_at(stack, &by_angle, Some("xyz"))?);
+    let xy_by_thickness = xy(exact_colours_at(stack, &by_thickness, Some("xyz"))?);
     Ok(Curves {
         angle_deg,
         wavelengths_nm,
         reflectance,
         transmittance,
         colour_by_angle,
+        family_reflectance,
+        family_transmittance,
+        thicknesses_nm,
+        colour_by_thickness,
+        xy_by_angle,
+        xy_by_thickness,
     })
 }
 

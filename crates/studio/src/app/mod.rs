@@ -18,6 +18,7 @@ mod stack_editor;
 mod view_panel;
 
 pub use material_browser::{MAX_RESULTS, MaterialBrowser, MaterialTarget};
+pub use plots::{BY_ANGLE, BY_THICKNESS, CHROMATICITY, FAMILY_R, FAMILY_T, PlotReadout};
 pub use view_panel::is_gltf;
 
 use crate::bake::{BakeJob, BakeSettings};
@@ -122,6 +123,8 @@ pub struct Studio {
     pub engine_job: Option<EngineJob>,
     /// How the last engine export or write went.
     pub engine_status: Option<Result<String, String>>,
+    /// What the pointer last read on a plot.
+    pub plot_readout: Option<PlotReadout>,
 }
 
 impl Studio {
@@ -176,6 +179,7 @@ impl Studio {
             engine: None,
             engine_job: None,
             engine_status: None,
+            plot_readout: None,
         }
     }
 
