@@ -22,8 +22,9 @@ pub fn default_folder() -> Option<PathBuf> {
     if let Some(dir) = std::env::var_os(DB_ENV).filter(|v| !v.is_empty()) {
         return Some(PathBuf::from(dir));
     }
+    // Canonical, so that the folder field shows `/…/shared/…` rather than `crates/studio/../../..`.
     let shared = shared_folder();
-    shared.is_dir().then_some(shared)
+    shared.canonicalize().ok().filter(|d| d.is_dir())
 }
 
 /// A database opened for browsing: its folder and its catalog's pages.
