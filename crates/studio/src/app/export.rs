@@ -3,11 +3,11 @@
 //! ([`crate::engine`]): the closest glTF film, the stack JSON and the Bevy and three.js
 //! snippets, shown and written into the same folder under the same name.
 
-use super::Studio;
+use super::{Studio, status_label};
 use crate::bake::{BakeJob, BakeOutcome};
 use crate::engine::EngineJob;
 use eframe::egui;
-use egui::{Color32, RichText};
+use egui::RichText;
 use std::path::Path;
 
 impl Studio {
@@ -100,15 +100,7 @@ impl Studio {
                 ui.ctx()
                     .request_repaint_after(std::time::Duration::from_millis(50));
             }
-            match &self.bake_status {
-                Some(Ok(text)) => {
-                    ui.label(text);
-                }
-                Some(Err(text)) => {
-                    ui.label(RichText::new(text).color(Color32::LIGHT_RED));
-                }
-                None => {}
-            }
+            status_label(ui, &self.bake_status);
         });
     }
 
@@ -198,15 +190,7 @@ impl Studio {
             {
                 self.write_engine_files();
             }
-            match &self.engine_status {
-                Some(Ok(text)) => {
-                    ui.label(text);
-                }
-                Some(Err(text)) => {
-                    ui.label(RichText::new(text).color(Color32::LIGHT_RED));
-                }
-                None => {}
-            }
+            status_label(ui, &self.engine_status);
         });
         let Some(export) = &self.engine else {
             return;

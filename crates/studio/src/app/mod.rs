@@ -415,15 +415,7 @@ impl Studio {
                         .map(|()| format!("saved {path}")),
                 );
             }
-            match &self.status {
-                Some(Ok(text)) => {
-                    ui.label(text);
-                }
-                Some(Err(text)) => {
-                    ui.label(RichText::new(text).color(Color32::LIGHT_RED));
-                }
-                None => {}
-            }
+            status_label(ui, &self.status);
         });
     }
 }
@@ -452,6 +444,19 @@ fn texts(doc: &StackDoc) -> Vec<(String, Option<String>)> {
 pub fn format_nm(d: f64) -> String {
     let t = format!("{d:.2}");
     t.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
+/// An outcome's line: the text, in red when it is an error; nothing before the first.
+fn status_label(ui: &mut egui::Ui, status: &Option<Result<String, String>>) {
+    match status {
+        Some(Ok(text)) => {
+            ui.label(text);
+        }
+        Some(Err(text)) => {
+            ui.label(RichText::new(text).color(Color32::LIGHT_RED));
+        }
+        None => {}
+    }
 }
 
 /// A labelled single-line material entry.
