@@ -99,11 +99,10 @@ fn diffraction_taylor_sum(texel: vec2<i32>, c: ptr<function, array<vec2<f32>, 32
     return p;
 }
 
-// P̃(q) for wave number k (rad/µm) and (u, v, w), the windowed Taylor sum (header).
-fn diffraction_transform(k_per_um: f32, uvw: vec3<f32>) -> vec2<f32> {
-    // Taylor coefficients (k w)ⁿ / n!, in pairs (T₂ₗ, T₂ₗ₊₁) like the layers.
+// The Taylor coefficients (k w)ⁿ / n! of e^{i k w h} up to the table's order, in pairs
+// (T₂ₗ, T₂ₗ₊₁) like the layers (header); `kw` = k w.
+fn diffraction_taylor(kw: f32) -> array<vec2<f32>, 32> {
     var c: array<vec2<f32>, 32>;
-    let kw = k_per_um * uvw.z;
     var term = 1.0;
     let order = min(diffraction.order, DIFFRACTION_MAX_ORDER);
     for (var n = 0u; n <= order; n++) {
@@ -116,6 +115,12 @@ fn diffraction_transform(k_per_um: f32, uvw: vec3<f32>) -> vec2<f32> {
             c[n / 2u].y = term;
         }
     }
+    return c;
+}
+
+// P̃(q) for wave number k (rad/µm) and (u, v, w), the windowed Taylor sum (header).
+fn diffraction_transform(k_per_um: f32, uvw: vec3<f32>) -> vec2<f32> {
+    var c = diffraction_taylor(k_per_um * uvw.z);
     let q = k_per_um * uvw.xy;
     let size = vec2<i32>(diffraction.size);
     let lo = -diffraction.dc;
@@ -284,20 +289,7 @@ fn diffraction_row_corrections(
 // E|P̃|² over the footprint (above) for wave number k (rad/µm), (u, v, w) at the pixel's
 // centre and σ_uv ≥ 0 the footprint's standard deviation in (u, v) per axis.
 fn diffraction_filtered_intensity(k_per_um: f32, uvw: vec3<f32>, sigma_uv: vec2<f32>) -> f32 {
-    var c: array<vec2<f32>, 32>;
-    let kw = k_per_um * uvw.z;
-    var term = 1.0;
-    let order = min(diffraction.order, DIFFRACTION_MAX_ORDER);
-    for (var n = 0u; n <= order; n++) {
-        if n > 0u {
-            term *= kw / f32(n);
-        }
-        if (n & 1u) == 0u {
-            c[n / 2u].x = term;
-        } else {
-            c[n / 2u].y = term;
-        }
-    }
+    var c = diffraction_taylor(k_per_um * uvw.z);
     let q = k_per_um * uvw.xy;
     let s = k_per_um * max(sigma_uv, vec2<f32>(0.0));
     let s2 = diffraction.sigma_s_um * diffraction.sigma_s_um;
@@ -427,22 +419,10 @@ fn diffraction_specular_order_colour(cos_theta_in: f32) -> vec3<f32> {
     let fresnel = diffraction_fresnel(cos_theta);
     var colour = vec3<f32>(0.0);
     let count = min(diffraction.wavelength_count, arrayLength(&diffraction_spectrum));
-    let order = min(diffraction.order, DIFFRACTION_MAX_ORDER);
     for (var i = 0u; i < count; i++) {
         let s = diffraction_spectrum[i];
         let kw = -2.0 * cos_theta * DIFFRACTION_TWO_PI / (s.x * 1e-3);
-        var c: array<vec2<f32>, 32>;
-        var term = 1.0;
-        for (var n = 0u; n <= order; n++) {
-            if n > 0u {
-                term *= kw / f32(n);
-            }
-            if (n & 1u) == 0u {
-                c[n / 2u].x = term;
-            } else {
-                c[n / 2u].y = term;
-            }
-        }
+        var c = diffraction_taylor(kw);
         let p = diffraction_taylor_sum(diffraction.dc, &c);
         colour += fresnel * dot(p, p) * s.yzw;
     }
