@@ -87,6 +87,16 @@ impl Studio {
                 Some(t)
             }
         };
+        // A spectrum's axes: R or T from 0 to 1 against wavelength, no scroll zoom.
+        let spectrum_plot = |id: &'static str| {
+            Plot::new(id)
+                .height(120.0)
+                .legend(Legend::default())
+                .include_y(0.0)
+                .include_y(1.0)
+                .x_axis_label("wavelength (nm)")
+                .allow_scroll(false)
+        };
         let spectrum_text =
             |name: &str, _: usize, x: f64, y: f64| format!("{name} at {x:.0} nm: {y:.4}");
         let series = |values: &[f64]| -> PlotPoints<'static> {
@@ -110,13 +120,7 @@ impl Studio {
                     ("Transmittance", &c.transmittance, ["T s", "T p", "T"]),
                 ] {
                     ui.label(format!("{title} at {:.0}°", c.angle_deg));
-                    Plot::new(title)
-                        .height(120.0)
-                        .legend(Legend::default())
-                        .include_y(0.0)
-                        .include_y(1.0)
-                        .x_axis_label("wavelength (nm)")
-                        .allow_scroll(false)
+                    spectrum_plot(title)
                         .label_formatter(reader(title, spectrum_text))
                         .show(ui, |p| {
                             for k in 0..3 {
@@ -143,13 +147,7 @@ impl Studio {
                     ),
                 ] {
                     ui.label(format!("{letter} (unpolarised) at {angles}"));
-                    Plot::new(title)
-                        .height(120.0)
-                        .legend(Legend::default())
-                        .include_y(0.0)
-                        .include_y(1.0)
-                        .x_axis_label("wavelength (nm)")
-                        .allow_scroll(false)
+                    spectrum_plot(title)
                         .label_formatter(reader(plot, spectrum_text))
                         .show(ui, |p| {
                             for (k, v) in values.iter().enumerate() {
