@@ -10,7 +10,7 @@
 //! before it starts, and the files are written only once the whole table is computed (each
 //! atomically, the manifest last: [`nacre_format::stage`]).
 
-use crate::doc::StackDoc;
+use crate::doc::{Film, StackDoc};
 use crate::view::INDEX_WAVELENGTH_NM;
 use nacre_bake::kinds::TableRecipe;
 use nacre_bake::kinds::film_lut::{FilmLutRecipe, bake_recipe_cancellable};
@@ -61,6 +61,13 @@ pub fn film_ior_range(ambient_index: f64, film_index: f64) -> [f64; 2] {
     [lo, (hi * 100.0).ceil() / 100.0]
 }
 
+/// The top of the table's thickness axis for a top film `d ± r` thick: max(1200 nm, d + r
+/// rounded up to 100 nm), nm.
+pub fn thickness_max_nm(top: &Film) -> f64 {
+    (((top.thickness_nm + top.relative_nm.abs()) / 100.0).ceil() * 100.0)
+        .max(MIN_THICKNESS_RANGE_NM)
+}
+
 /// The `film-lut` recipe TOML of `doc` with `settings`' texel counts: the ambient, the top
 /// film's index range ([`film_ior_range`]), the films under it as fixed layers, the base;
 /// thicknesses 0 to max(1200 nm, the top film's d + r rounded up to 100 nm).
@@ -75,8 +82,7 @@ pub fn film_lut_recipe(doc: &StackDoc, settings: &BakeSettings) -> Result<String
     };
     let ambient = index(stack.ambient(), "ambient")?;
     let film = index(&stack.layers()[0].material, "film 1")?;
-    let thickness_max_nm =
-        (((top.thickness_nm + top.relative_nm) / 100.0).ceil() * 100.0).max(MIN_THICKNESS_RANGE_NM);
+    let thickness_max_nm = thickness_max_nm(top);
     #[derive(Serialize)]
     struct Under<'a> {
         material: &'a str,

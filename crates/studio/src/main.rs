@@ -49,9 +49,26 @@ struct Args {
     /// Technique: stack, spectral, fourier or lut.
     #[arg(long, default_value = "stack")]
     technique: String,
-    /// Lighting: studio (the bundled environment and its sun) or uniform (a white sky).
+    /// Lighting: studio (the bundled environment and its sun) or uniform (a white sky);
+    /// --env replaces both.
     #[arg(long, default_value = "studio")]
     lighting: String,
+    /// Light the view with this equirectangular environment (OpenEXR or Radiance HDR,
+    /// linear; PNG or JPEG, sRGB; row 0 = zenith), as `nacre render --env`.
+    #[arg(long, value_name = "FILE")]
+    env: Option<PathBuf>,
+    /// A thickness map (PNG or JPEG, grey or colour) in place of the procedural one, as
+    /// `nacre render --thickness-map`.
+    #[arg(long, value_name = "FILE.png")]
+    thickness_map: Option<PathBuf>,
+    /// Where `lut` keeps the tables it bakes for stacks the bundled table does not hold
+    /// [default: $XDG_CACHE_HOME/nacre/studio-luts, else ~/.cache/nacre/studio-luts].
+    #[arg(long, value_name = "DIR", conflicts_with = "no_lut_cache")]
+    lut_cache: Option<PathBuf>,
+    /// Bake no stack tables: `lut` draws every stack with the bundled film-dielectric table
+    /// (its ambient and base), as before.
+    #[arg(long)]
+    no_lut_cache: bool,
     /// Turn the camera by a degree every frame (every frame is drawn anew) and print the
     /// mean frame time at exit: the frame-time benchmark.
     #[arg(long)]
@@ -118,7 +135,10 @@ impl eframe::App for App {
                 self.first_picture = Some(t);
                 eprintln!("first picture after {t:.2} s");
             }
-            if let Some(f) = &self.studio.frame {
+            // A stack's lut table baking in the background: the frames draw `stack`.
+            if let Some(f) = &self.studio.frame
+                && self.studio.live_lut.progress().is_none()
+            {
                 self.spin_seconds.push((f.seconds, f.image.gpu_seconds));
             }
         }
@@ -165,7 +185,10 @@ impl eframe::App for App {
             ctx.send_viewport_cmd(egui::ViewportCommand::Close);
             return;
         }
-        let ready = self.studio.frame.is_some() && self.studio.curves_current();
+        // With `lut` on a stack that needs its own table: once the table is drawn.
+        let ready = self.studio.frame.is_some()
+            && self.studio.curves_current()
+            && self.studio.live_lut.progress().is_none();
         if !self.requested
             && self.frames >= self.wanted_frames
             && (ready || self.studio.view_error.is_some())
@@ -249,6 +272,31 @@ fn main() {
         }
         None => StackDoc::default(),
     };
+    if let Some(path) = &args.env
+        && let Err(e) = nacre_runtime::render::EnvironmentMap::load(path)
+    {
+        bad("--env", e);
+    }
+    if let Some(path) = &args.thickness_map
+        && let Err(e) = nacre_runtime::render::ThicknessMap::load(path)
+    {
+        bad("--thickness-map", e);
+    }
+    let lut_cache = if args.no_lut_cache {
+        None
+    } else {
+        args.lut_cache
+            .clone()
+            .or_else(nacre_studio::live_lut::default_folder)
+    };
+    if let Some(dir) = &lut_cache
+        && dir.is_file()
+    {
+        bad(
+            "--lut-cache",
+            format!("{} is a file, not a folder", dir.display()),
+        );
+    }
     if let Some(path) = &args.screenshot
         && path.is_dir()
     {
@@ -297,6 +345,7 @@ fn main() {
         ..Default::default()
     };
     let code = Arc::clone(&exit_code);
+    let (env, thickness_map) = (args.env.clone(), args.thickness_map.clone());
     let result = eframe::run_native(
         "nacre studio",
         options,
@@ -323,6 +372,13 @@ fn main() {
             studio.follow_panel = view_size.is_none();
             studio.settings.technique = technique;
             studio.settings.lighting = lighting;
+            studio.live_lut.folder = lut_cache;
+            if let Some(path) = &env {
+                studio.environment_error = studio.open_environment(path).err();
+            }
+            if let Some(path) = &thickness_map {
+                studio.thickness_map_error = studio.open_thickness_map(path).err();
+            }
             Ok(Box::new(App {
                 studio,
                 started,

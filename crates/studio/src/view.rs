@@ -38,17 +38,22 @@ pub enum Lighting {
     /// A uniform white sky of radiance 1 and no sun: a mirror-smooth film then shows its
     /// own reflectance colour (the sphere's centre: `nacre color` at 0°, tone-mapped).
     Uniform,
+    /// An equirectangular environment file (OpenEXR, Radiance HDR, PNG or JPEG: what
+    /// `nacre render --env` reads), [`ViewSettings::environment`], lighting the scene
+    /// alone: the file holds its own sun, so the studio's is off.
+    File,
 }
 
 impl Lighting {
     /// Every lighting, in menu order.
-    pub const ALL: [Lighting; 2] = [Lighting::Studio, Lighting::Uniform];
+    pub const ALL: [Lighting; 3] = [Lighting::Studio, Lighting::Uniform, Lighting::File];
 
     /// The menu name.
     pub fn name(self) -> &'static str {
         match self {
             Lighting::Studio => "studio environment",
             Lighting::Uniform => "uniform white sky",
+            Lighting::File => "environment file",
         }
     }
 }
@@ -117,6 +122,20 @@ pub struct ViewSettings {
     /// With a model: the stack's film on every material (true) or on the materials that
     /// have `KHR_materials_iridescence` only (false, the default).
     pub film_on_all: bool,
+    /// The environment file [`Lighting::File`] draws ([`View::load_environment`] loads it).
+    pub environment: Option<PathBuf>,
+    /// A thickness map file in place of the procedural one ([`View::load_thickness_map`]
+    /// loads it): grey g ∈ [0, 1] maps film 1 to d ± r (d + r(2g − 1)), as `nacre render
+    /// --thickness-map` does.
+    pub thickness_map: Option<PathBuf>,
+    /// With a colour thickness map and `stack`: the channel each film follows (0 R, 1 G,
+    /// 2 B; film 1 always follows R; a film past the end follows R), the thesis's one map
+    /// per layer (Sussenbach 2013 §4.2).
+    pub film_channels: Vec<usize>,
+    /// The key ([`crate::live_lut::key`]) of the stack's own film-lut table that `lut`
+    /// draws with, once [`View::set_stack_lut`] has loaded it; `stack` draws the film
+    /// meanwhile. None: `lut` draws with the bundled `film-dielectric` table.
+    pub lut_key: Option<String>,
 }
 
 impl ViewSettings {
@@ -132,6 +151,10 @@ impl ViewSettings {
             size,
             model: None,
             film_on_all: false,
+            environment: None,
+            thickness_map: None,
+            film_channels: Vec::new(),
+            lut_key: None,
         }
     }
 }
@@ -152,12 +175,35 @@ pub struct View {
     tables: TableSet,
     /// Compiled renderers, the most recently used last (at most [`KEPT_RENDERERS`]), each
     /// with the stack its group 1 was built from.
-    renderers: Vec<(Renderer, Option<StackDoc>)>,
+    renderers: Vec<(Renderer, Option<Bound>)>,
     studio: EnvironmentMap,
     uniform: EnvironmentMap,
     thickness: ThicknessMap,
     /// The loaded glTF model.
     model: Option<GltfScene>,
+    /// The loaded environment file.
+    environment_file: Option<(PathBuf, EnvironmentMap)>,
+    /// The loaded thickness map: as read, and its grey channel alone (for the techniques
+    /// that draw one film).
+    thickness_file: Option<(PathBuf, ThicknessMap, ThicknessMap)>,
+    /// The bundled film-lut table's base material.
+    bundled_base: Option<nacre_optics::Material>,
+    /// The stack's own film-lut table ([`View::set_stack_lut`]) and its key.
+    stack_lut: Option<(String, TableSet)>,
+}
+
+/// What a kept renderer's group 1 was built from: the stack, its films' thickness-map
+/// channels, and the key of the stack's own film-lut table when it was built from that one.
+type Bound = (StackDoc, Vec<usize>, Option<String>);
+
+/// Which tables draw a frame, and with which technique.
+struct Source<'a> {
+    /// The technique drawn (`stack` in place of `lut` while the stack's table bakes).
+    technique: Technique,
+    /// The tables it reads.
+    tables: &'a TableSet,
+    /// The stack table's key, when those are the tables.
+    key: Option<&'a str>,
 }
 
 /// The view's errors: the runtime's, or a stack the technique cannot draw.
@@ -172,6 +218,9 @@ pub enum ViewError {
     /// A model is chosen but none is loaded.
     #[error("no glTF model is loaded: open one")]
     NoModel,
+    /// [`Lighting::File`] without an environment file loaded.
+    #[error("no environment file is loaded: open one")]
+    NoEnvironment,
     /// A material without an index at [`INDEX_WAVELENGTH_NM`].
     #[error("{what}: {source}")]
     Index {
@@ -189,6 +238,17 @@ impl View {
         for name in TABLES {
             tables.add(&ctx, &resolve_table(name))?;
         }
+        let bundled_base = tables
+            .film_lut
+            .as_ref()
+            .map(|lut| {
+                nacre_format::materials::resolve(
+                    &lut.manifest.base,
+                    format!("{} (base)", lut.manifest_path.display()),
+                    lut.manifest_path.parent(),
+                )
+            })
+            .transpose()?;
         Ok(View {
             ctx,
             tables,
@@ -201,7 +261,147 @@ impl View {
             },
             thickness: procedural_thickness_map(DEFAULT_THICKNESS_MAP_SIZE),
             model: None,
+            environment_file: None,
+            thickness_file: None,
+            bundled_base,
+            stack_lut: None,
         })
+    }
+
+    /// Reads the environment file at `path` ([`EnvironmentMap::load`], the reader of
+    /// `nacre render --env`) as the one [`Lighting::File`] draws when
+    /// [`ViewSettings::environment`] names it. A file that does not load changes nothing.
+    pub fn load_environment(&mut self, path: &Path) -> Result<(), ViewError> {
+        let map = EnvironmentMap::load(path)?;
+        self.environment_file = Some((path.to_path_buf(), map));
+        Ok(())
+    }
+
+    /// The loaded environment file's path, if any.
+    pub fn environment_path(&self) -> Option<&Path> {
+        self.environment_file.as_ref().map(|(p, _)| p.as_path())
+    }
+
+    /// Reads the thickness map at `path` ([`ThicknessMap::load`], the reader of `nacre
+    /// render --thickness-map`: PNG or JPEG, grey or colour) as the one the scenes draw
+    /// when [`ViewSettings::thickness_map`] names it; returns whether it is a colour map
+    /// (channels G and B for the lower films). A file that does not load changes nothing.
+    pub fn load_thickness_map(&mut self, path: &Path) -> Result<bool, ViewError> {
+        let map = ThicknessMap::load(path)?;
+        let grey = ThicknessMap {
+            green_blue: None,
+            ..map.clone()
+        };
+        let colour = map.green_blue.is_some();
+        self.thickness_file = Some((path.to_path_buf(), map, grey));
+        Ok(colour)
+    }
+
+    /// The loaded thickness map's path, if any.
+    pub fn thickness_map_path(&self) -> Option<&Path> {
+        self.thickness_file.as_ref().map(|(p, _, _)| p.as_path())
+    }
+
+    /// The environment `settings` light the scene with.
+    fn environment(&self, settings: &ViewSettings) -> Result<&EnvironmentMap, ViewError> {
+        match settings.lighting {
+            Lighting::Studio => Ok(&self.studio),
+            Lighting::Uniform => Ok(&self.uniform),
+            Lighting::File => self
+                .environment_file
+                .as_ref()
+                .filter(|(p, _)| settings.environment.as_deref() == Some(p.as_path()))
+                .map(|(_, m)| m)
+                .ok_or(ViewError::NoEnvironment),
+        }
+    }
+
+    /// The thickness map `settings` draw with `technique`: the loaded file (its grey
+    /// channel alone unless `technique` is `stack`, which gives the lower films G and B),
+    /// or the procedural one.
+    fn thickness(&self, settings: &ViewSettings, technique: Technique) -> &ThicknessMap {
+        match &self.thickness_file {
+            Some((path, map, grey))
+                if settings.thickness_map.as_deref() == Some(path.as_path()) =>
+            {
+                if technique == Technique::Stack {
+                    map
+                } else {
+                    grey
+                }
+            }
+            _ => &self.thickness,
+        }
+    }
+
+    /// Whether the bundled `film-dielectric` table holds `doc`'s film exactly: the same
+    /// ambient index, no film under the top one, the same base (its index at every 5 nm
+    /// from 380 to 780 nm), and the film's index and thickness range inside the table's
+    /// axes. `lut` then needs no table of the stack's own.
+    pub fn bundled_lut_holds(&self, doc: &StackDoc, stack: &Stack) -> bool {
+        let Some(lut) = &self.tables.film_lut else {
+            return false;
+        };
+        let a = &lut.axes;
+        let (Some(layer), [top]) = (stack.layers().first(), doc.films.as_slice()) else {
+            return false;
+        };
+        let same = |x: &nacre_optics::Material, y: &nacre_optics::Material| {
+            (0..=80).all(|k| {
+                let nm = 380.0 + 5.0 * f64::from(k);
+                matches!((x.index_at(nm), y.index_at(nm)), (Ok(p), Ok(q)) if (p - q).norm() <= 1e-9 * q.norm())
+            })
+        };
+        let index = |m: &nacre_optics::Material| m.index_at(INDEX_WAVELENGTH_NM).ok();
+        let in_axes = index(&layer.material)
+            .is_some_and(|n| n.im == 0.0 && (a.ior_min..=a.ior_max).contains(&n.re));
+        index(stack.ambient())
+            .is_some_and(|n| n.im == 0.0 && (n.re - a.ambient_index).abs() <= 1e-9)
+            && self
+                .bundled_base
+                .as_ref()
+                .is_some_and(|base| same(stack.substrate(), base))
+            && in_axes
+            && top.thickness_nm + top.relative_nm.abs() <= a.thickness_max_nm
+    }
+
+    /// Loads the stack's own film-lut table (a manifest [`crate::live_lut`] baked) under
+    /// `key`: `lut` draws with it while [`ViewSettings::lut_key`] is `key`.
+    pub fn set_stack_lut(&mut self, key: String, manifest: &Path) -> Result<(), ViewError> {
+        let tables = TableSet::load(&self.ctx, manifest)?;
+        self.stack_lut = Some((key, tables));
+        // Renderers built from the previous table rebind on their next frame.
+        Ok(())
+    }
+
+    /// The key of the loaded stack table, if any.
+    pub fn stack_lut_key(&self) -> Option<&str> {
+        self.stack_lut.as_ref().map(|(k, _)| k.as_str())
+    }
+
+    /// The technique and tables that draw `settings` (see [`ViewSettings::lut_key`]).
+    fn source(&self, settings: &ViewSettings) -> Source<'_> {
+        let bundled = Source {
+            technique: settings.technique,
+            tables: &self.tables,
+            key: None,
+        };
+        if settings.technique != Technique::Lut {
+            return bundled;
+        }
+        match (&settings.lut_key, &self.stack_lut) {
+            (None, _) => bundled,
+            (Some(want), Some((key, tables))) if want == key => Source {
+                technique: Technique::Lut,
+                tables,
+                key: Some(key),
+            },
+            (Some(_), _) => Source {
+                technique: Technique::Stack,
+                tables: &self.tables,
+                key: None,
+            },
+        }
     }
 
     /// The device description (adapter, backend).
@@ -222,11 +422,16 @@ impl View {
         o.camera.eye = settings.orbit.eye(o.camera.target);
         o.exposure_ev = settings.exposure_ev;
         o.material.roughness_alpha = settings.roughness_alpha;
-        if settings.lighting == Lighting::Uniform {
-            o.light.intensity = 0.0;
-            o.material.base_colour = [0.0; 3];
+        match settings.lighting {
+            Lighting::Uniform => {
+                o.light.intensity = 0.0;
+                o.material.base_colour = [0.0; 3];
+            }
+            Lighting::File => o.light.intensity = 0.0,
+            Lighting::Studio => {}
         }
         let mut notes = Vec::new();
+        let source = self.source(settings);
         let index = |m: &nacre_optics::Material, what: &str| {
             m.index_at(INDEX_WAVELENGTH_NM)
                 .map_err(|source| ViewError::Index {
@@ -272,18 +477,64 @@ impl View {
                 o.material.film_ior = o.material.ambient_ior.max(1.0);
             }
         }
+        let colour_map = self
+            .thickness(settings, Technique::Stack)
+            .green_blue
+            .is_some();
         o.stack = StackSetup {
             stack: stack.clone(),
             relative_nm: doc.relative_nm(),
-            channels: Vec::new(),
+            channels: if colour_map && source.technique == Technique::Stack {
+                (0..doc.films.len())
+                    .map(|k| settings.film_channels.get(k).copied().unwrap_or(0).min(2))
+                    .collect()
+            } else {
+                Vec::new()
+            },
             samples: None,
         };
-        if settings.technique == Technique::Lut {
-            o.fit_to_tables(&self.tables)?;
-            notes.push(
-                "lut draws the film-dielectric table's ambient and base (n 1.5, black glaze)"
-                    .into(),
-            );
+        let follows_gb = settings
+            .film_channels
+            .iter()
+            .take(doc.films.len())
+            .skip(1)
+            .any(|&c| c != 0);
+        if colour_map && follows_gb && source.technique != Technique::Stack {
+            notes.push(format!(
+                "{} draws the thickness map's R channel only; `stack` gives the lower films G and B",
+                source.technique.name()
+            ));
+        }
+        match (settings.technique, source.technique, source.key) {
+            (Technique::Lut, Technique::Lut, Some(_)) => {
+                // The stack's own table: its ambient and base are the stack's, the films
+                // under the top one are in its texels.
+                if let Some(lut) = &source.tables.film_lut {
+                    let a = &lut.axes;
+                    o.material.film_ior = o
+                        .material
+                        .film_ior
+                        .clamp(a.ior_min as f32, a.ior_max as f32);
+                }
+                notes.push(format!(
+                    "lut draws this stack's own film-lut table (baked in the background: film 1 varies, {} film(s) under it and the base are in the table)",
+                    doc.films.len().saturating_sub(1)
+                ));
+            }
+            (Technique::Lut, Technique::Lut, None) => {
+                let holds = self.bundled_lut_holds(doc, stack);
+                o.fit_to_tables(&self.tables)?;
+                if !holds {
+                    notes.push(
+                        "lut draws the film-dielectric table's ambient and base (n 1.5, black glaze)"
+                            .into(),
+                    );
+                }
+            }
+            (Technique::Lut, _, _) => notes.push(
+                "the lut table of this stack is baking: `stack` draws it exactly meanwhile".into(),
+            ),
+            _ => {}
         }
         if settings.technique == Technique::Stack && stack.layers().is_empty() {
             notes.push("a bare interface: the base alone".into());
@@ -351,13 +602,16 @@ impl View {
         let mut o = SceneOptions::new(SceneKind::Sphere);
         [o.width, o.height] = settings.size;
         o.exposure_ev = settings.exposure_ev;
-        if settings.lighting == Lighting::Uniform {
+        if settings.lighting != Lighting::Studio {
             o.light.intensity = 0.0;
         }
-        let environment = match settings.lighting {
-            Lighting::Studio => self.studio.clone(),
-            Lighting::Uniform => self.uniform.clone(),
-        };
+        let environment = self.environment(settings)?.clone();
+        if settings.thickness_map.is_some() {
+            notes.push(
+                "a glTF material takes its thickness from its own iridescence texture: the thickness map is not drawn"
+                    .into(),
+            );
+        }
         let view = ViewPoint::Orbit(MeshOrbit {
             yaw_deg: f64::from(settings.orbit.yaw_deg),
             pitch_deg: f64::from(settings.orbit.pitch_deg),
@@ -388,44 +642,48 @@ impl View {
         let start = std::time::Instant::now();
         let (options, notes) = self.options(settings, doc, stack)?;
         let technique_options = options.technique_options();
-        let kept = self
-            .renderers
-            .iter()
-            .position(|(r, _)| r.technique() == settings.technique);
-        let (mut renderer, mut bound) = match kept {
-            Some(k) => self.renderers.remove(k),
-            None => (
-                Renderer::new(
-                    &self.ctx,
-                    &self.tables,
-                    settings.technique,
-                    &technique_options,
-                )?,
-                None,
-            ),
-        };
-        if bound.as_ref() != Some(doc) {
-            // A failed rebind drops the renderer: the next frame builds it anew.
-            renderer.rebind(&self.ctx, &self.tables, &technique_options)?;
-            bound = Some(doc.clone());
-        }
-        let environment = match settings.lighting {
-            Lighting::Studio => &self.studio,
-            Lighting::Uniform => &self.uniform,
-        };
-        let image = renderer.render_with(
-            &self.ctx,
-            &self.tables,
-            &options,
-            environment,
-            &self.thickness,
+        // Checked before the renderers are taken out (an early return would lose them).
+        self.environment(settings)?;
+        // Taken out while the tables are borrowed; put back below, the latest last. A
+        // renderer whose build or rebind fails is dropped: the next frame builds it anew.
+        let mut renderers = std::mem::take(&mut self.renderers);
+        let source = self.source(settings);
+        let (technique, tables) = (source.technique, source.tables);
+        let want: Bound = (
+            doc.clone(),
+            technique_options.stack.channels.clone(),
+            source.key.map(str::to_string),
         );
-        self.renderers.push((renderer, bound));
-        if self.renderers.len() > KEPT_RENDERERS {
-            self.renderers.remove(0);
-        }
+        let environment = self.environment(settings).unwrap_or(&self.studio);
+        let thickness = self.thickness(settings, technique);
+        let kept = renderers
+            .iter()
+            .position(|(r, _)| r.technique() == technique);
+        let drawn = (|| -> Result<_, ViewError> {
+            let (mut renderer, mut bound) = match kept {
+                Some(k) => renderers.remove(k),
+                None => (
+                    Renderer::new(&self.ctx, tables, technique, &technique_options)?,
+                    Some(want.clone()),
+                ),
+            };
+            if bound.as_ref() != Some(&want) {
+                renderer.rebind(&self.ctx, tables, &technique_options)?;
+                bound = Some(want);
+            }
+            let image = renderer.render_with(&self.ctx, tables, &options, environment, thickness);
+            Ok((renderer, bound, image))
+        })();
+        let image = drawn.map(|(renderer, bound, image)| {
+            renderers.push((renderer, bound));
+            if renderers.len() > KEPT_RENDERERS {
+                renderers.remove(0);
+            }
+            image
+        });
+        self.renderers = renderers;
         Ok(Frame {
-            image: image?,
+            image: image??,
             notes,
             seconds: start.elapsed().as_secs_f64(),
         })

@@ -26,6 +26,7 @@ use crate::compare::{DEFAULT_SCALE_MAX, DeltaE};
 use crate::curves::{CurveWorker, Curves};
 use crate::doc::{History, PRESETS, StackDoc};
 use crate::engine::{EngineExport, EngineJob};
+use crate::live_lut::LiveLut;
 use crate::view::{Frame, View, ViewSettings};
 use eframe::egui;
 use egui::{Color32, RichText, TextureHandle};
@@ -89,6 +90,19 @@ pub struct Studio {
     pub model_path: String,
     /// Why the last model did not open.
     pub model_error: Option<String>,
+    /// The environment file the field names.
+    pub environment_path: String,
+    /// Why the last environment file did not open.
+    pub environment_error: Option<String>,
+    /// The thickness map file the field names.
+    pub thickness_map_path: String,
+    /// Why the last thickness map did not open.
+    pub thickness_map_error: Option<String>,
+    /// Whether the loaded thickness map is a colour map (channels for the lower films).
+    pub thickness_map_colour: bool,
+    /// `lut` on stacks the bundled table does not hold: their own tables, baked in the
+    /// background ([`crate::live_lut`]).
+    pub live_lut: LiveLut,
     /// The last export's outcome.
     pub status: Option<Result<String, String>>,
     /// What the export panel bakes.
@@ -162,6 +176,12 @@ impl Studio {
             picture_path: "studio.png".into(),
             model_path: String::new(),
             model_error: None,
+            environment_path: String::new(),
+            environment_error: None,
+            thickness_map_path: String::new(),
+            thickness_map_error: None,
+            thickness_map_colour: false,
+            live_lut: LiveLut::new(None),
             status: None,
             bake: BakeSettings::default(),
             bake_job: None,

@@ -10,6 +10,9 @@ use egui::{Color32, RichText, TextureOptions};
 use nacre_runtime::render::SceneKind;
 use std::path::{Path, PathBuf};
 
+/// The thickness map's channels, as the menus name them.
+const CHANNELS: [&str; 3] = ["R", "G", "B"];
+
 /// A scene's menu name.
 fn scene_name(scene: SceneKind) -> &'static str {
     match scene {
@@ -44,17 +47,165 @@ impl Studio {
         }
     }
 
-    /// Opens the first `.gltf`/`.glb` file dropped on the window, if any.
+    /// Opens the environment file at `path` (OpenEXR, Radiance HDR, PNG or JPEG) and lights
+    /// the view with it ([`Lighting::File`]). A file that does not load leaves the view as
+    /// it was.
+    pub fn open_environment(&mut self, path: &Path) -> Result<(), String> {
+        let view = self
+            .view
+            .as_mut()
+            .map_err(|e| format!("no live view: {e}"))?;
+        view.load_environment(path)
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+        self.settings.environment = Some(path.to_path_buf());
+        self.settings.lighting = Lighting::File;
+        self.environment_path = path.display().to_string();
+        Ok(())
+    }
+
+    /// Opens the thickness map at `path` (PNG or JPEG, grey or colour) in place of the
+    /// procedural one. A file that does not load leaves the view as it was.
+    pub fn open_thickness_map(&mut self, path: &Path) -> Result<(), String> {
+        let view = self
+            .view
+            .as_mut()
+            .map_err(|e| format!("no live view: {e}"))?;
+        let colour = view
+            .load_thickness_map(path)
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+        self.settings.thickness_map = Some(path.to_path_buf());
+        self.thickness_map_colour = colour;
+        self.thickness_map_path = path.display().to_string();
+        Ok(())
+    }
+
+    /// Opens what is dropped on the window: the first `.gltf`/`.glb` file as the model, the
+    /// first `.exr`/`.hdr` file as the environment, the first `.png`/`.jpg`/`.jpeg` file as
+    /// the thickness map.
     pub(super) fn take_dropped_model(&mut self, ctx: &egui::Context) {
-        let dropped = ctx.input(|i| {
+        let dropped: Vec<PathBuf> = ctx.input(|i| {
             i.raw
                 .dropped_files
                 .iter()
                 .map(|f| f.path().to_path_buf())
-                .find(|p| is_gltf(p))
+                .collect()
         });
-        if let Some(path) = dropped {
-            self.model_error = self.open_model(&path).err();
+        let has = |exts: &[&str], p: &Path| {
+            p.extension()
+                .and_then(|e| e.to_str())
+                .is_some_and(|e| exts.iter().any(|x| e.eq_ignore_ascii_case(x)))
+        };
+        if let Some(path) = dropped.iter().find(|p| is_gltf(p)) {
+            self.model_error = self.open_model(path).err();
+        }
+        if let Some(path) = dropped.iter().find(|p| has(&["exr", "hdr"], p)) {
+            self.environment_error = self.open_environment(path).err();
+        }
+        if let Some(path) = dropped.iter().find(|p| has(&["png", "jpg", "jpeg"], p)) {
+            self.thickness_map_error = self.open_thickness_map(path).err();
+        }
+    }
+
+    /// The environment file and thickness map rows.
+    fn files_ui(&mut self, ui: &mut egui::Ui) {
+        ui.horizontal_wrapped(|ui| {
+            let label = ui.label("Environment file");
+            ui.add(egui::TextEdit::singleline(&mut self.environment_path).desired_width(220.0))
+                .labelled_by(label.id)
+                .on_hover_text(
+                    "an equirectangular .exr or .hdr (linear), or .png/.jpg (sRGB), row 0 at the zenith (or drop one on the window)",
+                );
+            if ui.button("Open environment").clicked() {
+                let path = PathBuf::from(self.environment_path.trim());
+                self.environment_error = self.open_environment(&path).err();
+            }
+            if let Some(e) = &self.environment_error {
+                ui.label(RichText::new(e.as_str()).color(Color32::LIGHT_RED));
+            }
+        });
+        ui.horizontal_wrapped(|ui| {
+            let label = ui.label("Thickness map");
+            ui.add(egui::TextEdit::singleline(&mut self.thickness_map_path).desired_width(220.0))
+                .labelled_by(label.id)
+                .on_hover_text(
+                    "a .png or .jpg: grey g maps film 1 to d + r(2g − 1); a colour map's G and B can drive the lower films under `stack`",
+                );
+            if ui.button("Open thickness map").clicked() {
+                let path = PathBuf::from(self.thickness_map_path.trim());
+                self.thickness_map_error = self.open_thickness_map(&path).err();
+            }
+            if ui
+                .add_enabled(
+                    self.settings.thickness_map.is_some(),
+                    egui::Button::new("Procedural map"),
+                )
+                .clicked()
+            {
+                self.settings.thickness_map = None;
+            }
+            if let Some(e) = &self.thickness_map_error {
+                ui.label(RichText::new(e.as_str()).color(Color32::LIGHT_RED));
+            }
+        });
+        let films = self.good.0.films.len();
+        if self.thickness_map_colour && self.settings.thickness_map.is_some() && films > 1 {
+            ui.horizontal_wrapped(|ui| {
+                let channels = &mut self.settings.film_channels;
+                channels.resize(films, 0);
+                for (k, channel) in channels.iter_mut().enumerate().skip(1) {
+                    egui::ComboBox::from_label(format!("Film {} follows", k + 1))
+                        .selected_text(CHANNELS[*channel])
+                        .show_ui(ui, |ui| {
+                            for (c, name) in CHANNELS.iter().enumerate() {
+                                ui.selectable_value(channel, c, *name);
+                            }
+                        });
+                }
+            });
+        }
+    }
+
+    /// The `lut` technique's table: the stack's own while it bakes (progress) or when its
+    /// bake failed.
+    fn live_lut_ui(&mut self, ui: &mut egui::Ui) {
+        if self.settings.technique != nacre_runtime::Technique::Lut || self.settings.model.is_some()
+        {
+            return;
+        }
+        if let Some((done, total)) = self.live_lut.progress() {
+            ui.horizontal(|ui| {
+                ui.label("lut table of this stack");
+                ui.add(
+                    egui::ProgressBar::new(done as f32 / total.max(1) as f32)
+                        .desired_width(160.0)
+                        .show_percentage(),
+                );
+            });
+            ui.ctx()
+                .request_repaint_after(std::time::Duration::from_millis(50));
+        }
+        if let Some(e) = self.live_lut.error() {
+            ui.label(
+                RichText::new(format!("the lut table of this stack did not bake: {e}"))
+                    .color(Color32::LIGHT_RED),
+            );
+        }
+    }
+
+    /// Sets [`crate::view::ViewSettings::lut_key`] for this frame ([`crate::live_lut`]).
+    fn update_live_lut(&mut self) {
+        let lut = self.settings.technique == nacre_runtime::Technique::Lut
+            && self.settings.model.is_none();
+        let state = match (&mut self.view, lut) {
+            (Ok(view), true) => self.live_lut.update(view, &self.good.0, &self.good.1),
+            _ => crate::live_lut::LutState {
+                key: None,
+                loaded: false,
+            },
+        };
+        self.settings.lut_key = state.key;
+        if state.loaded {
+            self.drawn = None;
         }
     }
 
@@ -130,6 +281,9 @@ impl Studio {
                 ui.label(RichText::new(e.as_str()).color(Color32::LIGHT_RED));
             }
         });
+        self.files_ui(ui);
+        self.update_live_lut();
+        self.live_lut_ui(ui);
         if self.follow_panel {
             let ppp = ui.ctx().pixels_per_point();
             let avail = ui.available_size() * ppp;
