@@ -110,7 +110,21 @@ fn bad_flags_exit_2_naming_the_flag_before_any_window() {
     )
     .unwrap();
     let shot = dir.path().join("never.png");
+    let no_sky = dir.path().join("sky.exr");
+    std::fs::write(&no_sky, b"not an OpenEXR file").unwrap();
+    let no_map = dir.path().join("missing-map.png");
     for (args, flag, text) in [
+        (vec!["--env", no_sky.to_str().unwrap()], "--env", "sky.exr"),
+        (
+            vec!["--thickness-map", no_map.to_str().unwrap()],
+            "--thickness-map",
+            "missing-map.png",
+        ),
+        (
+            vec!["--lut-cache", bad_recipe.to_str().unwrap()],
+            "--lut-cache",
+            "is a file",
+        ),
         (
             vec!["--recipe", missing.to_str().unwrap()],
             "--recipe",
