@@ -18,19 +18,14 @@ use nacre_bake::commands::color_request::ColourSettings;
 use nacre_bake::commands::export_stack::{StackExport, stack_export};
 use nacre_bake::commands::fit_gltf::{fit_gltf, material_json};
 use nacre_optics::fit::gltf::GltfBase;
-use nacre_runtime::GpuContext;
+use nacre_studio::Studio;
 use nacre_studio::doc::{Film, StackDoc};
-use nacre_studio::{Studio, View};
 use std::time::{Duration, Instant};
 
+mod support;
+
 fn harness(doc: StackDoc) -> Harness<'static, Studio> {
-    let ctx = GpuContext::new_headless().expect("a wgpu adapter (lavapipe in CI)");
-    let view = View::new(ctx).expect("the default tables load");
-    let studio = Studio::new(Ok(view), doc, [64, 48]);
-    Harness::builder()
-        .with_size([1400.0, 1000.0])
-        .wgpu()
-        .build_ui_state(|ui, s: &mut Studio| s.ui(ui), studio)
+    support::harness_of(support::new_studio(doc, [64, 48]), [1400.0, 1000.0])
 }
 
 fn read_json(path: &std::path::Path) -> serde_json::Value {

@@ -12,12 +12,13 @@
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use nacre_format::materials::MaterialDb;
-use nacre_runtime::GpuContext;
+use nacre_studio::Studio;
 use nacre_studio::app::MaterialTarget;
 use nacre_studio::doc::StackDoc;
 use nacre_studio::material_db::{DB_ENV, shared_folder};
-use nacre_studio::{Studio, View};
 use std::path::PathBuf;
+
+mod support;
 
 /// The database folder, or None (the test skips) outside CI.
 fn database() -> Option<PathBuf> {
@@ -41,13 +42,10 @@ fn database() -> Option<PathBuf> {
 }
 
 fn harness() -> Harness<'static, Studio> {
-    let ctx = GpuContext::new_headless().expect("a wgpu adapter (lavapipe in CI)");
-    let view = View::new(ctx).expect("the default tables load");
-    let studio = Studio::new(Ok(view), StackDoc::default(), [64, 48]);
-    Harness::builder()
-        .with_size([1400.0, 1000.0])
-        .wgpu()
-        .build_ui_state(|ui, s: &mut Studio| s.ui(ui), studio)
+    support::harness_of(
+        support::new_studio(StackDoc::default(), [64, 48]),
+        [1400.0, 1000.0],
+    )
 }
 
 fn index_550(db: &MaterialDb, spec: &str) -> (f64, f64) {

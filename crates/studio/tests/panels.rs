@@ -29,42 +29,9 @@ use nacre_studio::{Studio, View};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-/// The view's picture size in the tests, pixels.
-const VIEW: [u32; 2] = [96, 72];
+mod support;
 
-fn studio(doc: StackDoc) -> Studio {
-    let ctx = GpuContext::new_headless().expect("a wgpu adapter (lavapipe in CI)");
-    let view = View::new(ctx).expect("the default tables load");
-    let mut s = Studio::new(Ok(view), doc, VIEW);
-    s.settings.lighting = Lighting::Uniform;
-    s.settings.roughness_alpha = 0.001;
-    s
-}
-
-fn harness(doc: StackDoc) -> Harness<'static, Studio> {
-    Harness::builder()
-        .with_size([1400.0, 900.0])
-        .wgpu()
-        .build_ui_state(|ui, s: &mut Studio| s.ui(ui), studio(doc))
-}
-
-/// Steps until the plots show the current stack and a frame is drawn, at most 60 s.
-fn settle(h: &mut Harness<'_, Studio>) {
-    let start = Instant::now();
-    loop {
-        h.step();
-        if h.state().curves_current() && h.state().frame.is_some() {
-            h.step();
-            return;
-        }
-        assert!(
-            start.elapsed() < Duration::from_secs(60),
-            "the plots never caught up: {:?}",
-            h.state().curves_error
-        );
-        std::thread::sleep(Duration::from_millis(20));
-    }
-}
+use support::{VIEW, harness, settle};
 
 /// Steps until the bake has ended, at most `limit`; returns the frames drawn meanwhile.
 fn until_baked(h: &mut Harness<'_, Studio>, limit: Duration) -> u64 {

@@ -8,17 +8,16 @@
 //! * The pointer over the reflectance family's plot reads the nearest data point: its
 //!   series, wavelength and R are the curves' own, and the label shows R to 4 decimals.
 
-use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use nacre_bake::commands::color::Point;
-use nacre_runtime::GpuContext;
 use nacre_studio::app::{BY_ANGLE, FAMILY_R};
 use nacre_studio::curves::{
     FAMILY_ANGLES_DEG, THICKNESS_SWEEP_NM, chromaticity, exact_colours_at, wavelengths,
 };
 use nacre_studio::doc::{Film, StackDoc};
-use nacre_studio::{Studio, View};
 use std::time::{Duration, Instant};
+
+mod support;
 
 #[test]
 fn plot_values_are_the_libraries_and_hovering_reads_them() {
@@ -26,13 +25,7 @@ fn plot_values_are_the_libraries_and_hovering_reads_them() {
         films: vec![Film::new("water", 300.0)],
         ..StackDoc::default()
     };
-    let ctx = GpuContext::new_headless().expect("a wgpu adapter (lavapipe in CI)");
-    let view = View::new(ctx).expect("the default tables load");
-    let studio = Studio::new(Ok(view), doc.clone(), [64, 48]);
-    let mut h = Harness::builder()
-        .with_size([1600.0, 1400.0])
-        .wgpu()
-        .build_ui_state(|ui, s: &mut Studio| s.ui(ui), studio);
+    let mut h = support::harness_of(support::new_studio(doc.clone(), [64, 48]), [1600.0, 1400.0]);
     let start = Instant::now();
     while !h.state().curves_current() {
         h.step();

@@ -4,88 +4,26 @@
 //!
 //! * A typed film thickness changes the sphere's centre pixel to the colour `nacre color`
 //!   (the spectral method, [`nacre_studio::curves::exact_colours`]) gives for that
-//!   thickness at 0°, under the uniform sky ([`uniform_sky_pixel`]); on screen too.
+//!   thickness at 0°, under the uniform sky (`uniform_sky_pixel`); on screen too.
 //! * An invalid material or thickness shows an error and changes neither the stack nor the
 //!   picture.
 //! * "Save recipe" writes a recipe that the CLI's reader (`--recipe`) reads back as the same
 //!   stack, and "Open recipe" opens it; undo and redo step through edits.
 
-use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
-use nacre_runtime::GpuContext;
-use nacre_studio::curves::exact_colours;
 use nacre_studio::doc::{Film, PRESETS, StackDoc};
-use nacre_studio::view::{Lighting, uniform_sky_pixel};
-use nacre_studio::{Studio, View};
-use std::time::{Duration, Instant};
 
-/// The view's picture size in the tests, pixels.
-const VIEW: [u32; 2] = [96, 72];
+mod support;
 
-/// A mirror-smooth roughness, so that the centre pixel is the film at normal incidence.
-const ALPHA: f32 = 0.001;
-
-fn studio(doc: StackDoc) -> Studio {
-    let ctx = GpuContext::new_headless().expect("a wgpu adapter (lavapipe in CI)");
-    let view = View::new(ctx).expect("the default tables load");
-    let mut s = Studio::new(Ok(view), doc, VIEW);
-    s.settings.lighting = Lighting::Uniform;
-    s.settings.roughness_alpha = ALPHA;
-    s
-}
-
-fn harness(doc: StackDoc) -> Harness<'static, Studio> {
-    Harness::builder()
-        .with_size([1400.0, 900.0])
-        .wgpu()
-        .build_ui_state(|ui, s: &mut Studio| s.ui(ui), studio(doc))
-}
-
-/// Steps until the plots show the current stack (the worker thread), at most 60 s.
-fn settle(h: &mut Harness<'_, Studio>) {
-    let start = Instant::now();
-    loop {
-        h.step();
-        if h.state().curves_current() && h.state().frame.is_some() {
-            h.step();
-            return;
-        }
-        assert!(
-            start.elapsed() < Duration::from_secs(60),
-            "the plots never caught up: {:?}",
-            h.state().curves_error
-        );
-        std::thread::sleep(Duration::from_millis(20));
-    }
-}
-
-fn centre(s: &Studio) -> [u8; 3] {
-    let img = &s.frame.as_ref().expect("a frame").image;
-    let (x, y) = (img.width as usize / 2, img.height as usize / 2);
-    let i = 4 * (y * img.width as usize + x);
-    [img.pixels[i], img.pixels[i + 1], img.pixels[i + 2]]
-}
+use support::{TOLERANCE, centre, distance, harness, settle};
 
 /// The pixel `nacre color` predicts for a stack of one water film `d_nm` thick in air.
 fn predicted(d_nm: f64) -> [u8; 3] {
-    let doc = StackDoc {
+    support::predicted(&StackDoc {
         films: vec![Film::new("water", d_nm)],
         ..StackDoc::default()
-    };
-    let rgb = exact_colours(&doc.build().unwrap(), &[0.0]).unwrap()[0];
-    uniform_sky_pixel(rgb, f64::from(ALPHA))
+    })
 }
-
-fn distance(a: [u8; 3], b: [u8; 3]) -> i32 {
-    (0..3)
-        .map(|k| (i32::from(a[k]) - i32::from(b[k])).abs())
-        .max()
-        .unwrap()
-}
-
-/// The film_stack technique's few fitted wavelengths against the exact spectral sum, in
-/// 8-bit sRGB levels at the sphere's centre (measured ≤ 3 over the thicknesses below).
-const TOLERANCE: i32 = 4;
 
 #[test]
 fn typed_thickness_changes_the_centre_pixel_to_nacre_colors_colour() {

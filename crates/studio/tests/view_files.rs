@@ -15,84 +15,21 @@
 
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
-use nacre_runtime::{GpuContext, Technique};
-use nacre_studio::curves::exact_colours;
+use nacre_runtime::Technique;
+use nacre_studio::Studio;
 use nacre_studio::doc::{Film, StackDoc};
 use nacre_studio::live_lut::LiveLut;
-use nacre_studio::view::{Lighting, uniform_sky_pixel};
-use nacre_studio::{Studio, View};
+use nacre_studio::view::Lighting;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-/// The view's picture size in the tests, pixels.
-const VIEW: [u32; 2] = [96, 72];
+mod support;
 
-/// A mirror-smooth roughness: the centre pixel is the film at normal incidence.
-const ALPHA: f32 = 0.001;
-
-fn studio(doc: StackDoc) -> Studio {
-    let ctx = GpuContext::new_headless().expect("a wgpu adapter (lavapipe in CI)");
-    let view = View::new(ctx).expect("the default tables load");
-    let mut s = Studio::new(Ok(view), doc, VIEW);
-    s.settings.lighting = Lighting::Uniform;
-    s.settings.roughness_alpha = ALPHA;
-    s
-}
+use support::{TOLERANCE, centre, distance, harness_of, pixels, predicted, settle, studio};
 
 fn harness(s: Studio) -> Harness<'static, Studio> {
-    Harness::builder()
-        .with_size([1400.0, 900.0])
-        .wgpu()
-        .build_ui_state(|ui, s: &mut Studio| s.ui(ui), s)
+    harness_of(s, [1400.0, 900.0])
 }
-
-/// Steps until the plots show the current stack and a frame is drawn, at most 60 s.
-fn settle(h: &mut Harness<'_, Studio>) {
-    let start = Instant::now();
-    loop {
-        h.step();
-        if h.state().curves_current() && h.state().frame.is_some() {
-            h.step();
-            return;
-        }
-        assert!(
-            start.elapsed() < Duration::from_secs(60),
-            "the plots never caught up: {:?}",
-            h.state().curves_error
-        );
-        std::thread::sleep(Duration::from_millis(20));
-    }
-}
-
-fn pixels(s: &Studio) -> Vec<[u8; 3]> {
-    let img = &s.frame.as_ref().expect("a frame").image;
-    img.pixels
-        .chunks_exact(4)
-        .map(|p| [p[0], p[1], p[2]])
-        .collect()
-}
-
-fn centre(s: &Studio) -> [u8; 3] {
-    let img = &s.frame.as_ref().expect("a frame").image;
-    let (x, y) = (img.width as usize / 2, img.height as usize / 2);
-    pixels(s)[y * img.width as usize + x]
-}
-
-fn distance(a: [u8; 3], b: [u8; 3]) -> i32 {
-    (0..3)
-        .map(|k| (i32::from(a[k]) - i32::from(b[k])).abs())
-        .max()
-        .unwrap()
-}
-
-/// The centre pixel `nacre color` predicts for `doc` under the uniform sky.
-fn predicted(doc: &StackDoc) -> [u8; 3] {
-    let rgb = exact_colours(&doc.build().unwrap(), &[0.0]).unwrap()[0];
-    uniform_sky_pixel(rgb, f64::from(ALPHA))
-}
-
-/// film_stack's fitted wavelengths against the exact spectral sum, 8-bit levels (ui.rs).
-const TOLERANCE: i32 = 4;
 
 /// A Radiance HDR file of one radiance `rgb` everywhere (64 × 32).
 fn uniform_hdr(path: &Path, rgb: [f32; 3]) {
