@@ -68,6 +68,23 @@ pub fn thickness_max_nm(top: &Film) -> f64 {
         .max(MIN_THICKNESS_RANGE_NM)
 }
 
+/// The real indices of the ambient and of film 1 at [`INDEX_WAVELENGTH_NM`]: the table's
+/// ambient and the centre of its film-index axis ([`film_ior_range`]).
+pub fn top_indices(stack: &nacre_optics::Stack) -> Result<[f64; 2], String> {
+    let index = |m: &nacre_optics::Material, what: &str| {
+        m.index_at(INDEX_WAVELENGTH_NM)
+            .map(|n| n.re)
+            .map_err(|e| format!("{what}: {e}"))
+    };
+    let Some(top) = stack.layers().first() else {
+        return Err("a bare interface has no film: add a film".into());
+    };
+    Ok([
+        index(stack.ambient(), "ambient")?,
+        index(&top.material, "film 1")?,
+    ])
+}
+
 /// The `film-lut` recipe TOML of `doc` with `settings`' texel counts: the ambient, the top
 /// film's index range ([`film_ior_range`]), the films under it as fixed layers, the base;
 /// thicknesses 0 to max(1200 nm, the top film's d + r rounded up to 100 nm).
@@ -76,12 +93,7 @@ pub fn film_lut_recipe(doc: &StackDoc, settings: &BakeSettings) -> Result<String
     let Some(top) = doc.films.first() else {
         return Err("a bare interface has no film to bake: add a film".into());
     };
-    let index = |m: &nacre_optics::Material, what: &str| {
-        m.index_at(INDEX_WAVELENGTH_NM)
-            .map_err(|e| format!("{what}: {e}"))
-    };
-    let ambient = index(stack.ambient(), "ambient")?;
-    let film = index(&stack.layers()[0].material, "film 1")?;
+    let [ambient, film] = top_indices(&stack)?;
     let thickness_max_nm = thickness_max_nm(top);
     #[derive(Serialize)]
     struct Under<'a> {
@@ -115,7 +127,7 @@ pub fn film_lut_recipe(doc: &StackDoc, settings: &BakeSettings) -> Result<String
         description: format!(
             "nacre studio: film 1 ({}, index axis around {:.3}) over {} fixed layer(s) on {}",
             top.material.trim(),
-            film.re,
+            film,
             doc.films.len() - 1,
             doc.substrate.trim()
         ),
@@ -135,7 +147,7 @@ pub fn film_lut_recipe(doc: &StackDoc, settings: &BakeSettings) -> Result<String
             cos_theta_count: settings.cos_theta_count,
             thickness_nm: [0.0, thickness_max_nm],
             opd_count: settings.opd_count,
-            film_ior: film_ior_range(ambient.re, film.re),
+            film_ior: film_ior_range(ambient, film),
             film_ior_count: settings.film_ior_count,
         },
     };

@@ -14,6 +14,7 @@ pub mod compare;
 pub mod curves;
 pub mod doc;
 pub mod engine;
+pub mod folders;
 pub mod live_lut;
 pub mod material_db;
 pub mod view;

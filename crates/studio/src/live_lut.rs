@@ -14,9 +14,12 @@
 //! 1's thickness inside the axis, its index inside the index axis) reuse the table and redraw
 //! in one frame. The folder keeps the [`KEPT_TABLES`] most recently baked tables.
 
-use crate::bake::{BakeJob, BakeOutcome, BakeSettings, film_ior_range, thickness_max_nm};
+use crate::bake::{
+    BakeJob, BakeOutcome, BakeSettings, film_ior_range, thickness_max_nm, top_indices,
+};
 use crate::doc::StackDoc;
-use crate::view::{INDEX_WAVELENGTH_NM, View};
+use crate::folders::user_folder;
+use crate::view::View;
 use nacre_optics::Stack;
 use std::path::{Path, PathBuf};
 
@@ -34,12 +37,7 @@ pub fn key(doc: &StackDoc, stack: &Stack, counts: &BakeSettings) -> Result<Strin
     let Some(top) = doc.films.first() else {
         return Err("a bare interface has no film".into());
     };
-    let index = |m: &nacre_optics::Material, what: &str| {
-        m.index_at(INDEX_WAVELENGTH_NM)
-            .map_err(|e| format!("{what}: {e}"))
-    };
-    let ambient = index(stack.ambient(), "ambient")?;
-    let film = index(&stack.layers()[0].material, "film 1")?;
+    let [ambient, film] = top_indices(stack)?;
     let under: Vec<String> = doc.films[1..]
         .iter()
         .map(|f| format!("{}@{}", f.material.trim(), f.thickness_nm))
@@ -50,7 +48,7 @@ pub fn key(doc: &StackDoc, stack: &Stack, counts: &BakeSettings) -> Result<Strin
         under.join(","),
         doc.substrate.trim(),
         doc.base_dir,
-        film_ior_range(ambient.re, film.re),
+        film_ior_range(ambient, film),
         thickness_max_nm(top),
         counts.cos_theta_count,
         counts.opd_count,
@@ -69,15 +67,11 @@ pub fn fnv1a(text: &str) -> u64 {
 /// The default cache folder: `$XDG_CACHE_HOME/nacre/studio-luts`, else
 /// `~/.cache/nacre/studio-luts`; None when neither is known.
 pub fn default_folder() -> Option<PathBuf> {
-    let cache = std::env::var_os("XDG_CACHE_HOME")
-        .filter(|v| !v.is_empty())
-        .map(PathBuf::from)
-        .or_else(|| {
-            std::env::var_os("HOME")
-                .filter(|v| !v.is_empty())
-                .map(|h| PathBuf::from(h).join(".cache"))
-        })?;
-    Some(cache.join("nacre").join("studio-luts"))
+    Some(
+        user_folder("XDG_CACHE_HOME", ".cache")?
+            .join("nacre")
+            .join("studio-luts"),
+    )
 }
 
 /// The stack tables: the cache folder, the bake running, and how the last one went.

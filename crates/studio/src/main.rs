@@ -83,15 +83,11 @@ fn bad(flag: &str, message: impl std::fmt::Display) -> ! {
 
 /// The default session file (`--session`), if a home or state folder is known.
 fn default_session() -> Option<PathBuf> {
-    let state = std::env::var_os("XDG_STATE_HOME")
-        .filter(|v| !v.is_empty())
-        .map(PathBuf::from)
-        .or_else(|| {
-            std::env::var_os("HOME")
-                .filter(|v| !v.is_empty())
-                .map(|h| PathBuf::from(h).join(".local/state"))
-        })?;
-    Some(state.join("nacre").join("studio-session.toml"))
+    Some(
+        nacre_studio::folders::user_folder("XDG_STATE_HOME", ".local/state")?
+            .join("nacre")
+            .join("studio-session.toml"),
+    )
 }
 
 fn size(flag: &str, text: &str) -> [u32; 2] {

@@ -109,29 +109,25 @@ impl Studio {
     /// The environment file and thickness map rows.
     fn files_ui(&mut self, ui: &mut egui::Ui) {
         ui.horizontal_wrapped(|ui| {
-            let label = ui.label("Environment file");
-            ui.add(egui::TextEdit::singleline(&mut self.environment_path).desired_width(220.0))
-                .labelled_by(label.id)
-                .on_hover_text(
-                    "an equirectangular .exr or .hdr (linear), or .png/.jpg (sRGB), row 0 at the zenith (or drop one on the window)",
-                );
-            if ui.button("Open environment").clicked() {
-                let path = PathBuf::from(self.environment_path.trim());
+            if let Some(path) = file_field(
+                ui,
+                "Environment file",
+                &mut self.environment_path,
+                "an equirectangular .exr or .hdr (linear), or .png/.jpg (sRGB), row 0 at the zenith (or drop one on the window)",
+                "Open environment",
+            ) {
                 self.environment_error = self.open_environment(&path).err();
             }
-            if let Some(e) = &self.environment_error {
-                ui.label(RichText::new(e.as_str()).color(Color32::LIGHT_RED));
-            }
+            error_label(ui, &self.environment_error);
         });
         ui.horizontal_wrapped(|ui| {
-            let label = ui.label("Thickness map");
-            ui.add(egui::TextEdit::singleline(&mut self.thickness_map_path).desired_width(220.0))
-                .labelled_by(label.id)
-                .on_hover_text(
-                    "a .png or .jpg: grey g maps film 1 to d + r(2g − 1); a colour map's G and B can drive the lower films under `stack`",
-                );
-            if ui.button("Open thickness map").clicked() {
-                let path = PathBuf::from(self.thickness_map_path.trim());
+            if let Some(path) = file_field(
+                ui,
+                "Thickness map",
+                &mut self.thickness_map_path,
+                "a .png or .jpg: grey g maps film 1 to d + r(2g − 1); a colour map's G and B can drive the lower films under `stack`",
+                "Open thickness map",
+            ) {
                 self.thickness_map_error = self.open_thickness_map(&path).err();
             }
             if ui
@@ -143,9 +139,7 @@ impl Studio {
             {
                 self.settings.thickness_map = None;
             }
-            if let Some(e) = &self.thickness_map_error {
-                ui.label(RichText::new(e.as_str()).color(Color32::LIGHT_RED));
-            }
+            error_label(ui, &self.thickness_map_error);
         });
         let films = self.good.0.films.len();
         if self.thickness_map_colour && self.settings.thickness_map.is_some() && films > 1 {
@@ -259,12 +253,13 @@ impl Studio {
             );
         });
         ui.horizontal_wrapped(|ui| {
-            let label = ui.label("Model file");
-            ui.add(egui::TextEdit::singleline(&mut self.model_path).desired_width(220.0))
-                .labelled_by(label.id)
-                .on_hover_text("a .gltf or .glb file (or drop one on the window)");
-            if ui.button("Open model").clicked() {
-                let path = PathBuf::from(self.model_path.trim());
+            if let Some(path) = file_field(
+                ui,
+                "Model file",
+                &mut self.model_path,
+                "a .gltf or .glb file (or drop one on the window)",
+                "Open model",
+            ) {
                 self.model_error = self.open_model(&path).err();
             }
             if ui
@@ -277,9 +272,7 @@ impl Studio {
                 self.close_model();
             }
             ui.checkbox(&mut self.settings.film_on_all, "Film on every material");
-            if let Some(e) = &self.model_error {
-                ui.label(RichText::new(e.as_str()).color(Color32::LIGHT_RED));
-            }
+            error_label(ui, &self.model_error);
         });
         self.files_ui(ui);
         self.update_live_lut();
@@ -480,6 +473,31 @@ impl Studio {
             d.mean_differing,
             d.p95_differing
         ));
+    }
+}
+
+/// A path field labelled `label` (its accessible name) with `hover` help, and its `button`:
+/// the path typed when the button is clicked.
+fn file_field(
+    ui: &mut egui::Ui,
+    label: &str,
+    path: &mut String,
+    hover: &str,
+    button: &str,
+) -> Option<PathBuf> {
+    let label = ui.label(label);
+    ui.add(egui::TextEdit::singleline(path).desired_width(220.0))
+        .labelled_by(label.id)
+        .on_hover_text(hover);
+    ui.button(button)
+        .clicked()
+        .then(|| PathBuf::from(path.trim()))
+}
+
+/// An error beside a field, in red, when there is one.
+fn error_label(ui: &mut egui::Ui, error: &Option<String>) {
+    if let Some(e) = error {
+        ui.label(RichText::new(e.as_str()).color(Color32::LIGHT_RED));
     }
 }
 
