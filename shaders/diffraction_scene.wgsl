@@ -20,7 +20,9 @@
 //
 // where each Σ_λ ρ u is filtered over the pixel's footprint (diffraction_colour_footprint,
 // issue 37: the footprint's σ_uv from the neighbouring pixels' rays, scene_footprint below;
-// the integrated layout's adapter point-samples).
+// the integrated layout's adapter point-samples); a rough grating's light is its lobes
+// blurred by the footprint and the microfacets' slopes instead (scene_rough_light, the
+// two-scale model).
 //
 // I_k = E_k · (σ_s k₀)²/π is the radiance of source k's mirror image spread over the
 // coherence lobe (E_k its irradiance at normal incidence, k₀ = 2π/555 nm; computed on the
@@ -66,7 +68,7 @@
 // irradiance at normal incidence, and view.scene = 0 cd-disc, 1 snake-skin, 2 bench,
 // 3 grating-plane.
 //
-// Group 2, the lights as the gratings see them (binding 0: 288 bytes, uniform;
+// Group 2, the lights as the gratings see them (binding 0: 304 bytes, uniform;
 // `nacre_runtime::diffraction::DiffractionLightsUniform` mirrors it; bindings 1–3:
 // `nacre_runtime::diffraction::LobeData`):
 //
@@ -78,6 +80,9 @@
 //       16  128 samples: array<vec4<f32>, 8>          direction xyz (unit), w unused
 //      144  128 sample_radiance: array<vec4<f32>, 8>  I_k rgb (× env_intensity on the CPU)
 //      272   16 lobe_kw: vec4<f32>          (kw_min, samples per unit kw, Δλ µm, 0)
+//      288   16 roughness: vec4<f32>        (σ_m² = α²/2 the microfacet slope variance per
+//                                           axis, α the GGX roughness, π/σ_s², 0): the grating's
+//                                           micro-geometry, π/σ_s² (scene_rough_light)
 struct DiffractionLights {
     light_radiance: f32,
     sample_count: u32,
@@ -86,6 +91,7 @@ struct DiffractionLights {
     samples: array<vec4<f32>, 8>,
     sample_radiance: array<vec4<f32>, 8>,
     lobe_kw: vec4<f32>,
+    roughness: vec4<f32>,
 }
 
 @group(2) @binding(0) var<uniform> lights: DiffractionLights;
@@ -100,6 +106,9 @@ struct DiffractionLights {
 const SCENE_LOBE_SAMPLES: u32 = 64u;
 
 const SCENE_PI: f32 = 3.14159265358979;
+
+// The light's gain wavelength k₀ = 2π/555 nm (`nacre_runtime::diffraction::LOBE_REFERENCE_NM`).
+const SCENE_LOBE_REFERENCE_NM: f32 = 555.0;
 
 @vertex
 fn diffraction_vs(@builtin(vertex_index) index: u32) -> @builtin(position) vec4<f32> {
@@ -254,9 +263,10 @@ fn scene_lobe_efficiency(l: u32, kw: f32) -> f32 {
 // variance σ_q² per axis spans σ_q/k in (u, v), and the band of one wavelength step Δλ
 // sweeps it by |κ_c| Δλ/2π (a uniform spread, variance /12); the pixel's footprint adds the
 // spread σ_fp of ω_r,t across the pixel (ray differentials, `scene_footprint` with no light:
-// ω_c,t follows −ω_r,t), the variances adding as for independent spreads; divided by cos θ_c
-// that is its angular size σ, read at the mip level log₂(2.5 σ/texel₀) of the environment's
-// box chain.
+// ω_c,t follows −ω_r,t) and a rough grating its microfacets' w² σ_m² (scene_rough_light:
+// a facet of slope s moves the lobe by w s in (u, v)), the variances adding as for
+// independent spreads; divided by cos θ_c that is its angular size σ, read at the mip level
+// log₂(2.5 σ/texel₀) of the environment's box chain.
 fn scene_env_diffracted(frame: mat3x3<f32>, wr: vec3<f32>, sigma_fp: f32) -> vec3<f32> {
     let count = min(lights.lobe_count, arrayLength(&lobes));
     let wavelengths = min(lights.lobe_wavelength_count, arrayLength(&lobe_spectrum));
@@ -286,7 +296,7 @@ fn scene_env_diffracted(frame: mat3x3<f32>, wr: vec3<f32>, sigma_fp: f32) -> vec
             let cos_h = -dot(wi, uvw) * inverseSqrt(dot(uvw, uvw));
             let eta = scene_lobe_efficiency(l, k * uvw.z);
             let sweep = length(lobe.xy) * lights.lobe_kw.z / (2.0 * SCENE_PI);
-            let spread2 = lobe.z / (k * k) + sweep * sweep / 12.0 + sigma_fp * sigma_fp;
+            let spread2 = lobe.z / (k * k) + sweep * sweep / 12.0 + sigma_fp * sigma_fp + uvw.z * uvw.z * lights.roughness.x;
             let sigma = sqrt(spread2) / max(wi.z, 0.05);
             let lod = clamp(log2(max(2.5 * sigma / texel, 1.0)), 0.0, view.env_lod_max);
             band += (diffraction_fresnel(cos_h) * g * eta) * scene_env(to_world * wi, lod);
@@ -372,6 +382,98 @@ fn scene_footprint(l: vec3<f32>, frame: mat3x3<f32>, wr: vec3<f32>, n: array<Nei
     return select(vec2<f32>(0.0), min(sigma, vec2<f32>(0.25)), diffraction_finite(sigma.x) && diffraction_finite(sigma.y));
 }
 
+// ─── Rough gratings (issue 37, item 4) ────────────────────────────────────────────────────
+//
+// The two-scale model (Holzschuch & Pacanowski, "A two-scale microfacet reflectance model
+// combining reflection and diffraction", SIGGRAPH 2017): the grating's height field lies on
+// microfacets whose normals follow GGX of roughness α, and Stam's BRDF is evaluated in each
+// facet's tilted frame. A facet of slope s = (s_x, s_y) (normal ∝ (−s_x, −s_y, 1) in the
+// grating frame) has tangent axes x′ ∝ (1, 0, s_x), y′ ∝ (0, 1, s_y), so to first order in s
+//
+//   (u, v)′ = −(ω_i + ω_r)·(x′, y′) = (u, v) + w s,     q′ = k (u, v)′ = q + k w s,
+//
+// and the facets' mean of |P̃(q′)|² is |P̃|² convolved with the slope distribution scaled by
+// k |w|: every order is blurred in q by the variance k² w² σ_m² per axis (the blur grows with
+// k and with |w| = cos θ_i + cos θ_r: per order and per wavelength). The pixel's footprint
+// σ_uv (scene_footprint) is one more independent spread: the variances add,
+// k² (σ_uv² + w² σ_m²).
+//
+// GGX's slope distribution P₂₂(s) = 1/(π α² (1 + |s|²/α²)²) has no finite variance (its
+// tails fall as |s|⁻⁴); it is matched to the Beckmann distribution of the same α (Walter et
+// al., "Microfacet models for refraction through rough surfaces", EGSR 2007: the same
+// parameter, the same peak), σ_m² = α²/2 per axis (`nacre_runtime::diffraction::
+// rough_slope_variance`). Left out, to first order in α: the change of w, G/w² and F² with
+// the tilt and Smith's masking-shadowing; the Mitsuba reference (nacre.mitsuba,
+// `roughness`) keeps them all, drawing a facet per path.
+//
+// Evaluation. The blur is wide against the table's bins: the CD's σ_m k |w| at α = 0.05 is
+// 0.6 rad/µm, three bins (Δκ = 0.196 rad/µm), and the footprint filter would need a window
+// of ±17 bins, past its cap of 8, where it keeps the energy but not the spread. So a rough
+// grating's light is summed over the table's lobes instead (the environment's, `lobes.rs`:
+// |P̃(q)|² ≈ Σ_c η_c(kw) (π/σ_s²) N(q; κ_c, v_c) with N the normalised Gaussian of variance
+// v_c per axis, the cross terms between bins dropped), each lobe's variance widened by the
+// blur, plus the specular order as one more lobe (η = |P_DC(kw)|², v = 1/(2σ_s²), appended
+// past the environment's lobes by the host):
+//
+//   ρ_rough = F² G/w² (π/σ_s²) Σ_c η_c(kw) N(q; κ_c, v_c + k² (σ_uv² + w² σ_m²))
+//
+// with Stam's k² per wavelength: the light's radiance I₀ = E₀ (σ_s k₀)²/π takes k₀ at 555 nm
+// (lobe_gain), so ρ_rough is scaled by (k/k₀)². (The smooth path leaves that factor out, as
+// lobe_gain says; a blurred lobe spreads over (u, v) the same at every wavelength, so left
+// out here it would tint the rough picture red by (λ/555 nm)².)
+//
+// — exact for the model's Gaussian blur of each lobe, and cheaper than the filter (lobes ×
+// wavelengths reads, no Taylor sums). The environment's lobes are widened the same way
+// (scene_env_diffracted), and its zeroth order is read wider at angular spread 2 σ_m (a facet
+// tilts the mirror direction by twice its own tilt; scene_rough_mirror_lod). α = 0 (σ_m² = 0)
+// takes none of these branches: the smooth picture, bit for bit.
+
+// ρ_rough of the light (above) for ω_i, ω_r in the grating frame and the pixel's footprint
+// σ_uv per axis, as a colour Σ_λ ρ_rough u(λ) over the lobes' spectrum. Always finite.
+fn scene_rough_light(wi_in: vec3<f32>, wr_in: vec3<f32>, fp: vec2<f32>) -> vec3<f32> {
+    let total = min(lights.lobe_count + 1u, arrayLength(&lobes));
+    let wavelengths = min(lights.lobe_wavelength_count, arrayLength(&lobe_spectrum));
+    let wi = diffraction_unit(wi_in);
+    let wr = diffraction_unit(wr_in);
+    let g = diffraction_geometry_over_w2(wi, wr);
+    if !(g > 0.0) || !diffraction_finite(g) || wavelengths == 0u {
+        return vec3<f32>(0.0);
+    }
+    let uvw = -wi - wr;
+    let cos_h = -dot(wi, uvw) * inverseSqrt(dot(uvw, uvw));
+    let fresnel = diffraction_fresnel(cos_h);
+    let spread = fp * fp + vec2<f32>(uvw.z * uvw.z * lights.roughness.x);
+    var sum = vec3<f32>(0.0);
+    for (var i = 0u; i < wavelengths; i++) {
+        let sp = lobe_spectrum[i];
+        let k = 2.0 * SCENE_PI / (sp.x * 1e-3);
+        let q = k * uvw.xy;
+        let kw = k * uvw.z;
+        var density = 0.0;
+        for (var l = 0u; l < total; l++) {
+            let lobe = lobes[l];
+            let v = vec2<f32>(lobe.z) + k * k * spread;
+            let d = q - lobe.xy;
+            let n = exp(-0.5 * dot(d * d, vec2<f32>(1.0) / v)) / (2.0 * SCENE_PI * sqrt(v.x * v.y));
+            density += scene_lobe_efficiency(l, kw) * n;
+        }
+        // Stam's k² at this wavelength over the light's gain at k₀ (555 nm; lobe_gain).
+        let k_ratio = k * SCENE_LOBE_REFERENCE_NM * 1e-3 / (2.0 * SCENE_PI);
+        sum += (density * k_ratio * k_ratio) * sp.yzw;
+    }
+    let colour = (fresnel * g * lights.roughness.z) * sum;
+    return select(vec3<f32>(0.0), colour, diffraction_finite3(colour));
+}
+
+// The mip level of the environment's zeroth order on a rough grating: the mirror direction
+// spreads by 2 σ_m (radians, per axis), read as the lobes are (level log₂(2.5 σ/texel₀)),
+// never sharper than the smooth grating's level 1.
+fn scene_rough_mirror_lod() -> f32 {
+    let texel = SCENE_PI / f32(max(textureDimensions(env_map, 0).y, 1u));
+    let sigma = 2.0 * sqrt(max(lights.roughness.x, 0.0));
+    return clamp(log2(max(2.5 * sigma / texel, 2.0)), 1.0, max(view.env_lod_max, 1.0));
+}
+
 // World direction into the grating frame of the surface; around: the neighbouring pixels' views
 // at +x, −x, +y, −y (the footprint filter of diffraction_colour_footprint).
 fn scene_shade(s: Surface, to_eye: vec3<f32>, around: array<Neighbour, 4>) -> vec3<f32> {
@@ -381,7 +483,13 @@ fn scene_shade(s: Surface, to_eye: vec3<f32>, around: array<Neighbour, 4>) -> ve
     let light = normalize(view.light_direction);
     let light_radiance = view.light_colour * lights.light_radiance;
     if s.grating > 0.0 {
-        var diffracted = diffraction_colour_footprint(frame * light, wr, scene_footprint(light, frame, wr, around)) * light_radiance;
+        let fp_light = scene_footprint(light, frame, wr, around);
+        var diffracted: vec3<f32>;
+        if lights.roughness.x > 0.0 {
+            diffracted = scene_rough_light(frame * light, wr, fp_light) * light_radiance;
+        } else {
+            diffracted = diffraction_colour_footprint(frame * light, wr, fp_light) * light_radiance;
+        }
         let count = min(lights.sample_count, 8u);
         for (var k = 0u; k < count; k++) {
             let l = lights.samples[k].xyz;
@@ -399,7 +507,14 @@ fn scene_shade(s: Surface, to_eye: vec3<f32>, around: array<Neighbour, 4>) -> ve
     let env = scene_env(mirror, 1.0);
     let specular = diffraction_specular_order_colour(cos_v);
     let clear = vec3<f32>(diffraction_fresnel(cos_v));
-    radiance += env * mix(clear, specular, s.grating);
+    if lights.roughness.x > 0.0 {
+        // A rough grating's zeroth order sees the environment wider; the clear parts stay
+        // smooth mirrors.
+        let env_rough = scene_env(mirror, scene_rough_mirror_lod());
+        radiance += env * clear * (1.0 - s.grating) + env_rough * specular * s.grating;
+    } else {
+        radiance += env * mix(clear, specular, s.grating);
+    }
     // The snake's dark skin: diffuse under the light and a constant sky term.
     let n_dot_l = max(dot(n, light), 0.0);
     radiance += s.base * (n_dot_l * view.light_colour * view.light_intensity + vec3<f32>(0.6) * view.env_intensity);

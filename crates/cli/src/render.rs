@@ -169,6 +169,12 @@ pub struct RenderArgs {
     /// diffracts 4 directions by default).
     #[arg(long, value_name = "K")]
     env_samples: Option<usize>,
+    /// Diffraction scenes: GGX roughness α of the grating's microfacets, 0 to 1 (a brushed
+    /// or scratched grating, a CD's worn coat): the two-scale model, every order blurred by
+    /// the facets' slopes (docs/architecture.md, "Rough gratings"); a "terms" table only
+    /// [default: 0, a smooth grating].
+    #[arg(long, value_name = "ALPHA", allow_hyphen_values = true)]
+    roughness: Option<f64>,
     /// Output PNG file.
     #[arg(short = 'o', long = "output", value_name = "FILE.png")]
     output: PathBuf,
@@ -227,6 +233,15 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     use nacre_runtime::{Scene, TableSet, Technique};
     let film_eval = FilmEval::from(args.film_eval);
     let all = Scene::from(args.scene);
+    if let (Some(alpha), Scene::RoughRow | Scene::Film(_)) = (args.roughness, all) {
+        return Err(nacre_bake::error::Error::invalid(
+            Param::Roughness,
+            format!(
+                "{alpha}: the roughness of a grating, for the diffraction scenes (cd-disc, snake-skin, grating-plane) only"
+            ),
+        )
+        .into());
+    }
     let scene = match all {
         Scene::RoughRow => return run_render_rough_row(args),
         Scene::Diffraction(scene) => return run_render_diffraction(args, scene),
@@ -408,8 +423,8 @@ fn run_render_diffraction(
     scene: nacre_runtime::diffraction::DiffractionScene,
 ) -> Result<()> {
     use nacre_runtime::diffraction::{
-        DiffractionLayout, DiffractionSceneOptions, DiffractionTables, render_diffraction_scene,
-        wavelength_grid,
+        DiffractionLayout, DiffractionSceneOptions, DiffractionTables, MAX_ROUGHNESS,
+        render_diffraction_scene, wavelength_grid,
     };
     let name = match args.tables.as_slice() {
         [] => scene.default_table().to_string(),
@@ -428,6 +443,23 @@ fn run_render_diffraction(
     options.environment = args.env.clone();
     options.exposure_ev = args.exposure;
     options.env_samples = args.env_samples;
+    if let Some(alpha) = args.roughness {
+        if !(alpha.is_finite() && (0.0..=MAX_ROUGHNESS).contains(&alpha)) {
+            return Err(nacre_bake::error::Error::invalid(
+                Param::Roughness,
+                format!("{alpha} (expected 0 to {MAX_ROUGHNESS}: the GGX α of the grating's microfacets)"),
+            )
+            .into());
+        }
+        if alpha > 0.0 && args.env_samples.is_some() {
+            return Err(nacre_bake::error::Error::invalid(
+                Param::Roughness,
+                format!("{alpha}: a rough grating is drawn through the table's environment lobes, which --env-samples replaces: leave --env-samples out"),
+            )
+            .into());
+        }
+        options.roughness = alpha;
+    }
     // Check the settings and read every input before starting the GPU: bad input fails fast.
     options.validate()?;
     let path = set::resolve_table(&name);
@@ -461,6 +493,16 @@ fn run_render_diffraction(
         }
         DiffractionLayout::Integrated { .. } => {
             refuse_step_for_integrated(Param::WavelengthStep, args.wavelength_step, &manifest)?;
+            if options.roughness > 0.0 {
+                return Err(nacre_bake::error::Error::invalid(
+                    Param::Roughness,
+                    format!(
+                        "{}: table `{}` has the layout \"integrated\", which is point-sampled; a rough grating is drawn by the footprint filter of a \"terms\" table (e.g. cd-tracks)",
+                        options.roughness, manifest.name
+                    ),
+                )
+                .into());
+            }
             "integrated".to_string()
         }
     };
@@ -476,9 +518,14 @@ fn run_render_diffraction(
     let png = image.encode_png()?;
     write_atomic(&args.output, |w| w.write_all(&png))?;
     eprintln!(
-        "rendered {} (diffraction, {}, {sum}) at {}x{} in {:.2} s (render pass {:.2} s) -> {}",
+        "rendered {} (diffraction, {}, {sum}{}) at {}x{} in {:.2} s (render pass {:.2} s) -> {}",
         scene.name(),
         table.name(),
+        if options.roughness > 0.0 {
+            format!(", roughness {}", options.roughness)
+        } else {
+            String::new()
+        },
         image.width,
         image.height,
         total,

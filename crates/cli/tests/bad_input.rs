@@ -1222,6 +1222,50 @@ fn fixtures(d: &Path) -> Vec<Case> {
             &["99"],
         ),
         with(
+            "render: diffraction roughness negative",
+            render(&["--scene", "cd-disc", "--roughness", "-0.1"]),
+            &["--roughness", "-0.1", "0 to 1"],
+        ),
+        with(
+            "render: diffraction roughness above 1",
+            render(&["--scene", "grating-plane", "--roughness", "1.5"]),
+            &["--roughness", "1.5", "0 to 1"],
+        ),
+        with(
+            "render: diffraction roughness NaN",
+            render(&["--scene", "snake-skin", "--roughness", "nan"]),
+            &["--roughness", "NaN"],
+        ),
+        with(
+            "render: roughness on a film scene",
+            render(&["--scene", "sphere", "--roughness", "0.1"]),
+            &["--roughness", "diffraction scenes"],
+        ),
+        with(
+            "render: roughness with an integrated table",
+            render(&[
+                "--scene",
+                "cd-disc",
+                "--tables",
+                "cd-tracks-fast",
+                "--roughness",
+                "0.1",
+            ]),
+            &["--roughness", "cd-tracks-fast", "\"integrated\""],
+        ),
+        with(
+            "render: roughness with environment samples",
+            render(&[
+                "--scene",
+                "cd-disc",
+                "--env-samples",
+                "2",
+                "--roughness",
+                "0.1",
+            ]),
+            &["--roughness", "--env-samples"],
+        ),
+        with(
             "render: diffraction scene given a film-lut table",
             render(&["--scene", "cd-disc", "--tables", "film-dielectric"]),
             &["film-dielectric", "diffraction table"],

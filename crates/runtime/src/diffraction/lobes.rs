@@ -112,6 +112,12 @@ pub struct EnvironmentLobes {
     pub scattered: f64,
     /// The part of `scattered` the kept lobes carry at the reference.
     pub captured: f64,
+    /// The specular order's efficiency |P_DC(kw)|² at the lobes' [`LOBE_KW_SAMPLES`] points
+    /// (the rough light of the scenes sums it as one more lobe: `scene_rough_light`).
+    pub specular: Vec<f64>,
+    /// The window's variance per axis in q, 1/(2σ_s²), (rad/µm)²: the specular order's and
+    /// every sharp lobe's.
+    pub window_per_um2: f64,
 }
 
 impl EnvironmentLobes {
@@ -197,19 +203,22 @@ impl EnvironmentLobes {
             }
         };
         let count = 2 * sharp.len() + 1;
+        // Per sample: the lobes' efficiencies, then the specular order's |P_DC|² last.
         let samples: Vec<Vec<f64>> = (0..LOBE_KW_SAMPLES)
             .into_par_iter()
             .map(|s| {
                 let kw = kw_min * (1.0 - s as f64 / (LOBE_KW_SAMPLES - 1) as f64);
-                let mut eta = vec![0.0; count];
+                let mut eta = vec![0.0; count + 1];
                 for (i, p) in terms.series(kw).iter().enumerate() {
-                    if let Some(l) = lobe_of(i) {
-                        eta[l] += p.norm_sqr();
+                    match lobe_of(i) {
+                        Some(l) => eta[l] += p.norm_sqr(),
+                        None => eta[count] = p.norm_sqr(),
                     }
                 }
                 eta
             })
             .collect();
+        let specular = samples.iter().map(|e| e[count]).collect();
         let window = 1.0 / (2.0 * sigma * sigma);
         // Lobe l as (l, lobe); a halo's group is empty when every bin went elsewhere.
         let mut lobes: Vec<(usize, Lobe)> = Vec::with_capacity(count);
@@ -271,6 +280,8 @@ impl EnvironmentLobes {
             kw_min,
             scattered,
             captured,
+            specular,
+            window_per_um2: window,
         })
     }
 }

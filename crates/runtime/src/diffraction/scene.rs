@@ -195,6 +195,23 @@ pub struct DiffractionSceneOptions {
     /// The technique's settings (default here: a 10 nm wavelength step, which an
     /// integrated table leaves unused: [`DiffractionOptions`]).
     pub technique: DiffractionOptions,
+    /// GGX roughness α of the grating's microfacets (0 to [`MAX_ROUGHNESS`]; default 0, a
+    /// smooth grating): the two-scale model of `shaders/diffraction_scene.wgsl`
+    /// (`scene_rough_light`), which blurs every order of the table's environment lobes by
+    /// the facets' slopes — so a "terms" table without `env_samples` only.
+    pub roughness: f64,
+}
+
+/// Largest GGX roughness α of a diffraction scene's grating.
+pub const MAX_ROUGHNESS: f64 = 1.0;
+
+/// The slope variance per axis σ_m² of microfacets of GGX roughness α, as the scenes blur a
+/// rough grating's orders with it: GGX's slope distribution
+/// P₂₂(s) = 1/(π α² (1 + |s|²/α²)²) has no finite variance (tails ∝ |s|⁻⁴), so it is matched
+/// to the Beckmann distribution of the same α (Walter et al., EGSR 2007: the same parameter,
+/// the same peak), whose slopes have variance α²/2 per axis.
+pub fn rough_slope_variance(alpha: f64) -> f64 {
+    0.5 * alpha * alpha
 }
 
 impl DiffractionSceneOptions {
@@ -217,6 +234,7 @@ impl DiffractionSceneOptions {
                 fresnel: scene.fresnel(),
                 ..DiffractionOptions::default()
             },
+            roughness: 0.0,
         }
     }
 
@@ -259,6 +277,14 @@ impl DiffractionSceneOptions {
                 "≥ 0".into(),
             );
         }
+        if !(self.roughness.is_finite() && (0.0..=MAX_ROUGHNESS).contains(&self.roughness)) {
+            return bad(
+                "roughness (GGX α)",
+                self.roughness,
+                "",
+                format!("0 to {MAX_ROUGHNESS}"),
+            );
+        }
         if let Some(k) = self.env_samples.filter(|k| *k > MAX_ENV_SAMPLES) {
             return bad(
                 "environment samples",
@@ -284,7 +310,7 @@ impl DiffractionSceneOptions {
     }
 }
 
-/// Mirror of `DiffractionLights` (shaders/diffraction_scene.wgsl, group 2 binding 0, 288
+/// Mirror of `DiffractionLights` (shaders/diffraction_scene.wgsl, group 2 binding 0, 304
 /// bytes): the light, the environment samples and the environment lobes' settings as the
 /// gratings see them (the lobes, their efficiencies and the spectrum are bindings 1–3,
 /// [`LobeData`]). The camera, the exposure, the
@@ -308,6 +334,11 @@ pub struct DiffractionLightsUniform {
     /// (kw_min, (S − 1)/(−kw_min), Δλ µm, 0): the efficiency samples' first kw and their
     /// density (S = [`LOBE_KW_SAMPLES`]), and the step of the lobes' wavelength grid.
     pub lobe_kw: [f32; 4],
+    /// (σ_m², α, π/σ_s², 0): the grating's microfacets, GGX roughness α and the slope
+    /// variance per axis σ_m² = α²/2 of the Beckmann distribution it is matched to
+    /// ([`rough_slope_variance`]; 0 for a smooth grating), and the lobes' normalisation
+    /// π/σ_s² (`scene_rough_light`).
+    pub roughness: [f32; 4],
 }
 
 /// Bindings 1–3 of the scenes' group 2: the environment lobes of a "terms" table
@@ -370,6 +401,17 @@ impl LobeData {
     /// Per-pixel loop iterations of the lobe sum (lobes × wavelengths).
     pub fn iterations(&self) -> u64 {
         (self.lobes.len() * self.spectrum.len()) as u64
+    }
+
+    /// Appends the specular order of `lobes` as one more lobe (centre 0, the window's
+    /// variance, efficiency |P_DC(kw)|²) past the environment's, for a rough grating's light
+    /// (`scene_rough_light`, which sums every order; the environment's lobe sum stops at
+    /// `DiffractionLights.lobe_count` and keeps its mirror image apart).
+    pub fn push_specular(&mut self, lobes: &EnvironmentLobes) {
+        self.lobes
+            .push([0.0, 0.0, lobes.window_per_um2 as f32, 0.0]);
+        self.efficiency
+            .extend(lobes.specular.iter().map(|&e| e as f32));
     }
 }
 
@@ -763,6 +805,34 @@ pub fn llvmpipe_filter_radius(
         .or(Some(0)))
 }
 
+/// Refuses a rough grating (`options.roughness` > 0) without the environment lobes of a
+/// "terms" table: a rough grating's light is drawn through them (`scene_rough_light`), and an
+/// "integrated" table has none, as has a scene whose environment is `env_samples`.
+///
+/// # Errors
+/// [`Error::Refused`] naming the roughness and the way out.
+fn refuse_rough_without_lobes(
+    table: &DiffractionTables,
+    options: &DiffractionSceneOptions,
+) -> Result<()> {
+    if options.roughness <= 0.0 {
+        return Ok(());
+    }
+    let why = match (table, options.env_samples) {
+        (DiffractionTables::Integrated(_), _) => {
+            ": an \"integrated\" table keeps no orders to blur; a rough grating needs a \"terms\" table"
+        }
+        (_, Some(_)) => {
+            ": a rough grating is drawn through the table's environment lobes, which environment samples replace"
+        }
+        _ => return Ok(()),
+    };
+    Err(Error::Refused {
+        context: format!("the {} scene", options.scene.name()),
+        message: msg![Param::Roughness.given(options.roughness.to_string()), why],
+    })
+}
+
 /// Reference wavelength of [`lobe_gain`], nm.
 pub const LOBE_REFERENCE_NM: f64 = 555.0;
 
@@ -840,15 +910,22 @@ pub fn render_diffraction_scene_in(
         ..ViewUniform::zeroed()
     };
     // The whole environment through the lobes (terms tables), or its brightest texels.
+    refuse_rough_without_lobes(table, options)?;
+    let mut env_lobe_count = 0;
     let lobes = match (table, options.env_samples) {
         (DiffractionTables::Terms(t), None) => {
             let lobes = EnvironmentLobes::new(&t.terms, &t.record)?;
-            LobeData::new(
+            let mut data = LobeData::new(
                 &lobes,
                 &t.record,
                 &t.colorimeter()?,
                 options.technique.wavelength_step_nm,
-            )?
+            )?;
+            env_lobe_count = data.lobes.len();
+            if options.roughness > 0.0 {
+                data.push_specular(&lobes);
+            }
+            data
         }
         _ => LobeData::default(),
     };
@@ -861,9 +938,15 @@ pub fn render_diffraction_scene_in(
     let mut lights = DiffractionLightsUniform {
         light_radiance: options.light.intensity * gain,
         sample_count: samples.len() as u32,
-        lobe_count: lobes.lobes.len() as u32,
+        lobe_count: env_lobe_count as u32,
         lobe_wavelength_count: lobes.spectrum.len() as u32,
         lobe_kw: lobes.kw,
+        roughness: [
+            rough_slope_variance(options.roughness) as f32,
+            options.roughness as f32,
+            (std::f64::consts::PI / (table.record().sigma_s_um * table.record().sigma_s_um)) as f32,
+            0.0,
+        ],
         ..DiffractionLightsUniform::zeroed()
     };
     for (k, (d, l)) in samples.iter().enumerate() {
