@@ -21,6 +21,14 @@ impl From<QuantityArg> for Quantity {
     }
 }
 
+/// `nacre render --footprint-filter`: whether the diffraction scenes average the BRDF over
+/// each pixel's footprint.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum OnOffArg {
+    On,
+    Off,
+}
+
 /// `nacre render --layer-channel`, `nacre export --layer-channel`: the thickness-map channel
 /// a stack's film follows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]

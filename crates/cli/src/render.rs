@@ -2,7 +2,7 @@
 //! on the GPU.
 
 use crate::args::{DEFAULT_WAVELENGTH_STEP_NM, StackArgs, load_stack, refuse_step_for_integrated};
-use crate::choices::{ChannelArg, FilmEvalArg, SceneArg, TechniqueArg};
+use crate::choices::{ChannelArg, FilmEvalArg, OnOffArg, SceneArg, TechniqueArg};
 use crate::error::{self, Result};
 use clap::Args;
 use nacre_bake::commands::stack_spec::StackSpec;
@@ -175,6 +175,12 @@ pub struct RenderArgs {
     /// [default: 0, a smooth grating].
     #[arg(long, value_name = "ALPHA", allow_hyphen_values = true)]
     roughness: Option<f64>,
+    /// Diffraction scenes: average the grating's BRDF over each pixel's footprint (ray
+    /// differentials; a "terms" table) or point-sample it once per pixel, as before issue 37
+    /// (aliasing: a distant disc shows speckle). A rough grating's blur keeps the footprint
+    /// either way [default: on].
+    #[arg(long, value_enum, value_name = "ON|OFF")]
+    footprint_filter: Option<OnOffArg>,
     /// Output PNG file.
     #[arg(short = 'o', long = "output", value_name = "FILE.png")]
     output: PathBuf,
@@ -238,6 +244,16 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             Param::Roughness,
             format!(
                 "{alpha}: the roughness of a grating, for the diffraction scenes (cd-disc, snake-skin, grating-plane) only"
+            ),
+        )
+        .into());
+    }
+    if let (Some(filter), Scene::RoughRow | Scene::Film(_)) = (args.footprint_filter, all) {
+        return Err(nacre_bake::error::Error::invalid(
+            "--footprint-filter",
+            format!(
+                "{}: the footprint filter of the diffraction scenes (cd-disc, snake-skin, grating-plane) only",
+                if filter == OnOffArg::On { "on" } else { "off" }
             ),
         )
         .into());
@@ -443,6 +459,9 @@ fn run_render_diffraction(
     options.environment = args.env.clone();
     options.exposure_ev = args.exposure;
     options.env_samples = args.env_samples;
+    if args.footprint_filter == Some(OnOffArg::Off) {
+        options.technique.filter_radius = None;
+    }
     if let Some(alpha) = args.roughness {
         if !(alpha.is_finite() && (0.0..=MAX_ROUGHNESS).contains(&alpha)) {
             return Err(nacre_bake::error::Error::invalid(

@@ -1266,6 +1266,11 @@ fn fixtures(d: &Path) -> Vec<Case> {
             &["--roughness", "--env-samples"],
         ),
         with(
+            "render: footprint filter switch on a film scene",
+            render(&["--scene", "bubble", "--footprint-filter", "off"]),
+            &["--footprint-filter", "diffraction scenes"],
+        ),
+        with(
             "render: diffraction scene given a film-lut table",
             render(&["--scene", "cd-disc", "--tables", "film-dielectric"]),
             &["film-dielectric", "diffraction table"],

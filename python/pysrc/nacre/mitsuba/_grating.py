@@ -26,6 +26,31 @@ Sampling: one of the path's wavelengths λ (uniformly), a bin j with probability
 (over the wavelengths, bins and the cosine lobe) is evaluated exactly, so the estimator is
 unbiased.
 
+Rough gratings (``roughness``, GGX α > 0): the two-scale model (Holzschuch & Pacanowski,
+"A two-scale microfacet reflectance model combining reflection and diffraction", SIGGRAPH
+2017): the height field lies on microfacets whose normals m follow GGX of roughness α, and
+Stam's BRDF f_μ is evaluated in each facet's frame (the grating frame turned so that its
+normal is m, the direction across the lines kept as near as it can be). With Smith's
+uncorrelated masking-shadowing G₂ = G₁(ω_i, m) G₁(ω_r, m) (Heitz, "Understanding the
+masking-shadowing function", JCGT 3(2), 2014), the microfacet BRDF
+
+    f(ω_i, ω_r) cos θ_r = ∫ f_μ(ω_i, ω_r; m) |ω_i·m| |ω_r·m| D(m) G₂ / cos θ_i dm
+                        = E_{m ~ D_{ω_i}} [ f_μ(ω_i, ω_r; m) (ω_r·m)₊ G₁(ω_r, m) ]
+
+with D_{ω_i}(m) = G₁(ω_i, m) (ω_i·m)₊ D(m) / cos θ_i the distribution of visible normals,
+sampled exactly (Heitz, "Sampling the GGX distribution of visible normals", JCGT 7(4), 2018).
+``eval`` draws one facet per call from a hash of the hit point, the path's wavelengths and ω_r
+(every sample of a pixel lands elsewhere, so the pixel's mean is a Monte-Carlo estimate of the
+integral), importance-sampled: a facet's lobe is 1/(σ_s k |w|) wide in slope, a few hundredths
+of GGX's spread, so facets drawn from the visible normals would rarely put the light in it;
+the slope is drawn instead, mostly, so that the light lands in one of the smooth lobes, and
+the estimate divides by that mixture's density (``_rough_estimate``); ``sample`` draws a facet, then a direction from the smooth grating's lobes in the
+facet's frame, with the weight f_μ (ω_r·m)₊ G₁(ω_r, m) / p_m(ω_r), an unbiased estimate of
+f cos θ_r / p. The density reported to the integrator's MIS (``pdf``, ``bs.pdf``) is the
+smooth grating's lobe mixture in the facet-free frame, one deterministic function of (ω_i, ω_r)
+for both, so the MIS weights still sum to one. This is an independent estimate of the
+two-scale model: no Gaussian in it, the change of w, G/w², F² and the masking kept.
+
 Per point, the scenes may give the grating frame (``set_frame_function``: world normal and
 direction across the lines) and the grating's coverage c ∈ [0, 1]; where c < 1 the surface
 is a smooth mirror of reflectance F² (weight 1 − c), and an optional Lambertian ``base``
@@ -51,6 +76,9 @@ MIN_WAVELENGTH_NM = 360.0
 WINDOW_CUTOFF = 1e-5
 #: Probability of a cosine-weighted direction in `sample`.
 P_COSINE = 0.1
+#: Probability that a rough grating's ``eval`` draws its facet through the smooth lobes (else
+#: from GGX's slopes): see ``NacreGrating._rough_estimate``.
+P_FACET_LOBE = 0.8
 
 
 class Spectra:
@@ -158,6 +186,57 @@ def fresnel_unpolarised(n: float, cos_theta):
     return 0.5 * (rs * rs + rp * rp)
 
 
+def _hash_uniforms(*values):
+    """Two uniforms in [0, 1) per lane from Dr.Jit floats: their bits mixed (the finaliser of
+    MurmurHash3, Appleby 2008) — the per-call random numbers of a rough grating's ``eval``."""
+    h = mi.UInt32(0x9E3779B9)
+    for v in values:
+        h = (h ^ dr.reinterpret_array(mi.UInt32, mi.Float(v))) * 0x85EBCA6B
+        h = h ^ (h >> 13)
+        h = h * 0xC2B2AE35
+        h = h ^ (h >> 16)
+    h2 = (h ^ 0x68E31DA4) * 0x1B873593
+    h2 = h2 ^ (h2 >> 15)
+    h2 = h2 * 0x85EBCA6B
+    h2 = h2 ^ (h2 >> 13)
+    scale = 1.0 / 16777216.0
+    return mi.Float(h >> 8) * scale, mi.Float(h2 >> 8) * scale
+
+
+def ggx_visible_normal(wi, alpha: float, u1, u2):
+    """A GGX normal (roughness ``alpha``) from the distribution of normals visible from ``wi``
+    (local frame, z up): Heitz 2018, "Sampling the GGX distribution of visible normals"."""
+    vh = dr.normalize(mi.Vector3f(alpha * wi.x, alpha * wi.y, wi.z))
+    lensq = vh.x * vh.x + vh.y * vh.y
+    inv = dr.rsqrt(dr.maximum(lensq, 1e-20))
+    t1 = dr.select(lensq > 1e-12, mi.Vector3f(-vh.y * inv, vh.x * inv, 0.0), mi.Vector3f(1.0, 0.0, 0.0))
+    t2 = dr.cross(vh, t1)
+    r = dr.sqrt(u1)
+    phi = 2.0 * dr.pi * u2
+    p1 = r * dr.cos(phi)
+    p2 = r * dr.sin(phi)
+    s = 0.5 * (1.0 + vh.z)
+    p2 = (1.0 - s) * dr.sqrt(dr.maximum(1.0 - p1 * p1, 0.0)) + s * p2
+    nh = p1 * t1 + p2 * t2 + dr.sqrt(dr.maximum(1.0 - p1 * p1 - p2 * p2, 0.0)) * vh
+    return dr.normalize(mi.Vector3f(alpha * nh.x, alpha * nh.y, dr.maximum(nh.z, 1e-6)))
+
+
+def ggx_g1(v, m, alpha: float):
+    """Smith's masking G₁(v, m) of GGX (Heitz 2014, Eq. 72): 2 / (1 + √(1 + α² tan²θ_v)) where
+    v·m > 0 and v·n > 0, else 0."""
+    cos2 = dr.maximum(v.z * v.z, 1e-12)
+    tan2 = dr.maximum(1.0 - cos2, 0.0) / cos2
+    g = 2.0 / (1.0 + dr.sqrt(1.0 + alpha * alpha * tan2))
+    return dr.select((dr.dot(v, m) > 0) & (v.z > 0), g, 0.0)
+
+
+def facet_frame(m):
+    """The grating frame turned onto the facet normal ``m`` (local coordinates): x′ the
+    direction across the lines made perpendicular to m, y′ = m × x′."""
+    x = dr.normalize(mi.Vector3f(1.0 - m.x * m.x, -m.x * m.y, -m.x * m.z))
+    return mi.Frame3f(x, dr.cross(m, x), m)
+
+
 def _p_mirror(coverage):
     """Probability of sampling the clear part's mirror: 0.9 (1 − coverage), so that the
     glossy and diffuse lobes keep a chance where the grating is absent."""
@@ -171,7 +250,9 @@ class NacreGrating(mi.BSDF):
       1.6 µm, 0.05 µm); any periodic height field through :meth:`set_height_field`;
     * ``coherence_um`` — coherence diameter 4σ_s (default 32 µm, the bundled tables');
     * ``fresnel_ior`` — F² of a bulk dielectric at θ_h (default: F = 1);
-    * ``base`` — RGB albedo of a Lambertian layer (default none).
+    * ``base`` — RGB albedo of a Lambertian layer (default none);
+    * ``roughness`` — GGX α of the grating's microfacets (default 0: smooth; see the module
+      docstring).
     """
 
     def __init__(self, props: "mi.Properties") -> None:
@@ -184,6 +265,9 @@ class NacreGrating(mi.BSDF):
         if "base" in props:
             self.base = mi.load_dict({"type": "srgb", "color": props.get("base")})
         self.frame_fn: Optional[Callable] = None
+        self.roughness = float(props.get("roughness", 0.0))
+        if not (math.isfinite(self.roughness) and 0.0 <= self.roughness <= 1.0):
+            raise ValueError(f"nacre_grating: roughness {self.roughness} (expected 0 to 1, the GGX α)")
         flags = mi.BSDFFlags.GlossyReflection | mi.BSDFFlags.DeltaReflection | mi.BSDFFlags.DiffuseReflection
         self.m_components = [
             mi.BSDFFlags.GlossyReflection | mi.BSDFFlags.FrontSide,
@@ -282,6 +366,101 @@ class NacreGrating(mi.BSDF):
         k = 2.0 * dr.pi / (wavelength_nm * 1e-3)
         return self.rho(wi, wo, wavelength_nm) * dr.square(self.spectra.sigma_um * k) / dr.pi
 
+    def _base_term(self, si, wo, active):
+        """The Lambertian base's albedo/π · cos θ_r (0 without one)."""
+        if self.base is None:
+            return mi.Spectrum(0.0)
+        return self.base.eval(si, active) * (dr.inv_pi * wo.z)
+
+    def _q_density(self, qx, qy):
+        """Density in q of the bin-and-Gaussian sampling (a bin j ∝ |P_j(s₀)|², then
+        q ~ N(κ_j, 1/(2σ_s²)) per axis) at q = (qx, qy), rad/µm."""
+        sp = self.spectra
+        cx = mi.Int32(dr.round(qx / sp.dk[0]))
+        cy = mi.Int32(dr.round(qy / sp.dk[1])) if sp.ny > 1 else mi.Int32(0)
+        inv = 1.0 / float(self.spectra.weights.astype(np.float32).sum(dtype=np.float64))
+        sig2 = sp.sigma_um * sp.sigma_um
+        side = 2 * sp.rx + 1
+        count = side * (2 * sp.ry + 1)
+
+        def body(n, total):
+            jx = cx + mi.Int32(n % side) - sp.rx
+            jy = cy + mi.Int32(n // side) - sp.ry
+            idx, valid = sp.bin_index(jx, jy)
+            p_j = dr.gather(mi.Float, self._sampler.pmf, idx, valid) * inv
+            dx = qx - mi.Float(jx) * sp.dk[0]
+            dy = qy - mi.Float(jy) * sp.dk[1]
+            return n + 1, total + dr.select(valid, p_j * dr.exp(-sig2 * (dx * dx + dy * dy)), 0.0)
+
+        _, total = dr.while_loop(
+            state=(mi.UInt32(0), dr.zeros(mi.Float, dr.width(qx))),
+            cond=lambda n, total: n < count,
+            body=body,
+        )
+        return total * (sig2 / dr.pi)
+
+    def _rough_estimate(self, wi, wo, si):
+        """One-sample estimate of the rough grating's f cos θ_r (module docstring) per
+        wavelength lane, the facet's slope s drawn from a mixture: with probability
+        ``P_FACET_LOBE`` through the smooth lobes (a lane, a bin and a Gaussian offset give q′,
+        and s = (q′ − q)/(k w) puts the light in that lobe to first order), else from GGX's
+        slope distribution P₂₂; the estimate is f_μ (ω_r·m)₊ G₁(ω_r, m) D_{ω_i}(s) / p(s),
+        with D_{ω_i}(s) = G₁(ω_i, m) (cos θ_i − ω_i,t·s)₊ P₂₂(s) / cos θ_i the visible normals'
+        density over slopes and p the mixture's density (over every lane), exact."""
+        sp = self.spectra
+        alpha = self.roughness
+        a2 = alpha * alpha
+        u1, u2 = _hash_uniforms(si.p.x, si.p.y, si.p.z, si.wavelengths[0], wo.x, wo.y)
+        u3, u4 = _hash_uniforms(u1, u2, si.p.x, wo.z)
+        u5, _ = _hash_uniforms(u3, u4, si.p.z)
+        lanes = len(si.wavelengths)
+        w = -(wi.z + wo.z)
+        u, v = -wi.x - wo.x, -wi.y - wo.y
+        # The lane, the bin and the Gaussian offset of the lobe branch.
+        pick = dr.clip(u3, 0.0, 0.999999) * lanes
+        lane = dr.floor(pick)
+        k_sel = mi.Float(2.0 * dr.pi / (si.wavelengths[0] * 1e-3))
+        for i in range(1, lanes):
+            k_sel = dr.select(lane == i, 2.0 * dr.pi / (si.wavelengths[i] * 1e-3), k_sel)
+        j = self._sampler.sample(dr.clip(pick - lane, 0.0, 0.999999))
+        jx = mi.Int32(j % sp.nx)
+        jy = mi.Int32(j // sp.nx)
+        jx = dr.select(jx >= (sp.nx + 1) // 2, jx - sp.nx, jx)
+        jy = dr.select(jy >= (sp.ny + 1) // 2, jy - sp.ny, jy)
+        r = dr.sqrt(-dr.log(dr.maximum(1.0 - u1, 1e-12))) / sp.sigma_um
+        phi = 2.0 * dr.pi * u2
+        qx = mi.Float(jx) * sp.dk[0] + r * dr.cos(phi)
+        qy = mi.Float(jy) * sp.dk[1] + r * dr.sin(phi)
+        s_lobe_x = (qx - k_sel * u) / (k_sel * w)
+        s_lobe_y = (qy - k_sel * v) / (k_sel * w)
+        # GGX's slopes: |s| = α √(ξ/(1 − ξ)), uniform azimuth.
+        rg = alpha * dr.sqrt(u4 / dr.maximum(1.0 - u4, 1e-7))
+        lobe_branch = u5 < P_FACET_LOBE
+        sx = dr.select(lobe_branch, s_lobe_x, rg * dr.cos(phi))
+        sy = dr.select(lobe_branch, s_lobe_y, rg * dr.sin(phi))
+        s2 = sx * sx + sy * sy
+        p22 = 1.0 / (dr.pi * a2 * dr.square(1.0 + s2 / a2))
+        density = (1.0 - P_FACET_LOBE) * p22
+        lobe = mi.Float(0.0)
+        for i in range(lanes):
+            k = 2.0 * dr.pi / (si.wavelengths[i] * 1e-3)
+            lobe += self._q_density(k * (u + w * sx), k * (v + w * sy)) * dr.square(k * w)
+        density += P_FACET_LOBE * lobe / lanes
+        m = dr.normalize(mi.Vector3f(-sx, -sy, 1.0))
+        visible = ggx_g1(wi, m, alpha) * dr.maximum(wi.z - wi.x * sx - wi.y * sy, 0.0) * p22 / dr.maximum(wi.z, 1e-12)
+        ratio = dr.select(density > 0, visible / density, 0.0)
+        return self._facet_value(wi, wo, m, si.wavelengths) * ratio
+
+    def _facet_value(self, wi, wo, m, wavelengths):
+        """f_μ(ω_i, ω_r; m) (ω_r·m)₊ G₁(ω_r, m) per wavelength lane: Stam's BRDF in the facet's
+        frame (both directions in the grating frame; 0 where either is below the facet)."""
+        frame = facet_frame(m)
+        wi_m, wo_m = frame.to_local(wi), frame.to_local(wo)
+        ok = (wi_m.z > 0) & (wo_m.z > 0)
+        lanes = [self.brdf(wi_m, wo_m, wavelengths[lane]) for lane in range(len(wavelengths))]
+        weight = dr.select(ok, wo_m.z * ggx_g1(wo, m, self.roughness), 0.0)
+        return mi.Spectrum(mi.UnpolarizedSpectrum(*lanes)) * weight
+
     def _mirror_f2(self, cos_i):
         if self.fresnel_ior is None:
             return mi.Float(1.0)
@@ -324,12 +503,15 @@ class NacreGrating(mi.BSDF):
         wo = self._to_grating(si, frame, wo_local)
         active = active & (wi.z > 0) & (wo.z > 0) & (mi.Frame3f.cos_theta(wo_local) > 0)
         value = mi.Spectrum(0.0)
-        lanes = []
-        for lane in range(len(si.wavelengths)):
-            lanes.append(self.brdf(wi, wo, si.wavelengths[lane]))
-        value = mi.Spectrum(mi.UnpolarizedSpectrum(*lanes)) * (coverage * wo.z)
-        if self.base is not None:
-            value += self.base.eval(si, active) * (dr.inv_pi * wo.z)
+        if self.roughness > 0.0:
+            # One facet per call, importance-sampled (module docstring).
+            value = self._rough_estimate(wi, wo, si) * coverage
+        else:
+            lanes = []
+            for lane in range(len(si.wavelengths)):
+                lanes.append(self.brdf(wi, wo, si.wavelengths[lane]))
+            value = mi.Spectrum(mi.UnpolarizedSpectrum(*lanes)) * (coverage * wo.z)
+        value += self._base_term(si, wo, active)
         lanes = len(si.wavelengths)
         lobe = mi.Float(0.0)
         for lane in range(lanes):
@@ -377,16 +559,38 @@ class NacreGrating(mi.BSDF):
         phi = 2.0 * dr.pi * sample2.y
         qx = mi.Float(jx) * sp.dk[0] + r * dr.cos(phi)
         qy = mi.Float(jy) * sp.dk[1] + r * dr.sin(phi)
-        ox = -wi.x - qx / k
-        oy = -wi.y - qy / k
+        # A rough grating: a facet from the visible normals, and the lobes in its frame.
+        rough = self.roughness > 0.0
+        if rough:
+            v1, v2 = _hash_uniforms(sample1, sample2.x, sample2.y)
+            m = ggx_visible_normal(wi, self.roughness, v1, v2)
+            facet = facet_frame(m)
+            wi_s = facet.to_local(wi)
+        else:
+            wi_s = wi
+        ox = -wi_s.x - qx / k
+        oy = -wi_s.y - qy / k
         oz2 = 1.0 - ox * ox - oy * oy
         wo_lobe = mi.Vector3f(ox, oy, dr.sqrt(dr.maximum(oz2, 0.0)))
         wo_cos = mi.warp.square_to_cosine_hemisphere(sample2)
-        wo_g = dr.select(cosine, wo_cos, wo_lobe)
+        wo_s = dr.select(cosine, wo_cos, wo_lobe)
+        wo_g = facet.to_world(wo_s) if rough else wo_s
         wo_world_g = si.to_local(frame.to_world(wo_g))
         value, pdf = self._eval_pdf(ctx, si, wo_world_g, active)
         ok_g = active & (cosine | (oz2 > 0)) & (pdf > 0)
-        weight_g = value / dr.select(pdf > 0, pdf, 1.0)
+        if rough:
+            # f cos θ_r / p estimated as f_μ (ω_r·m)₊ G₁ / p_m (module docstring), with p_m the
+            # lobe mixture's density in the facet's frame; `pdf` (the facet-free mixture) is
+            # what the integrator's MIS sees.
+            lobe = mi.Float(0.0)
+            for i in range(lanes):
+                lobe += self._lobe_pdf(wi_s, wo_s, 2.0 * dr.pi / (si.wavelengths[i] * 1e-3))
+            density = ((1.0 - P_COSINE) * lobe / lanes + P_COSINE * dr.inv_pi * dr.maximum(wo_s.z, 0.0)) * (1.0 - p_m)
+            value = self._facet_value(wi, wo_g, m, si.wavelengths) * coverage + self._base_term(si, wo_g, active)
+            ok_g = ok_g & (wi_s.z > 0) & (wo_g.z > 0) & (density > 0)
+        else:
+            density = pdf
+        weight_g = value / dr.select(density > 0, density, 1.0)
         # The mirror.
         wo_m = si.to_local(frame.to_world(mi.Vector3f(-wi.x, -wi.y, wi.z)))
         weight_m = mi.Spectrum(self._mirror_f2(wi.z) * (1.0 - coverage) / dr.maximum(p_m, 1e-6))

@@ -6,6 +6,7 @@ reference's own noise (ΔE2000 mean and p95, from two independent halves)."""
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 import tempfile
@@ -43,12 +44,21 @@ def main(argv=None) -> int:
     parser.add_argument("--variant", default="llvm_ad_spectral", help="Mitsuba variant (a spectral one)")
     parser.add_argument("-o", "--output", required=True, help="output PNG; the linear EXR goes beside it")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    parser.add_argument("--roughness", type=float, default=0.0,
+                        help="GGX α of the grating's microfacets, 0 to 1 (diffraction scenes; default 0)")
     args = parser.parse_args(argv)
     for flag, value, low, high in (("--width", args.width, 1, 8192), ("--height", args.height, 1, 8192),
                                    ("--spp", args.spp, 2, 1 << 20)):
         if not low <= value <= high:
             print(f"error: {flag} {value}: expected {low} to {high}", file=sys.stderr)
             return 2
+    if not (math.isfinite(args.roughness) and 0.0 <= args.roughness <= 1.0):
+        print(f"error: --roughness {args.roughness}: expected 0 to 1 (the GGX α)", file=sys.stderr)
+        return 2
+    if args.roughness > 0.0 and args.scene not in ("cd-disc", "snake-skin", "grating-plane"):
+        print(f"error: --roughness {args.roughness}: the diffraction scenes (cd-disc, snake-skin, grating-plane) only",
+              file=sys.stderr)
+        return 2
     if not args.output.lower().endswith(".png"):
         print(f"error: -o {args.output}: expected a .png file", file=sys.stderr)
         return 2
@@ -62,7 +72,8 @@ def main(argv=None) -> int:
         print("error: nacre.reference needs Mitsuba 3: pip install 'nacre[mitsuba]'", file=sys.stderr)
         return 2
     ref = render(args.scene, args.width, args.height, args.spp, args.seed, args.variant,
-                 passes=min(8, args.spp - args.spp % 2), progress=None if args.quiet else _bar)
+                 passes=min(8, args.spp - args.spp % 2), progress=None if args.quiet else _bar,
+                 roughness=args.roughness)
     shown = np.round(ref.display() * 255.0).astype(np.uint8)
     exr = os.path.splitext(args.output)[0] + ".exr"
     _write_atomic(args.output, lambda p: mi.Bitmap(shown, mi.Bitmap.PixelFormat.RGB).write(p))

@@ -200,8 +200,8 @@ def cd_height_field() -> Tuple[np.ndarray, float]:
     return _grating.cd_tracks(256, 256, 0.125, 0.1, 1), 0.125
 
 
-def _grating_bsdf(surface: Dict[str, Any]) -> "_grating.NacreGrating":
-    values: Dict[str, Any] = {"coherence_um": 32.0}
+def _grating_bsdf(surface: Dict[str, Any], roughness: float = 0.0) -> "_grating.NacreGrating":
+    values: Dict[str, Any] = {"coherence_um": 32.0, "roughness": float(roughness)}
     if surface.get("fresnel_ior") is not None:
         values["fresnel_ior"] = float(surface["fresnel_ior"])
     if surface.get("base") is not None:
@@ -217,9 +217,13 @@ def _grating_bsdf(surface: Dict[str, Any]) -> "_grating.NacreGrating":
     return bsdf
 
 
-def build(scene: Scene, width: int, height: int, max_depth: int = 8) -> Tuple["mi.Scene", List[Any]]:
+def build(scene: Scene, width: int, height: int, max_depth: int = 8,
+          roughness: float = 0.0) -> Tuple["mi.Scene", List[Any]]:
     """The Mitsuba scene of ``scene`` at ``width × height`` (and the Python BSDFs it holds,
-    which must outlive it)."""
+    which must outlive it); ``roughness``: the GGX α of a diffraction scene's grating
+    (``nacre render --roughness``; film scenes take 0 only)."""
+    if roughness and scene.surface["kind"] in ("sphere", "plane"):
+        raise ValueError(f"roughness {roughness}: the diffraction scenes' gratings only, not {scene.name}")
     nacre.mitsuba.register(mi.variant() if mi.variant() and "spectral" in mi.variant() else None)
     s = scene.surface
     keep: List[Any] = []
@@ -241,7 +245,7 @@ def build(scene: Scene, width: int, height: int, max_depth: int = 8) -> Tuple["m
                 "bsdf": bsdf,
             }
     else:
-        bsdf = _grating_bsdf(s)
+        bsdf = _grating_bsdf(s, roughness)
         keep.append(bsdf)
         if s["kind"] == "cd-disc":
             bsdf.set_frame_function(_cd_frame)
