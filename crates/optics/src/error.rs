@@ -235,6 +235,14 @@ pub enum Error {
         /// What was wrong.
         message: String,
     },
+    /// A fit stopped because its caller cancelled it ([`crate::fit::Watch`]).
+    #[error("the fit was cancelled after {done} of {total} steps")]
+    FitCancelled {
+        /// Steps done when it stopped.
+        done: usize,
+        /// Steps in all.
+        total: usize,
+    },
 }
 
 /// Shorthand for `Result<T, nacre_optics::Error>`.

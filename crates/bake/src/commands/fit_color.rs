@@ -24,7 +24,9 @@ use crate::commands::fit_template::FitTemplate;
 use crate::csv_text::{self, line_text};
 use crate::error::{Error, Param, Result};
 use nacre_optics::colour::{Colorimeter, delta_e_2000, xyz_to_lab};
-use nacre_optics::fit::{ColourSettings, ColourTarget, FreeKind, Quantity, fit_colour};
+use nacre_optics::fit::{
+    ColourSettings, ColourTarget, FreeKind, Quantity, Watch, fit_colour_watched,
+};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -307,6 +309,19 @@ pub fn design(
     colorimeter: &Colorimeter,
     settings: &ColourSettings,
 ) -> Result<Design> {
+    design_watched(template, rows, colorimeter, settings, Watch::none())
+}
+
+/// [`design`] reporting its progress to `watch` and stopping with
+/// [`nacre_optics::Error::FitCancelled`] once its cancel flag is set
+/// ([`fit_colour_watched`]; the studio's background design).
+pub fn design_watched(
+    template: &FitTemplate,
+    rows: &[TargetRow],
+    colorimeter: &Colorimeter,
+    settings: &ColourSettings,
+    watch: Watch<'_>,
+) -> Result<Design> {
     let targets: Vec<ColourTarget> = rows
         .iter()
         .map(|r| ColourTarget {
@@ -321,7 +336,8 @@ pub fn design(
             .stack
             .attribute(template.template.stack(), Error::Optics(e))
     };
-    let fit = fit_colour(&template.template, &targets, colorimeter, settings).map_err(attribute)?;
+    let fit = fit_colour_watched(&template.template, &targets, colorimeter, settings, watch)
+        .map_err(attribute)?;
     let quantity = match settings.quantity {
         Quantity::Reflectance => color::Quantity::Reflectance,
         Quantity::Transmittance => color::Quantity::Transmittance,

@@ -15,7 +15,8 @@ use crate::commands::fit_template::FitTemplate;
 use crate::csv_text::{self, line_text};
 use crate::error::{Error, Param, Result};
 use nacre_optics::fit::{
-    Baseline, FreeKind, Loss, Measurement, Quantity, Settings, SpectrumFit, fit_spectrum,
+    Baseline, FreeKind, Loss, Measurement, Quantity, Settings, SpectrumFit, Watch,
+    fit_spectrum_watched,
 };
 use rayon::prelude::*;
 use std::fmt::Write as _;
@@ -297,41 +298,51 @@ pub fn fit_all(
 ) -> Result<Vec<Outcome>> {
     spectra
         .par_iter()
-        .map(|s| {
-            let points: Vec<Measurement> = s
-                .points
-                .iter()
-                .filter(|p| {
-                    request
-                        .window
-                        .is_none_or(|(a, b)| p.wavelength_nm >= a && p.wavelength_nm <= b)
-                })
-                .copied()
-                .collect();
-            let settings = Settings {
-                quantity: s.quantity,
-                ..request.settings
-            };
-            let fit = fit_spectrum(&template.template, &points, &settings).map_err(|e| {
-                let e = template
-                    .spec
-                    .stack
-                    .attribute(template.template.stack(), Error::Optics(e));
-                match e {
-                    Error::Optics(source) => {
-                        Error::optics_in(Param::Measured.given(s.name.clone()), source)
-                    }
-                    other => other,
-                }
-            })?;
-            Ok(Outcome {
-                name: s.name.clone(),
-                quantity: s.quantity,
-                points,
-                fit,
-            })
-        })
+        .map(|s| fit_one(template, s, request, Watch::none()))
         .collect()
+}
+
+/// Fits one spectrum (what [`fit_all`] does for each), reporting its progress to `watch`
+/// and stopping with [`nacre_optics::Error::FitCancelled`] once its cancel flag is set
+/// ([`fit_spectrum_watched`]; the studio's background fit).
+pub fn fit_one(
+    template: &FitTemplate,
+    s: &Spectrum,
+    request: &Request,
+    watch: Watch<'_>,
+) -> Result<Outcome> {
+    let points: Vec<Measurement> = s
+        .points
+        .iter()
+        .filter(|p| {
+            request
+                .window
+                .is_none_or(|(a, b)| p.wavelength_nm >= a && p.wavelength_nm <= b)
+        })
+        .copied()
+        .collect();
+    let settings = Settings {
+        quantity: s.quantity,
+        ..request.settings
+    };
+    let fit = fit_spectrum_watched(&template.template, &points, &settings, watch).map_err(|e| {
+        let e = template
+            .spec
+            .stack
+            .attribute(template.template.stack(), Error::Optics(e));
+        match e {
+            Error::Optics(source) => {
+                Error::optics_in(Param::Measured.given(s.name.clone()), source)
+            }
+            other => other,
+        }
+    })?;
+    Ok(Outcome {
+        name: s.name.clone(),
+        quantity: s.quantity,
+        points,
+        fit,
+    })
 }
 
 /// The warnings of a fit: parameters on a bound, too few fringes, an ambiguous fit.

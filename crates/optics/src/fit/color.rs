@@ -44,7 +44,7 @@
 use super::lm::{self, LmOptions, Residuals};
 use super::spectrum::Quantity;
 use super::template::{FreeKind, Template};
-use super::{PRIMES, halton};
+use super::{PRIMES, Steps, Watch, halton};
 use crate::colour::{Colorimeter, delta_e_2000, xyz_to_lab};
 use crate::error::{Error, Result};
 use crate::jacobian::{Wrt, colour_jacobian, delta_e_2000_param_gradient, lab_jacobian};
@@ -327,6 +327,19 @@ pub fn fit_colour(
     colorimeter: &Colorimeter,
     settings: &ColourSettings,
 ) -> Result<ColourFit> {
+    fit_colour_watched(template, targets, colorimeter, settings, Watch::none())
+}
+
+/// [`fit_colour`] reporting its steps to `watch` and stopping with
+/// [`Error::FitCancelled`] once its cancel flag is set: the steps are the chunks of
+/// [`SAMPLE_CHUNK`] samples, then the polishes. The result is [`fit_colour`]'s.
+pub fn fit_colour_watched(
+    template: &Template,
+    targets: &[ColourTarget],
+    colorimeter: &Colorimeter,
+    settings: &ColourSettings,
+    watch: Watch<'_>,
+) -> Result<ColourFit> {
     if targets.is_empty() {
         return Err(Error::FitData {
             message: "no target colour to fit".into(),
@@ -373,8 +386,12 @@ pub fn fit_colour(
         })
     };
     if dims == 0 {
+        let steps = Steps::new(watch, 1);
+        steps.check()?;
+        let solution = polish(&[])?;
+        steps.step();
         return Ok(ColourFit {
-            solutions: vec![polish(&[])?],
+            solutions: vec![solution],
             samples: 0,
             starts: 1,
         });
@@ -389,18 +406,24 @@ pub fn fit_colour(
             .map(|k| lo[k] + (hi[k] - lo[k]) * halton(i + 1, PRIMES[k % PRIMES.len()]))
             .collect()
     };
+    let want = settings.starts.max(settings.solutions).max(1);
+    let chunks = samples.div_ceil(SAMPLE_CHUNK);
+    let steps = Steps::new(watch, chunks + want);
     // Value-only costs of the samples, in fixed chunks.
-    let costs: Vec<f64> = (0..samples.div_ceil(SAMPLE_CHUNK))
+    let costs: Vec<f64> = (0..chunks)
         .into_par_iter()
         .map(|c| -> Result<Vec<f64>> {
+            steps.check()?;
             let mut sweep = model.sweep()?;
             let mut powers = Vec::new();
-            (c * SAMPLE_CHUNK..((c + 1) * SAMPLE_CHUNK).min(samples))
+            let chunk = (c * SAMPLE_CHUNK..((c + 1) * SAMPLE_CHUNK).min(samples))
                 .map(|i| {
                     let labs = model.labs(&mut sweep, &point(i), &mut powers)?;
                     Ok(model.cost(&model.delta_es(&labs)))
                 })
-                .collect()
+                .collect();
+            steps.step();
+            chunk
         })
         .collect::<Result<Vec<Vec<f64>>>>()?
         .into_iter()
@@ -409,7 +432,6 @@ pub fn fit_colour(
     let mut order: Vec<usize> = (0..samples).collect();
     order.sort_by(|&a, &b| costs[a].total_cmp(&costs[b]).then(a.cmp(&b)));
     // The best samples that lie apart.
-    let want = settings.starts.max(settings.solutions).max(1);
     let mut starts: Vec<Vec<f64>> = Vec::with_capacity(want);
     for &i in &order {
         if starts.len() == want {
@@ -423,9 +445,15 @@ pub fn fit_colour(
             starts.push(x);
         }
     }
+    steps.set_total(chunks + starts.len());
     let mut polished = starts
         .par_iter()
-        .map(|x0| polish(x0))
+        .map(|x0| {
+            steps.check()?;
+            let solution = polish(x0)?;
+            steps.step();
+            Ok(solution)
+        })
         .collect::<Result<Vec<_>>>()?;
     polished.sort_by(|a, b| a.cost.total_cmp(&b.cost));
     let same = |a: &ColourSolution, b: &ColourSolution| {
@@ -614,5 +642,37 @@ mod tests {
         let fit = fit_colour(&t, &far, &colorimeter(), &ColourSettings::default()).unwrap();
         assert!(fit.solutions[0].max_delta_e() > 10.0);
         assert!(fit_colour(&t, &[], &colorimeter(), &settings).is_err());
+    }
+
+    /// A watched design reports every sample chunk and polish and gives the plain
+    /// design's result; a set cancel flag stops it.
+    #[test]
+    fn a_watched_design_reports_and_cancels() {
+        use std::sync::Mutex;
+        use std::sync::atomic::{AtomicBool, Ordering};
+        let t = template(vec![thickness(1, 20.0, 600.0)]);
+        let targets = targets_of(&t, &[300.0], &[0.0, 40.0]);
+        let settings = ColourSettings::default();
+        let plain = fit_colour(&t, &targets, &colorimeter(), &settings).unwrap();
+        let seen = Mutex::new(Vec::new());
+        let progress = |done: usize, total: usize| seen.lock().unwrap().push((done, total));
+        let cancel = AtomicBool::new(false);
+        let watch = Watch {
+            progress: &progress,
+            cancel: &cancel,
+        };
+        let watched = fit_colour_watched(&t, &targets, &colorimeter(), &settings, watch).unwrap();
+        assert_eq!(watched, plain);
+        let seen = seen.lock().unwrap().clone();
+        // 256 samples in chunks of 64, then the polishes.
+        let total = 256 / SAMPLE_CHUNK + plain.starts;
+        assert_eq!(seen.len(), total, "{seen:?}");
+        assert!(
+            seen.iter().any(|&(d, t)| (d, t) == (total, total)),
+            "{seen:?}"
+        );
+        cancel.store(true, Ordering::Relaxed);
+        let e = fit_colour_watched(&t, &targets, &colorimeter(), &settings, watch).unwrap_err();
+        assert!(matches!(e, Error::FitCancelled { done: 0, .. }), "{e}");
     }
 }

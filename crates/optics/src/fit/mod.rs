@@ -17,9 +17,89 @@ pub mod nelder_mead;
 pub mod spectrum;
 pub mod template;
 
-pub use color::{ColourFit, ColourSettings, ColourSolution, ColourTarget, fit_colour};
-pub use spectrum::{Baseline, Loss, Measurement, Quantity, Settings, SpectrumFit, fit_spectrum};
+pub use color::{
+    ColourFit, ColourSettings, ColourSolution, ColourTarget, fit_colour, fit_colour_watched,
+};
+pub use spectrum::{
+    Baseline, Loss, Measurement, Quantity, Settings, SpectrumFit, fit_spectrum,
+    fit_spectrum_watched,
+};
 pub use template::{Free, FreeKind, Template};
+
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+
+/// The hooks a long fit reports to and is stopped by (the studio's background fits): after
+/// every step of work (a chunk of search samples, a local polish, a start of the global
+/// search) `progress` is called with (steps done, steps in all), and before every step
+/// `cancel` is read; once it is set the fit stops with [`crate::Error::FitCancelled`].
+/// Neither changes a fit that runs to the end: its result is the same with any watch.
+#[derive(Clone, Copy)]
+pub struct Watch<'a> {
+    /// Called with (steps done, steps in all) after each step, from any thread.
+    pub progress: &'a (dyn Fn(usize, usize) + Sync),
+    /// Read before each step; set: the fit stops.
+    pub cancel: &'a AtomicBool,
+}
+
+/// Never set: the cancel flag of [`Watch::none`].
+static NEVER: AtomicBool = AtomicBool::new(false);
+
+impl Watch<'static> {
+    /// No progress report and no cancel (the plain fits).
+    pub fn none() -> Watch<'static> {
+        Watch {
+            progress: &|_, _| {},
+            cancel: &NEVER,
+        }
+    }
+}
+
+/// A fit's step counter over a [`Watch`].
+pub(crate) struct Steps<'a> {
+    watch: Watch<'a>,
+    done: AtomicUsize,
+    total: AtomicUsize,
+}
+
+impl<'a> Steps<'a> {
+    pub(crate) fn new(watch: Watch<'a>, total: usize) -> Self {
+        Steps {
+            watch,
+            done: AtomicUsize::new(0),
+            total: AtomicUsize::new(total),
+        }
+    }
+
+    /// Errs with [`crate::Error::FitCancelled`] once the watch's cancel flag is set.
+    pub(crate) fn check(&self) -> crate::Result<()> {
+        if self.watch.cancel.load(Ordering::Relaxed) {
+            return Err(crate::Error::FitCancelled {
+                done: self.done.load(Ordering::Relaxed),
+                total: self.total.load(Ordering::Relaxed),
+            });
+        }
+        Ok(())
+    }
+
+    /// One more step done.
+    pub(crate) fn step(&self) {
+        let done = self.done.fetch_add(1, Ordering::Relaxed) + 1;
+        let total = self.total.load(Ordering::Relaxed).max(done);
+        (self.watch.progress)(done, total);
+    }
+
+    /// Sets the steps in all (once the work is known).
+    pub(crate) fn set_total(&self, total: usize) {
+        self.total.store(total, Ordering::Relaxed);
+    }
+
+    /// All steps done (a search that stops early).
+    pub(crate) fn finish(&self) {
+        let total = self.total.load(Ordering::Relaxed);
+        self.done.store(total, Ordering::Relaxed);
+        (self.watch.progress)(total, total);
+    }
+}
 
 /// The Halton sequence's `i`-th value in base `b` (i ≥ 1), in (0, 1): the low-discrepancy
 /// starts of the global searches (Halton 1960, *Numer. Math.* 2, 84).

@@ -45,7 +45,7 @@
 
 use super::lm::{self, LmOptions, Residuals};
 use super::template::{FreeKind, Template};
-use super::{PRIMES, halton};
+use super::{PRIMES, Steps, Watch, halton};
 use crate::error::{Error, Result};
 use crate::jacobian::{Wrt, point_jacobian};
 use crate::power::Power;
@@ -566,6 +566,20 @@ pub fn fit_spectrum(
     points: &[Measurement],
     settings: &Settings,
 ) -> Result<SpectrumFit> {
+    fit_spectrum_watched(template, points, settings, Watch::none())
+}
+
+/// [`fit_spectrum`] reporting its steps to `watch` (one per start of the global search; a
+/// search that stops early at the noise jumps to the end) and stopping with
+/// [`Error::FitCancelled`] once its cancel flag is set (read before every start and every
+/// round of scans). The result is [`fit_spectrum`]'s.
+pub fn fit_spectrum_watched(
+    template: &Template,
+    points: &[Measurement],
+    settings: &Settings,
+    watch: Watch<'_>,
+) -> Result<SpectrumFit> {
+    let progress = Steps::new(watch, settings.starts.max(1));
     let dims = template.dims();
     let linear = settings.scale.terms() + settings.offset.terms();
     if points.len() <= dims + linear {
@@ -718,12 +732,14 @@ pub fn fit_spectrum(
     let good_enough =
         |r: &lm::LmResult| r.cost / n as f64 <= 1.5 * noise_var && white(&r.residuals);
     for s in 1..=settings.starts.max(1) {
+        progress.check()?;
         starts = s;
         let mut x: Vec<f64> = (0..dims)
             .map(|k| lo[k] + (hi[k] - lo[k]) * halton(s, PRIMES[k % PRIMES.len()]))
             .collect();
         let mut cost = f64::INFINITY;
         for _round in 0..4 {
+            progress.check()?;
             let before = cost;
             for dir in &directions {
                 cost = line_scan(&mut scan, &mut r_scan, &mut x, dir, &steps, &lo, &hi)?;
@@ -739,10 +755,12 @@ pub fn fit_spectrum(
         if best.as_ref().is_none_or(|b| r.cost < b.cost) {
             best = Some(r);
         }
+        progress.step();
         if done || dims == 0 {
             break;
         }
     }
+    progress.finish();
     let mut best = match best {
         Some(b) => b,
         None => lm::minimize(&mut full, &[], &lo, &hi, options)?,
@@ -960,5 +978,67 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A watched fit reports its starts and gives the plain fit's result; a set cancel
+    /// flag stops it before its first start.
+    #[test]
+    fn a_watched_fit_reports_and_cancels() {
+        use std::sync::Mutex;
+        use std::sync::atomic::AtomicBool;
+        let m = |n: f64| Material::constant(format!("{n}"), C64::new(n, 0.0)).unwrap();
+        let stack = Stack::new(
+            m(1.0),
+            vec![Layer {
+                material: m(1.46),
+                thickness_nm: 300.0,
+            }],
+            m(3.9),
+        )
+        .unwrap();
+        let t = Template::new(
+            stack.clone(),
+            vec![Free {
+                layer: 1,
+                kind: FreeKind::ThicknessNm,
+                lo: 10.0,
+                hi: 1000.0,
+            }],
+        )
+        .unwrap();
+        let measured: Vec<Measurement> = (400..=800)
+            .step_by(4)
+            .map(|w| {
+                let wl = w as f64;
+                let p = stack.evaluate(0.0, wl).unwrap().power;
+                Measurement {
+                    angle_deg: 0.0,
+                    wavelength_nm: wl,
+                    value: 0.5 * (p.R_s + p.R_p),
+                    sigma: None,
+                }
+            })
+            .collect();
+        let settings = Settings::default();
+        let plain = fit_spectrum(&t, &measured, &settings).unwrap();
+        let seen = Mutex::new(Vec::new());
+        let progress = |done: usize, total: usize| seen.lock().unwrap().push((done, total));
+        let cancel = AtomicBool::new(false);
+        let watch = Watch {
+            progress: &progress,
+            cancel: &cancel,
+        };
+        let watched = fit_spectrum_watched(&t, &measured, &settings, watch).unwrap();
+        assert_eq!(watched.x, plain.x);
+        assert_eq!(watched.rms, plain.rms);
+        let seen = seen.lock().unwrap().clone();
+        assert!(!seen.is_empty());
+        assert_eq!(seen.last(), Some(&(settings.starts, settings.starts)));
+        cancel.store(true, std::sync::atomic::Ordering::Relaxed);
+        let e = fit_spectrum_watched(&t, &measured, &settings, watch).unwrap_err();
+        assert!(
+            matches!(e, Error::FitCancelled { done: 0, total } if total == settings.starts),
+            "{e}"
+        );
     }
 }

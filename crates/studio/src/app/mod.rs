@@ -3,7 +3,7 @@
 //! native window (`main.rs`, eframe) and in the UI tests (`egui_kittest`).
 //!
 //! Each panel is its own file: `stack_editor.rs` (left), `view_panel.rs` (centre: the
-//! picture, the model, the ΔE2000 map), `material_browser.rs` (under the stack), `plots.rs` (right), `export.rs` (bottom: the table
+//! picture, the model, the ΔE2000 map), `material_browser.rs` (under the stack), `plots.rs` (right, the "Plots" tab), `fit.rs` (right, the "Fit" tab), `export.rs` (bottom: the table
 //! bake and the engine export). This file holds the state they share, undo, the session, the recipe and the
 //! toolbar.
 //!
@@ -12,11 +12,13 @@
 //! exports keep the last stack that built.
 
 mod export;
+mod fit;
 mod material_browser;
 mod plots;
 mod stack_editor;
 mod view_panel;
 
+pub use fit::{FitPanel, FreeText, TargetText, hex, parse_hex};
 pub use material_browser::{MAX_RESULTS, MaterialBrowser, MaterialTarget};
 pub use plots::{BY_ANGLE, BY_THICKNESS, CHROMATICITY, FAMILY_R, FAMILY_T, PlotReadout};
 pub use view_panel::is_gltf;
@@ -139,6 +141,8 @@ pub struct Studio {
     pub engine_status: Option<Result<String, String>>,
     /// What the pointer last read on a plot.
     pub plot_readout: Option<PlotReadout>,
+    /// The fit panel (the right panel's "Fit" tab).
+    pub fit: FitPanel,
 }
 
 impl Studio {
@@ -200,6 +204,7 @@ impl Studio {
             engine_job: None,
             engine_status: None,
             plot_readout: None,
+            fit: FitPanel::default(),
         }
     }
 
@@ -358,7 +363,7 @@ impl Studio {
         egui::Panel::right("studio plots")
             .default_size(360.0)
             .resizable(true)
-            .show(ui, |ui| self.plots(ui));
+            .show(ui, |ui| self.side_panel(ui));
         egui::CentralPanel::default().show(ui, |ui| self.view_ui(ui));
     }
 
@@ -490,14 +495,6 @@ fn material_field(ui: &mut egui::Ui, label: &str, text: &mut String) {
 
 /// Linear sRGB → an 8-bit sRGB-encoded colour (clipped to [0, 1]; IEC 61966-2-1).
 pub fn srgb8(rgb: [f64; 3]) -> Color32 {
-    let e = |c: f64| {
-        let c = c.clamp(0.0, 1.0);
-        let v = if c <= 0.003_130_8 {
-            12.92 * c
-        } else {
-            1.055 * c.powf(1.0 / 2.4) - 0.055
-        };
-        (v * 255.0).round() as u8
-    };
-    Color32::from_rgb(e(rgb[0]), e(rgb[1]), e(rgb[2]))
+    let [r, g, b] = rgb.map(crate::fit::linear_to_srgb);
+    Color32::from_rgb(r, g, b)
 }
