@@ -283,16 +283,16 @@ impl SpectrumResult {
 #[derive(Clone, Debug)]
 pub enum FitResult {
     /// A colour design.
-    Colour(ColourResult),
+    Colour(Box<ColourResult>),
     /// A spectrum fit.
-    Spectrum(SpectrumResult),
+    Spectrum(Box<SpectrumResult>),
 }
 
 /// How a fit ended.
 #[derive(Clone, Debug)]
 pub enum FitOutcome {
     /// Finished.
-    Done(Box<FitResult>),
+    Done(FitResult),
     /// Cancelled: nothing to show.
     Cancelled,
     /// Failed: why.
@@ -341,13 +341,13 @@ impl FitJob {
             let start = Instant::now();
             let design = design_watched(&template, &rows, &colorimeter, &settings, watch)
                 .map_err(|e| e.to_string())?;
-            Ok(FitResult::Colour(ColourResult {
+            Ok(FitResult::Colour(Box::new(ColourResult {
                 doc,
                 template,
                 rows,
                 design,
                 seconds: start.elapsed().as_secs_f64(),
-            }))
+            })))
         })
     }
 
@@ -368,13 +368,13 @@ impl FitJob {
             let start = Instant::now();
             let outcome =
                 fit_one(&template, &spectrum, &request, watch).map_err(|e| e.to_string())?;
-            Ok(FitResult::Spectrum(SpectrumResult {
+            Ok(FitResult::Spectrum(Box::new(SpectrumResult {
                 warnings: warnings(&template, &outcome.fit),
                 doc,
                 template,
                 outcome,
                 seconds: start.elapsed().as_secs_f64(),
-            }))
+            })))
         })
     }
 
@@ -448,7 +448,7 @@ impl FitJob {
         let thread = self.thread.take()?;
         Some(match thread.join() {
             _ if self.cancelling() => FitOutcome::Cancelled,
-            Ok(Ok(result)) => FitOutcome::Done(Box::new(result)),
+            Ok(Ok(result)) => FitOutcome::Done(result),
             Ok(Err(e)) => FitOutcome::Failed(e),
             Err(_) => FitOutcome::Failed(format!("the {} thread stopped unexpectedly", self.what)),
         })
@@ -512,8 +512,8 @@ impl SampleImage {
         for py in y.saturating_sub(r)..=(y + r).min(self.height - 1) {
             for px in x.saturating_sub(r)..=(x + r).min(self.width - 1) {
                 let at = ((py * self.width + px) * 4) as usize;
-                for c in 0..3 {
-                    sum[c] += srgb_to_linear(self.rgba[at + c]);
+                for (s, &v) in sum.iter_mut().zip(&self.rgba[at..at + 3]) {
+                    *s += srgb_to_linear(v);
                 }
                 count += 1.0;
             }

@@ -226,6 +226,12 @@ impl Studio {
     /// shows.
     pub(super) fn side_panel(&mut self, ui: &mut egui::Ui) {
         self.poll_fit();
+        if self.fit.job.is_some() {
+            // Keep drawing while the fit works, whichever tab shows: the bar moves and the
+            // outcome shows.
+            ui.ctx()
+                .request_repaint_after(std::time::Duration::from_millis(50));
+        }
         ui.horizontal(|ui| {
             ui.selectable_value(&mut self.fit.open, false, "Plots");
             ui.selectable_value(&mut self.fit.open, true, "Fit");
@@ -306,7 +312,7 @@ impl Studio {
         let what = job.what;
         self.fit.job = None;
         self.fit.status = Some(match outcome {
-            FitOutcome::Done(result) => match *result {
+            FitOutcome::Done(result) => match result {
                 FitResult::Colour(c) => {
                     let line = format!(
                         "colour design: {} solution(s) in {:.1} s ({} samples, {} polishes)",
@@ -315,7 +321,7 @@ impl Studio {
                         c.design.samples,
                         c.design.starts
                     );
-                    self.fit.colour = Some(c);
+                    self.fit.colour = Some(*c);
                     Ok(line)
                 }
                 FitResult::Spectrum(s) => {
@@ -323,7 +329,7 @@ impl Studio {
                         "spectrum fit in {:.1} s ({} starts)",
                         s.seconds, s.outcome.fit.starts
                     );
-                    self.fit.spectrum = Some(s);
+                    self.fit.spectrum = Some(*s);
                     Ok(line)
                 }
             },
@@ -386,7 +392,7 @@ impl Studio {
             .map(|(k, t)| number(&format!("target {} angle", k + 1), &t.angle_deg))
             .collect();
         let colours = angles.and_then(|a| {
-            if a.iter().any(|v| !(v.abs() < 90.0)) {
+            if a.iter().any(|v| v.abs() >= 90.0) {
                 return Err("target angles must lie strictly between -90 and 90".into());
             }
             exact_colours(&self.good.1, &a).map_err(|e| e.to_string())
@@ -441,8 +447,6 @@ impl Studio {
                 {
                     job.cancel();
                 }
-                ui.ctx()
-                    .request_repaint_after(std::time::Duration::from_millis(50));
             }
         });
         if let Some(e) = &self.fit.error {
@@ -470,17 +474,25 @@ impl Studio {
                     "thickness",
                     &mut f.thickness_free,
                     &mut f.thickness_nm,
-                    " (nm)",
+                    "nm",
                 ),
                 ("index", &mut f.index_free, &mut f.index, ""),
             ] {
-                ui.horizontal(|ui| {
-                    ui.checkbox(free, format!("Film {n} {what} free"));
+                ui.horizontal_wrapped(|ui| {
+                    let check = ui.checkbox(free, format!("{what} free"));
+                    check.widget_info(|| {
+                        egui::WidgetInfo::selected(
+                            egui::Role::CheckBox,
+                            true,
+                            *free,
+                            format!("Film {n} {what} free"),
+                        )
+                    });
                     ui.add_enabled_ui(*free, |ui| {
-                        for (k, end) in ["min", "max"].iter().enumerate() {
-                            let label = ui.label(format!("{end}{unit}"));
+                        for (k, (end, shown)) in [("min", "from"), ("max", "to")].iter().enumerate()
+                        {
+                            ui.label(*shown);
                             ui.add(egui::TextEdit::singleline(&mut texts[k]).desired_width(50.0))
-                                .labelled_by(label.id)
                                 .widget_info(|| {
                                     egui::WidgetInfo::labeled(
                                         egui::Role::TextInput,
@@ -489,6 +501,7 @@ impl Studio {
                                     )
                                 });
                         }
+                        ui.label(unit);
                     });
                 });
             }
@@ -536,7 +549,7 @@ impl Studio {
                 if egui::color_picker::color_edit_button_srgb(ui, &mut t.srgb).changed() {
                     t.hex = hex(t.srgb);
                 }
-                let typed = ui.add(egui::TextEdit::singleline(&mut t.hex).desired_width(62.0));
+                let typed = ui.add(egui::TextEdit::singleline(&mut t.hex).desired_width(70.0));
                 typed.widget_info(|| {
                     egui::WidgetInfo::labeled(
                         egui::Role::TextInput,
@@ -559,7 +572,9 @@ impl Studio {
                             format!("Target {n} weight"),
                         )
                     });
-                let button = ui.small_button("Remove").on_hover_text("remove this target");
+                let button = ui
+                    .small_button("Remove")
+                    .on_hover_text("remove this target");
                 button.widget_info(|| {
                     egui::WidgetInfo::labeled(
                         egui::Role::Button,
