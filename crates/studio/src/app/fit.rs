@@ -326,7 +326,7 @@ impl Studio {
                 }
                 FitResult::Spectrum(s) => {
                     let line = format!(
-                        "spectrum fit in {:.1} s ({} starts)",
+                        "spectrum fit in {:.1} s ({} start(s) of the global search)",
                         s.seconds, s.outcome.fit.starts
                     );
                     self.fit.spectrum = Some(*s);
