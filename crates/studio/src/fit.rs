@@ -521,3 +521,160 @@ impl SampleImage {
         sum.map(|s| linear_to_srgb(s / count))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::doc::Film;
+
+    fn two_films() -> StackDoc {
+        StackDoc {
+            ambient: "1.0".into(),
+            films: vec![Film::new("tio2", 100.0), Film::new("1.46", 0.0)],
+            substrate: "bk7".into(),
+            base_dir: None,
+        }
+    }
+
+    #[test]
+    fn free_films_make_the_template_and_its_stacks() {
+        let doc = two_films();
+        let mut free = vec![FreeFilm::for_film(100.0), FreeFilm::for_film(0.0)];
+        assert_eq!(free[0].thickness_nm, [50.0, 150.0]);
+        assert_eq!(free[1].thickness_nm, DEFAULT_RANGE_NM);
+        free[1].index_free = true;
+        let t = template(&doc, &free).unwrap();
+        // Film 1's thickness, film 2's index, film 2's thickness.
+        let kinds: Vec<(usize, FreeKind)> = t.free().iter().map(|f| (f.layer, f.kind)).collect();
+        assert_eq!(
+            kinds,
+            [
+                (1, FreeKind::ThicknessNm),
+                (2, FreeKind::Index),
+                (2, FreeKind::ThicknessNm)
+            ]
+        );
+        let d = doc_at(&doc, &t, &[120.5, 1.52, 333.0]);
+        assert_eq!(d.films[0].thickness_nm, 120.5);
+        assert_eq!(d.films[0].material, "tio2");
+        assert_eq!(d.films[1].material, "1.52");
+        assert_eq!(d.films[1].thickness_nm, 333.0);
+        assert_eq!(d.substrate, "bk7");
+        d.build().unwrap();
+    }
+
+    #[test]
+    fn bad_free_settings_name_the_field() {
+        let doc = two_films();
+        let ok = FreeFilm::for_film(100.0);
+        let with = |j: usize, f: FreeFilm| {
+            let mut v = vec![ok.clone(), ok.clone()];
+            v[j] = f;
+            template(&doc, &v).unwrap_err()
+        };
+        let e = with(
+            1,
+            FreeFilm {
+                thickness_nm: [300.0, 20.0],
+                ..ok.clone()
+            },
+        );
+        assert_eq!(
+            e,
+            "film 2 thickness range 300–20 nm is inverted: the minimum comes first"
+        );
+        let e = with(
+            0,
+            FreeFilm {
+                thickness_nm: [-5.0, 20.0],
+                ..ok.clone()
+            },
+        );
+        assert!(
+            e.contains("film 1 thickness range: the minimum -5 nm is negative"),
+            "{e}"
+        );
+        let e = with(
+            0,
+            FreeFilm {
+                index_free: true,
+                index: [0.0, 2.0],
+                ..ok.clone()
+            },
+        );
+        assert!(
+            e.contains("film 1 index range: the minimum 0 must be positive"),
+            "{e}"
+        );
+        let none = FreeFilm {
+            thickness_free: false,
+            ..ok.clone()
+        };
+        let e = template(&doc, &[none.clone(), none]).unwrap_err();
+        assert!(e.starts_with("nothing is free"), "{e}");
+        let e = template(&doc, &[ok.clone()]).unwrap_err();
+        assert!(
+            e.contains("free parameters for 1 films, the stack has 2"),
+            "{e}"
+        );
+        let mut bad = doc.clone();
+        bad.films[0].material = "unobtainium".into();
+        assert!(template(&bad, &[ok.clone(), ok]).is_err());
+    }
+
+    #[test]
+    fn a_sample_is_the_mean_in_linear_light_over_its_box() {
+        // Columns alternate black and white: the 5 × 5 box round (2, 2) holds 3 white
+        // columns of 5, clipped boxes fewer.
+        let (width, height) = (8u32, 6u32);
+        let mut rgba = Vec::new();
+        for _ in 0..height {
+            for x in 0..width {
+                let v = if x % 2 == 0 { 255 } else { 0 };
+                rgba.extend([v, v, v, 255]);
+            }
+        }
+        let image = SampleImage {
+            path: PathBuf::from("checks.png"),
+            width,
+            height,
+            rgba,
+        };
+        let mean = |white: f64, all: f64| linear_to_srgb(white / all);
+        assert_eq!(image.sample(2, 2), [mean(3.0, 5.0); 3]);
+        // At the corner the box holds columns 0–2: two white of three.
+        assert_eq!(image.sample(0, 0), [mean(2.0, 3.0); 3]);
+        // Beyond the image: its last pixel's box (columns 5–7, one white).
+        assert_eq!(image.sample(99, 99), [mean(1.0, 3.0); 3]);
+        // The mean of black and white is 50 % linear (188), not 128.
+        assert_eq!(mean(1.0, 2.0), 188);
+        for v in [0u8, 1, 10, 60, 128, 200, 255] {
+            assert_eq!(linear_to_srgb(srgb_to_linear(v)), v);
+        }
+        assert!(SampleImage::load(Path::new("")).is_err());
+    }
+
+    #[test]
+    fn targets_need_a_row_and_good_values() {
+        let c = studio_colorimeter();
+        assert_eq!(
+            target_rows(&[], &c).unwrap_err(),
+            "no colour target: add a target row"
+        );
+        let t = |angle_deg: f64, weight: f64| TargetEntry {
+            angle_deg,
+            srgb: [200, 100, 50],
+            weight,
+        };
+        let rows = target_rows(&[t(0.0, 1.0), t(45.0, 2.0)], &c).unwrap();
+        assert_eq!(rows[1].line, 2);
+        assert_eq!(rows[1].weight, 2.0);
+        for k in 0..3 {
+            assert_eq!(rows[0].colour[k], srgb_to_linear([200, 100, 50][k]));
+        }
+        assert_eq!(
+            target_rows(&[t(0.0, 1.0), t(0.0, 0.0)], &c).unwrap_err(),
+            "target 2: weight 0 must be positive"
+        );
+    }
+}
