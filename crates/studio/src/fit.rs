@@ -612,7 +612,7 @@ mod tests {
         };
         let e = template(&doc, &[none.clone(), none]).unwrap_err();
         assert!(e.starts_with("nothing is free"), "{e}");
-        let e = template(&doc, &[ok.clone()]).unwrap_err();
+        let e = template(&doc, std::slice::from_ref(&ok)).unwrap_err();
         assert!(
             e.contains("free parameters for 1 films, the stack has 2"),
             "{e}"
