@@ -230,6 +230,42 @@ fn a_measured_spectrum_is_fitted_within_a_nanometre() {
     h.get_by_label("Undo").click();
     h.step();
     assert_eq!(h.state().stack().0, start);
+
+    // A wide file holds two spectra: the second, picked from the list, is the one fitted.
+    let wide = dir.path().join("wide.csv");
+    let one = std::fs::read_to_string(&path).unwrap();
+    let other = oxide(250.0).build().unwrap();
+    let mut text = String::from("wavelength_nm,a,b\n");
+    for line in one.lines().skip(2) {
+        let (w, r) = line.split_once(',').unwrap();
+        let p = other.evaluate(0.0, w.parse().unwrap()).unwrap().power;
+        text.push_str(&format!("{w},{:.6},{r}\n", 0.5 * (p.R_s + p.R_p)));
+    }
+    std::fs::write(&wide, text).unwrap();
+    type_into(&mut h, "Spectrum file", wide.to_str().unwrap());
+    h.get_by_label("Load spectrum").click();
+    h.step();
+    h.step();
+    assert_eq!(h.state().fit.spectra.len(), 2);
+    assert!(h.query_by_label_contains("(spectrum 1 of 2)").is_some());
+    h.get_by_label("Spectrum").click();
+    h.step();
+    h.step();
+    h.get_by_label(&format!("{}:b", wide.display())).click();
+    h.step();
+    h.step();
+    assert_eq!(h.state().fit.spectrum_index, 1);
+    assert!(h.query_by_label_contains("(spectrum 2 of 2)").is_some());
+    h.get_by_label("Fit spectrum").click();
+    h.step();
+    until_fitted(&mut h, Duration::from_secs(300));
+    let fit = h.state().fit.spectrum.clone().expect("a spectrum fit");
+    assert_eq!(fit.outcome.name, format!("{}:b", wide.display()));
+    assert!(
+        (fit.outcome.fit.x[0] - truth_nm).abs() <= 1.0,
+        "{:?}",
+        fit.outcome.fit.x
+    );
 }
 
 #[test]

@@ -151,8 +151,10 @@ pub struct FitPanel {
     texture: Option<TextureHandle>,
     /// The spectrum file field.
     pub spectrum_path: String,
-    /// The spectra loaded (a wide file or a folder holds several; the first is fitted).
+    /// The spectra loaded (a wide file or a folder holds several).
     pub spectra: Vec<Spectrum>,
+    /// The one shown and fitted (0-based).
+    pub spectrum_index: usize,
     /// The fit running, if any.
     pub job: Option<FitJob>,
     /// The last colour design.
@@ -184,6 +186,7 @@ impl Default for FitPanel {
             texture: None,
             spectrum_path: String::new(),
             spectra: Vec::new(),
+            spectrum_index: 0,
             job: None,
             colour: None,
             spectrum: None,
@@ -281,7 +284,7 @@ impl Studio {
             let spectrum = self
                 .fit
                 .spectra
-                .first()
+                .get(self.fit.spectrum_index)
                 .cloned()
                 .ok_or("no spectrum loaded: load a spectrum file first")?;
             let free = self.fit.read_free()?;
@@ -375,6 +378,7 @@ impl Studio {
         match crate::fit::load_spectra(Path::new(self.fit.spectrum_path.trim())) {
             Ok(spectra) => {
                 self.fit.spectra = spectra;
+                self.fit.spectrum_index = 0;
                 self.fit.spectrum = None;
                 self.fit.error = None;
             }
@@ -734,7 +738,18 @@ impl Studio {
                 self.load_fit_spectrum();
             }
         });
-        let Some(spectrum) = self.fit.spectra.first() else {
+        if self.fit.spectra.len() > 1 {
+            let spectra = &self.fit.spectra;
+            let index = &mut self.fit.spectrum_index;
+            egui::ComboBox::from_label("Spectrum")
+                .selected_text(spectra.get(*index).map_or("", |s| s.name.as_str()))
+                .show_ui(ui, |ui| {
+                    for (i, s) in spectra.iter().enumerate() {
+                        ui.selectable_value(index, i, s.name.as_str());
+                    }
+                });
+        }
+        let Some(spectrum) = self.fit.spectra.get(self.fit.spectrum_index) else {
             return;
         };
         let letter = match spectrum.quantity {
@@ -746,7 +761,11 @@ impl Studio {
             spectrum.name,
             spectrum.points.len(),
             if self.fit.spectra.len() > 1 {
-                format!(" (the first of {} spectra)", self.fit.spectra.len())
+                format!(
+                    " (spectrum {} of {})",
+                    self.fit.spectrum_index + 1,
+                    self.fit.spectra.len()
+                )
             } else {
                 String::new()
             }
