@@ -31,8 +31,8 @@ static SRGB: LazyLock<Colorimeter> = LazyLock::new(|| {
     )
 });
 
-/// The sRGB transfer function's inverse (IEC 61966-2-1) of an 8-bit value.
-fn decode(v: u8) -> f64 {
+/// The sRGB transfer function's inverse (IEC 61966-2-1) of an 8-bit value: linear light.
+pub fn srgb_to_linear(v: u8) -> f64 {
     let c = f64::from(v) / 255.0;
     if c <= 0.040_45 {
         c / 12.92
@@ -41,9 +41,20 @@ fn decode(v: u8) -> f64 {
     }
 }
 
+/// Linear light → an 8-bit sRGB-encoded value (clipped to [0, 1]; IEC 61966-2-1).
+pub fn linear_to_srgb(c: f64) -> u8 {
+    let c = c.clamp(0.0, 1.0);
+    let v = if c <= 0.003_130_8 {
+        12.92 * c
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    };
+    (v * 255.0).round() as u8
+}
+
 /// CIELAB of an 8-bit sRGB pixel (D65 white, Y = 1 for (255, 255, 255)).
 pub fn lab_of_srgb8(p: [u8; 3]) -> [f64; 3] {
-    let linear = p.map(decode);
+    let linear = p.map(srgb_to_linear);
     xyz_to_lab(SRGB.xyz_from_output(linear), SRGB.white_xyz())
 }
 

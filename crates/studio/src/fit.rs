@@ -10,6 +10,7 @@
 //! decoded to linear sRGB (IEC 61966-2-1) and read as `nacre fit color`'s `R,G,B` columns
 //! ([`target_row`], CIE 1931 2°, D65, sRGB: the CLI's default colorimeter).
 
+pub use crate::compare::{linear_to_srgb, srgb_to_linear};
 use crate::doc::StackDoc;
 use nacre_bake::commands::color_request::{ColourSettings as ColourFlags, colorimeter};
 use nacre_bake::commands::fit_color::{Design, Given, TargetRow, design_watched, target_row};
@@ -165,27 +166,6 @@ pub fn describe_value(free: &Free, v: f64) -> String {
 /// The colorimeter of the colour targets: the CLI's default (CIE 1931 2°, D65, sRGB).
 pub fn studio_colorimeter() -> Colorimeter {
     colorimeter(&ColourFlags::default()).expect("the default colorimeter exists")
-}
-
-/// An 8-bit sRGB-encoded channel → linear (IEC 61966-2-1).
-pub fn srgb_to_linear(v: u8) -> f64 {
-    let c = f64::from(v) / 255.0;
-    if c <= 0.040_45 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-/// Linear → an 8-bit sRGB-encoded channel (clipped to [0, 1]; IEC 61966-2-1).
-pub fn linear_to_srgb(c: f64) -> u8 {
-    let c = c.clamp(0.0, 1.0);
-    let v = if c <= 0.003_130_8 {
-        12.92 * c
-    } else {
-        1.055 * c.powf(1.0 / 2.4) - 0.055
-    };
-    (v * 255.0).round() as u8
 }
 
 /// A colour target as the panel holds it.
