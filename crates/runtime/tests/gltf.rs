@@ -1563,3 +1563,62 @@ fn a_metallic_texture_without_metal_makes_glass() {
     scene.textures.clear();
     assert_eq!(scene.metallic_range(0), (0.0, 1.0));
 }
+
+/// `mesh::render_cached` keeps the compiled passes between frames: a new camera or film
+/// thickness compiles nothing, another technique or base index compiles anew, and every
+/// frame is the same bytes as an uncached `mesh::render` of the same inputs.
+#[test]
+fn a_mesh_cache_keeps_the_passes_and_draws_the_same_bytes() {
+    use nacre_runtime::mesh::{MeshCache, Orbit, RenderInputs, ViewPoint, render, render_cached};
+    let ctx = ctx();
+    let tables = film_tables("film-dielectric");
+    let scene = GltfScene::load(&asset_dir().join("sweep-thickness.glb")).unwrap();
+    let orbit = |yaw_deg: f64| {
+        ViewPoint::Orbit(Orbit {
+            yaw_deg,
+            ..Orbit::default()
+        })
+    };
+    let mut cache = MeshCache::default();
+    let frame =
+        |scene: &GltfScene, technique: Technique, view: ViewPoint, cache: &mut MeshCache| {
+            let inputs = RenderInputs::load(scene, &options(), view).unwrap();
+            let cached = render_cached(ctx, &tables, technique, &inputs, cache).unwrap();
+            let fresh = render(ctx, &tables, technique, &inputs).unwrap();
+            assert!(
+                cached.image.pixels == fresh.image.pixels,
+                "{technique:?}: the cached frame differs from a fresh render"
+            );
+            cached.image.pixels
+        };
+    let first = frame(&scene, Technique::Lut, orbit(0.0), &mut cache);
+    assert_eq!(cache.builds(), 1);
+
+    // Another camera and thinner films (inside the table): uniforms only.
+    let mut thinner = scene.clone();
+    for m in &mut thinner.materials {
+        if let Some(i) = &mut m.iridescence {
+            i.thickness_max_nm *= 0.8;
+        }
+    }
+    let moved = frame(&thinner, Technique::Lut, orbit(25.0), &mut cache);
+    assert_eq!(
+        cache.builds(),
+        1,
+        "a camera and a film thickness compile nothing"
+    );
+    assert_ne!(moved, first, "the frame follows the camera and the films");
+
+    // Another technique, then another base index under spectral (its group 1 holds the
+    // base's index per wavelength): compiled anew.
+    frame(&thinner, Technique::Spectral, orbit(25.0), &mut cache);
+    assert_eq!(cache.builds(), 2);
+    let mut denser = thinner.clone();
+    for m in &mut denser.materials {
+        m.ior = 1.8;
+    }
+    frame(&denser, Technique::Spectral, orbit(25.0), &mut cache);
+    assert_eq!(cache.builds(), 3, "a new base index compiles anew");
+    frame(&denser, Technique::Spectral, orbit(50.0), &mut cache);
+    assert_eq!(cache.builds(), 3);
+}

@@ -181,6 +181,9 @@ pub struct View {
     thickness: ThicknessMap,
     /// The loaded glTF model.
     model: Option<GltfScene>,
+    /// The model's compiled passes, kept between frames (an orbit or a film edit compiles
+    /// nothing).
+    mesh_cache: nacre_runtime::mesh::MeshCache,
     /// The loaded environment file.
     environment_file: Option<(PathBuf, EnvironmentMap)>,
     /// The loaded thickness map: as read, and its grey channel alone (for the techniques
@@ -261,6 +264,7 @@ impl View {
             },
             thickness: procedural_thickness_map(DEFAULT_THICKNESS_MAP_SIZE),
             model: None,
+            mesh_cache: Default::default(),
             environment_file: None,
             thickness_file: None,
             bundled_base,
@@ -546,6 +550,7 @@ impl View {
     /// model the view draws when [`ViewSettings::model`] names it.
     pub fn load_model(&mut self, path: &Path) -> Result<(), ViewError> {
         self.model = Some(GltfScene::load(path)?);
+        self.mesh_cache = Default::default();
         Ok(())
     }
 
@@ -619,7 +624,13 @@ impl View {
         });
         let inputs =
             nacre_runtime::mesh::RenderInputs::with_environment(&scene, &o, view, environment)?;
-        let out = nacre_runtime::mesh::render(&self.ctx, &self.tables, technique, &inputs)?;
+        let out = nacre_runtime::mesh::render_cached(
+            &self.ctx,
+            &self.tables,
+            technique,
+            &inputs,
+            &mut self.mesh_cache,
+        )?;
         notes.extend(out.notes.iter().map(|n| n.to_string()));
         Ok(Frame {
             image: out.image,

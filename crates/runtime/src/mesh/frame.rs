@@ -53,6 +53,7 @@ pub(super) fn draw(
     tables: &TableSet,
     technique: Technique,
     inputs: &RenderInputs,
+    cache: &mut MeshCache,
 ) -> Result<MeshRender> {
     let (scene, options) = (inputs.scene, &inputs.options);
     let (width, height) = (options.width, options.height);
@@ -65,36 +66,52 @@ pub(super) fn draw(
     let plan = plan(tables, technique, inputs)?;
 
     let device = &ctx.device;
-    let layouts = [
-        crate::render::view_group_layout(device, "mesh view"),
-        group_layout(device, "mesh material"),
-        mesh_group_layout(device),
-    ];
-    let passes = Passes::new(
-        ctx,
-        tables,
-        &options.technique_options(),
-        &plan.colorimeter,
-        scene,
-        &plan.drawn,
-        &plan.glass,
-        &plan.used,
-        [&layouts[0], &layouts[1], &layouts[2]],
-    )?;
+    let technique_options = options.technique_options();
+    let key = passes_key(tables, technique, &technique_options, scene, &plan);
+    let kept = match cache.passes.take() {
+        Some(kept) if kept.key == key => kept,
+        _ => {
+            let layouts = [
+                crate::render::view_group_layout(device, "mesh view"),
+                group_layout(device, "mesh material"),
+                mesh_group_layout(device),
+            ];
+            let passes = Passes::new(
+                ctx,
+                tables,
+                &technique_options,
+                &plan.colorimeter,
+                scene,
+                &plan.drawn,
+                &plan.glass,
+                &plan.used,
+                [&layouts[0], &layouts[1], &layouts[2]],
+            )?;
+            cache.builds += 1;
+            KeptPasses {
+                key,
+                layouts,
+                passes,
+            }
+        }
+    };
+    let KeptPasses {
+        layouts, passes, ..
+    } = cache.passes.insert(kept);
     crate::render::check_film_eval(tables, options)?;
     let resources = Resources::upload(ctx, tables, inputs, &plan, passes.behind_needed)?;
 
     let (target, submitted) = ctx.checked("rendering the glTF scene", || {
-        let bound = Bound::new(device, inputs, &plan, &resources, &layouts);
+        let bound = Bound::new(device, inputs, &plan, &resources, layouts);
         let targets = Targets::new(device, (width, height), passes.behind_needed);
         let frame = Frame {
             device,
             inputs,
             resources: &resources,
             mesh_layout: &layouts[2],
-            passes: &passes,
+            passes,
             bound: &bound,
-            order: draw_order(&bound.geometry, scene, &passes),
+            order: draw_order(&bound.geometry, scene, passes),
             depth: &targets.depth_view,
         };
         let mut encoder = device.create_command_encoder(&Default::default());
@@ -125,6 +142,88 @@ pub(super) fn draw(
         },
         notes: plan.notes,
     })
+}
+
+/// The compiled passes of the last frame, kept for the next ([`super::render_cached`]):
+/// compiling a scene's pipelines is most of a frame (1.1–1.3 s of 1.8 s for Khronos'
+/// IridescenceSuzanne on lavapipe), while a frame that moves the camera or changes a film's
+/// thickness or index (uniforms) needs none.
+#[derive(Default)]
+pub struct MeshCache {
+    passes: Option<KeptPasses>,
+    builds: u64,
+}
+
+impl MeshCache {
+    /// How many times the passes were compiled (a frame that reused them adds nothing).
+    pub fn builds(&self) -> u64 {
+        self.builds
+    }
+}
+
+/// Passes and the layouts their pipelines were made with, under the key of what decides them.
+struct KeptPasses {
+    key: String,
+    layouts: [wgpu::BindGroupLayout; 3],
+    passes: Passes,
+}
+
+/// What decides [`Passes::new`]'s pipelines and group-1 bindings, as text: the tables, the
+/// technique and its options (harmonics, wavelengths, the stack), per used material the
+/// technique that draws it, its base and its pane, and per primitive its material, its
+/// fixed-function state and whether it transmits. Films' thicknesses and indices, the
+/// camera, lights and environment are uniforms and textures: not part of it.
+fn passes_key(
+    tables: &TableSet,
+    technique: Technique,
+    technique_options: &crate::technique::TechniqueOptions,
+    scene: &GltfScene,
+    plan: &Plan,
+) -> String {
+    let table = |path: Option<&std::path::Path>| path.map(|p| p.display().to_string());
+    let drawn: Vec<_> = plan
+        .used
+        .iter()
+        .map(|&i| {
+            let (m, t) = &plan.drawn[i];
+            (
+                i,
+                t.name(),
+                format!("{:?}", m.base),
+                format!("{:?}", plan.glass.get(i)),
+            )
+        })
+        .collect();
+    let states: Vec<_> = scene
+        .primitives
+        .iter()
+        .filter(|p| !p.indices.is_empty() && plan.used.contains(&p.material))
+        .map(|p| {
+            let gm = &scene.materials[p.material];
+            (
+                p.material,
+                PipelineState::of(gm, Raster::of(p)),
+                transmits(gm),
+            )
+        })
+        .collect();
+    format!(
+        "{:?}",
+        (
+            table(tables.film_lut.as_ref().map(|t| t.manifest_path.as_path())),
+            table(tables.fourier.as_ref().map(|t| t.manifest_path.as_path())),
+            table(
+                tables
+                    .rough_film_lut
+                    .as_ref()
+                    .map(|t| t.manifest_path.as_path())
+            ),
+            technique.name(),
+            technique_options,
+            drawn,
+            states,
+        )
+    )
 }
 
 /// What the frame draws, decided on the CPU.

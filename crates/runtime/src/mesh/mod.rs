@@ -34,6 +34,7 @@ pub use camera::{
     DEFAULT_PITCH_DEG, FIT_FOV_X_DEG, FIT_FOV_Y_DEG, FittedCamera, Orbit, ViewPoint, file_camera,
     fit_camera, orbit_camera, view_camera,
 };
+pub use frame::MeshCache;
 pub use inputs::{RenderInputs, TableFile, load_environment};
 pub use lights::scene_lights;
 pub use materials::{NM_PER_WORLD_UNIT, glass_setup};
@@ -260,7 +261,22 @@ pub fn render(
     technique: Technique,
     inputs: &RenderInputs,
 ) -> Result<MeshRender> {
-    frame::draw(ctx, tables, technique, inputs)
+    frame::draw(ctx, tables, technique, inputs, &mut MeshCache::default())
+}
+
+/// [`render`] keeping the compiled passes in `cache` for the next frame: a frame whose
+/// pipelines are those of the last (the same tables, technique and options, the same
+/// materials' techniques, bases and states; only the camera, lights, environment or the
+/// films' thicknesses and indices changed) compiles nothing. The picture is the same bytes
+/// [`render`] gives.
+pub fn render_cached(
+    ctx: &GpuContext,
+    tables: &TableSet,
+    technique: Technique,
+    inputs: &RenderInputs,
+    cache: &mut MeshCache,
+) -> Result<MeshRender> {
+    frame::draw(ctx, tables, technique, inputs, cache)
 }
 
 /// The interleaved vertices of a primitive ([`VERTEX_FLOATS`] floats each).
