@@ -25,7 +25,7 @@ use nacre_runtime::diffraction::{
 use std::sync::OnceLock;
 
 mod support;
-use support::{ctx, manifest};
+use support::{ctx, linear, manifest, radiance};
 
 fn cd_tracks() -> &'static DiffractionTables {
     static TABLE: OnceLock<DiffractionTables> = OnceLock::new();
@@ -34,29 +34,11 @@ fn cd_tracks() -> &'static DiffractionTables {
     })
 }
 
-/// sRGB byte → linear [0, 1] (IEC 61966-2-1): the display-linear (tone-mapped) value.
-fn linear(byte: u8) -> f64 {
-    let c = f64::from(byte) / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
 /// A rendered picture as display-linear RGB, row-major.
 struct Picture {
     width: usize,
     height: usize,
     rgb: Vec<[f64; 3]>,
-}
-
-/// Display-linear (tone-mapped) → radiance × exposure: the inverse of the scenes' tone map
-/// m = c/(1 + max c) (`tone_map_max_channel`, shaders/output.wgsl), c = m/(1 − max m). A
-/// channel at the top of the range (max m ≥ 254/255) is clamped there.
-fn radiance(p: [f64; 3]) -> [f64; 3] {
-    let top = p.iter().copied().fold(0.0, f64::max).min(254.0 / 255.0);
-    p.map(|m| m / (1.0 - top))
 }
 
 impl Picture {

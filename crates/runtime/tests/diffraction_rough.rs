@@ -36,7 +36,7 @@ use nacre_runtime::diffraction::{
 use std::sync::OnceLock;
 
 mod support;
-use support::{ctx, manifest};
+use support::{ctx, linear, manifest, radiance};
 
 const SIZE: u32 = 96;
 const EXPOSURE_EV: f32 = -3.0;
@@ -46,22 +46,6 @@ fn grating() -> &'static DiffractionTables {
     TABLE.get_or_init(|| {
         DiffractionTables::load(ctx(), &manifest("grating-1200"), FresnelTerm::Unity).unwrap()
     })
-}
-
-/// sRGB byte → display-linear value (IEC 61966-2-1).
-fn linear(byte: u8) -> f64 {
-    let c = f64::from(byte) / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-/// Display-linear → radiance × exposure: the inverse of the scenes' tone map c/(1 + max c).
-fn radiance(p: [f64; 3]) -> [f64; 3] {
-    let top = p.iter().copied().fold(0.0, f64::max).min(254.0 / 255.0);
-    p.map(|m| m / (1.0 - top))
 }
 
 fn options(alpha: f64) -> DiffractionSceneOptions {

@@ -186,3 +186,21 @@ fn translate_resolved(name: &str, module: &naga::Module, info: &ModuleInfo) {
         }
     }
 }
+
+/// sRGB byte → display-linear value in [0, 1] (IEC 61966-2-1).
+pub fn linear(byte: u8) -> f64 {
+    let c = f64::from(byte) / 255.0;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// Display-linear (tone-mapped) → radiance × exposure: the inverse of the diffraction
+/// scenes' tone map m = c/(1 + max c) (`tone_map_max_channel`, shaders/output.wgsl),
+/// c = m/(1 − max m). A channel at the top of the range (max m ≥ 254/255) is clamped there.
+pub fn radiance(p: [f64; 3]) -> [f64; 3] {
+    let top = p.iter().copied().fold(0.0, f64::max).min(254.0 / 255.0);
+    p.map(|m| m / (1.0 - top))
+}
