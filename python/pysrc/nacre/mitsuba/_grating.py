@@ -470,32 +470,9 @@ class NacreGrating(mi.BSDF):
 
     def _lobe_pdf(self, wi, wo, k):
         """Density (per solid angle) of the bin-and-Gaussian sampling at wavenumber ``k``
-        (rad/µm)."""
-        sp = self.spectra
+        (rad/µm): the density in q (``_q_density``) times dq/dω_r = k² cos θ_r."""
         qx, qy = k * (-wi.x - wo.x), k * (-wi.y - wo.y)
-        cx = mi.Int32(dr.round(qx / sp.dk[0]))
-        cy = mi.Int32(dr.round(qy / sp.dk[1])) if sp.ny > 1 else mi.Int32(0)
-        inv = 1.0 / float(self.spectra.weights.astype(np.float32).sum(dtype=np.float64))
-        sig2 = sp.sigma_um * sp.sigma_um
-        side = 2 * sp.rx + 1
-        count = side * (2 * sp.ry + 1)
-
-        def body(n, total):
-            jx = cx + mi.Int32(n % side) - sp.rx
-            jy = cy + mi.Int32(n // side) - sp.ry
-            idx, valid = sp.bin_index(jx, jy)
-            p_j = dr.gather(mi.Float, self._sampler.pmf, idx, valid) * inv
-            dx = qx - mi.Float(jx) * sp.dk[0]
-            dy = qy - mi.Float(jy) * sp.dk[1]
-            return n + 1, total + dr.select(valid, p_j * dr.exp(-sig2 * (dx * dx + dy * dy)), 0.0)
-
-        _, total = dr.while_loop(
-            state=(mi.UInt32(0), dr.zeros(mi.Float, dr.width(qx))),
-            cond=lambda n, total: n < count,
-            body=body,
-        )
-        # q ~ N(κ_j, 1/(2σ²)) per axis: density σ²/π in q; dq = k² cos θ_r dω_r.
-        return total * (sig2 / dr.pi) * k * k * dr.maximum(wo.z, 0.0)
+        return self._q_density(qx, qy) * k * k * dr.maximum(wo.z, 0.0)
 
     def _eval_pdf(self, ctx, si, wo_local, active):
         frame, coverage = self._frame(si)
