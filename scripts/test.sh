@@ -102,7 +102,7 @@ slangpy_venv() {
 # only the extension list.
 GL_TESTS=(
     # crates/runtime/tests (diffraction: 18 s on GL here)
-    diffraction diffraction_footprint diffraction_integrated diffraction_rough gltf gltf_basisu gltf_samples ktx2_load lost_device render rough
+    diffraction diffraction_footprint diffraction_integrated diffraction_light diffraction_rough gltf gltf_basisu gltf_samples ktx2_load lost_device render rough
     # tests/tests
     engine_shaders_gpu gpu_probe grating_equation
     # crates/cli/tests that render (gltf_sweep: the 48 Khronos samples under ../shared, one

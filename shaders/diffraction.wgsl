@@ -348,22 +348,24 @@ fn diffraction_filtered_intensity(k_per_um: f32, uvw: vec3<f32>, sigma_uv: vec2<
     return select(0.0, max(e, 0.0), diffraction_finite(e));
 }
 
-// The colour Σ_λ F² G/w² E|P̃|² u(λ) of `diffraction_colour` filtered over a pixel's
-// footprint of standard deviation σ_uv in (u, v) per axis of the grating frame (the filter
-// above); σ_uv = 0 is `diffraction_colour` (up to rounding). A table whose own radius R
-// exceeds the shader's row buffers (DIFFRACTION_MAX_FILTER_RADIUS), and every table when the
-// host turned the filter off (filter_radius −1), is evaluated unfiltered.
-// Always finite.
-fn diffraction_colour_footprint(wi_in: vec3<f32>, wr_in: vec3<f32>, sigma_uv: vec2<f32>) -> vec3<f32> {
-    if any(diffraction.radius > vec2<i32>(DIFFRACTION_MAX_FILTER_RADIUS)) || diffraction.filter_radius.x < 0 {
-        return diffraction_colour(wi_in, wr_in);
-    }
+// The colour Σ_λ (λ_ref/λ)² F² G/w² E|P̃|² u(λ) of a light seen through the grating,
+// filtered over a pixel's footprint of standard deviation σ_uv in (u, v) per axis of the
+// grating frame (the filter above), each wavelength weighted by (k/k_ref)² = (λ_ref/λ)²:
+// Stam's BRDF is f = ρ (σ_s k)²/π (a flat mirror's lobe |P̃|² integrates to π/(σ_s k)² over
+// (u, v)), and the caller's gain (σ_s k_ref)²/π takes k at λ_ref = `reference_nm` (the
+// scenes: `nacre_runtime::diffraction::lobe_gain`, 555 nm), so the weight puts back k² at
+// every wavelength. σ_uv = 0 is Σ_λ (λ_ref/λ)² ρ(λ) u(λ) (up to rounding). A table whose own
+// radius R exceeds the shader's row buffers (DIFFRACTION_MAX_FILTER_RADIUS), and every
+// table when the host turned the filter off (filter_radius −1), is evaluated unfiltered
+// (the same weights). Always finite.
+fn diffraction_colour_footprint(wi_in: vec3<f32>, wr_in: vec3<f32>, sigma_uv: vec2<f32>, reference_nm: f32) -> vec3<f32> {
     let wi = diffraction_unit(wi_in);
     let wr = diffraction_unit(wr_in);
     let g = diffraction_geometry_over_w2(wi, wr);
-    if !(g > 0.0) || !diffraction_finite(g) || !diffraction_finite(sigma_uv.x) || !diffraction_finite(sigma_uv.y) {
+    if !(g > 0.0) || !diffraction_finite(g) || !diffraction_finite(sigma_uv.x) || !diffraction_finite(sigma_uv.y) || !diffraction_finite(reference_nm) {
         return vec3<f32>(0.0);
     }
+    let filtered = !(any(diffraction.radius > vec2<i32>(DIFFRACTION_MAX_FILTER_RADIUS)) || diffraction.filter_radius.x < 0);
     let uvw = -wi - wr;
     let cos_h = -dot(wi, uvw) * inverseSqrt(dot(uvw, uvw));
     let fresnel = diffraction_fresnel(cos_h);
@@ -372,7 +374,14 @@ fn diffraction_colour_footprint(wi_in: vec3<f32>, wr_in: vec3<f32>, sigma_uv: ve
     for (var i = 0u; i < count; i++) {
         let sp = diffraction_spectrum[i];
         let k = DIFFRACTION_TWO_PI / (sp.x * 1e-3);
-        colour += (fresnel * g * diffraction_filtered_intensity(k, uvw, sigma_uv)) * sp.yzw;
+        let ratio = reference_nm / sp.x;
+        var rho: f32;
+        if filtered {
+            rho = fresnel * g * diffraction_filtered_intensity(k, uvw, sigma_uv);
+        } else {
+            rho = diffraction_rho(wi, wr, sp.x, fresnel, g);
+        }
+        colour += (rho * ratio * ratio) * sp.yzw;
     }
     return select(vec3<f32>(0.0), colour, diffraction_finite3(colour));
 }

@@ -13,21 +13,31 @@
 //
 // Radiance leaving a grating point towards the eye:
 //
-//   L = Σ_k I_k · Σ_λ ρ(F ω_k, F ω_r, λ) u(λ)              light (+ environment samples)
+//   L = Σ_k I_k cos θ_k · Σ_λ (λ₀/λ)² ρ(F ω_k, F ω_r, λ) u(λ)  light (+ environment samples)
 //     + L_env(reflect(−ω_r, n)) ⊙ Σ_λ F² |P_DC(k w)|² u(λ)  the specular order of the environment
 //     + Σ_λ u(λ) ⊙ Σ_c F² G/w² η_c(k w_c) L_env(ω_c(λ))     the environment through the lobes
 //     + base (snake skin only: a dark diffuse layer, albedo × (n·ω_0 E_0 + ambient))
 //
-// where each Σ_λ ρ u is filtered over the pixel's footprint (diffraction_colour_footprint,
+// where each Σ_λ (λ₀/λ)² ρ u is filtered over the pixel's footprint (diffraction_colour_footprint,
 // issue 37: the footprint's σ_uv from the neighbouring pixels' rays, scene_footprint below;
 // the integrated layout's adapter point-samples); a rough grating's light is its lobes
 // blurred by the footprint and the microfacets' slopes instead (scene_rough_light, the
 // two-scale model).
 //
 // I_k = E_k · (σ_s k₀)²/π is the radiance of source k's mirror image spread over the
-// coherence lobe (E_k its irradiance at normal incidence, k₀ = 2π/555 nm; computed on the
-// CPU, `nacre_runtime::diffraction::lobe_gain`): a flat mirror's lobe |P̃|² integrates to
-// π/(σ_s k)² over (u, v), so ρ · I is the reflected radiance (Stam's k² included at 555 nm).
+// coherence lobe (E_k its irradiance at normal incidence, k₀ = 2π/λ₀, λ₀ = 555 nm; computed
+// on the CPU, `nacre_runtime::diffraction::lobe_gain`): a flat mirror's lobe |P̃|² integrates
+// to π/(σ_s k)² over (u, v), so Stam's BRDF is f = ρ (σ_s k)²/π and the reflected radiance
+// f E_k cos θ_k = ρ I_k (k/k₀)² cos θ_k, θ_k the angle of ω_k from the normal (the
+// irradiance the surface receives is E_k cos θ_k). The technique weights each wavelength
+// by (k/k₀)² = (λ₀/λ)² (diffraction_colour_footprint's reference_nm), the scene multiplies
+// by cos θ_k: the Mitsuba plugin's f cos θ (nacre.mitsuba, `nacre_grating`). An integrated
+// table's adapter leaves the (λ₀/λ)² out (its bake summed ρ u without it).
+//
+// The environment's lobes need neither factor: their integral runs over (u, v), and
+// du dv = cos θ_i dω_i at a fixed ω_r, so ∫ L_env f cos θ_i dω_i = ∫ L_env ρ (σ_s k)²/π du dv,
+// and a lobe's η_c (π/σ_s²) N(k(u, v); κ_c, v_c) integrates over (u, v) to η_c π/(σ_s k)²:
+// the k² cancels and each lobe brings F² G/w² η_c L_env.
 //
 // The environment enters through its mirror image in the zeroth order (exact for an extended
 // source: the order keeps |P_DC|² of the radiance) and, with a "terms" table, through the
@@ -418,9 +428,9 @@ fn scene_footprint(l: vec3<f32>, frame: mat3x3<f32>, wr: vec3<f32>, n: array<Nei
 //   ρ_rough = F² G/w² (π/σ_s²) Σ_c η_c(kw) N(q; κ_c, v_c + k² (σ_uv² + w² σ_m²))
 //
 // with Stam's k² per wavelength: the light's radiance I₀ = E₀ (σ_s k₀)²/π takes k₀ at 555 nm
-// (lobe_gain), so ρ_rough is scaled by (k/k₀)². (The smooth path leaves that factor out, as
-// lobe_gain says; a blurred lobe spreads over (u, v) the same at every wavelength, so left
-// out here it would tint the rough picture red by (λ/555 nm)².)
+// (lobe_gain), so ρ_rough is scaled by (k/k₀)² (as the smooth path's technique does; a
+// blurred lobe spreads over (u, v) the same at every wavelength, so left out it would tint
+// the rough picture red by (λ/555 nm)²), and scene_shade multiplies by cos θ_i.
 //
 // — exact for the model's Gaussian blur of each lobe, and cheaper than the filter (lobes ×
 // wavelengths reads, no Taylor sums). The environment's lobes are widened the same way
@@ -483,17 +493,21 @@ fn scene_shade(s: Surface, to_eye: vec3<f32>, around: array<Neighbour, 4>) -> ve
     let light = normalize(view.light_direction);
     let light_radiance = view.light_colour * lights.light_radiance;
     if s.grating > 0.0 {
+        // L = f E₀ cos θ_i with f = ρ (σ_s k)²/π (header): the light's I₀ carries (σ_s k₀)²/π,
+        // the technique (k/k₀)² per wavelength, and here the cosine at the light.
+        let wi = frame * light;
         let fp_light = scene_footprint(light, frame, wr, around);
         var diffracted: vec3<f32>;
         if lights.roughness.x > 0.0 {
-            diffracted = scene_rough_light(frame * light, wr, fp_light) * light_radiance;
+            diffracted = scene_rough_light(wi, wr, fp_light) * (light_radiance * max(wi.z, 0.0));
         } else {
-            diffracted = diffraction_colour_footprint(frame * light, wr, fp_light) * light_radiance;
+            diffracted = diffraction_colour_footprint(wi, wr, fp_light, SCENE_LOBE_REFERENCE_NM) * (light_radiance * max(wi.z, 0.0));
         }
         let count = min(lights.sample_count, 8u);
         for (var k = 0u; k < count; k++) {
             let l = lights.samples[k].xyz;
-            diffracted += diffraction_colour_footprint(frame * l, wr, scene_footprint(l, frame, wr, around)) * lights.sample_radiance[k].rgb;
+            let wk = frame * l;
+            diffracted += diffraction_colour_footprint(wk, wr, scene_footprint(l, frame, wr, around), SCENE_LOBE_REFERENCE_NM) * (lights.sample_radiance[k].rgb * max(wk.z, 0.0));
         }
         // The view direction's own spread over the pixel (u, v) = −ω_r,t: its larger axis.
         let fp = scene_footprint(vec3<f32>(0.0), frame, wr, around);

@@ -163,9 +163,10 @@ fn gaps(distance: f32) -> ([f64; 3], [Picture; 3]) {
 }
 
 /// The scene's distance. Measured on Mesa lavapipe (LLVM 15, Vulkan; llvmpipe caps the
-/// filter's neighbourhood at 5 bins here): without the filter 6.77e-3, with it 3.14e-3
-/// (2.2 × closer; the reference's mean 9.3e-2); the 512² filtered picture averaged down
-/// 4.5e-4 from the reference.
+/// filter's neighbourhood at 5 bins here): without the filter 6.37e-3, with it 2.64e-3
+/// (2.4 × closer; the reference's mean 9.3e-2); the 512² filtered picture averaged down
+/// 6.0e-4 from the reference. (With the light's Stam k² per wavelength and cos θ_i; before
+/// them 6.77e-3 and 3.14e-3.)
 #[test]
 fn the_filtered_cd_disc_converges_with_resolution() {
     let ([point, filtered, _], _) = gaps(1.0);
@@ -264,9 +265,10 @@ fn neighbour_variance(picture: &Picture, pairs: &[usize]) -> f64 {
 }
 
 /// The disc 4 × farther away at 128². Measured on Mesa lavapipe (LLVM 15, Vulkan): mean |Δ|
-/// without the filter 2.39e-2, with it 5.6e-3 (4.2 × closer; the reference's mean 4.5e-2,
-/// the 512² filtered picture 4.7e-4 from it); relative neighbour variance 0.726 without,
-/// 0.522 with, 0.468 supersampled (excess 0.258 → 0.054).
+/// without the filter 2.08e-2, with it 5.0e-3 (4.1 × closer; the reference's mean 4.0e-2,
+/// the 512² filtered picture 4.2e-4 from it); relative neighbour variance 0.745 without,
+/// 0.541 with, 0.479 supersampled (excess 0.266 → 0.062). (Before the light's Stam k² per
+/// wavelength and cos θ_i: 2.39e-2 and 5.6e-3; variance 0.726, 0.522, 0.468.)
 #[test]
 fn a_distant_cd_shows_its_average_colour_not_noise() {
     const DISTANCE: f32 = 4.0;

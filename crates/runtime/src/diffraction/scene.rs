@@ -188,7 +188,7 @@ pub struct DiffractionSceneOptions {
     /// with either layout, and no lobes (0: only the environment's mirror image remains).
     pub env_samples: Option<usize>,
     /// The directional light; `intensity` is its irradiance E₀ at normal incidence (the
-    /// grating sees the radiance E₀ (σ_s k₀)²/π of its mirror image, [`lobe_gain`]).
+    /// grating reflects f E₀ cos θ_i, f = ρ (σ_s k)²/π Stam's BRDF: [`lobe_gain`]).
     pub light: Light,
     /// Exposure, EV stops.
     pub exposure_ev: f32,
@@ -838,10 +838,15 @@ pub const LOBE_REFERENCE_NM: f64 = 555.0;
 
 /// (σ_s k₀)²/π at k₀ = 2π/[`LOBE_REFERENCE_NM`]: the radiance, per unit irradiance at normal
 /// incidence, of a light's mirror image spread over the coherence lobe. A flat mirror's
-/// |P̃|² = exp(−σ_s² k² |Δ(u, v)|²) integrates to π/(σ_s k)² over (u, v), so a source of
-/// irradiance E seen in a surface of relative reflectance ρ has radiance
-/// ρ · E · (σ_s k)²/π (the k² of Stam's BRDF); the scenes take k at 555 nm for every
-/// wavelength (the lobe's wavelength dependence, a factor (555/λ)², is left out).
+/// |P̃|² = exp(−σ_s² k² |Δ(u, v)|²) integrates to π/(σ_s k)² over (u, v), so Stam's BRDF is
+/// f = ρ (σ_s k)²/π and a source of irradiance E at normal incidence, at θ_i from the normal
+/// of a surface of relative reflectance ρ, gives the radiance
+/// f · E cos θ_i = ρ · E · (σ_s k₀)²/π · (k/k₀)² · cos θ_i. The scenes pass E · this gain as
+/// one number; the terms technique weights each wavelength by (k/k₀)² = (555 nm/λ)²
+/// (`diffraction_colour_footprint`'s `reference_nm`, `shaders/diffraction.wgsl`) and the
+/// scene multiplies by cos θ_i (`scene_shade`, `shaders/diffraction_scene.wgsl`). An
+/// integrated table, summed over wavelengths at bake time without the k², leaves the
+/// (k/k₀)² out.
 pub fn lobe_gain(record: &DiffractionRecord) -> f32 {
     let k0 = std::f64::consts::TAU / (LOBE_REFERENCE_NM * 1e-3);
     ((record.sigma_s_um * k0).powi(2) / std::f64::consts::PI) as f32
