@@ -79,7 +79,8 @@ fn the_light_reflects_stams_brdf_times_the_cosine() {
             .wavelengths_nm()
             .iter()
             .map(|&lambda| {
-                let rho = surface.relative_reflectance(omega_i, omega_r, lambda, FresnelTerm::Unity);
+                let rho =
+                    surface.relative_reflectance(omega_i, omega_r, lambda, FresnelTerm::Unity);
                 let f = rho * (sigma * k_per_um(lambda)).powi(2) / std::f64::consts::PI;
                 f * cos_i
             })
