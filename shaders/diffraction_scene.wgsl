@@ -16,7 +16,8 @@
 //   L = Σ_k I_k cos θ_k · Σ_λ (λ₀/λ)² ρ(F ω_k, F ω_r, λ) u(λ)  light (+ environment samples)
 //     + L_env(reflect(−ω_r, n)) ⊙ Σ_λ F² |P_DC(k w)|² u(λ)  the specular order of the environment
 //     + Σ_λ u(λ) ⊙ Σ_c F² G/w² η_c(k w_c) L_env(ω_c(λ))     the environment through the lobes
-//     + base (snake skin only: a dark diffuse layer, albedo × (n·ω_0 E_0 + ambient))
+//     + base (snake skin only: a dark Lambertian layer of albedo π · base,
+//             base × (n·ω_0 E_0 + ambient))
 //
 // where each Σ_λ (λ₀/λ)² ρ u is filtered over the pixel's footprint (diffraction_colour_footprint,
 // issue 37: the footprint's σ_uv from the neighbouring pixels' rays, scene_footprint below;
@@ -154,7 +155,7 @@ struct Surface {
     normal: vec3<f32>,
     across: vec3<f32>,      // t: across the grating lines
     grating: f32,           // 1 on the grating, 0 on clear parts
-    base: vec3<f32>,        // diffuse albedo under the grating (0: none)
+    base: vec3<f32>,        // Lambertian BRDF albedo/π under the grating (0: none)
 }
 
 fn miss() -> Surface {
@@ -529,7 +530,9 @@ fn scene_shade(s: Surface, to_eye: vec3<f32>, around: array<Neighbour, 4>) -> ve
     } else {
         radiance += env * mix(clear, specular, s.grating);
     }
-    // The snake's dark skin: diffuse under the light and a constant sky term.
+    // The snake's dark skin: Lambertian under the light (base = albedo/π, so base E₀ cos θ_i;
+    // the reference's albedo is π · base) and a constant sky term (irradiance 0.6 × the
+    // environment's intensity).
     let n_dot_l = max(dot(n, light), 0.0);
     radiance += s.base * (n_dot_l * view.light_colour * view.light_intensity + vec3<f32>(0.6) * view.env_intensity);
     return radiance;

@@ -54,7 +54,8 @@ two-scale model: no Gaussian in it, the change of w, G/w², F² and the masking 
 Per point, the scenes may give the grating frame (``set_frame_function``: world normal and
 direction across the lines) and the grating's coverage c ∈ [0, 1]; where c < 1 the surface
 is a smooth mirror of reflectance F² (weight 1 − c), and an optional Lambertian ``base``
-adds its albedo/π.
+adds its albedo/π, scaled per point by ``set_base_weight_function`` where the scene gives one
+(the snake's scales: a tint per scale).
 """
 
 from __future__ import annotations
@@ -265,6 +266,7 @@ class NacreGrating(mi.BSDF):
         if "base" in props:
             self.base = mi.load_dict({"type": "srgb", "color": props.get("base")})
         self.frame_fn: Optional[Callable] = None
+        self.base_weight_fn: Optional[Callable] = None
         self.roughness = float(props.get("roughness", 0.0))
         if not (math.isfinite(self.roughness) and 0.0 <= self.roughness <= 1.0):
             raise ValueError(f"nacre_grating: roughness {self.roughness} (expected 0 to 1, the GGX α)")
@@ -291,6 +293,10 @@ class NacreGrating(mi.BSDF):
         """``fn(si) -> (normal, across, coverage)``: world unit normal, world direction across
         the lines (any length, not parallel to the normal) and grating coverage in [0, 1]."""
         self.frame_fn = fn
+
+    def set_base_weight_function(self, fn: Optional[Callable]) -> None:
+        """``fn(si) -> weight``: a factor ≥ 0 on the ``base`` albedo at each point (default 1)."""
+        self.base_weight_fn = fn
 
     # ─── Frames ────────────────────────────────────────────────────────────────────
 
@@ -370,7 +376,10 @@ class NacreGrating(mi.BSDF):
         """The Lambertian base's albedo/π · cos θ_r (0 without one)."""
         if self.base is None:
             return mi.Spectrum(0.0)
-        return self.base.eval(si, active) * (dr.inv_pi * wo.z)
+        weight = dr.inv_pi * wo.z
+        if self.base_weight_fn is not None:
+            weight *= self.base_weight_fn(si)
+        return self.base.eval(si, active) * weight
 
     def _q_density(self, qx, qy):
         """Density in q of the bin-and-Gaussian sampling (a bin j ∝ |P_j(s₀)|², then

@@ -174,6 +174,16 @@ def _snake_frame(si):
     return n, across, coverage
 
 
+def _snake_tint(si):
+    """The snake's skin tint per scale, 0.6 + 0.4 × the scale's second hash (the shader's
+    ``tint``), on the base albedo."""
+    p = si.p
+    phi = dr.atan2(p.z, p.y)
+    qx, qy = p.x / 0.4, phi / 0.3
+    _, ry = _hash(mi.Int32(dr.floor(qx + qy)), mi.Int32(dr.floor(qx - qy)))
+    return 0.6 + 0.4 * ry
+
+
 def _cd_frame(si):
     p = si.p
     r = dr.sqrt(p.x * p.x + p.z * p.z)
@@ -252,6 +262,7 @@ def build(scene: Scene, width: int, height: int, max_depth: int = 8,
             mesh = _annulus(0.12, 1.0)
         elif s["kind"] == "snake-skin":
             bsdf.set_frame_function(_snake_frame)
+            bsdf.set_base_weight_function(_snake_tint)
             mesh = _cylinder_patch()
         else:
             bsdf.set_frame_function(_plane_frame)

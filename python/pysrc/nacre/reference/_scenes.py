@@ -73,7 +73,11 @@ SCENES: Dict[str, Scene] = {
         "snake-skin", eye=(0.35, 2.6, 2.3), target=(0.0, 0.55, 0.0), fov_y_deg=42.0,
         light_direction=(0.3, 0.85, -0.45), light_colour=(1.0, 0.97, 0.92), light_intensity=3.0,
         env_sun=False, env_intensity=0.5, tone_map="max_channel",
-        surface=dict(kind="snake-skin", grating="sine:0.8:0.07", fresnel_ior=1.56),
+        # The dark skin under the scales: the shader's radiance base · E₀ cos θ_i, base =
+        # (0.022, 0.018, 0.014) × the scale's tint, is a Lambertian of albedo π · base
+        # (radiance albedo/π · E₀ cos θ_i); the tint per scale is _build._snake_tint.
+        surface=dict(kind="snake-skin", grating="sine:0.8:0.07", fresnel_ior=1.56,
+                     base=tuple(math.pi * c for c in (0.022, 0.018, 0.014))),
     ),
     # `nacre render --scene grating-plane` (table grating-1200): a 1200 lines/mm sinusoidal
     # grating (period 0.833333 µm, amplitude 0.06 µm, F = 1) on the square |x|, |z| ≤ 1 of
