@@ -17,7 +17,7 @@
 //     + L_env(reflect(−ω_r, n)) ⊙ Σ_λ F² |P_DC(k w)|² u(λ)  the specular order of the environment
 //     + Σ_λ u(λ) ⊙ Σ_c F² G/w² η_c(k w_c) L_env(ω_c(λ))     the environment through the lobes
 //     + base (snake skin only: a dark Lambertian layer of albedo π · base,
-//             base × (n·ω_0 E_0 + ambient))
+//             base × (n·ω_0 E_0 + E_env(n)), E_env the environment's irradiance)
 //
 // where each Σ_λ (λ₀/λ)² ρ u is filtered over the pixel's footprint (diffraction_colour_footprint,
 // issue 37: the footprint's σ_uv from the neighbouring pixels' rays, scene_footprint below;
@@ -79,7 +79,7 @@
 // irradiance at normal incidence, and view.scene = 0 cd-disc, 1 snake-skin, 2 bench,
 // 3 grating-plane.
 //
-// Group 2, the lights as the gratings see them (binding 0: 304 bytes, uniform;
+// Group 2, the lights as the gratings see them (binding 0: 448 bytes, uniform;
 // `nacre_runtime::diffraction::DiffractionLightsUniform` mirrors it; bindings 1–3:
 // `nacre_runtime::diffraction::LobeData`):
 //
@@ -94,6 +94,8 @@
 //      288   16 roughness: vec4<f32>        (σ_m² = α²/2 the microfacet slope variance per
 //                                           axis, α the GGX roughness, π/σ_s², 0): the grating's
 //                                           micro-geometry, π/σ_s² (scene_rough_light)
+//      304  144 irradiance: array<vec4<f32>, 9>  the environment's irradiance in nine spherical
+//                                           harmonics, × env_intensity (rgb; scene_irradiance)
 struct DiffractionLights {
     light_radiance: f32,
     sample_count: u32,
@@ -103,6 +105,7 @@ struct DiffractionLights {
     sample_radiance: array<vec4<f32>, 8>,
     lobe_kw: vec4<f32>,
     roughness: vec4<f32>,
+    irradiance: array<vec4<f32>, 9>,
 }
 
 @group(2) @binding(0) var<uniform> lights: DiffractionLights;
@@ -530,12 +533,29 @@ fn scene_shade(s: Surface, to_eye: vec3<f32>, around: array<Neighbour, 4>) -> ve
     } else {
         radiance += env * mix(clear, specular, s.grating);
     }
-    // The snake's dark skin: Lambertian under the light (base = albedo/π, so base E₀ cos θ_i;
-    // the reference's albedo is π · base) and a constant sky term (irradiance 0.6 × the
-    // environment's intensity).
+    // The snake's dark skin: Lambertian (base = albedo/π; the reference's albedo is π · base)
+    // under the light, base E₀ cos θ_i, and under the environment, base E_env(n).
     let n_dot_l = max(dot(n, light), 0.0);
-    radiance += s.base * (n_dot_l * view.light_colour * view.light_intensity + vec3<f32>(0.6) * view.env_intensity);
+    radiance += s.base * (n_dot_l * view.light_colour * view.light_intensity + scene_irradiance(n));
     return radiance;
+}
+
+// The environment's irradiance E(n) = ∫ L_env max(n·ω, 0) dω at the world unit normal n,
+// from its nine spherical harmonics (Ramamoorthi & Hanrahan 2001): Σ c_lm Y_lm(n) with the
+// coefficients Â_l L_lm of `nacre_runtime::ibl::irradiance_sh9` (the CPU twin: sh9_irradiance;
+// the same basis, Y₁₋₁ ∝ y, Y₁₀ ∝ z, Y₁₁ ∝ x), clamped at 0.
+fn scene_irradiance(n: vec3<f32>) -> vec3<f32> {
+    let c = lights.irradiance;
+    let e = c[0].rgb * 0.282095
+        + c[1].rgb * (0.488603 * n.y)
+        + c[2].rgb * (0.488603 * n.z)
+        + c[3].rgb * (0.488603 * n.x)
+        + c[4].rgb * (1.092548 * n.x * n.y)
+        + c[5].rgb * (1.092548 * n.y * n.z)
+        + c[6].rgb * (0.315392 * (3.0 * n.z * n.z - 1.0))
+        + c[7].rgb * (1.092548 * n.x * n.z)
+        + c[8].rgb * (0.546274 * (n.x * n.x - n.y * n.y));
+    return max(e, vec3<f32>(0.0));
 }
 
 fn scene_display(radiance: vec3<f32>) -> vec4<f32> {

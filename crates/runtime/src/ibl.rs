@@ -105,6 +105,73 @@ pub fn prefilter_level(alpha: f64) -> f64 {
     alpha.clamp(0.0, 1.0).sqrt() * (PREFILTER_LEVELS - 1) as f64
 }
 
+/// The nine real spherical harmonics Y_lm (l ≤ 2) of a unit direction d = (x, y, z), in the
+/// order (0,0), (1,−1), (1,0), (1,1), (2,−2), (2,−1), (2,0), (2,1), (2,2) with
+/// Y₁₋₁ ∝ y, Y₁₀ ∝ z, Y₁₁ ∝ x (Ramamoorthi & Hanrahan 2001, Eq. 3; `scene_irradiance` in
+/// `shaders/diffraction_scene.wgsl` evaluates the same functions).
+pub fn sh9_basis(d: [f64; 3]) -> [f64; 9] {
+    let [x, y, z] = d;
+    [
+        0.282_095,
+        0.488_603 * y,
+        0.488_603 * z,
+        0.488_603 * x,
+        1.092_548 * x * y,
+        1.092_548 * y * z,
+        0.315_392 * (3.0 * z * z - 1.0),
+        1.092_548 * x * z,
+        0.546_274 * (x * x - y * y),
+    ]
+}
+
+/// The irradiance of `env` (its linear radiance, the whole sphere) in nine spherical
+/// harmonics (Ramamoorthi & Hanrahan, "An efficient representation for irradiance environment
+/// maps", SIGGRAPH 2001): E(n) = ∫ L(ω) max(n·ω, 0) dω ≈ Σ_lm Â_l L_lm Y_lm(n), with
+/// L_lm = Σ_texels L Y_lm dΩ (dΩ = (2π/W)(π/H) sin θ at the texel's centre) and the clamped
+/// cosine's coefficients Â₀ = π, Â₁ = 2π/3, Â₂ = π/4. Returns Â_l L_lm per coefficient (RGB),
+/// to be evaluated with [`sh9_irradiance`]. The nine terms keep the irradiance of any
+/// environment to a few per cent (the clamped cosine's energy past l = 2 is under 1 %).
+/// A sequential sum: deterministic.
+pub fn irradiance_sh9(env: &EnvironmentMap) -> [[f64; 3]; 9] {
+    const A: [f64; 9] = [
+        PI,
+        2.0 * PI / 3.0,
+        2.0 * PI / 3.0,
+        2.0 * PI / 3.0,
+        PI / 4.0,
+        PI / 4.0,
+        PI / 4.0,
+        PI / 4.0,
+        PI / 4.0,
+    ];
+    let (w, h) = (env.width.max(1), env.height.max(1));
+    let cell = (2.0 * PI / w as f64) * (PI / h as f64);
+    let mut c = [[0.0f64; 3]; 9];
+    for (j, row) in env.rgb.chunks(w).enumerate().take(h) {
+        let v = (j as f64 + 0.5) / h as f64;
+        for (i, texel) in row.iter().enumerate() {
+            let d = env_uv_to_direction((i as f64 + 0.5) / w as f64, v);
+            let d_omega = cell * (1.0 - d[1] * d[1]).max(0.0).sqrt();
+            for (k, y) in sh9_basis(d).iter().enumerate() {
+                for (ch, l) in texel.iter().enumerate() {
+                    c[k][ch] += f64::from(*l) * y * d_omega;
+                }
+            }
+        }
+    }
+    for (k, a) in A.iter().enumerate() {
+        c[k] = c[k].map(|x| x * a);
+    }
+    c
+}
+
+/// E(n) = Σ c_k Y_k(n) of [`irradiance_sh9`]'s coefficients at the unit normal `n`, clamped
+/// at 0 (the CPU twin of `scene_irradiance`).
+pub fn sh9_irradiance(c: &[[f64; 3]; 9], n: [f64; 3]) -> [f64; 3] {
+    let y = sh9_basis(n);
+    std::array::from_fn(|ch| (0..9).map(|k| c[k][ch] * y[k]).sum::<f64>().max(0.0))
+}
+
 /// Unit direction of equirectangular coordinates (u, v) ([`EnvironmentMap`]'s convention):
 /// φ = 2π(u − 0.5) from −z towards +x, θ = π v from +y.
 pub fn env_uv_to_direction(u: f64, v: f64) -> [f64; 3] {
@@ -360,6 +427,88 @@ pub fn ggx_albedo_table() -> &'static Level<2> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// L(d) = 1 + 0.5 d_y has only l ≤ 1 terms, so its irradiance is exact in nine
+    /// harmonics: E(n) = π + (π/3) n_y (∫ max(n·ω, 0) dω = π, ∫ ω max(n·ω, 0) dω = 2π/3 n).
+    #[test]
+    fn sh9_irradiance_of_a_linear_sky_is_exact() {
+        let (width, height) = (256, 128);
+        let mut rgb = Vec::with_capacity(width * height);
+        for j in 0..height {
+            for i in 0..width {
+                let d = env_uv_to_direction(
+                    (i as f64 + 0.5) / width as f64,
+                    (j as f64 + 0.5) / height as f64,
+                );
+                rgb.push([(1.0 + 0.5 * d[1]) as f32, 1.0, (2.0 - d[0]) as f32]);
+            }
+        }
+        let c = irradiance_sh9(&EnvironmentMap { width, height, rgb });
+        for n in [
+            [0.0, 1.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.6, 0.0, 0.8],
+            [-0.48, 0.6, -0.64],
+        ] {
+            let e = sh9_irradiance(&c, n);
+            let expected = [PI + PI / 3.0 * n[1], PI, 2.0 * PI - 2.0 * PI / 3.0 * n[0]];
+            for ch in 0..3 {
+                assert!(
+                    (e[ch] - expected[ch]).abs() <= 2e-3 * expected[ch],
+                    "{n:?} channel {ch}: {} against {}",
+                    e[ch],
+                    expected[ch]
+                );
+            }
+        }
+    }
+
+    /// The studio without its sun (the diffraction scenes' environment): nine harmonics
+    /// against the brute-force ∫ L max(n·ω, 0) dω over its texels, within 5 % of the
+    /// luminance at normals from up to sideways (measured: 2.1 % up, 1.3 % and 0.8 % at 60°
+    /// from it, 3.7 % sideways towards −z).
+    #[test]
+    fn sh9_irradiance_of_the_studio_is_close() {
+        let env = crate::environment::procedural_environment_with(256, 128, false);
+        let c = irradiance_sh9(&env);
+        let (w, h) = (env.width, env.height);
+        let lum = |x: [f64; 3]| 0.2126 * x[0] + 0.7152 * x[1] + 0.0722 * x[2];
+        for n in [
+            [0.0, 1.0, 0.0],
+            [0.0, 0.5, 0.866_025],
+            [0.866_025, 0.5, 0.0],
+            [0.0, 0.0, -1.0],
+        ] {
+            let mut brute = [0.0; 3];
+            for j in 0..h {
+                for i in 0..w {
+                    let d = env_uv_to_direction(
+                        (i as f64 + 0.5) / w as f64,
+                        (j as f64 + 0.5) / h as f64,
+                    );
+                    let cos = (n[0] * d[0] + n[1] * d[1] + n[2] * d[2]).max(0.0);
+                    let d_omega =
+                        (2.0 * PI / w as f64) * (PI / h as f64) * (1.0 - d[1] * d[1]).sqrt();
+                    for ch in 0..3 {
+                        brute[ch] += f64::from(env.rgb[j * w + i][ch]) * cos * d_omega;
+                    }
+                }
+            }
+            let e = sh9_irradiance(&c, n);
+            let err = (lum(e) - lum(brute)).abs() / lum(brute);
+            eprintln!(
+                "{n:?}: nine harmonics {:.4}, texels {:.4} ({err:.4})",
+                lum(e),
+                lum(brute)
+            );
+            assert!(
+                err <= 0.05,
+                "{n:?}: {} against {} ({err})",
+                lum(e),
+                lum(brute)
+            );
+        }
+    }
 
     #[test]
     fn levels_and_alphas_are_inverse() {

@@ -310,7 +310,7 @@ impl DiffractionSceneOptions {
     }
 }
 
-/// Mirror of `DiffractionLights` (shaders/diffraction_scene.wgsl, group 2 binding 0, 304
+/// Mirror of `DiffractionLights` (shaders/diffraction_scene.wgsl, group 2 binding 0, 448
 /// bytes): the light, the environment samples and the environment lobes' settings as the
 /// gratings see them (the lobes, their efficiencies and the spectrum are bindings 1–3,
 /// [`LobeData`]). The camera, the exposure, the
@@ -339,6 +339,9 @@ pub struct DiffractionLightsUniform {
     /// ([`rough_slope_variance`]; 0 for a smooth grating), and the lobes' normalisation
     /// π/σ_s² (`scene_rough_light`).
     pub roughness: [f32; 4],
+    /// The environment's irradiance in nine spherical harmonics, × env_intensity (rgb, w 0;
+    /// [`crate::ibl::irradiance_sh9`]): the snake's Lambertian skin (`scene_irradiance`).
+    pub irradiance: [[f32; 4]; 9],
 }
 
 /// Bindings 1–3 of the scenes' group 2: the environment lobes of a "terms" table
@@ -954,6 +957,10 @@ pub fn render_diffraction_scene_in(
         ],
         ..DiffractionLightsUniform::zeroed()
     };
+    for (k, c) in crate::ibl::irradiance_sh9(env).iter().enumerate() {
+        lights.irradiance[k] =
+            [c[0], c[1], c[2], 0.0].map(|x| (x * f64::from(options.env_intensity)) as f32);
+    }
     for (k, (d, l)) in samples.iter().enumerate() {
         lights.samples[k] = [d[0], d[1], d[2], 0.0];
         lights.sample_radiance[k] =
