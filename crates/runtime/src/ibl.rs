@@ -489,8 +489,8 @@ mod tests {
                     let cos = (n[0] * d[0] + n[1] * d[1] + n[2] * d[2]).max(0.0);
                     let d_omega =
                         (2.0 * PI / w as f64) * (PI / h as f64) * (1.0 - d[1] * d[1]).sqrt();
-                    for ch in 0..3 {
-                        brute[ch] += f64::from(env.rgb[j * w + i][ch]) * cos * d_omega;
+                    for (b, l) in brute.iter_mut().zip(env.rgb[j * w + i]) {
+                        *b += f64::from(l) * cos * d_omega;
                     }
                 }
             }
