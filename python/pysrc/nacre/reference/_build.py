@@ -150,18 +150,24 @@ def _smoothstep(e0, e1, x):
     return t * t * (3.0 - 2.0 * t)
 
 
-def _snake_frame(si):
-    """Normal, direction across the ridges and grating coverage of the snake's scales."""
-    p = si.p
+def _snake_scale(p):
+    """The scale at point p of the snake: its position (fx, fy) ∈ [−0.5, 0.5)² in the rhombic
+    lattice cell and the cell's two hashes (the shader's ``f`` and ``rnd``)."""
     phi = dr.atan2(p.z, p.y)
-    n0 = mi.Vector3f(0.0, p.y, p.z)
-    along = mi.Vector3f(1.0, 0.0, 0.0)
-    around = dr.normalize(mi.Vector3f(0.0, -p.z, p.y))
     qx, qy = p.x / 0.4, phi / 0.3
     gx, gy = qx + qy, qx - qy
     cx, cy = dr.floor(gx), dr.floor(gy)
-    fx, fy = gx - cx - 0.5, gy - cy - 0.5
-    rx, _ = _hash(mi.Int32(cx), mi.Int32(cy))
+    rx, ry = _hash(mi.Int32(cx), mi.Int32(cy))
+    return gx - cx - 0.5, gy - cy - 0.5, rx, ry
+
+
+def _snake_frame(si):
+    """Normal, direction across the ridges and grating coverage of the snake's scales."""
+    p = si.p
+    n0 = mi.Vector3f(0.0, p.y, p.z)
+    along = mi.Vector3f(1.0, 0.0, 0.0)
+    around = dr.normalize(mi.Vector3f(0.0, -p.z, p.y))
+    fx, fy, rx, _ = _snake_scale(p)
     la = 0.5 * (fx + fy)
     lb = 0.5 * (fx - fy)
     tilt = 0.55 * la * along + 0.9 * lb * around
@@ -177,11 +183,7 @@ def _snake_frame(si):
 def _snake_tint(si):
     """The snake's skin tint per scale, 0.6 + 0.4 × the scale's second hash (the shader's
     ``tint``), on the base albedo."""
-    p = si.p
-    phi = dr.atan2(p.z, p.y)
-    qx, qy = p.x / 0.4, phi / 0.3
-    _, ry = _hash(mi.Int32(dr.floor(qx + qy)), mi.Int32(dr.floor(qx - qy)))
-    return 0.6 + 0.4 * ry
+    return 0.6 + 0.4 * _snake_scale(si.p)[3]
 
 
 def _cd_frame(si):
