@@ -40,14 +40,29 @@
 // only directions at or below the horizon give 0. The tables are baked with u_max = 2 sin θ_max,
 // so every pair of directions within θ_max of the normal is inside.
 //
+// Filtered over a spread σ in (u, v) (issue 37: a pixel's footprint, item 3, and a rough
+// grating's facets, item 4; `diffraction_integrated_colour_filtered`): the texture holds L
+// levels of the 2N + 1 layers (layer ℓ (2N + 1) + p), level 0 the table, level ℓ ≥ 1 the
+// table blurred by a Gaussian of σ_ℓ = σ₁ 2^{ℓ−1} per axis in u and v (not in texel
+// coordinates; `nacre_optics::diffraction::integrated::IntegratedLevels`, made when the
+// table is loaded), σ₁ = u_max / 2^{L−2}. With
+//
+//   σ² = σ_uv² + w² σ_m²            the footprint's spread and the facets' (slope s moves
+//                                   (u, v) by w s; σ_m² = α²/2, GGX α matched to Beckmann)
+//   σ_ℓ² ≤ σ² ≤ σ_{ℓ+1}²,  t = (σ² − σ_ℓ²)/(σ_{ℓ+1}² − σ_ℓ²)  (σ₀ = 0; t ≤ 1 past the top)
+//   S_σ = S_ℓ + t (S_{ℓ+1} − S_ℓ)   the two levels' Horner sums at the same texel coordinates
+//
+// interpolated in σ²: the kernel keeps the energy and has the variance σ² exactly.
+//
 // Cost per call: 4 (2N + 1) texel loads (92 for the CD table, N = 11) and 3 (2N + 1)
-// multiply-adds of the Horner sum; no loop over wavelengths.
+// multiply-adds of the Horner sum; no loop over wavelengths. Filtered: twice that when σ² > 0
+// (two levels), the same at σ² = 0.
 //
 // Robustness: non-finite or zero directions and directions at or below the horizon give 0;
 // huge components are rescaled before normalising; the layer loop is bounded by the texture's
 // own layer count; the result is always finite.
 
-// Byte layout (32 bytes; `nacre_runtime::diffraction_integrated::DiffractionIntegratedUniform`
+// Byte layout (48 bytes; `nacre_runtime::diffraction_integrated::DiffractionIntegratedUniform`
 // mirrors it):
 //
 //   offset size field
@@ -58,6 +73,11 @@
 //       16    4 max_uv: f32              u_max = 2 sin θ_max
 //       20    4 inv_gamma: f32           1/γ
 //       24    8 fresnel_ior: vec2<f32>   (n, κ) of the bulk material (fresnel_kind 1)
+//       32    4 levels: u32              L, prefiltered levels in the texture (1: the table only)
+//       36    4 footprint_filter: u32    the host's footprint filter for the adapter: 0 point
+//                                        samples, 1 filters (diffraction_colour_footprint)
+//       40    4 sigma_base_sq: f32       σ₁² of level 1
+//       44    4 slope_variance: f32      σ_m² = α²/2 of the grating's facets, for the adapter
 struct DiffractionIntegratedParams {
     size: vec2<u32>,
     layers: u32,
@@ -65,10 +85,14 @@ struct DiffractionIntegratedParams {
     max_uv: f32,
     inv_gamma: f32,
     fresnel_ior: vec2<f32>,
+    levels: u32,
+    footprint_filter: u32,
+    sigma_base_sq: f32,
+    slope_variance: f32,
 }
 
 @group(1) @binding(0) var<uniform> diffraction_integrated: DiffractionIntegratedParams;
-// Rgba32Float 2-D array, (n/2) × n × (2N + 1), unfilterable: read with textureLoad only.
+// Rgba32Float 2-D array, (n/2) × n × L (2N + 1), unfilterable: read with textureLoad only.
 @group(1) @binding(1) var diffraction_integrated_table: texture_2d_array<f32>;
 
 // The warped coordinate t = (a/u_max)^{1/γ} ∈ [0, 1] of a ≥ 0 (a above u_max clamps to 1;
@@ -79,8 +103,10 @@ fn diffraction_integrated_warp(a: f32) -> f32 {
 }
 
 // S = Σₚ wᵖ Iₚ(u, v) (header): the fold, the warped coordinates, bilinear from four loads
-// per layer, Horner from p = 2N down. 0 for non-finite input or an empty table.
-fn diffraction_integrated_sum(uvw_in: vec3<f32>) -> vec3<f32> {
+// per layer, Horner from p = 2N down; of level `level` alone when t = 0, else
+// S_ℓ + t (S_{ℓ+1} − S_ℓ) of levels ℓ = `level` and ℓ + 1 (header). 0 for non-finite input,
+// an empty table or levels past the texture.
+fn diffraction_integrated_sum_levels(uvw_in: vec3<f32>, level: u32, t: f32) -> vec3<f32> {
     if !diffraction_finite3(uvw_in) {
         return vec3<f32>(0.0);
     }
@@ -89,7 +115,9 @@ fn diffraction_integrated_sum(uvw_in: vec3<f32>) -> vec3<f32> {
     let cols = i32(min(diffraction_integrated.size.x, dims.x));
     let rows = i32(min(diffraction_integrated.size.y, dims.y));
     let layers = min(diffraction_integrated.layers, textureNumLayers(diffraction_integrated_table));
-    if cols < 2 || rows < 2 || layers == 0u {
+    let blend = t > 0.0;
+    let last = level + select(0u, 1u, blend);
+    if cols < 2 || rows < 2 || layers == 0u || (last + 1u) * layers > textureNumLayers(diffraction_integrated_table) {
         return vec3<f32>(0.0);
     }
     let half_n = 0.5 * f32(rows);
@@ -102,9 +130,11 @@ fn diffraction_integrated_sum(uvw_in: vec3<f32>) -> vec3<f32> {
     let fx = x - f32(x0);
     let fy = y - f32(y0);
     let w = uvw.z;
+    let base = i32(level * layers);
     var s = vec3<f32>(0.0);
+    var s_hi = vec3<f32>(0.0);
     for (var k = 0u; k < layers; k++) {
-        let p = i32(layers - 1u - k);
+        let p = base + i32(layers - 1u - k);
         let a = textureLoad(diffraction_integrated_table, vec2<i32>(x0, y0), p, 0).xyz;
         let b = textureLoad(diffraction_integrated_table, vec2<i32>(x0 + 1, y0), p, 0).xyz;
         let c = textureLoad(diffraction_integrated_table, vec2<i32>(x0, y0 + 1), p, 0).xyz;
@@ -112,8 +142,45 @@ fn diffraction_integrated_sum(uvw_in: vec3<f32>) -> vec3<f32> {
         let lo = a + fx * (b - a);
         let hi = c + fx * (d - c);
         s = s * w + (lo + fy * (hi - lo));
+        if blend {
+            let q = p + i32(layers);
+            let e = textureLoad(diffraction_integrated_table, vec2<i32>(x0, y0), q, 0).xyz;
+            let f = textureLoad(diffraction_integrated_table, vec2<i32>(x0 + 1, y0), q, 0).xyz;
+            let g = textureLoad(diffraction_integrated_table, vec2<i32>(x0, y0 + 1), q, 0).xyz;
+            let h = textureLoad(diffraction_integrated_table, vec2<i32>(x0 + 1, y0 + 1), q, 0).xyz;
+            let lo2 = e + fx * (f - e);
+            let hi2 = g + fx * (h - g);
+            s_hi = s_hi * w + (lo2 + fy * (hi2 - lo2));
+        }
+    }
+    if blend {
+        s = s + t * (s_hi - s);
     }
     return s;
+}
+
+// S = Σₚ wᵖ Iₚ(u, v) of the table itself (level 0).
+fn diffraction_integrated_sum(uvw_in: vec3<f32>) -> vec3<f32> {
+    return diffraction_integrated_sum_levels(uvw_in, 0u, 0.0);
+}
+
+// The level pair (ℓ, t) of the variance σ² (header): σ_ℓ² = σ₁² 4^{ℓ−1} by exact products in
+// f32, t = (σ² − σ_ℓ²)/(σ_{ℓ+1}² − σ_ℓ²) ≤ 1; (0, 0) for σ² ≤ 0, NaN or a single level
+// (`IntegratedLevels::level_weights` on the CPU).
+fn diffraction_integrated_level(sigma2: f32) -> vec2<f32> {
+    let count = diffraction_integrated.levels;
+    if !(sigma2 > 0.0) || count < 2u {
+        return vec2<f32>(0.0);
+    }
+    var l = 0u;
+    var lo = 0.0;
+    var hi = diffraction_integrated.sigma_base_sq;
+    while l + 2u < count && sigma2 > hi {
+        l += 1u;
+        lo = hi;
+        hi *= 4.0;
+    }
+    return vec2<f32>(f32(l), min((sigma2 - lo) / (hi - lo), 1.0));
 }
 
 // The colour (the table's output space) of Stam's BRDF for ω_i, ω_r in the grating frame
@@ -132,6 +199,25 @@ fn diffraction_integrated_colour(wi_in: vec3<f32>, wr_in: vec3<f32>, fresnel_kin
     let cos_h = -dot(wi, uvw) * inverseSqrt(dot(uvw, uvw));
     let f = diffraction_fresnel_of(cos_h, fresnel_kind, fresnel_ior);
     let colour = (f * g) * diffraction_integrated_sum(uvw);
+    return select(vec3<f32>(0.0), colour, diffraction_finite3(colour));
+}
+
+// diffraction_integrated_colour filtered over the spread σ² = σ_uv² + w² σ_m² in (u, v)
+// (header): `sigma_uv` the footprint's standard deviation, `slope_variance` σ_m² of the
+// facets. σ² = 0 is diffraction_integrated_colour exactly (level 0 alone). Always finite.
+fn diffraction_integrated_colour_filtered(wi_in: vec3<f32>, wr_in: vec3<f32>, sigma_uv: f32, slope_variance: f32, fresnel_kind: u32, fresnel_ior: vec2<f32>) -> vec3<f32> {
+    let wi = diffraction_unit(wi_in);
+    let wr = diffraction_unit(wr_in);
+    let g = diffraction_geometry_over_w2(wi, wr);
+    if !(g > 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let uvw = -wi - wr;
+    let cos_h = -dot(wi, uvw) * inverseSqrt(dot(uvw, uvw));
+    let f = diffraction_fresnel_of(cos_h, fresnel_kind, fresnel_ior);
+    let sigma2 = sigma_uv * sigma_uv + uvw.z * uvw.z * slope_variance;
+    let lt = diffraction_integrated_level(sigma2);
+    let colour = (f * g) * diffraction_integrated_sum_levels(uvw, u32(lt.x), lt.y);
     return select(vec3<f32>(0.0), colour, diffraction_finite3(colour));
 }
 

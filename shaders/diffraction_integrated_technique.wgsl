@@ -10,12 +10,19 @@
 // (the host's `FresnelTerm`, as the terms technique's uniform carries it).
 //
 //   diffraction_colour(ω_i, ω_r)              = diffraction_integrated_colour(ω_i, ω_r, F²)
-//   diffraction_colour_footprint(ω_i, ω_r, σ_uv, λ_ref) = diffraction_colour(ω_i, ω_r): the
-//                                               integrated tables are not filtered over the
-//                                               footprint, and their bake summed ρ u(λ) over
-//                                               the wavelengths without Stam's k², so the
-//                                               (λ_ref/λ)² weight of the terms technique is
-//                                               left out (it would need tables baked with it)
+//   diffraction_colour_footprint(ω_i, ω_r, σ_uv, λ_ref) = diffraction_integrated_colour_filtered(
+//                                               ω_i, ω_r, max(σ_u, σ_v), σ_m², F²): the prefiltered
+//                                               levels read at σ² = max(σ_u, σ_v)² + w² σ_m²
+//                                               (isotropic levels: the footprint's larger axis,
+//                                               blurring the other more than it needs rather
+//                                               than aliasing), σ_m² the uniform's
+//                                               slope_variance (a rough grating); with the
+//                                               uniform's footprint_filter 0 (`--footprint-filter off`
+//                                               on a smooth grating), diffraction_colour. The
+//                                               tables' bake summed ρ u(λ) over the wavelengths
+//                                               without Stam's k², so the (λ_ref/λ)² weight of
+//                                               the terms technique is left out (it would need
+//                                               tables baked with it)
 //   diffraction_specular_order_colour(cos θ)  = diffraction_integrated_specular_colour(cos θ, F²)
 //                                               (the mirror-lobe peak; see its comment)
 //   diffraction_fresnel(cos θ)                = diffraction_fresnel_of(cos θ, the uniform's F²)
@@ -30,7 +37,17 @@ fn diffraction_colour(wi: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
 }
 
 fn diffraction_colour_footprint(wi: vec3<f32>, wr: vec3<f32>, sigma_uv: vec2<f32>, reference_nm: f32) -> vec3<f32> {
-    return diffraction_colour(wi, wr);
+    if diffraction_integrated.footprint_filter == 0u {
+        return diffraction_colour(wi, wr);
+    }
+    return diffraction_integrated_colour_filtered(
+        wi,
+        wr,
+        max(sigma_uv.x, sigma_uv.y),
+        diffraction_integrated.slope_variance,
+        diffraction_integrated.fresnel_kind,
+        diffraction_integrated.fresnel_ior,
+    );
 }
 
 fn diffraction_specular_order_colour(cos_theta: f32) -> vec3<f32> {

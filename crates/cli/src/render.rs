@@ -176,9 +176,10 @@ pub struct RenderArgs {
     #[arg(long, value_name = "ALPHA", allow_hyphen_values = true)]
     roughness: Option<f64>,
     /// Diffraction scenes: average the grating's BRDF over each pixel's footprint (ray
-    /// differentials; a "terms" table) or point-sample it once per pixel, as before issue 37
-    /// (aliasing: a distant disc shows speckle). A rough grating's blur keeps the footprint
-    /// either way [default: on].
+    /// differentials; a "terms" table sums its bins' Gaussians, an "integrated" table reads
+    /// prefiltered levels) or point-sample it once per pixel, as before issue 37 (aliasing:
+    /// a distant disc shows speckle). A rough grating's blur keeps the footprint either way
+    /// [default: on].
     #[arg(long, value_enum, value_name = "ON|OFF")]
     footprint_filter: Option<OnOffArg>,
     /// Output PNG file.

@@ -93,6 +93,18 @@ fn rounded(f: FresnelTerm) -> FresnelTerm {
     }
 }
 
+/// The CPU twin of one probe case's filtered colour
+/// (`IntegratedLevels::colour_filtered` of the loaded levels).
+fn cpu_filtered(t: &DiffractionIntegrated, c: &ProbeCase) -> [f64; 3] {
+    t.levels.colour_filtered(
+        c.omega_i.map(f64::from),
+        c.omega_r.map(f64::from),
+        rounded(c.fresnel),
+        c.sigma_uv,
+        c.slope_variance,
+    )
+}
+
 /// The CPU twin of one probe case: (colour, specular colour).
 fn cpu(t: &DiffractionIntegrated, c: &ProbeCase) -> ([f64; 3], [f64; 3]) {
     let f = rounded(c.fresnel);
@@ -113,11 +125,22 @@ fn gpu_matches_the_cpu_evaluation() {
         4 * (2 * t.record.taylor_order + 1)
     );
     let white = white(t);
-    let case = |wi: [f64; 3], wr: [f64; 3], fresnel: FresnelTerm| ProbeCase {
-        omega_i: f32s(wi),
-        omega_r: f32s(wr),
-        fresnel,
-        cos_theta: wr[2] as f32,
+    // The filtered call of every case at one of a cycle of spreads: no filter, σ_uv from
+    // below level 1 (σ₁ = u_max/256 = 0.0055) to beyond the last level (u_max), alone and
+    // with the facets of GGX α = 0.05 and 0.3 (σ_m² = α²/2).
+    let mut counter = 0usize;
+    let mut case = |wi: [f64; 3], wr: [f64; 3], fresnel: FresnelTerm| {
+        const SIGMA: [f32; 7] = [0.0, 0.002, 0.0055, 0.013, 0.05, 0.2, 2.0];
+        const SLOPES: [f32; 3] = [0.0, 0.00125, 0.045];
+        counter += 1;
+        ProbeCase {
+            omega_i: f32s(wi),
+            omega_r: f32s(wr),
+            fresnel,
+            cos_theta: wr[2] as f32,
+            sigma_uv: SIGMA[counter % SIGMA.len()],
+            slope_variance: SLOPES[(counter / SIGMA.len()) % SLOPES.len()],
+        }
     };
     let mut cases = Vec::new();
     // In-plane sweeps across the lines, −45° … 45° every 0.25°.
@@ -181,6 +204,7 @@ fn gpu_matches_the_cpu_evaluation() {
         for (what, expected, got) in [
             ("colour", colour, g.colour),
             ("specular", specular, g.specular),
+            ("filtered", cpu_filtered(t, c), g.filtered),
         ] {
             for ch in 0..3 {
                 let e = expected[ch] / white[ch];
@@ -252,6 +276,8 @@ fn the_terms_consumers_run_on_the_integrated_table() {
                 omega_r: wr,
                 fresnel: keratin,
                 cos_theta: wr[2],
+                sigma_uv: 0.0,
+                slope_variance: 0.0,
             },
         );
         for ch in 0..3 {
@@ -314,6 +340,8 @@ fn gpu_matches_the_terms_layout_within_the_baked_tolerance() {
             omega_r: f32s(wr),
             fresnel: FresnelTerm::Unity,
             cos_theta: 1.0,
+            sigma_uv: 0.0,
+            slope_variance: 0.0,
         })
         .collect();
     let gpu = run_probe(ctx(), t, &cases).unwrap();
@@ -416,6 +444,8 @@ fn bad_inputs_give_finite_colours() {
                 omega_r: wr,
                 fresnel: FresnelTerm::Unity,
                 cos_theta: d[2],
+                sigma_uv: 0.0,
+                slope_variance: 0.0,
             });
         }
     }
@@ -434,6 +464,27 @@ fn bad_inputs_give_finite_colours() {
             omega_r: good_r,
             fresnel: FresnelTerm::Index(C64::new(f64::from(ior[0]), f64::from(ior[1]))),
             cos_theta: cos,
+            sigma_uv: 0.0,
+            slope_variance: 0.0,
+        });
+    }
+    // Bad spreads for the filtered call (NaN, negative, infinite): finite.
+    for (sigma_uv, slope_variance) in [
+        (nan, 0.0),
+        (0.0, nan),
+        (-1.0, -1.0),
+        (inf, 0.0),
+        (0.0, inf),
+        (-inf, nan),
+        (3e38, 3e38),
+    ] {
+        cases.push(ProbeCase {
+            omega_i: good_i,
+            omega_r: good_r,
+            fresnel: FresnelTerm::Unity,
+            cos_theta: 0.8,
+            sigma_uv,
+            slope_variance,
         });
     }
     // Huge and tiny but valid directions: the unit vector's colour.
@@ -444,11 +495,13 @@ fn bad_inputs_give_finite_colours() {
             omega_r: good_r.map(|x| x * s),
             fresnel: FresnelTerm::Unity,
             cos_theta: 0.8,
+            sigma_uv: 0.0,
+            slope_variance: 0.0,
         });
     }
     let out = run_probe(ctx(), t, &cases).unwrap();
     for (c, o) in cases.iter().zip(&out) {
-        for v in o.colour.iter().chain(&o.specular) {
+        for v in o.colour.iter().chain(&o.specular).chain(&o.filtered) {
             assert!(v.is_finite(), "{c:?} gave {o:?}");
         }
     }
@@ -568,7 +621,7 @@ fn the_shaders_validate_and_translate() {
         std::mem::size_of::<DiffractionIntegratedUniform>()
     );
     let offsets: Vec<u32> = members.iter().map(|m| m.offset).collect();
-    assert_eq!(offsets, [0, 8, 12, 16, 20, 24]);
+    assert_eq!(offsets, [0, 8, 12, 16, 20, 24, 32, 36, 40, 44]);
     // The terms technique's consumers (scenes, bench, probe) through the adapter.
     let (module, info) = validate(
         "diffraction_integrated + adapter + scene",
@@ -606,4 +659,34 @@ fn fs_bindingless(@builtin(position) p: vec4<f32>) -> @location(0) vec4<f32> {
         }
     }
     assert_eq!(bound, 2);
+}
+
+/// The prefiltered levels the loader adds (issue 37: the footprint filter and rough
+/// gratings): how many, their σ ladder, the texture's size against the unfiltered table's,
+/// and the time to make them (printed, not asserted: speed is the benchmarks' business).
+#[test]
+fn the_loader_prefilters_ten_levels_up_to_u_max() {
+    use nacre_optics::diffraction::integrated::{INTEGRATED_FILTER_LEVELS, IntegratedLevels};
+    let t = technique();
+    let count = t.levels.levels().len();
+    assert_eq!(count, INTEGRATED_FILTER_LEVELS);
+    assert_eq!(t.uniform.levels as usize, count);
+    let max_uv = t.table.axis().max_uv;
+    assert!((t.levels.sigma(count - 1) - max_uv).abs() < 1e-12);
+    assert_eq!(t.uniform.sigma_base_sq, t.levels.sigma_base_sq_f32());
+    let (cols, rows) = t.table.size();
+    let unfiltered = (cols * rows * t.table.layers() * 16) as u64;
+    assert_eq!(t.texture_bytes(), count as u64 * unfiltered);
+    let start = std::time::Instant::now();
+    let again = IntegratedLevels::new(&t.table, count).unwrap();
+    let seconds = start.elapsed().as_secs_f64();
+    assert_eq!(&again, &t.levels, "the same levels on every load");
+    eprintln!(
+        "{count} levels, σ₁ = {:.5} … σ_{} = {:.4} (u_max); texture {:.1} MB against {:.1} MB unfiltered; made in {seconds:.2} s",
+        t.levels.sigma(1),
+        count - 1,
+        t.levels.sigma(count - 1),
+        t.texture_bytes() as f64 / 1e6,
+        unfiltered as f64 / 1e6
+    );
 }

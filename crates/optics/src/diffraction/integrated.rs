@@ -324,6 +324,13 @@ impl IntegratedTable {
     /// coordinates of the forward mapping (clamped to the edge), bilinear weights, and
     /// the Horner sum (…(I_{2N} w + I_{2N−1}) w + …) w + I₀, all in f32.
     pub fn sum_at(&self, u: f64, v: f64, w: f64) -> [f64; 3] {
+        let at = self.lookup(u, v, w);
+        self.horner(&at).map(f64::from)
+    }
+
+    /// Where (u, v, w) reads the table: the fold, the clamped texel coordinates, the
+    /// bilinear weights and the (folded) w in f32.
+    fn lookup(&self, u: f64, v: f64, w: f64) -> Lookup {
         let (u, v, w) = if u < 0.0 { (-u, -v, -w) } else { (u, v, w) };
         let (cols, rows) = self.size();
         let split = |x: f64, n: usize| {
@@ -333,7 +340,18 @@ impl IntegratedTable {
         };
         let (x0, fx) = split(self.axis.coordinate(u) - cols as f64, cols);
         let (y0, fy) = split(self.axis.coordinate(v), rows);
-        let w = w as f32;
+        Lookup {
+            x0,
+            y0,
+            fx,
+            fy,
+            w: w as f32,
+        }
+    }
+
+    /// The f32 Horner sum of the bilinear reads at `at`.
+    fn horner(&self, at: &Lookup) -> [f32; 3] {
+        let (x0, y0, fx, fy, w) = (at.x0, at.y0, at.fx, at.fy, at.w);
         let mut acc = [0.0f32; 3];
         for p in (0..self.layers()).rev() {
             let a = self.texel(p, x0, y0);
@@ -346,7 +364,7 @@ impl IntegratedTable {
                 acc[ch] = acc[ch] * w + (lo + fy * (hi - lo));
             }
         }
-        acc.map(f64::from)
+        acc
     }
 
     /// The colour (output space) C(ω_i, ω_r) · Σₚ wᵖ Iₚ(u, v) with
@@ -482,6 +500,275 @@ impl IntegratedTable {
         errors
             .into_iter()
             .fold(0.0, |m: f64, e| if e <= m { m } else { e })
+    }
+}
+
+/// Where a point (u, v, w) reads an integrated table (the same for every level).
+#[derive(Clone, Copy, Debug)]
+struct Lookup {
+    x0: usize,
+    y0: usize,
+    fx: f32,
+    fy: f32,
+    w: f32,
+}
+
+/// Φ(z), the standard normal distribution, as ½ erfc(−z/√2).
+fn normal_cdf(z: f64) -> f64 {
+    0.5 * elementary::erfc(-z * std::f64::consts::FRAC_1_SQRT_2)
+}
+
+/// Weights below which the ends of a row of [`gaussian_weights`] are dropped (the row is
+/// renormalised): at most 2·10⁻¹² of its mass, far below the f32 storage.
+const WEIGHT_FLOOR: f64 = 1e-12;
+
+/// The weights of the nodes `nodes` (ascending) in ∫ f(u) N(u − c; σ²) du, where f is
+/// linear in u between neighbouring nodes and constant beyond the end nodes (the shader's
+/// clamp to the edge), N the normal density: per segment [a, b] of length h, with
+/// z = (u − c)/σ, P = Φ(z_b) − Φ(z_a) and M = ∫ₐᵇ (u − c) N du = σ (φ(z_a) − φ(z_b)),
+/// node b gets ((c − a) P + M)/h and node a gets P minus that; the end nodes get the tails
+/// Φ(z₀) and Φ(−z_last). Returned as (first node, weights), trimmed of ends below
+/// [`WEIGHT_FLOOR`] and normalised to sum 1.
+fn gaussian_weights(nodes: &[f64], c: f64, sigma: f64) -> (usize, Vec<f64>) {
+    let m = nodes.len();
+    let z = |u: f64| (u - c) / sigma;
+    let pdf = |z: f64| elementary::exp(-0.5 * z * z) / (2.0 * std::f64::consts::PI).sqrt();
+    let mut w = vec![0.0f64; m];
+    w[0] += normal_cdf(z(nodes[0]));
+    w[m - 1] += normal_cdf(-z(nodes[m - 1]));
+    for j in 0..m - 1 {
+        let (a, b) = (nodes[j], nodes[j + 1]);
+        let (za, zb) = (z(a), z(b));
+        if za > 40.0 || zb < -40.0 {
+            continue;
+        }
+        // Both in the upper tail: the difference of the complements keeps its digits.
+        let p = if za > 0.0 {
+            normal_cdf(-za) - normal_cdf(-zb)
+        } else {
+            normal_cdf(zb) - normal_cdf(za)
+        };
+        let mean = sigma * (pdf(za) - pdf(zb));
+        let to_b = ((c - a) * p + mean) / (b - a);
+        w[j + 1] += to_b;
+        w[j] += p - to_b;
+    }
+    let first = w.iter().position(|x| x.abs() > WEIGHT_FLOOR).unwrap_or(0);
+    let last = w
+        .iter()
+        .rposition(|x| x.abs() > WEIGHT_FLOOR)
+        .unwrap_or(m - 1)
+        .max(first);
+    let kept = &w[first..=last];
+    let sum: f64 = kept.iter().sum();
+    (first, kept.iter().map(|x| x / sum).collect())
+}
+
+impl IntegratedTable {
+    /// The table blurred by an isotropic Gaussian of standard deviation `sigma_uv` per axis
+    /// in (u, v) — in u and v, not in texel coordinates: the axes are warped —
+    /// Iₚ^σ(u, v) = ∬ Iₚ(u′, v′) N(u′ − u; σ²) N(v′ − v; σ²) du′ dv′ at every texel centre,
+    /// with Iₚ between the texel centres as the shader reads it (linear between
+    /// neighbouring centres, taken linear in u rather than in the warped coordinate: they
+    /// differ only within a texel, to second order) and clamped beyond the edge texels.
+    /// The blur is separable: v first (every column), then u, where u′ < 0 is the folded
+    /// half Iₚ(u′, v) = (−1)ᵖ Iₚ(−u′, −v) (rows r and n − 1 − r hold ±v): a v-blurred
+    /// layer keeps the point symmetry, so the shader's fold holds for every level. Weights
+    /// by [`gaussian_weights`] (exact for that piecewise-linear Iₚ); sums in f64, stored in
+    /// f32. σ ≤ 0 or not finite returns the table itself. Layers in parallel, each summed in
+    /// a fixed order: the values do not depend on the thread count.
+    ///
+    /// As Iₚ enters the colour linearly, Σₚ wᵖ Iₚ^σ is the colour's (u, v) blur at fixed w:
+    /// the mean of the BRDF over a footprint of that spread (issue 37, item 3), and the
+    /// two-scale model's facet average (item 4): a facet of slope s moves (u, v) by w s.
+    pub fn blurred(&self, sigma_uv: f64) -> IntegratedTable {
+        if !(sigma_uv > 0.0 && sigma_uv.is_finite()) {
+            return self.clone();
+        }
+        let n = self.axis.count;
+        let half = n / 2;
+        let nodes: Vec<f64> = (0..n).map(|i| self.axis.texel_centre(i)).collect();
+        let along_v: Vec<(usize, Vec<f64>)> = nodes
+            .iter()
+            .map(|&v| gaussian_weights(&nodes, v, sigma_uv))
+            .collect();
+        let along_u: Vec<(usize, Vec<f64>)> = nodes[half..]
+            .iter()
+            .map(|&u| gaussian_weights(&nodes, u, sigma_uv))
+            .collect();
+        let blocks: Vec<Vec<[f32; 3]>> = (0..self.layers())
+            .into_par_iter()
+            .map(|p| {
+                // v first: j[r * half + c].
+                let mut j = vec![[0.0f64; 3]; n * half];
+                for (r, (first, weights)) in along_v.iter().enumerate() {
+                    let out = &mut j[r * half..(r + 1) * half];
+                    for (k, &wk) in weights.iter().enumerate() {
+                        for (c, o) in out.iter_mut().enumerate() {
+                            let t = self.texel(p, c, first + k);
+                            for ch in 0..3 {
+                                o[ch] += wk * f64::from(t[ch]);
+                            }
+                        }
+                    }
+                }
+                // Then u over the whole axis: node i ≥ n/2 is column i − n/2; node i < n/2
+                // is column n/2 − 1 − i of row n − 1 − r, times (−1)ᵖ.
+                let sign = if p % 2 == 0 { 1.0 } else { -1.0 };
+                let mut out = vec![[0.0f32; 3]; n * half];
+                for r in 0..n {
+                    for (c, (first, weights)) in along_u.iter().enumerate() {
+                        let mut acc = [0.0f64; 3];
+                        for (k, &wk) in weights.iter().enumerate() {
+                            let i = first + k;
+                            let (value, s) = if i >= half {
+                                (j[r * half + i - half], wk)
+                            } else {
+                                (j[(n - 1 - r) * half + half - 1 - i], sign * wk)
+                            };
+                            for ch in 0..3 {
+                                acc[ch] += s * value[ch];
+                            }
+                        }
+                        out[r * half + c] = acc.map(|x| x as f32);
+                    }
+                }
+                out
+            })
+            .collect();
+        IntegratedTable {
+            axis: self.axis,
+            order: self.order,
+            values: blocks.concat(),
+        }
+    }
+}
+
+/// Prefiltered levels most integrated tables get ([`IntegratedLevels::new`]): the table and
+/// 9 blurs, σ from u_max/256 to u_max.
+pub const INTEGRATED_FILTER_LEVELS: usize = 10;
+
+/// An integrated table with prefiltered copies of its layers, for the lookup filtered over
+/// a spread σ in (u, v) (issue 37, items 3 and 4): level 0 is the table, level ℓ ≥ 1 the
+/// table [`IntegratedTable::blurred`] by σ_ℓ = σ₁ 2^{ℓ−1}, σ₁ = u_max / 2^{L−2} (L levels,
+/// so the last is u_max: a blur as wide as the table). Every level has the table's axes and
+/// size (a shader reads them with the same texel coordinates).
+///
+/// The filtered sum at a variance σ² between two levels' σ_ℓ² ≤ σ² ≤ σ_{ℓ+1}² (σ₀ = 0) is
+///
+/// ```text
+/// S_σ = (1 − t) S_ℓ + t S_{ℓ+1},   t = (σ² − σ_ℓ²)/(σ_{ℓ+1}² − σ_ℓ²),
+/// ```
+///
+/// interpolated in σ², so the kernel (a mixture of the two Gaussians, each of mass 1) keeps
+/// the energy and has exactly the variance σ² per axis; above the last level t is clamped
+/// to 1. The level pair is found by a loop over σ_ℓ² = σ₁² 4^{ℓ−1} in f32 (products by 4
+/// are exact), the arithmetic the shader repeats.
+#[derive(Clone, Debug, PartialEq)]
+pub struct IntegratedLevels {
+    levels: Vec<IntegratedTable>,
+    sigma_base: f64,
+}
+
+impl IntegratedLevels {
+    /// `count` levels of `table` (level 0 the table itself; 1 = no filter).
+    ///
+    /// # Errors
+    /// [`Error::OutOfRange`] for `count` outside 1 … 16.
+    pub fn new(table: &IntegratedTable, count: usize) -> Result<Self> {
+        if !(1..=16).contains(&count) {
+            return Err(Error::OutOfRange {
+                what: "prefiltered levels of an integrated table",
+                value: count as f64,
+                expected: "1 to 16",
+            });
+        }
+        let sigma_base = table.axis.max_uv / elementary::powi(2.0, count as i32 - 2);
+        let mut levels = vec![table.clone()];
+        let blurred: Vec<IntegratedTable> = (1..count)
+            .map(|l| table.blurred(sigma_base * elementary::powi(2.0, l as i32 - 1)))
+            .collect();
+        levels.extend(blurred);
+        Ok(IntegratedLevels { levels, sigma_base })
+    }
+
+    /// The levels, 0 (the table) first.
+    pub fn levels(&self) -> &[IntegratedTable] {
+        &self.levels
+    }
+
+    /// σ₁, the spread of level 1 in (u, v).
+    pub fn sigma_base(&self) -> f64 {
+        self.sigma_base
+    }
+
+    /// σ₁² as the shader takes it (f32).
+    pub fn sigma_base_sq_f32(&self) -> f32 {
+        (self.sigma_base * self.sigma_base) as f32
+    }
+
+    /// σ_ℓ of level ℓ (0 for level 0).
+    pub fn sigma(&self, level: usize) -> f64 {
+        if level == 0 {
+            0.0
+        } else {
+            self.sigma_base * elementary::powi(2.0, level as i32 - 1)
+        }
+    }
+
+    /// (ℓ, t) for the variance σ² (f32, as the shader): S = (1 − t) S_ℓ + t S_{ℓ+1}
+    /// (type docs); (0, 0) for σ² ≤ 0, NaN or a single level.
+    pub fn level_weights(sigma2: f32, sigma_base_sq: f32, count: usize) -> (usize, f32) {
+        if !(sigma2 > 0.0) || count < 2 {
+            return (0, 0.0);
+        }
+        let (mut l, mut lo, mut hi) = (0usize, 0.0f32, sigma_base_sq);
+        while l + 2 < count && sigma2 > hi {
+            l += 1;
+            lo = hi;
+            hi *= 4.0;
+        }
+        (l, ((sigma2 - lo) / (hi - lo)).min(1.0))
+    }
+
+    /// Σₚ wᵖ Iₚ filtered by the variance σ² per axis in (u, v) (type docs), in f32 as the
+    /// shader: the Horner sums of levels ℓ and ℓ + 1 at the same texel coordinates, then
+    /// S_ℓ + t (S_{ℓ+1} − S_ℓ); level ℓ alone when t = 0.
+    pub fn sum_filtered(&self, u: f64, v: f64, w: f64, sigma2: f32) -> [f64; 3] {
+        let (l, t) = Self::level_weights(sigma2, self.sigma_base_sq_f32(), self.levels.len());
+        let at = self.levels[0].lookup(u, v, w);
+        let lo = self.levels[l].horner(&at);
+        if !(t > 0.0) {
+            return lo.map(f64::from);
+        }
+        let hi = self.levels[l + 1].horner(&at);
+        std::array::from_fn(|c| f64::from(lo[c] + t * (hi[c] - lo[c])))
+    }
+
+    /// The colour C(ω_i, ω_r) · S_σ (as [`IntegratedTable::colour`], the sum filtered) for
+    /// a footprint of spread `sigma_uv` in (u, v) and microfacets of slope variance
+    /// `slope_variance` σ_m² per axis: σ² = σ_uv² + w² σ_m² in f32 (the variances of
+    /// independent spreads add; a facet of slope s moves (u, v) by w s). σ² = 0 is
+    /// [`IntegratedTable::colour`] of level 0 exactly.
+    pub fn colour_filtered(
+        &self,
+        omega_i: [f64; 3],
+        omega_r: [f64; 3],
+        fresnel: FresnelTerm,
+        sigma_uv: f32,
+        slope_variance: f32,
+    ) -> [f64; 3] {
+        let g = geometry_over_w2(omega_i, omega_r);
+        if g == 0.0 {
+            return [0.0; 3];
+        }
+        let [u, v, w] = std::array::from_fn(|i| -omega_i[i] - omega_r[i]);
+        let cos_h =
+            -(omega_i[0] * u + omega_i[1] * v + omega_i[2] * w) / (u * u + v * v + w * w).sqrt();
+        let c = fresnel.reflectance(cos_h) * g;
+        let wf = w as f32;
+        let sigma2 = sigma_uv * sigma_uv + wf * wf * slope_variance;
+        self.sum_filtered(u, v, w, sigma2).map(|s| c * s)
     }
 }
 

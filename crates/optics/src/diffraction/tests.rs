@@ -538,3 +538,107 @@ fn f32_storage_cancels_for_tall_structures_only() {
     assert!(errors[0] < 1e-5, "{errors:?}");
     assert!(errors[1] > 1.0, "{errors:?}");
 }
+
+/// A table of order `order` whose layer p holds `f(p, u, v)` at the texel centres.
+fn integrated_from_fn(
+    axis: super::integrated::WarpedAxis,
+    order: usize,
+    f: impl Fn(usize, f64, f64) -> f64,
+) -> super::integrated::IntegratedTable {
+    let n = axis.count;
+    let half = n / 2;
+    let mut values = Vec::new();
+    for p in 0..2 * order + 1 {
+        for iv in 0..n {
+            for c in 0..half {
+                let x = f(p, axis.texel_centre(half + c), axis.texel_centre(iv)) as f32;
+                values.push([x, 0.5 * x, -x]);
+            }
+        }
+    }
+    super::integrated::IntegratedTable::from_values(axis, order, values).unwrap()
+}
+
+/// A normalised 2-D Gaussian of variance s2 per axis centred at (u0, v0).
+fn bump(u: f64, v: f64, u0: f64, v0: f64, s2: f64) -> f64 {
+    let d2 = (u - u0) * (u - u0) + (v - v0) * (v - v0);
+    (-0.5 * d2 / s2).exp() / (2.0 * std::f64::consts::PI * s2)
+}
+
+#[test]
+fn integrated_blur_is_a_gaussian_in_uv_on_both_halves_and_warped_axes() {
+    use super::integrated::WarpedAxis;
+    // Layer 0: a bump at (0.3, 0.1) and its point twin at (−0.3, −0.1) (even p); layer 1:
+    // a bump at (0.02, 0.2) minus its twin at (−0.02, −0.2) (odd p: Iₚ(−u, −v) = −Iₚ(u, v)),
+    // whose blur reaches across u = 0 into the folded half. A Gaussian of variance s0²
+    // blurred by σ² is the Gaussian of variance s0² + σ² with the same mass.
+    let (s0, sigma) = (0.05f64, 0.04f64);
+    let even = |u: f64, v: f64, s2: f64| bump(u, v, 0.3, 0.1, s2) + bump(u, v, -0.3, -0.1, s2);
+    let odd = |u: f64, v: f64, s2: f64| bump(u, v, 0.02, 0.2, s2) - bump(u, v, -0.02, -0.2, s2);
+    let layer = |p: usize, u: f64, v: f64, s2: f64| match p {
+        0 => even(u, v, s2),
+        1 => odd(u, v, s2),
+        _ => 0.0,
+    };
+    for gamma in [1.0, 2.0] {
+        let axis = WarpedAxis::new(1.0, gamma, 256).unwrap();
+        let table = integrated_from_fn(axis, 1, |p, u, v| layer(p, u, v, s0 * s0));
+        let blurred = table.blurred(sigma);
+        let s2 = s0 * s0 + sigma * sigma;
+        let peak = bump(0.0, 0.0, 0.0, 0.0, s2);
+        let mut worst: f64 = 0.0;
+        for c in (0..128).step_by(3) {
+            for iv in (0..256).step_by(5) {
+                let (u, v) = (axis.texel_centre(128 + c), axis.texel_centre(iv));
+                for p in 0..2 {
+                    let want = layer(p, u, v, s2);
+                    let got = f64::from(blurred.texel(p, c, iv)[0]);
+                    worst = worst.max((got - want).abs() / peak);
+                }
+            }
+        }
+        eprintln!("γ = {gamma}: blurred bumps within {worst:.2e} of the peak");
+        assert!(worst < 0.01, "γ = {gamma}: {worst}");
+        // σ = 0 is the table itself.
+        assert_eq!(table.blurred(0.0), table);
+    }
+}
+
+#[test]
+fn integrated_levels_interpolate_in_sigma_squared_and_start_at_the_table() {
+    use super::integrated::{IntegratedLevels, WarpedAxis};
+    let axis = WarpedAxis::new(1.0, 3.0, 256).unwrap();
+    let s0 = 0.03f64;
+    let table = integrated_from_fn(axis, 0, |_, u, v| {
+        bump(u, v, 0.4, 0.0, s0 * s0) + bump(u, v, -0.4, 0.0, s0 * s0)
+    });
+    let levels = IntegratedLevels::new(&table, 6).unwrap();
+    assert_eq!(levels.levels().len(), 6);
+    assert_eq!(levels.sigma(5), 1.0);
+    assert_eq!(levels.sigma(1), 1.0 / 16.0);
+    // σ² = 0 reads the table exactly.
+    for (u, v, w) in [(0.4, 0.0, -2.0), (0.1, -0.3, -1.5), (-0.4, 0.02, -1.8)] {
+        assert_eq!(levels.sum_filtered(u, v, w, 0.0), table.sum_at(u, v, w));
+    }
+    // (ℓ, t): level pairs bracket σ², t linear in σ² and clamped above the last level.
+    let b = levels.sigma_base_sq_f32();
+    assert_eq!(IntegratedLevels::level_weights(0.5 * b, b, 6), (0, 0.5));
+    assert_eq!(IntegratedLevels::level_weights(b, b, 6), (0, 1.0));
+    assert_eq!(IntegratedLevels::level_weights(2.5 * b, b, 6), (1, 0.5));
+    assert_eq!(IntegratedLevels::level_weights(1e3, b, 6), (4, 1.0));
+    assert_eq!(IntegratedLevels::level_weights(f32::NAN, b, 6), (0, 0.0));
+    assert_eq!(IntegratedLevels::level_weights(1.0, b, 1), (0, 0.0));
+    // Continuous across a level boundary, and the peak falls as the spread grows, with the
+    // mass of a Gaussian of variance s0² + σ² (the peak ∝ 1/(s0² + σ²)).
+    let at = |s2: f32| levels.sum_filtered(0.4, 0.0, -2.0, s2)[0];
+    let edge = 4.0 * b;
+    assert!((at(edge * (1.0 - 1e-6)) - at(edge * (1.0 + 1e-6))).abs() < 1e-3 * at(edge));
+    for s2 in [b, 4.0 * b, 16.0 * b] {
+        let want = bump(0.0, 0.0, 0.0, 0.0, s0 * s0 + f64::from(s2));
+        assert!(
+            (at(s2) / want - 1.0).abs() < 0.02,
+            "σ² {s2}: {} vs {want}",
+            at(s2)
+        );
+    }
+}

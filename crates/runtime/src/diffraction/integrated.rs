@@ -18,17 +18,25 @@
 //!
 //! # Upload
 //!
-//! One 2-D array texture, `Rgba32Float`, n/2 × n texels (u ≥ 0 columns, v rows), 2N + 1
-//! layers, layer p = (Iₚ ch 0, ch 1, ch 2, 0) — the layout of the table's KTX2 file. The
-//! texels come from the EXR file, else the KTX2 file
-//! ([`nacre_format::Manifest::load_diffraction_integrated`]); every file is checked
+//! One 2-D array texture, `Rgba32Float`, n/2 × n texels (u ≥ 0 columns, v rows),
+//! L (2N + 1) layers, layer ℓ (2N + 1) + p = (Iₚ ch 0, ch 1, ch 2, 0) of level ℓ: level 0
+//! the table as its KTX2 file holds it, levels 1 … L − 1 the table blurred in (u, v) by
+//! σ_ℓ = σ₁ 2^{ℓ−1}, σ₁ = u_max/2^{L−2} ([`IntegratedLevels`], made here at load time:
+//! L = [`INTEGRATED_FILTER_LEVELS`] = 10 where the device takes L (2N + 1) layers, fewer
+//! otherwise). For `cd-tracks-fast` (72 × 144 texels, 23 layers) that is 230 layers,
+//! 38 MB on the GPU against 3.8 MB unfiltered, and 0.3 s of load (measured by
+//! `crates/runtime/tests/diffraction_integrated.rs`). The levels serve the lookup filtered
+//! over a pixel's footprint and a rough grating's facets (issue 37;
+//! `diffraction_integrated_colour_filtered`, CPU twin
+//! [`IntegratedLevels::colour_filtered`]). The texels come from the EXR file, else the KTX2
+//! file ([`nacre_format::Manifest::load_diffraction_integrated`]); every file is checked
 //! against its manifest's SHA-256 and the texture against the device's limits first.
 //!
 //! # Bind group (group 1 of a pipeline; fragment and compute)
 //!
 //! | binding | resource | WGSL |
 //! |---|---|---|
-//! | 0 | uniform [`DiffractionIntegratedUniform`] (32 bytes): layer size, 2N + 1, u_max, 1/γ, the host's F² | `diffraction_integrated: DiffractionIntegratedParams` |
+//! | 0 | uniform [`DiffractionIntegratedUniform`] (48 bytes): layer size, 2N + 1, u_max, 1/γ, the host's F², levels L, σ₁², the scene's filter and σ_m² | `diffraction_integrated: DiffractionIntegratedParams` |
 //! | 1 | the table, `texture_2d_array<f32>`, unfilterable (`textureLoad` only) | `diffraction_integrated_table` |
 //!
 //! # Using it from a scene shader
@@ -57,11 +65,12 @@
 //! # Cost
 //!
 //! 4 (2N + 1) texel loads and 3 (2N + 1) multiply-adds per call (the CD table, N = 11: 92
-//! loads), independent of the number of wavelengths; the terms technique loads
+//! loads; the filtered call twice that between two levels), independent of the number of
+//! wavelengths; the terms technique loads
 //! ⌈(N + 1)/2⌉ layers per bin for (2R + 1)² bins per wavelength (the CD table at 5 nm:
 //! 6 × 25 × 81 = 12 150 loads).
 
-use super::common::{check_array_limits, dispatch_probe, upload_rgba32f_array};
+use super::common::{allocated_layers, check_array_limits, dispatch_probe, upload_rgba32f_array};
 use crate::context::{BufferInitExt, GpuContext};
 use crate::error::{Error, Result};
 use crate::shaders;
@@ -72,7 +81,9 @@ use nacre_format::diffraction::DiffractionRecord;
 use nacre_format::diffraction::IntegratedRecord;
 use nacre_optics::colour::Colorimeter;
 use nacre_optics::diffraction::FresnelTerm;
-use nacre_optics::diffraction::integrated::IntegratedTable;
+use nacre_optics::diffraction::integrated::{
+    INTEGRATED_FILTER_LEVELS, IntegratedLevels, IntegratedTable,
+};
 use std::path::{Path, PathBuf};
 
 /// The technique module, layout "integrated" ([`crate::diffraction::DIFFRACTION_COMMON`],
@@ -120,7 +131,7 @@ pub fn scene_composition() -> shaders::Composed {
         .expect("the diffraction modules resolve (tested)")
 }
 
-/// Mirror of `DiffractionIntegratedParams` (shaders/diffraction_integrated.wgsl, 32 bytes).
+/// Mirror of `DiffractionIntegratedParams` (shaders/diffraction_integrated.wgsl, 48 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct DiffractionIntegratedUniform {
@@ -136,6 +147,16 @@ pub struct DiffractionIntegratedUniform {
     pub inv_gamma: f32,
     /// (n, κ) of the bulk material (`fresnel_kind` 1).
     pub fresnel_ior: [f32; 2],
+    /// L, the prefiltered levels in the texture (1: the table only).
+    pub levels: u32,
+    /// The footprint filter of [`TECHNIQUE_ADAPTER`]'s `diffraction_colour_footprint`: 0
+    /// point-samples, 1 filters (a scene pass sets it; the table's own uniform has 1).
+    pub footprint_filter: u32,
+    /// σ₁² of level 1 ([`IntegratedLevels::sigma_base_sq_f32`]).
+    pub sigma_base_sq: f32,
+    /// σ_m² = α²/2, the slope variance of a rough grating's facets per axis, for
+    /// [`TECHNIQUE_ADAPTER`] (a scene pass sets it; 0 in the table's own uniform).
+    pub slope_variance: f32,
 }
 
 /// (kind, (n, κ)) of `fresnel` as the shader takes it.
@@ -170,6 +191,9 @@ pub struct DiffractionIntegrated {
     pub integrated: IntegratedRecord,
     /// The table as uploaded (f32 values), for CPU twins ([`IntegratedTable::colour`]).
     pub table: IntegratedTable,
+    /// The table and its prefiltered levels as uploaded, for the filtered CPU twin
+    /// ([`IntegratedLevels::colour_filtered`]).
+    pub levels: IntegratedLevels,
     /// The 2-D array `Rgba32Float` texture (module docs).
     pub texture: wgpu::Texture,
     /// The uniform as uploaded.
@@ -246,6 +270,14 @@ impl DiffractionIntegrated {
             )));
         }
         let axis = table.axis();
+        // As many prefiltered levels (up to INTEGRATED_FILTER_LEVELS) as the device's array
+        // layers take.
+        let max_layers = ctx.device.limits().max_texture_array_layers as usize;
+        let count = (1..=INTEGRATED_FILTER_LEVELS)
+            .rev()
+            .find(|l| allocated_layers([cols, rows, l * layers]) <= max_layers)
+            .unwrap_or(1);
+        let levels = IntegratedLevels::new(&table, count).map_err(|e| bad(e.to_string()))?;
         let uniform = DiffractionIntegratedUniform {
             size: [cols as u32, rows as u32],
             layers: layers as u32,
@@ -253,15 +285,20 @@ impl DiffractionIntegrated {
             max_uv: axis.max_uv as f32,
             inv_gamma: (1.0 / axis.gamma) as f32,
             fresnel_ior,
+            levels: count as u32,
+            footprint_filter: 1,
+            sigma_base_sq: levels.sigma_base_sq_f32(),
+            slope_variance: 0.0,
         };
-        let texels: Vec<f32> = table
-            .values()
+        let texels: Vec<f32> = levels
+            .levels()
             .iter()
+            .flat_map(|level| level.values())
             .flat_map(|v| [v[0], v[1], v[2], 0.0])
             .collect();
         let name = manifest.name.clone();
         let device = &ctx.device;
-        let texture = upload_rgba32f_array(ctx, &name, [cols, rows, layers], &texels)?;
+        let texture = upload_rgba32f_array(ctx, &name, [cols, rows, count * layers], &texels)?;
         let (layout, bind_group) =
             ctx.checked("binding an integrated diffraction table", || {
                 let visibility = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
@@ -328,10 +365,49 @@ impl DiffractionIntegrated {
             record,
             integrated,
             table,
+            levels,
             texture,
             uniform,
             layout,
             bind_group,
+        })
+    }
+
+    /// A bind group of group 1 ([`Self::bind_group_layout`]) with this table's texture and
+    /// `uniform` in place of its own (a scene pass's footprint filter and slope variance).
+    ///
+    /// # Errors
+    /// [`Error::Gpu`] or [`Error::DeviceLost`] from the device.
+    pub fn bind_group_with(
+        &self,
+        ctx: &GpuContext,
+        uniform: &DiffractionIntegratedUniform,
+    ) -> Result<wgpu::BindGroup> {
+        let device = &ctx.device;
+        ctx.checked("binding an integrated diffraction table", || {
+            let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("DiffractionIntegratedParams"),
+                contents: bytemuck::bytes_of(uniform),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            let view = self.texture.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                ..Default::default()
+            });
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("diffraction integrated technique"),
+                layout: &self.layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: buffer.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: wgpu::BindingResource::TextureView(&view),
+                    },
+                ],
+            })
         })
     }
 
@@ -355,6 +431,12 @@ impl DiffractionIntegrated {
     pub fn texel_loads_per_call(&self) -> usize {
         4 * self.table.layers()
     }
+
+    /// Bytes of the texture on the GPU (`Rgba32Float`, every level and any extra layer).
+    pub fn texture_bytes(&self) -> u64 {
+        let s = self.texture.size();
+        u64::from(s.width) * u64::from(s.height) * u64::from(s.depth_or_array_layers) * 16
+    }
 }
 
 /// One probe evaluation: a light/view pair in the grating frame (any values, unit or not,
@@ -369,6 +451,10 @@ pub struct ProbeCase {
     pub fresnel: FresnelTerm,
     /// cos θ of the specular-colour call.
     pub cos_theta: f32,
+    /// σ_uv of the filtered call (`diffraction_integrated_colour_filtered`).
+    pub sigma_uv: f32,
+    /// σ_m² of the filtered call.
+    pub slope_variance: f32,
 }
 
 /// One probe result.
@@ -378,6 +464,9 @@ pub struct ProbeOutput {
     pub colour: [f32; 3],
     /// `diffraction_integrated_specular_colour(cos θ, F²)`.
     pub specular: [f32; 3],
+    /// `diffraction_integrated_colour_filtered(ω_i, ω_r, σ_uv, σ_m², F²)` ([`run_probe`]
+    /// only; 0 from [`run_scene_probe`]).
+    pub filtered: [f32; 3],
 }
 
 /// Evaluates the technique for every case in a compute pass
@@ -401,24 +490,27 @@ pub fn run_probe(
             let (i, r) = (c.omega_i, c.omega_r);
             [
                 [i[0], i[1], i[2], kind],
-                [r[0], r[1], r[2], 0.0],
-                [ior[0], ior[1], c.cos_theta, 0.0],
+                [r[0], r[1], r[2], c.sigma_uv],
+                [ior[0], ior[1], c.cos_theta, c.slope_variance],
             ]
         })
         .collect();
+    // Four vec4 per case: twice the dispatcher's two (the probe shader's header).
     let values = dispatch_probe(
         ctx,
         &probe_composition(),
         "diffraction_integrated_probe",
         (technique.bind_group_layout(), technique.bind_group()),
         &input,
-        cases.len(),
+        2 * cases.len(),
     )?;
     Ok(values
-        .chunks_exact(2)
+        .chunks_exact(4)
+        .take(cases.len())
         .map(|c| ProbeOutput {
             colour: [c[0][0], c[0][1], c[0][2]],
             specular: [c[1][0], c[1][1], c[1][2]],
+            filtered: [c[2][0], c[2][1], c[2][2]],
         })
         .collect())
 }
@@ -454,6 +546,7 @@ pub fn run_scene_probe(
         .map(|c| ProbeOutput {
             colour: [c[0][0], c[0][1], c[0][2]],
             specular: [c[1][0], c[1][1], c[1][2]],
+            filtered: [0.0; 3],
         })
         .collect())
 }

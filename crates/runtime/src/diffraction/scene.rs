@@ -613,10 +613,20 @@ impl ScenePass {
                         fresnel: format!("{:?}", technique.fresnel),
                     });
                 }
+                // The footprint filter (off: point samples, as before issue 37) and a rough
+                // grating's facets, which blur with or without it.
+                let slope_variance = lights.roughness[0];
+                let uniform = integrated::DiffractionIntegratedUniform {
+                    footprint_filter: u32::from(
+                        technique.filter_radius.is_some() || slope_variance > 0.0,
+                    ),
+                    slope_variance,
+                    ..t.uniform
+                };
                 (
                     SceneTechnique::Integrated {
                         layout: t.bind_group_layout().clone(),
-                        bind_group: t.bind_group().clone(),
+                        bind_group: t.bind_group_with(ctx, &uniform)?,
                     },
                     integrated::scene_composition(),
                 )

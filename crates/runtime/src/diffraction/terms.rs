@@ -217,8 +217,9 @@ pub struct DiffractionOptions {
     /// grow to as a pixel's footprint widens (default [`MAX_FILTER_RADIUS`]; at least the
     /// table's own radius R, at most [`MAX_FILTER_RADIUS`] and the table's half-size; 0 keeps
     /// R: the filter's weights without the wider neighbourhood). `None`: no filter, one point
-    /// sample of the BRDF per pixel (what the scenes drew before issue 37). Layout "terms"
-    /// only.
+    /// sample of the BRDF per pixel (what the scenes drew before issue 37). An "integrated"
+    /// table filters through its prefiltered levels instead (`Some` of any radius; `None`
+    /// point-samples a smooth grating: `shaders/diffraction_integrated_technique.wgsl`).
     pub filter_radius: Option<i32>,
 }
 
