@@ -21,9 +21,10 @@
 //
 // where each Σ_λ (λ₀/λ)² ρ u is filtered over the pixel's footprint (diffraction_colour_footprint,
 // issue 37: the footprint's σ_uv from the neighbouring pixels' rays, scene_footprint below;
-// the integrated layout's adapter point-samples); a rough grating's light is its lobes
-// blurred by the footprint and the microfacets' slopes instead (scene_rough_light, the
-// two-scale model).
+// the integrated layout's adapter reads prefiltered levels); a rough grating's light is its
+// lobes blurred by the footprint and the microfacets' slopes instead (scene_rough_light, the
+// two-scale model), or, with an integrated table (no lobes: lobe_wavelength_count 0), its
+// footprint filter widened by the slopes (the adapter's σ² = σ_uv² + w² σ_m²).
 //
 // I_k = E_k · (σ_s k₀)²/π is the radiance of source k's mirror image spread over the
 // coherence lobe (E_k its irradiance at normal incidence, k₀ = 2π/λ₀, λ₀ = 555 nm; computed
@@ -502,7 +503,7 @@ fn scene_shade(s: Surface, to_eye: vec3<f32>, around: array<Neighbour, 4>) -> ve
         let wi = frame * light;
         let fp_light = scene_footprint(light, frame, wr, around);
         var diffracted: vec3<f32>;
-        if lights.roughness.x > 0.0 {
+        if lights.roughness.x > 0.0 && lights.lobe_wavelength_count > 0u {
             diffracted = scene_rough_light(wi, wr, fp_light) * (light_radiance * max(wi.z, 0.0));
         } else {
             diffracted = diffraction_colour_footprint(wi, wr, fp_light, SCENE_LOBE_REFERENCE_NM) * (light_radiance * max(wi.z, 0.0));

@@ -171,8 +171,9 @@ pub struct RenderArgs {
     env_samples: Option<usize>,
     /// Diffraction scenes: GGX roughness α of the grating's microfacets, 0 to 1 (a brushed
     /// or scratched grating, a CD's worn coat): the two-scale model, every order blurred by
-    /// the facets' slopes (docs/architecture.md, "Rough gratings"); a "terms" table only
-    /// [default: 0, a smooth grating].
+    /// the facets' slopes (docs/architecture.md, "Rough gratings"); a "terms" table blurs its
+    /// environment lobes (not with --env-samples), an "integrated" table its prefiltered
+    /// levels [default: 0, a smooth grating].
     #[arg(long, value_name = "ALPHA", allow_hyphen_values = true)]
     roughness: Option<f64>,
     /// Diffraction scenes: average the grating's BRDF over each pixel's footprint (ray
@@ -471,13 +472,6 @@ fn run_render_diffraction(
             )
             .into());
         }
-        if alpha > 0.0 && args.env_samples.is_some() {
-            return Err(nacre_bake::error::Error::invalid(
-                Param::Roughness,
-                format!("{alpha}: a rough grating is drawn through the table's environment lobes, which --env-samples replaces: leave --env-samples out"),
-            )
-            .into());
-        }
         options.roughness = alpha;
     }
     // Check the settings and read every input before starting the GPU: bad input fails fast.
@@ -498,6 +492,13 @@ fn run_render_diffraction(
     let layout = DiffractionLayout::of(&record, &path)?;
     let sum = match layout {
         DiffractionLayout::Terms { .. } => {
+            if options.roughness > 0.0 && args.env_samples.is_some() {
+                return Err(nacre_bake::error::Error::invalid(
+                    Param::Roughness,
+                    format!("{}: a rough grating on a \"terms\" table (`{}`) is drawn through the table's environment lobes, which --env-samples replaces: leave --env-samples out, or use an \"integrated\" table (e.g. cd-tracks-fast)", options.roughness, manifest.name),
+                )
+                .into());
+            }
             let step_nm = args.wavelength_step.unwrap_or(DEFAULT_WAVELENGTH_STEP_NM);
             wavelength_grid(&record, Some(step_nm)).map_err(|_| {
                 nacre_bake::error::Error::invalid(
@@ -513,16 +514,6 @@ fn run_render_diffraction(
         }
         DiffractionLayout::Integrated { .. } => {
             refuse_step_for_integrated(Param::WavelengthStep, args.wavelength_step, &manifest)?;
-            if options.roughness > 0.0 {
-                return Err(nacre_bake::error::Error::invalid(
-                    Param::Roughness,
-                    format!(
-                        "{}: table `{}` has the layout \"integrated\", which is point-sampled; a rough grating is drawn by the footprint filter of a \"terms\" table (e.g. cd-tracks)",
-                        options.roughness, manifest.name
-                    ),
-                )
-                .into());
-            }
             "integrated".to_string()
         }
     };

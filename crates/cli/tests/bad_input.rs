@@ -1242,16 +1242,28 @@ fn fixtures(d: &Path) -> Vec<Case> {
             &["--roughness", "diffraction scenes"],
         ),
         with(
-            "render: roughness with an integrated table",
+            "render: negative roughness with an integrated table",
             render(&[
                 "--scene",
                 "cd-disc",
                 "--tables",
                 "cd-tracks-fast",
                 "--roughness",
-                "0.1",
+                "-0.2",
             ]),
-            &["--roughness", "cd-tracks-fast", "\"integrated\""],
+            &["--roughness", "-0.2", "0 to 1"],
+        ),
+        with(
+            "render: NaN roughness with an integrated table",
+            render(&[
+                "--scene",
+                "cd-disc",
+                "--tables",
+                "cd-tracks-fast",
+                "--roughness",
+                "NaN",
+            ]),
+            &["--roughness", "NaN"],
         ),
         with(
             "render: roughness with environment samples",

@@ -196,9 +196,11 @@ pub struct DiffractionSceneOptions {
     /// integrated table leaves unused: [`DiffractionOptions`]).
     pub technique: DiffractionOptions,
     /// GGX roughness α of the grating's microfacets (0 to [`MAX_ROUGHNESS`]; default 0, a
-    /// smooth grating): the two-scale model of `shaders/diffraction_scene.wgsl`
-    /// (`scene_rough_light`), which blurs every order of the table's environment lobes by
-    /// the facets' slopes — so a "terms" table without `env_samples` only.
+    /// smooth grating): the two-scale model of `shaders/diffraction_scene.wgsl`, which blurs
+    /// every order by the facets' slopes — a "terms" table's environment lobes
+    /// (`scene_rough_light`; so without `env_samples`), an "integrated" table's prefiltered
+    /// levels (σ² = σ_uv² + w² σ_m², `diffraction_integrated_colour_filtered`; with its
+    /// environment samples).
     pub roughness: f64,
 }
 
@@ -818,9 +820,10 @@ pub fn llvmpipe_filter_radius(
         .or(Some(0)))
 }
 
-/// Refuses a rough grating (`options.roughness` > 0) without the environment lobes of a
-/// "terms" table: a rough grating's light is drawn through them (`scene_rough_light`), and an
-/// "integrated" table has none, as has a scene whose environment is `env_samples`.
+/// Refuses a rough grating (`options.roughness` > 0) on a "terms" table without its
+/// environment lobes (a scene whose environment is `env_samples`): its rough light is drawn
+/// through them (`scene_rough_light`). An "integrated" table blurs its prefiltered levels
+/// instead, samples and all.
 ///
 /// # Errors
 /// [`Error::Refused`] naming the roughness and the way out.
@@ -832,9 +835,7 @@ fn refuse_rough_without_lobes(
         return Ok(());
     }
     let why = match (table, options.env_samples) {
-        (DiffractionTables::Integrated(_), _) => {
-            ": an \"integrated\" table keeps no orders to blur; a rough grating needs a \"terms\" table"
-        }
+        (DiffractionTables::Integrated(_), _) => return Ok(()),
         (_, Some(_)) => {
             ": a rough grating is drawn through the table's environment lobes, which environment samples replace"
         }
