@@ -325,9 +325,9 @@ fn distant_disc(table: &DiffractionTables, gap_factor: f64, variance_factor: f64
 /// The disc 4 × farther away at 128² through the integrated table (issue 37, item 3 for the
 /// fast path: `diffraction_integrated_colour_filtered`, the table's prefiltered levels read
 /// at the footprint's larger axis). Measured on Mesa lavapipe (LLVM 15, Vulkan): mean |Δ|
-/// without the filter 2.29e-2, with it 4.03e-3 (5.7 × closer; the reference's mean 4.6e-2,
-/// the 512² filtered picture 1.3e-3 from it); relative neighbour variance 0.654 without,
-/// 0.456 with, 0.438 supersampled (excess 0.216 → 0.018). At the scene's own distance the
+/// without the filter 2.19e-2, with it 3.95e-3 (5.5 × closer; the reference's mean 4.4e-2,
+/// the 512² filtered picture 1.3e-3 from it); relative neighbour variance 0.658 without,
+/// 0.463 with, 0.443 supersampled (excess 0.215 → 0.020). At the scene's own distance the
 /// isotropic levels gain less (5.5e-3 → 4.4e-3): read at the footprint's larger axis they
 /// blur the smaller one more than the pixel does.
 #[test]

@@ -282,8 +282,8 @@ fn roughness_spreads_the_first_order_about_the_grating_equation() {
 /// |w| α/√2 ≈ 0.006 … 0.026 against a band 0.011 wide; wider ones reach the zeroth order
 /// outside the patch, which then floods in). Laws: σ_v strictly growing with α and ≥ 1.4 ×
 /// the smooth band's at α = 0.02; the centre within 0.5° of the smooth band's; exitance
-/// within ±5 %. Measured (lavapipe, 96²): σ_v 0.0113 smooth, 0.0127, 0.0155, 0.0222
-/// (1.96 ×); centre 35.512° smooth, 35.528°, 35.535°, 35.544°; exitance 1.008, 1.013, 1.029
+/// within ±5 %. Measured (lavapipe, 96²): σ_v 0.0113 smooth, 0.0126, 0.0155, 0.0222
+/// (1.96 ×); centre 35.507° smooth, 35.530°, 35.546°, 35.539°; exitance 1.009, 1.014, 1.031
 /// of the smooth.
 #[test]
 fn roughness_spreads_the_integrated_tables_first_order_too() {

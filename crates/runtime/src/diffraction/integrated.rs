@@ -24,7 +24,7 @@
 //! σ_ℓ = σ₁ 2^{ℓ−1}, σ₁ = u_max/2^{L−2} ([`IntegratedLevels`], made here at load time:
 //! L = [`INTEGRATED_FILTER_LEVELS`] = 10 where the device takes L (2N + 1) layers, fewer
 //! otherwise). For `cd-tracks-fast` (72 × 144 texels, 23 layers) that is 230 layers,
-//! 38 MB on the GPU against 3.8 MB unfiltered, and 1.5 s of load on two shared cores
+//! 38 MB on the GPU against 3.8 MB unfiltered, and 0.45–1.5 s of load on two shared cores
 //! (`crates/runtime/tests/diffraction_integrated.rs` prints it; about 1 s more for
 //! `nacre render` than before, debug build). The levels serve the lookup filtered
 //! over a pixel's footprint and a rough grating's facets (issue 37;
