@@ -29,6 +29,14 @@ pub enum OnOffArg {
     Off,
 }
 
+/// `nacre render --lighting`: which of an analytic scene's sources light it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum LightingArg {
+    Both,
+    Light,
+    Environment,
+}
+
 /// `nacre render --layer-channel`, `nacre export --layer-channel`: the thickness-map channel
 /// a stack's film follows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]

@@ -2,7 +2,7 @@
 //! on the GPU.
 
 use crate::args::{DEFAULT_WAVELENGTH_STEP_NM, StackArgs, load_stack, refuse_step_for_integrated};
-use crate::choices::{ChannelArg, FilmEvalArg, OnOffArg, SceneArg, TechniqueArg};
+use crate::choices::{ChannelArg, FilmEvalArg, LightingArg, OnOffArg, SceneArg, TechniqueArg};
 use crate::error::{self, Result};
 use clap::Args;
 use nacre_bake::commands::stack_spec::StackSpec;
@@ -183,9 +183,25 @@ pub struct RenderArgs {
     /// [default: on].
     #[arg(long, value_enum, value_name = "ON|OFF")]
     footprint_filter: Option<OnOffArg>,
+    /// Analytic scenes (not --gltf or rough-row): which sources light the scene: both (the
+    /// directional light and the environment), light (the directional light alone: the
+    /// environment is black) or environment (the environment alone, with the film scenes'
+    /// sun in it). `python -m nacre.reference --lighting` takes the same choice, so that each
+    /// source's picture can be measured against its reference [default: both].
+    #[arg(long, value_enum, value_name = "SOURCES")]
+    lighting: Option<LightingArg>,
     /// Output PNG file.
     #[arg(short = 'o', long = "output", value_name = "FILE.png")]
     output: PathBuf,
+}
+
+/// The name `--lighting` takes for `lighting`.
+fn lighting_name(lighting: LightingArg) -> &'static str {
+    match lighting {
+        LightingArg::Both => "both",
+        LightingArg::Light => "light",
+        LightingArg::Environment => "environment",
+    }
 }
 
 /// Refuses a stack with an incoherent layer (`--layer bk7@2mm:incoherent`, or
@@ -260,6 +276,20 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         )
         .into());
     }
+    if let Some(lighting) = args.lighting {
+        if args.gltf.is_some() || all == Scene::RoughRow {
+            return Err(nacre_bake::error::Error::invalid(
+                "--lighting",
+                format!(
+                    "{}: the analytic scenes' light and environment (sphere, bubble, plane, cd-disc, snake-skin, grating-plane) only; {} lit by {}",
+                    lighting_name(lighting),
+                    if args.gltf.is_some() { "a glTF file is" } else { "rough-row is" },
+                    if args.gltf.is_some() { "its own lights and --env" } else { "its fixed light" },
+                ),
+            )
+            .into());
+        }
+    }
     let scene = match all {
         Scene::RoughRow => return run_render_rough_row(args),
         Scene::Diffraction(scene) => return run_render_diffraction(args, scene),
@@ -274,6 +304,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     options.thickness_map = args.thickness_map.clone();
     options.exposure_ev = args.exposure;
     options.film_eval = film_eval;
+    match args.lighting {
+        Some(LightingArg::Light) => options.env_intensity = 0.0,
+        Some(LightingArg::Environment) => options.light.intensity = 0.0,
+        Some(LightingArg::Both) | None => {}
+    }
     if let Some(m) = args.harmonics {
         options.harmonics = m;
     }
@@ -461,6 +496,11 @@ fn run_render_diffraction(
     options.environment = args.env.clone();
     options.exposure_ev = args.exposure;
     options.env_samples = args.env_samples;
+    match args.lighting {
+        Some(LightingArg::Light) => options.env_intensity = 0.0,
+        Some(LightingArg::Environment) => options.light.intensity = 0.0,
+        Some(LightingArg::Both) | None => {}
+    }
     if args.footprint_filter == Some(OnOffArg::Off) {
         options.technique.filter_radius = None;
     }

@@ -1222,6 +1222,26 @@ fn fixtures(d: &Path) -> Vec<Case> {
             &["99"],
         ),
         with(
+            "render: --lighting on rough-row",
+            render(&["--scene", "rough-row", "--lighting", "light"]),
+            &["--lighting", "light", "rough-row"],
+        ),
+        with(
+            "render: --lighting with --gltf",
+            render(&[
+                "--gltf",
+                "g/missing-buffer.gltf",
+                "--lighting",
+                "environment",
+            ]),
+            &["--lighting", "environment", "glTF"],
+        ),
+        with(
+            "render: --lighting unknown",
+            render(&["--scene", "cd-disc", "--lighting", "sun"]),
+            &["--lighting", "sun"],
+        ),
+        with(
             "render: diffraction roughness negative",
             render(&["--scene", "cd-disc", "--roughness", "-0.1"]),
             &["--roughness", "-0.1", "0 to 1"],

@@ -62,12 +62,16 @@ def render(
     passes: int = 8,
     progress: Optional[Callable[[int, int, float], None]] = None,
     roughness: float = 0.0,
+    lighting: str = "both",
 ) -> Reference:
     """Renders ``scene`` at ``width × height`` with ``spp`` samples per pixel in ``passes``
     passes (an even number; the first and second halves of the passes are the two
     independent halves), seeds from ``seed``. ``progress(done, total, started)`` is called
     after every pass (default: none). ``roughness``: the GGX α of a diffraction scene's
-    grating (``nacre render --roughness``), 0 to 1."""
+    grating (``nacre render --roughness``), 0 to 1. ``lighting``: ``both``, ``light`` (the
+    directional light alone) or ``environment`` (the environment alone), as ``nacre render
+    --lighting``; a scene's picture under both is the sum of the other two (rendering is
+    linear in the sources)."""
     import mitsuba as mi
 
     import nacre.mitsuba
@@ -79,7 +83,7 @@ def render(
     from ._build import build, scene_named
 
     definition = scene_named(scene)
-    mi_scene, keep = build(definition, width, height, roughness=roughness)
+    mi_scene, keep = build(definition, width, height, roughness=roughness, lighting=lighting)
     per_pass = [spp // passes + (1 if i < spp % passes else 0) for i in range(passes)]
     started = time.perf_counter()
     halves = [np.zeros((height, width, 3)), np.zeros((height, width, 3))]

@@ -46,6 +46,8 @@ def main(argv=None) -> int:
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.add_argument("--roughness", type=float, default=0.0,
                         help="GGX α of the grating's microfacets, 0 to 1 (diffraction scenes; default 0)")
+    parser.add_argument("--lighting", choices=["both", "light", "environment"], default="both",
+                        help="which sources light the scene, as nacre render --lighting (default both)")
     args = parser.parse_args(argv)
     for flag, value, low, high in (("--width", args.width, 1, 8192), ("--height", args.height, 1, 8192),
                                    ("--spp", args.spp, 2, 1 << 20)):
@@ -73,7 +75,7 @@ def main(argv=None) -> int:
         return 2
     ref = render(args.scene, args.width, args.height, args.spp, args.seed, args.variant,
                  passes=min(8, args.spp - args.spp % 2), progress=None if args.quiet else _bar,
-                 roughness=args.roughness)
+                 roughness=args.roughness, lighting=args.lighting)
     shown = np.round(ref.display() * 255.0).astype(np.uint8)
     exr = os.path.splitext(args.output)[0] + ".exr"
     _write_atomic(args.output, lambda p: mi.Bitmap(shown, mi.Bitmap.PixelFormat.RGB).write(p))

@@ -229,11 +229,19 @@ def _grating_bsdf(surface: Dict[str, Any], roughness: float = 0.0) -> "_grating.
     return bsdf
 
 
+#: ``nacre render --lighting``: which sources light a scene.
+LIGHTINGS = ("both", "light", "environment")
+
+
 def build(scene: Scene, width: int, height: int, max_depth: int = 8,
-          roughness: float = 0.0) -> Tuple["mi.Scene", List[Any]]:
+          roughness: float = 0.0, lighting: str = "both") -> Tuple["mi.Scene", List[Any]]:
     """The Mitsuba scene of ``scene`` at ``width × height`` (and the Python BSDFs it holds,
     which must outlive it); ``roughness``: the GGX α of a diffraction scene's grating
-    (``nacre render --roughness``; film scenes take 0 only)."""
+    (``nacre render --roughness``; film scenes take 0 only); ``lighting``: ``both`` (the
+    directional light and the environment), ``light`` (the light alone, the environment
+    black) or ``environment`` (the environment alone), as ``nacre render --lighting``."""
+    if lighting not in LIGHTINGS:
+        raise ValueError(f"lighting `{lighting}`: expected one of {', '.join(LIGHTINGS)}")
     if roughness and scene.surface["kind"] in ("sphere", "plane"):
         raise ValueError(f"roughness {roughness}: the diffraction scenes' gratings only, not {scene.name}")
     nacre.mitsuba.register(mi.variant() if mi.variant() and "spectral" in mi.variant() else None)
@@ -277,15 +285,15 @@ def build(scene: Scene, width: int, height: int, max_depth: int = 8,
                 "to_world": mi.ScalarTransform4f().rotate([1, 0, 0], -90),
                 "bsdf": bsdf,
             }
-    env = studio_environment(256, 128, scene.env_sun) * scene.env_intensity
-    emitters: Dict[str, Any] = {
-        "environment": {
+    emitters: Dict[str, Any] = {}
+    if lighting != "light":
+        env = studio_environment(256, 128, scene.env_sun) * scene.env_intensity
+        emitters["environment"] = {
             "type": "envmap",
             "bitmap": mi.Bitmap(mitsuba_environment(env)),
             "to_world": mi.ScalarTransform4f().rotate([0, 1, 0], 180),
         }
-    }
-    if scene.light_intensity > 0:
+    if scene.light_intensity > 0 and lighting != "environment":
         emitters["light"] = {
             "type": "directional",
             "direction": [-x for x in _unit(scene.light_direction)],
