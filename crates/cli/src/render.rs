@@ -276,19 +276,22 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         )
         .into());
     }
-    if let Some(lighting) = args.lighting {
-        if args.gltf.is_some() || all == Scene::RoughRow {
-            return Err(nacre_bake::error::Error::invalid(
-                "--lighting",
-                format!(
-                    "{}: the analytic scenes' light and environment (sphere, bubble, plane, cd-disc, snake-skin, grating-plane) only; {} lit by {}",
-                    lighting_name(lighting),
-                    if args.gltf.is_some() { "a glTF file is" } else { "rough-row is" },
-                    if args.gltf.is_some() { "its own lights and --env" } else { "its fixed light" },
-                ),
-            )
-            .into());
-        }
+    if let Some(lighting) = args.lighting
+        && (args.gltf.is_some() || all == Scene::RoughRow)
+    {
+        let (what, lit_by) = if args.gltf.is_some() {
+            ("a glTF file is", "its own lights and --env")
+        } else {
+            ("rough-row is", "its fixed light")
+        };
+        return Err(nacre_bake::error::Error::invalid(
+            "--lighting",
+            format!(
+                "{}: the analytic scenes' light and environment (sphere, bubble, plane, cd-disc, snake-skin, grating-plane) only; {what} lit by {lit_by}",
+                lighting_name(lighting),
+            ),
+        )
+        .into());
     }
     let scene = match all {
         Scene::RoughRow => return run_render_rough_row(args),
