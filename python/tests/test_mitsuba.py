@@ -402,9 +402,9 @@ def test_lighting_picks_the_sources():
 def test_snake_skin_under_its_light_matches_nacre_render():
     """The snake's scales under the directional light alone (no environment noise: the
     reference converges in a few samples) at 64 × 48: `nacre render --lighting light` within
-    ΔE2000 mean 3.5 of the reference (measured 2.54, noise 0.75; 1.02 at 128² and 8192 spp).
-    The dark Lambertian skin between the coloured orders is in both: the reference without it
-    was 6.2 away at 128²."""
+    ΔE2000 mean 3.5 of the reference (measured 2.01, noise 0.75; 0.77 at 128² and 8192 spp,
+    scripts/diffraction_targets.py). The dark Lambertian skin between the coloured orders is in
+    both, and the light is f E₀ cos θ_i: without the skin the reference was 6.2 away at 128²."""
     binary = nacre_binary()
     if binary is None:
         pytest.fail("no nacre binary (NACRE_BIN or target/{release,debug}/nacre): build it first")
