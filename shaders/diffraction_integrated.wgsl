@@ -102,11 +102,10 @@ fn diffraction_integrated_warp(a: f32) -> f32 {
     return pow(x, diffraction_integrated.inv_gamma);
 }
 
-// S = Σₚ wᵖ Iₚ(u, v) (header): the fold, the warped coordinates, bilinear from four loads
-// per layer, Horner from p = 2N down; of level `level` alone when t = 0, else
-// S_ℓ + t (S_{ℓ+1} − S_ℓ) of levels ℓ = `level` and ℓ + 1 (header). 0 for non-finite input,
-// an empty table or levels past the texture.
-fn diffraction_integrated_sum_levels(uvw_in: vec3<f32>, level: u32, t: f32) -> vec3<f32> {
+// S = Σₚ wᵖ Iₚ(u, v) of level `level` (header): the fold, the warped coordinates, bilinear
+// from four loads per layer, Horner from p = 2N down. 0 for non-finite input, an empty table
+// or a level past the texture.
+fn diffraction_integrated_sum_level(uvw_in: vec3<f32>, level: u32) -> vec3<f32> {
     if !diffraction_finite3(uvw_in) {
         return vec3<f32>(0.0);
     }
@@ -115,9 +114,7 @@ fn diffraction_integrated_sum_levels(uvw_in: vec3<f32>, level: u32, t: f32) -> v
     let cols = i32(min(diffraction_integrated.size.x, dims.x));
     let rows = i32(min(diffraction_integrated.size.y, dims.y));
     let layers = min(diffraction_integrated.layers, textureNumLayers(diffraction_integrated_table));
-    let blend = t > 0.0;
-    let last = level + select(0u, 1u, blend);
-    if cols < 2 || rows < 2 || layers == 0u || (last + 1u) * layers > textureNumLayers(diffraction_integrated_table) {
+    if cols < 2 || rows < 2 || layers == 0u || (level + 1u) * layers > textureNumLayers(diffraction_integrated_table) {
         return vec3<f32>(0.0);
     }
     let half_n = 0.5 * f32(rows);
@@ -132,7 +129,6 @@ fn diffraction_integrated_sum_levels(uvw_in: vec3<f32>, level: u32, t: f32) -> v
     let w = uvw.z;
     let base = i32(level * layers);
     var s = vec3<f32>(0.0);
-    var s_hi = vec3<f32>(0.0);
     for (var k = 0u; k < layers; k++) {
         let p = base + i32(layers - 1u - k);
         let a = textureLoad(diffraction_integrated_table, vec2<i32>(x0, y0), p, 0).xyz;
@@ -142,26 +138,23 @@ fn diffraction_integrated_sum_levels(uvw_in: vec3<f32>, level: u32, t: f32) -> v
         let lo = a + fx * (b - a);
         let hi = c + fx * (d - c);
         s = s * w + (lo + fy * (hi - lo));
-        if blend {
-            let q = p + i32(layers);
-            let e = textureLoad(diffraction_integrated_table, vec2<i32>(x0, y0), q, 0).xyz;
-            let f = textureLoad(diffraction_integrated_table, vec2<i32>(x0 + 1, y0), q, 0).xyz;
-            let g = textureLoad(diffraction_integrated_table, vec2<i32>(x0, y0 + 1), q, 0).xyz;
-            let h = textureLoad(diffraction_integrated_table, vec2<i32>(x0 + 1, y0 + 1), q, 0).xyz;
-            let lo2 = e + fx * (f - e);
-            let hi2 = g + fx * (h - g);
-            s_hi = s_hi * w + (lo2 + fy * (hi2 - lo2));
-        }
-    }
-    if blend {
-        s = s + t * (s_hi - s);
     }
     return s;
 }
 
 // S = Σₚ wᵖ Iₚ(u, v) of the table itself (level 0).
 fn diffraction_integrated_sum(uvw_in: vec3<f32>) -> vec3<f32> {
-    return diffraction_integrated_sum_levels(uvw_in, 0u, 0.0);
+    return diffraction_integrated_sum_level(uvw_in, 0u);
+}
+
+// S_σ = S_ℓ + t (S_{ℓ+1} − S_ℓ) of levels ℓ = `level` and ℓ + 1 (header); S_ℓ alone when
+// t = 0 (no second loop: the unfiltered cost).
+fn diffraction_integrated_sum_levels(uvw: vec3<f32>, level: u32, t: f32) -> vec3<f32> {
+    let s = diffraction_integrated_sum_level(uvw, level);
+    if !(t > 0.0) {
+        return s;
+    }
+    return s + t * (diffraction_integrated_sum_level(uvw, level + 1u) - s);
 }
 
 // The level pair (ℓ, t) of the variance σ² (header): σ_ℓ² = σ₁² 4^{ℓ−1} by exact products in
