@@ -484,7 +484,7 @@ fn diffraction_technique_validates_and_translates() {
         std::mem::size_of::<DiffractionLightsUniform>()
     );
     let offsets: Vec<u32> = members.iter().map(|m| m.1).collect();
-    assert_eq!(offsets, [0, 4, 8, 12, 16, 144, 272, 288]);
+    assert_eq!(offsets, [0, 4, 8, 12, 16, 144, 272, 288, 304]);
     // Group 0 is every scene's view (shaders/view.wgsl, `ViewUniform`).
     let (span, _) = layout("ViewParams");
     assert_eq!(
