@@ -1,7 +1,7 @@
 """Issue 37's accuracy targets: the diffraction scenes against their Mitsuba references, per
 source.
 
-For each scene (cd-disc, snake-skin, grating-plane) renders the path-traced reference under
+For each scene (cd-disc, dvd-disc, snake-skin, grating-plane) renders the path-traced reference under
 the directional light alone and under the environment alone (``python -m nacre.reference
 SCENE --lighting light|environment``), and ``nacre render --scene SCENE --lighting
 light|environment|both``; the reference under both is the sum of the two (rendering is linear
@@ -32,7 +32,7 @@ import time
 
 import numpy as np
 
-SCENES = ["cd-disc", "snake-skin", "grating-plane"]
+SCENES = ["cd-disc", "dvd-disc", "snake-skin", "grating-plane"]
 SOURCES = ["light", "environment"]
 TARGETS = {"light": (1.0, None), "environment": (2.0, 6.0), "both": (2.0, 6.0)}
 
@@ -74,7 +74,7 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--size", type=int, default=160, help="width = height, pixels (default 160)")
     parser.add_argument("--spp", type=int, default=4096, help="reference samples per pixel (default 4096)")
-    parser.add_argument("--scenes", default=",".join(SCENES), help="comma-separated scenes (default all three)")
+    parser.add_argument("--scenes", default=",".join(SCENES), help="comma-separated scenes (default all four)")
     parser.add_argument("--roughness", type=float, default=0.0, help="GGX α of the gratings (default 0)")
     parser.add_argument("--out", default="target/diffraction-targets", help="folder of the cached references")
     parser.add_argument("--fresh", action="store_true", help="render the references again")

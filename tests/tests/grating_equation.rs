@@ -14,6 +14,10 @@
 //!   (sin θ_r from 380/833.3 to 780/833.3, widened by the coherence lobe), blue nearer the
 //!   grating normal than red.
 //!
+//! The discs do the same along their circular tracks ([`disc_first_order`]): the CD
+//! (`cd-disc`, d = 1.6 µm, under a light from beyond it) and the DVD (`dvd-disc`,
+//! d = 0.74 µm, under the scene's own light, which brings its first orders onto the disc).
+//!
 //! A missing adapter fails the test: GPU tests never skip.
 
 use nacre_optics::diffraction::FresnelTerm;
@@ -205,34 +209,39 @@ fn first_order_sits_where_the_grating_equation_puts_it() {
     assert!(blue < green && green < red, "{blue} {green} {red}");
 }
 
-/// The CD (`nacre render --scene cd-disc`, a directional light only) of a 545–565 nm bake of
-/// `tables/recipes/cd-tracks.toml`: at every lit pixel of the data area the tracks run in
-/// circles, so t is the radial direction of its point and the grating equation reads
-/// |ω_i·t + ω_r·t| = mλ/d with ω_i·s + ω_r·s = 0 along the tracks (s), d = 1.6 µm. The
-/// first-order pixels (|ω_i·s + ω_r·s| ≤ 0.02, |ω_i·t + ω_r·t| between the zeroth and
-/// second orders; the pits' scatter off that line is left out) must put their radiance-weighted mean diffraction angle
-/// asin|ω_i·t + ω_r·t| within 0.5° of asin(555 nm / 1.6 µm).
-#[test]
-fn the_cds_first_order_sits_where_the_grating_equation_puts_it() {
-    let recipe = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../tables/recipes/cd-tracks.toml"),
+/// The radiance-weighted mean first-order angle asin|ω_i·t + ω_r·t| of a disc scene (the CD's
+/// disc, circular tracks) rendered from a bake of `recipe` over the wavelengths `band_nm`
+/// (its 5 nm grid) under `light` (the scene's own when `None`), and how many pixels it is
+/// taken over: at every lit
+/// pixel of the data area the tracks run in circles, so t is the radial direction of its
+/// point and the grating equation reads |ω_i·t + ω_r·t| = mλ/d with ω_i·s + ω_r·s = 0 along
+/// the tracks (s). The first-order pixels are those with |ω_i·s + ω_r·s| ≤ 0.02 (the orders
+/// of the track pitch lie at 0 within the 32 µm window's lobe, ~λ/32 µm; elsewhere the light
+/// is the pits' scatter along the tracks) and |ω_i·t + ω_r·t| in `first` (between the
+/// zeroth and the second order).
+fn disc_first_order(
+    scene: DiffractionScene,
+    recipe: &str,
+    band_nm: [u32; 2],
+    light: Option<[f32; 3]>,
+    first: std::ops::RangeInclusive<f64>,
+) -> (f64, usize) {
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../tables/recipes/{recipe}.toml")),
     )
     .unwrap();
-    assert!(recipe.contains("wavelengths = \"380:780:5\""));
+    assert!(text.contains("wavelengths = \"380:780:5\""));
     let dir = tempfile::tempdir().unwrap();
+    let [lo, hi] = band_nm;
     let narrow = bake(
         dir.path(),
-        "cd-tracks-narrow",
-        recipe.replace("380:780:5", "545:565:5"),
+        &format!("{recipe}-{lo}-{hi}"),
+        text.replace("380:780:5", &format!("{lo}:{hi}:5")),
     );
-    let scene = DiffractionScene::CdDisc;
-    // A light from beyond the disc (−z), 17.5° from the zenith: the 555 nm first order
-    // crosses the near half of the data area (the scene's own light puts it off the disc).
-    let light_f32 = [0.0, 0.95, -0.3];
+    let light_f32 = light.unwrap_or(DiffractionSceneOptions::new(scene).light.direction);
     let light = light_f32.map(f64::from);
     let len = light.iter().map(|x| x * x).sum::<f64>().sqrt();
     let omega_i = light.map(|x| x / len);
-    let d_um: f64 = 1.6;
     let (mut weight, mut sum, mut count) = (0.0, 0.0, 0);
     for l in lit_pixels(scene, &narrow, 320, 240, Some(light_f32)) {
         let r = (l.p[0] * l.p[0] + l.p[2] * l.p[2]).sqrt();
@@ -244,10 +253,7 @@ fn the_cds_first_order_sits_where_the_grating_equation_puts_it() {
         let h = [0, 1, 2].map(|k| omega_i[k] + l.to_eye[k]);
         let u = (0..3).map(|k| h[k] * t[k]).sum::<f64>().abs();
         let v = (0..3).map(|k| h[k] * along[k]).sum::<f64>().abs();
-        // The orders of the track pitch lie at v = 0 (within the 32 µm window's lobe,
-        // ~λ/32 µm); elsewhere the light is the pits' scatter along the tracks. Between the
-        // zeroth order (0) and the second (2λ/d ≈ 0.69).
-        if v > 0.02 || !(0.17..=0.52).contains(&u) {
+        if v > 0.02 || !first.contains(&u) {
             continue;
         }
         let w = l.rgb.iter().sum::<f64>();
@@ -255,8 +261,27 @@ fn the_cds_first_order_sits_where_the_grating_equation_puts_it() {
         sum += w * u.asin().to_degrees();
         count += 1;
     }
+    (sum / weight, count)
+}
+
+/// The CD (`nacre render --scene cd-disc`, a directional light only) of a 545–565 nm bake of
+/// `tables/recipes/cd-tracks.toml`, d = 1.6 µm ([`disc_first_order`]): the first-order pixels
+/// must put their radiance-weighted mean diffraction angle asin|ω_i·t + ω_r·t| within 0.5°
+/// of asin(555 nm / 1.6 µm).
+#[test]
+fn the_cds_first_order_sits_where_the_grating_equation_puts_it() {
+    // A light from beyond the disc (−z), 17.5° from the zenith: the 555 nm first order
+    // crosses the near half of the data area (the scene's own light puts it off the disc).
+    // Between the zeroth order (0) and the second (2λ/d ≈ 0.69).
+    let d_um: f64 = 1.6;
+    let (mean_deg, count) = disc_first_order(
+        DiffractionScene::CdDisc,
+        "cd-tracks",
+        [545, 565],
+        Some([0.0, 0.95, -0.3]),
+        0.17..=0.52,
+    );
     assert!(count >= 10, "{count} first-order pixels");
-    let mean_deg = sum / weight;
     let theory_deg = (0.555 / d_um).asin().to_degrees();
     eprintln!(
         "CD, 545–565 nm: {count} first-order pixels at {mean_deg:.3}° (theory at 555 nm {theory_deg:.3}°, error {:.3}°)",
@@ -266,4 +291,41 @@ fn the_cds_first_order_sits_where_the_grating_equation_puts_it() {
         (mean_deg - theory_deg).abs() <= 0.5,
         "first order at {mean_deg}°, theory {theory_deg}°"
     );
+}
+
+/// The DVD (`nacre render --scene dvd-disc` under its own light, a directional light only),
+/// d = 0.74 µm ([`disc_first_order`]): the scene's light puts the first order on the disc in
+/// view, violet to green on the near half of the data area and orange to red on the far
+/// half. Two bakes of `tables/recipes/dvd-tracks.toml`, 485–505 nm (the near half's middle)
+/// and 645–665 nm (the far half's), must each put their first-order pixels' radiance-weighted
+/// mean diffraction angle asin|ω_i·t + ω_r·t| within 0.5° of asin(λ / 0.74 µm) at the band's
+/// centre (41.98° at 495 nm, 62.27° at 655 nm). (At 555 nm the order reaches the data area's
+/// inner edge, which cuts its coherence lobe on one side: 1.7° short.)
+#[test]
+fn the_dvds_first_orders_sit_where_the_grating_equation_puts_them() {
+    let d_um: f64 = 0.74;
+    for band_nm in [[485, 505], [645, 665]] {
+        // Between the zeroth order (0) and the second (2λ/d ≥ 1.3, beyond the view).
+        let (mean_deg, count) = disc_first_order(
+            DiffractionScene::DvdDisc,
+            "dvd-tracks",
+            band_nm,
+            None,
+            0.4..=1.2,
+        );
+        assert!(count >= 10, "{band_nm:?}: {count} first-order pixels");
+        let centre_um = f64::from(band_nm[0] + band_nm[1]) / 2.0 * 1e-3;
+        let theory_deg = (centre_um / d_um).asin().to_degrees();
+        eprintln!(
+            "DVD, {}–{} nm: {count} first-order pixels at {mean_deg:.3}° (theory at {:.0} nm {theory_deg:.3}°, error {:.3}°)",
+            band_nm[0],
+            band_nm[1],
+            centre_um * 1e3,
+            mean_deg - theory_deg
+        );
+        assert!(
+            (mean_deg - theory_deg).abs() <= 0.5,
+            "{band_nm:?}: first order at {mean_deg}°, theory {theory_deg}°"
+        );
+    }
 }

@@ -98,6 +98,7 @@ pub enum SceneArg {
     Plane,
     RoughRow,
     CdDisc,
+    DvdDisc,
     SnakeSkin,
     GratingPlane,
 }
@@ -113,6 +114,7 @@ impl From<SceneArg> for nacre_runtime::Scene {
             SceneArg::Plane => Scene::Film(SceneKind::Plane),
             SceneArg::RoughRow => Scene::RoughRow,
             SceneArg::CdDisc => Scene::Diffraction(DiffractionScene::CdDisc),
+            SceneArg::DvdDisc => Scene::Diffraction(DiffractionScene::DvdDisc),
             SceneArg::SnakeSkin => Scene::Diffraction(DiffractionScene::SnakeSkin),
             SceneArg::GratingPlane => Scene::Diffraction(DiffractionScene::GratingPlane),
         }

@@ -39,10 +39,11 @@ Examples:
   # the same from above and to the left, or from the file's first camera
   nacre render --gltf scene.glb --yaw -35 --pitch 30 -o orbit.png
   nacre render --gltf scene.glb --camera 0 -o camera.png
-  # diffraction (technique `diffraction`, tables cd-tracks / snake-ridges / grating-1200): a CD,
-  # snake scales and a flat 1200 lines/mm grating under an overhead light
+  # diffraction (technique `diffraction`, tables cd-tracks / dvd-tracks / snake-ridges /
+  # grating-1200): a CD, a DVD, snake scales and a flat 1200 lines/mm grating under an
+  # overhead light
   nacre render --scene cd-disc -o cd.png && nacre render --scene snake-skin -o snake.png
-  nacre render --scene grating-plane -o grating.png
+  nacre render --scene dvd-disc -o dvd.png && nacre render --scene grating-plane -o grating.png
   # the CD from the fast table (layout \"integrated\": the wavelength sum baked in)
   nacre render --scene cd-disc --tables cd-tracks-fast -o cd-fast.png
 
@@ -62,7 +63,8 @@ pub struct RenderArgs {
     /// Scene: sphere, bubble, plane, rough-row (spheres of GGX α 0.05 … 0.8 by the
     /// film-at-n·v shortcut, the exact path and the Monte Carlo reference, three rows), or a
     /// diffraction scene: cd-disc (a CD-like disc with circular tracks; table cd-tracks),
-    /// snake-skin (a curved patch of scales with fanned ridges; table snake-ridges) or
+    /// dvd-disc (the same disc with a DVD's 0.74 µm track pitch, lit from the left; table
+    /// dvd-tracks), snake-skin (a curved patch of scales with fanned ridges; table snake-ridges) or
     /// grating-plane (a flat 1200 lines/mm grating; table grating-1200).
     #[arg(long, value_enum, default_value = "sphere")]
     scene: SceneArg,
@@ -83,9 +85,9 @@ pub struct RenderArgs {
     gltf: Option<PathBuf>,
     /// A table to load (repeatable): default-set name or manifest path [default: the scene's
     /// film-lut (sphere film-dielectric, bubble soap-film, plane oil-slick) + fourier-srgb;
-    /// cd-disc, snake-skin and grating-plane take one diffraction table, either layout:
-    /// cd-tracks, snake-ridges, grating-1200, dvd-tracks; cd-tracks-fast is the integrated
-    /// table of the CD].
+    /// cd-disc, dvd-disc, snake-skin and grating-plane take one diffraction table, either
+    /// layout: cd-tracks, dvd-tracks, snake-ridges, grating-1200; cd-tracks-fast is the
+    /// integrated table of the CD].
     #[arg(long = "tables", value_name = "NAME|PATH")]
     tables: Vec<String>,
     /// Technique: lut, fourier, spectral, or stack (a multilayer stack per pixel from
@@ -261,7 +263,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         return Err(nacre_bake::error::Error::invalid(
             Param::Roughness,
             format!(
-                "{alpha}: the roughness of a grating, for the diffraction scenes (cd-disc, snake-skin, grating-plane) only"
+                "{alpha}: the roughness of a grating, for the diffraction scenes (cd-disc, dvd-disc, snake-skin, grating-plane) only"
             ),
         )
         .into());
@@ -270,7 +272,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         return Err(nacre_bake::error::Error::invalid(
             "--footprint-filter",
             format!(
-                "{}: the footprint filter of the diffraction scenes (cd-disc, snake-skin, grating-plane) only",
+                "{}: the footprint filter of the diffraction scenes (cd-disc, dvd-disc, snake-skin, grating-plane) only",
                 if filter == OnOffArg::On { "on" } else { "off" }
             ),
         )
@@ -287,7 +289,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         return Err(nacre_bake::error::Error::invalid(
             "--lighting",
             format!(
-                "{}: the analytic scenes' light and environment (sphere, bubble, plane, cd-disc, snake-skin, grating-plane) only; {what} lit by {lit_by}",
+                "{}: the analytic scenes' light and environment (sphere, bubble, plane, cd-disc, dvd-disc, snake-skin, grating-plane) only; {what} lit by {lit_by}",
                 lighting_name(lighting),
             ),
         )
@@ -473,7 +475,8 @@ fn table_names(
     }
 }
 
-/// `nacre render --scene cd-disc | snake-skin | grating-plane`: the `diffraction` technique.
+/// `nacre render --scene cd-disc | dvd-disc | snake-skin | grating-plane`: the `diffraction`
+/// technique.
 fn run_render_diffraction(
     args: &RenderArgs,
     scene: nacre_runtime::diffraction::DiffractionScene,

@@ -1247,6 +1247,21 @@ fn fixtures(d: &Path) -> Vec<Case> {
             &["--roughness", "-0.1", "0 to 1"],
         ),
         with(
+            "render: dvd-disc roughness negative",
+            render(&["--scene", "dvd-disc", "--roughness", "-0.1"]),
+            &["--roughness", "-0.1", "0 to 1"],
+        ),
+        with(
+            "render: dvd-disc --lighting unknown",
+            render(&["--scene", "dvd-disc", "--lighting", "lamp"]),
+            &["--lighting", "lamp"],
+        ),
+        with(
+            "render: dvd-disc given a film-lut table",
+            render(&["--scene", "dvd-disc", "--tables", "soap-film"]),
+            &["soap-film", "diffraction table"],
+        ),
+        with(
             "render: diffraction roughness above 1",
             render(&["--scene", "grating-plane", "--roughness", "1.5"]),
             &["--roughness", "1.5", "0 to 1"],

@@ -23,15 +23,21 @@ fn nacre(args: &[&str]) -> Output {
 /// Renders `scene` at 40 × 30 under `lighting` into `dir` and returns its pixels, sRGB-encoded
 /// values in [0, 1].
 fn render(dir: &Path, scene: &str, lighting: &str) -> Vec<[f64; 3]> {
+    render_at(dir, scene, lighting, 40, 30)
+}
+
+/// Renders `scene` at `width` × `height` under `lighting` into `dir` and returns its pixels,
+/// sRGB-encoded values in [0, 1].
+fn render_at(dir: &Path, scene: &str, lighting: &str, width: u32, height: u32) -> Vec<[f64; 3]> {
     let out = dir.join(format!("{scene}-{lighting}.png"));
     let o = nacre(&[
         "render",
         "--scene",
         scene,
         "--width",
-        "40",
+        &width.to_string(),
         "--height",
-        "30",
+        &height.to_string(),
         "--lighting",
         lighting,
         "-o",
@@ -68,18 +74,34 @@ fn radiance(displayed: [f64; 3]) -> [f64; 3] {
 #[test]
 fn the_light_and_the_environment_add_up_to_both() {
     let dir = tempfile::tempdir().unwrap();
-    for scene in ["cd-disc", "snake-skin", "grating-plane"] {
-        let both = render(dir.path(), scene, "both");
-        let light = render(dir.path(), scene, "light");
-        let env = render(dir.path(), scene, "environment");
+    for scene in ["cd-disc", "dvd-disc", "snake-skin", "grating-plane"] {
+        // The DVD's first orders are two thin lines: at 40 × 30 they light only 57 channels
+        // that both sources light.
+        let (w, h) = if scene == "dvd-disc" {
+            (96, 72)
+        } else {
+            (40, 30)
+        };
+        let both = render_at(dir.path(), scene, "both", w, h);
+        let light = render_at(dir.path(), scene, "light", w, h);
+        let env = render_at(dir.path(), scene, "environment", w, h);
         let (mut worst, mut lit, mut env_lit, mut compared) = (0.0f64, 0usize, 0usize, 0usize);
         for ((b, l), e) in both.iter().zip(&light).zip(&env) {
             let (b, l, e) = (radiance(*b), radiance(*l), radiance(*e));
             lit += usize::from(l.iter().any(|&x| x > 0.01));
             env_lit += usize::from(e.iter().any(|&x| x > 0.01));
+            // The brightest channel of the three pictures: c = m/(1 − max m) makes every
+            // channel's radiance move with the peak's rounding, by c (1 + peak) per unit of m.
+            let peak = [b, l, e]
+                .iter()
+                .flatten()
+                .fold(0.0f64, |top, &x| top.max(x));
             for c in 0..3 {
-                // One 8-bit step of each of the three pictures, in radiance.
-                let step = 0.02 * (1.0 + b[c]) * (1.0 + b[c]);
+                // One 8-bit step of each of the three pictures, in radiance: ∂c/∂m = 1 + peak
+                // for the channel's own value, c (1 + peak) through the peak's (the peak
+                // channel: (1 + c)², as before; a dim channel beside a bright one, such as the
+                // DVD's saturated first-order line, much more than (1 + c)²).
+                let step = 0.02 * (1.0 + b[c]) * (1.0 + peak);
                 // A channel clipped at 0 (a spectral colour outside sRGB's gamut loses its
                 // negative part, and the sources' negative parts add before the clip) gives
                 // max(L + E, 0) ≤ max(L, 0) + max(E, 0); where no picture is clipped, equality.

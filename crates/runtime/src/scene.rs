@@ -24,18 +24,19 @@ pub enum Scene {
     /// The rough-film comparison: the engines' shortcut, the exact path and a Monte Carlo
     /// reference, side by side over roughness.
     RoughRow,
-    /// A diffraction scene: a CD-like disc, a snake's skin or a flat grating.
+    /// A diffraction scene: a CD-like or DVD-like disc, a snake's skin or a flat grating.
     Diffraction(DiffractionScene),
 }
 
 impl Scene {
     /// Every scene, in the order `nacre render --help` lists them.
-    pub const ALL: [Scene; 7] = [
+    pub const ALL: [Scene; 8] = [
         Scene::Film(SceneKind::Sphere),
         Scene::Film(SceneKind::Bubble),
         Scene::Film(SceneKind::Plane),
         Scene::RoughRow,
         Scene::Diffraction(DiffractionScene::CdDisc),
+        Scene::Diffraction(DiffractionScene::DvdDisc),
         Scene::Diffraction(DiffractionScene::SnakeSkin),
         Scene::Diffraction(DiffractionScene::GratingPlane),
     ];

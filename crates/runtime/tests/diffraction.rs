@@ -6,8 +6,9 @@
 //! * bad directions (NaN, ±∞, huge, zero, below the horizon) give finite colours;
 //! * the loaders check kind, layout and SHA-256, and `DiffractionTables::load` dispatches on
 //!   the layout;
-//! * the `cd-disc`, `snake-skin` and `grating-plane` scenes are deterministic and show diffraction colours
-//!   (saturated pixels whose hue spans the rainbow), which the specular order alone cannot;
+//! * the `cd-disc`, `dvd-disc`, `snake-skin` and `grating-plane` scenes are deterministic and
+//!   show diffraction colours (saturated pixels whose hue spans the rainbow), which the
+//!   specular order alone cannot;
 //! * the `cd-disc` scene from the integrated table `cd-tracks-fast` (the fast path) matches
 //!   the one from the terms table `cd-tracks` of the same surface, rainbow included.
 //!
@@ -34,11 +35,13 @@ fn tables(name: &str) -> &'static DiffractionTables {
     static CD_FAST: OnceLock<DiffractionTables> = OnceLock::new();
     static RIDGES: OnceLock<DiffractionTables> = OnceLock::new();
     static GRATING: OnceLock<DiffractionTables> = OnceLock::new();
+    static DVD: OnceLock<DiffractionTables> = OnceLock::new();
     let cell = match name {
         "cd-tracks" => &CD,
         "cd-tracks-fast" => &CD_FAST,
         "snake-ridges" => &RIDGES,
         "grating-1200" => &GRATING,
+        "dvd-tracks" => &DVD,
         other => panic!("no table {other}"),
     };
     cell.get_or_init(|| {

@@ -1,8 +1,8 @@
 """Path-traced references of ``nacre render``'s scenes in Mitsuba 3 (``nacre[mitsuba]``).
 
 ``python -m nacre.reference SCENE --width W --height H --spp N -o FILE.png`` renders SCENE
-(``sphere``, ``bubble``, ``plane``, ``cd-disc``, ``snake-skin``, ``grating-plane``) framed as
-``nacre render --scene SCENE --width W --height H`` frames it — the same camera, lights,
+(``sphere``, ``bubble``, ``plane``, ``cd-disc``, ``dvd-disc``, ``snake-skin``,
+``grating-plane``) framed as ``nacre render --scene SCENE --width W --height H`` frames it — the same camera, lights,
 environment (the bundled studio) and tone mapping — with nacre's BSDFs
 (:mod:`nacre.mitsuba`), spectrally. Besides the PNG it writes the linear radiance
 (``FILE.exr``) and the reference's own noise: the samples are rendered as two independent

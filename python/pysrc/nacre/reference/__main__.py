@@ -57,8 +57,9 @@ def main(argv=None) -> int:
     if not (math.isfinite(args.roughness) and 0.0 <= args.roughness <= 1.0):
         print(f"error: --roughness {args.roughness}: expected 0 to 1 (the GGX α)", file=sys.stderr)
         return 2
-    if args.roughness > 0.0 and args.scene not in ("cd-disc", "snake-skin", "grating-plane"):
-        print(f"error: --roughness {args.roughness}: the diffraction scenes (cd-disc, snake-skin, grating-plane) only",
+    if args.roughness > 0.0 and args.scene not in ("cd-disc", "dvd-disc", "snake-skin", "grating-plane"):
+        print(f"error: --roughness {args.roughness}: the diffraction scenes (cd-disc, dvd-disc, snake-skin, "
+              "grating-plane) only",
               file=sys.stderr)
         return 2
     if not args.output.lower().endswith(".png"):

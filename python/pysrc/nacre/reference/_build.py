@@ -1,8 +1,8 @@
 """Mitsuba scenes of :data:`nacre.reference._scenes.SCENES` (needs ``nacre[mitsuba]``).
 
 Geometry as the ray casters of ``nacre render``: the film scenes' sphere (centre (0, 1, 0),
-radius 1) and plane y = 0 (to 1000 units), the CD's annulus 0.12 ≤ r ≤ 1 in y = 0 (grating
-for 0.38 ≤ r ≤ 0.98, tracks circular, a plain mirror elsewhere), the snake's cylinder patch
+radius 1) and plane y = 0 (to 1000 units), the CD's (and the DVD's) annulus 0.12 ≤ r ≤ 1 in
+y = 0 (grating for 0.38 ≤ r ≤ 0.98, tracks circular, a plain mirror elsewhere), the snake's cylinder patch
 y² + z² = 1, |x| ≤ 1.6, |φ| ≤ 1.31 with its domed diamond scales, per-scale ridge rotation and
 fan, and matt scale edges, and grating-plane's 2 × 2 square (``shaders/diffraction_scene.wgsl``).
 The curved surfaces are fine triangle meshes (the CD's circles with 1024 segments,

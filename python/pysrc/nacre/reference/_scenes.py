@@ -69,6 +69,17 @@ SCENES: Dict[str, Scene] = {
         env_sun=False, env_intensity=0.5, tone_map="max_channel",
         surface=dict(kind="cd-disc", grating="cd", fresnel_ior=None, base=None),
     ),
+    # `nacre render --scene dvd-disc` (table dvd-tracks): the CD's disc, camera, frame and
+    # environment with a DVD's tracks (a sinusoid of period 0.74 µm, amplitude 0.06 µm:
+    # tables/recipes/dvd-tracks.toml), under a light from the left, 16.7° from the zenith
+    # (DiffractionScene::light: the CD's light would leave the first orders beyond 505 nm off
+    # the disc).
+    "dvd-disc": Scene(
+        "dvd-disc", eye=(0.0, 1.9, 2.2), target=(0.0, -0.12, 0.0), fov_y_deg=40.0,
+        light_direction=(-0.3, 1.0, 0.0), light_colour=(1.0, 0.97, 0.92), light_intensity=3.0,
+        env_sun=False, env_intensity=0.5, tone_map="max_channel",
+        surface=dict(kind="cd-disc", grating="sine:0.74:0.06", fresnel_ior=None, base=None),
+    ),
     "snake-skin": Scene(
         "snake-skin", eye=(0.35, 2.6, 2.3), target=(0.0, 0.55, 0.0), fov_y_deg=42.0,
         light_direction=(0.3, 0.85, -0.45), light_colour=(1.0, 0.97, 0.92), light_intensity=3.0,
