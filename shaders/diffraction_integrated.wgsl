@@ -23,6 +23,15 @@
 //   γ             1 / inv_gamma                 warp exponent of both axes
 //   F²(θ_h)       diffraction_fresnel_of          1, or unpolarised Fresnel of ñ = n + iκ
 //
+// Stam's k² (issue 37): the BRDF is f = ρ (σ_s k)²/π and the caller's light gain takes k at
+// λ_ref (`nacre_runtime::diffraction::lobe_gain`), so a table baked with the manifest's
+// `k_squared_reference_nm` holds Σ_λ (λ_ref/λ)² u(λ) … in its layers: the colour below is
+// that of Σ_λ (λ_ref/λ)² ρ u, as the terms technique weights it, and every prefiltered level
+// with it (a blur is linear). The zeroth order's efficiency has no k² (the lobe's integral
+// π/(σ_s k)² cancels it): the specular colour reads the unweighted Jₚ of binding 2. A table
+// without the field (an older bake) holds Σ_λ ρ u (tilted red by (λ/λ_ref)²) and renders as
+// it did.
+//
 // Reconstruction (the manifest's `reconstruction`):
 //
 //   (u, v, w) = −ω_i − ω_r;  u < 0: (u, v, w) → (−u, −v, −w)   (Iₚ(−u, −v) = (−1)ᵖ Iₚ(u, v))
@@ -94,6 +103,10 @@ struct DiffractionIntegratedParams {
 @group(1) @binding(0) var<uniform> diffraction_integrated: DiffractionIntegratedParams;
 // Rgba32Float 2-D array, (n/2) × n × L (2N + 1), unfilterable: read with textureLoad only.
 @group(1) @binding(1) var diffraction_integrated_table: texture_2d_array<f32>;
+// Jₚ, p = 0 … 2N: the table's layers at u = v = 0 without Stam's k² weight, (ch 0, ch 1,
+// ch 2, 0) (the manifest's `zeroth_order_layers`; a table without k² gives its own layers
+// there). The mirror image's colour reads these, not the layers (header: Stam's k²).
+@group(1) @binding(2) var<storage, read> diffraction_integrated_zeroth: array<vec4<f32>>;
 
 // The warped coordinate t = (a/u_max)^{1/γ} ∈ [0, 1] of a ≥ 0 (a above u_max clamps to 1;
 // a floor of 10⁻³⁰ keeps pow's argument positive: pow(0, y) is undefined in WGSL).
@@ -215,8 +228,9 @@ fn diffraction_integrated_colour_filtered(wi_in: vec3<f32>, wr_in: vec3<f32>, si
 }
 
 // The colour at the centre of the mirror lobe for a view at cos θ from the normal:
-// F²(θ) · Σₚ (−2 cos θ)ᵖ Iₚ(0, 0) (G/w² = 1 there): the colour of |P̃(0, 0)|², the zeroth
-// order's efficiency as the coherence window sees it. It equals the terms layout's
+// F²(θ) · Σₚ (−2 cos θ)ᵖ Jₚ (G/w² = 1 there; Jₚ = Iₚ(0, 0) without the k² weight, binding 2,
+// Horner from p = 2N): the colour of |P̃(0, 0)|², the zeroth order's efficiency as the
+// coherence window sees it. It equals the terms layout's
 // `diffraction_specular_order_colour` (F² |P_DC|²) when no other DFT bin lies within the
 // window of DC (a 1-D grating whose period divides the patch); otherwise it also holds the
 // window-weighted neighbouring bins (for the CD table 1.4 · 10⁻⁴ of the white, measured by
@@ -227,6 +241,12 @@ fn diffraction_integrated_specular_colour(cos_theta_in: f32, fresnel_kind: u32, 
         return vec3<f32>(0.0);
     }
     let f = diffraction_fresnel_of(cos_theta, fresnel_kind, fresnel_ior);
-    let colour = f * diffraction_integrated_sum(vec3<f32>(0.0, 0.0, -2.0 * cos_theta));
+    let w = -2.0 * cos_theta;
+    let layers = min(diffraction_integrated.layers, arrayLength(&diffraction_integrated_zeroth));
+    var s = vec3<f32>(0.0);
+    for (var k = 0u; k < layers; k++) {
+        s = s * w + diffraction_integrated_zeroth[layers - 1u - k].xyz;
+    }
+    let colour = f * s;
     return select(vec3<f32>(0.0), colour, diffraction_finite3(colour));
 }

@@ -18,13 +18,17 @@
 //                                               than aliasing), σ_m² the uniform's
 //                                               slope_variance (a rough grating); with the
 //                                               uniform's footprint_filter 0 (`--footprint-filter off`
-//                                               on a smooth grating), diffraction_colour. The
-//                                               tables' bake summed ρ u(λ) over the wavelengths
-//                                               without Stam's k², so the (λ_ref/λ)² weight of
-//                                               the terms technique is left out (it would need
-//                                               tables baked with it)
+//                                               on a smooth grating), diffraction_colour. λ_ref
+//                                               is not read: a table baked with Stam's k²
+//                                               (manifest `k_squared_reference_nm`) holds the
+//                                               (λ_ref/λ)² weight of the terms technique in its
+//                                               layers, and the host's light gain takes k_ref at
+//                                               the table's λ_ref (lobe_gain); a table without
+//                                               it (an older bake) renders without the weight,
+//                                               as it did
 //   diffraction_specular_order_colour(cos θ)  = diffraction_integrated_specular_colour(cos θ, F²)
-//                                               (the mirror-lobe peak; see its comment)
+//                                               (the mirror-lobe peak from the unweighted Jₚ;
+//                                               see its comment)
 //   diffraction_fresnel(cos θ)                = diffraction_fresnel_of(cos θ, the uniform's F²)
 //   (diffraction_frame and diffraction_finite3 come from diffraction_common.wgsl)
 

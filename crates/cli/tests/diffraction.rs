@@ -174,36 +174,87 @@ fn max_rgb_difference(a: &[Vec<f64>], b: &[Vec<f64>]) -> (f64, f64) {
 
 #[test]
 fn the_integrated_default_table_gives_the_colours_of_the_terms_table() {
-    // cd-tracks-fast is cd-tracks summed over wavelengths: the same colours within the
-    // integrated_tolerance its bake measured (0.01 of the specular white, which is
-    // RGB = (1, 1, 1)), read as a shader reads the table.
+    // cd-tracks-fast is cd-tracks summed over wavelengths with Stam's k² as (555 nm/λ)²
+    // (issue 37): the colours of the terms table's spectra weighted the same way, within the
+    // integrated_tolerance its bake measured (0.01 of the specular white with the same weight,
+    // Σ_λ (555/λ)² u(λ)), read as a shader reads the table.
     let dir = tempfile::tempdir().unwrap();
+    let path = nacre_format::set::resolve_table("cd-tracks-fast");
+    let manifest = nacre_format::Manifest::read(&path).unwrap();
+    let reference = manifest
+        .diffraction()
+        .unwrap()
+        .integrated
+        .as_ref()
+        .unwrap()
+        .k_squared_reference_nm;
+    assert_eq!(reference, Some(555.0));
+    let colorimeter = manifest.colorimeter(&path).unwrap();
+    let wavelengths: Vec<f64> = (0..=80).map(|i| 380.0 + 5.0 * f64::from(i)).collect();
+    let grid = nacre_optics::diffraction::SpectralGrid::new(&colorimeter, &wavelengths).unwrap();
+    let weights: Vec<f64> = wavelengths.iter().map(|l| (555.0 / l).powi(2)).collect();
+    let white = colorimeter.output_from_xyz(grid.xyz(&weights));
     for incidence in ["0", "10", "-30"] {
-        let common = [
-            "--incidence",
-            incidence,
-            "--views",
-            "-44:44:0.25",
-            "--color",
-        ];
-        let mut a = vec!["diffraction", "--table", "cd-tracks-fast"];
+        let common = ["--incidence", incidence, "--views", "-44:44:0.25"];
+        let mut a = vec!["diffraction", "--table", "cd-tracks-fast", "--color"];
         a.extend(common);
         let fast = nacre(&a, dir.path());
         assert!(fast.status.success(), "{}", stderr(&fast));
-        let mut b = vec!["diffraction", "--table", "cd-tracks"];
+        assert!(stderr(&fast).contains("Stam's k^2"), "{}", stderr(&fast));
+        let mut b = vec![
+            "diffraction",
+            "--table",
+            "cd-tracks",
+            "--wavelengths",
+            "380:780:5",
+        ];
         b.extend(common);
-        let terms = nacre(&b, dir.path());
-        assert!(terms.status.success(), "{}", stderr(&terms));
-        let (fast, terms) = (colour_rows(&fast), colour_rows(&terms));
+        let spectra = nacre(&b, dir.path());
+        assert!(spectra.status.success(), "{}", stderr(&spectra));
+        let (header, spectra) = rows(&spectra);
+        assert_eq!(header, "view_deg,wavelength_nm,reflectance");
+        // The terms table's colours with the k² weight: view_deg, R, G, B.
+        let terms: Vec<Vec<f64>> = spectra
+            .chunks_exact(wavelengths.len())
+            .map(|views| {
+                let rho: Vec<f64> = views
+                    .iter()
+                    .zip(&wavelengths)
+                    .map(|(r, &l)| {
+                        assert_eq!(r[1], l);
+                        (555.0 / l).powi(2) * r[2]
+                    })
+                    .collect();
+                let rgb = colorimeter.output_from_xyz(grid.xyz(&rho));
+                vec![views[0][0], 0.0, 0.0, 0.0, rgb[0], rgb[1], rgb[2]]
+            })
+            .collect();
+        // In units of the white with the same weight (the baker's metric).
+        let fast: Vec<Vec<f64>> = colour_rows(&fast)
+            .into_iter()
+            .map(|mut r| {
+                for c in 4..7 {
+                    r[c] /= white[c - 4];
+                }
+                r
+            })
+            .collect();
+        let terms: Vec<Vec<f64>> = terms
+            .into_iter()
+            .map(|mut r| {
+                for c in 4..7 {
+                    r[c] /= white[c - 4];
+                }
+                r
+            })
+            .collect();
         let (worst, at) = max_rgb_difference(&fast, &terms);
-        eprintln!("incidence {incidence}°: max |ΔRGB| {worst:.2e} at view {at}°");
+        eprintln!(
+            "incidence {incidence}°: max |ΔRGB| {worst:.2e} of the k²-weighted white at view {at}°"
+        );
         assert!(worst < 0.01, "incidence {incidence}: {worst} at {at}");
         // The specular highlight and the orders are there, not just agreement near zero.
         assert!(terms.iter().any(|r| r[5] > 0.1));
-        // XYZ is the inverse of the output matrix applied to the stored RGB.
-        for (f, t) in fast.iter().zip(&terms) {
-            assert!((f[2] - t[2]).abs() < 0.02, "{f:?} {t:?}");
-        }
     }
 }
 

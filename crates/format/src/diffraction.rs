@@ -60,7 +60,7 @@ pub struct DiffractionRecord {
 }
 
 /// The error metric recorded in manifests.
-pub const ERROR_METRIC: &str = "max over light/view pairs and output channels c of |colour_integrated,c - colour_terms,c| / white_c, white = the colour of rho = 1 (a flat perfect mirror in its specular direction); colour_integrated as a shader rebuilds it (f32 texels, bilinear in the warped coordinates, f32 Horner sum), colour_terms from the f64 Taylor terms at the same N and wavelength grid, F = 1";
+pub const ERROR_METRIC: &str = "max over light/view pairs and output channels c of |colour_integrated,c - colour_terms,c| / white_c, white = the colour of rho = 1 (a flat perfect mirror in its specular direction) with the table's k^2 weight (lambda_ref/lambda)^2, i.e. sum_lambda (k_squared_reference_nm/lambda)^2 u(lambda); colour_integrated as a shader rebuilds it (f32 texels, bilinear in the warped coordinates, f32 Horner sum), colour_terms from the f64 Taylor terms at the same N and wavelength grid with the same (k_squared_reference_nm/lambda)^2 weight per wavelength, F = 1";
 
 /// Largest integrated table accepted: (2N + 1)·n·n/2 RGBA32F texels, 1 GiB (the KTX2
 /// file; the EXR file is ¾ of it).
@@ -110,4 +110,21 @@ pub struct IntegratedRecord {
     /// Error of f32 storage and the f32 sum alone, at texel centres (no interpolation),
     /// same units: the catastrophic cancellation of tall structures.
     pub storage_error: f64,
+    /// λ_ref, nm, of Stam's k² weight (λ_ref/λ)² = (k/k_ref)² the layers were summed with
+    /// (issue 37): Stam's BRDF is f = ρ (σ_s k)²/π and a renderer's light gain
+    /// (σ_s k_ref)²/π takes k at λ_ref (`nacre_runtime::diffraction::lobe_gain`), so the
+    /// layers hold Σ_λ (λ_ref/λ)² u(λ) kᵖ … and colour = C · Σₚ wᵖ Iₚ is the colour of
+    /// Σ_λ (λ_ref/λ)² ρ(λ) u(λ), as the terms technique weights it. `None` (absent: a table
+    /// baked by a nacre before the weight) means the layers hold Σ_λ ρ u without it — a
+    /// picture drawn from them is tilted towards red by (λ/λ_ref)²; such a table still
+    /// loads and renders as it did.
+    #[serde(default)]
+    pub k_squared_reference_nm: Option<f64>,
+    /// Jₚ, p = 0 … 2N, in the output space (f32 values): the layers at u = v = 0 without the
+    /// k² weight, so that F²(θ) Σₚ (−2 cos θ)ᵖ Jₚ is the colour of the zeroth order's
+    /// efficiency |P̃(0, 0)|² (the mirror image has no k²: the lobe's integral
+    /// π/(σ_s k)² cancels it). Empty (absent) for a table without
+    /// `k_squared_reference_nm`, whose own layers at (0, 0) serve.
+    #[serde(default)]
+    pub zeroth_order_layers: Vec<[f32; 3]>,
 }

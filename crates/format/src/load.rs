@@ -240,13 +240,19 @@ impl Manifest {
         } else {
             return Err(invalid("the manifest lists no integrated file".into()));
         }
-        let table =
-            IntegratedTable::from_values(axis, r.taylor_order, values).map_err(|source| {
-                Error::OpticsIn {
-                    context: manifest_path.display().to_string().into(),
-                    source,
-                }
-            })?;
+        let optics = |source| Error::OpticsIn {
+            context: manifest_path.display().to_string().into(),
+            source,
+        };
+        let mut table =
+            IntegratedTable::from_values(axis, r.taylor_order, values).map_err(optics)?;
+        // With Stam's k² (issue 37) the manifest carries the unweighted zeroth order; a table
+        // without the field (an older bake) is read as it was: no k², its own peak.
+        if let Some(reference_nm) = s.k_squared_reference_nm {
+            table = table
+                .with_k_squared(reference_nm, s.zeroth_order_layers.clone())
+                .map_err(optics)?;
+        }
         Ok((r, table))
     }
 }

@@ -10,8 +10,11 @@
 //! * the terms technique's consumers (`diffraction_scene.wgsl`'s probe entry point) run on
 //!   the integrated table through the adapter, with the uniform's F²;
 //! * the GPU colours stay within the baker's tolerance of the exact terms-layout colours of
-//!   the same surface (`cd-tracks`), and the specular colour within 10⁻³ of the white of the
+//!   the same surface (`cd-tracks`) weighted by Stam's (555 nm/λ)² (the table's k²), and the
+//!   specular colour (the unweighted zeroth-order layers) within 10⁻³ of the white of the
 //!   zeroth order's |P_DC|²;
+//! * a table baked before the k² (a manifest without `k_squared_reference_nm`) still loads,
+//!   renders as before (its own peak as the mirror image) and is marked as lacking it;
 //! * bad directions and Fresnel inputs (NaN, ±∞, huge, zero, below the horizon) give finite
 //!   colours;
 //! * the loader checks kind, layout and SHA-256;
@@ -26,6 +29,7 @@ use nacre_optics::diffraction::integrated::check_directions;
 use nacre_optics::diffraction::{
     DiffractionSurface, FresnelTerm, SpectralGrid, in_plane_directions,
 };
+use nacre_runtime::diffraction::LOBE_REFERENCE_NM;
 use nacre_runtime::diffraction_integrated::{
     DiffractionIntegrated, DiffractionIntegratedUniform, ProbeCase, WGSL, compose_probe,
     compose_scene, run_probe, run_scene_probe,
@@ -113,7 +117,7 @@ fn cpu(t: &DiffractionIntegrated, c: &ProbeCase) -> ([f64; 3], [f64; 3]) {
         .colour(c.omega_i.map(f64::from), c.omega_r.map(f64::from), f);
     let cos = f64::from(c.cos_theta);
     let s = f.reflectance(cos);
-    let specular = t.table.sum_at(0.0, 0.0, -2.0 * cos).map(|x| s * x);
+    let specular = t.table.specular_sum(-2.0 * cos).map(|x| s * x);
     (colour, specular)
 }
 
@@ -316,10 +320,20 @@ fn gpu_matches_the_terms_layout_within_the_baked_tolerance() {
         (record.nx, record.taylor_order),
         (t.record.nx, t.record.taylor_order)
     );
+    // The table holds Stam's k² relative to 555 nm (issue 37): the exact colour weighs each
+    // wavelength by (555 nm/λ)², as the terms technique's scenes do.
+    assert_eq!(
+        t.integrated.k_squared_reference_nm,
+        Some(LOBE_REFERENCE_NM),
+        "cd-tracks-fast is baked with Stam's k²"
+    );
+    assert_eq!(t.table.k_squared_reference_nm(), Some(LOBE_REFERENCE_NM));
     let surface = DiffractionSurface::new(terms, record.sigma_s_um).unwrap();
     let grid = grid(t);
     let colorimeter = t.colorimeter().unwrap();
     let white = white(t);
+    // The baker's units: the white with the table's k² weight (like with like).
+    let weighted_white = t.table.white(&grid, &colorimeter);
     let mut pairs = Vec::new();
     for incidence in [0.0, 20.0, 40.0] {
         for i in 0..=180 {
@@ -352,7 +366,10 @@ fn gpu_matches_the_terms_layout_within_the_baked_tolerance() {
             let rho: Vec<f64> = grid
                 .wavelengths_nm()
                 .iter()
-                .map(|&l| surface.relative_reflectance(wi, wr, l, FresnelTerm::Unity))
+                .map(|&l| {
+                    (LOBE_REFERENCE_NM / l).powi(2)
+                        * surface.relative_reflectance(wi, wr, l, FresnelTerm::Unity)
+                })
                 .collect();
             colorimeter.output_from_xyz(grid.xyz(&rho))
         })
@@ -360,7 +377,7 @@ fn gpu_matches_the_terms_layout_within_the_baked_tolerance() {
     let (mut worst, mut at, mut sum) = (0.0f64, 0, 0.0);
     for (i, (g, e)) in gpu.iter().zip(&exact).enumerate() {
         let d = (0..3)
-            .map(|ch| (f64::from(g.colour[ch]) - e[ch]).abs() / white[ch])
+            .map(|ch| (f64::from(g.colour[ch]) - e[ch]).abs() / weighted_white[ch])
             .fold(0.0, f64::max);
         sum += d;
         if d > worst {
@@ -408,7 +425,8 @@ fn gpu_matches_the_terms_layout_within_the_baked_tolerance() {
             })
             .collect();
         let order = colorimeter.output_from_xyz(grid.xyz(&p2));
-        let lobe = t.table.sum_at(0.0, 0.0, -2.0 * cos);
+        // The zeroth order's layers, unweighted: the mirror image has no k².
+        let lobe = t.table.specular_sum(-2.0 * cos);
         for ch in 0..3 {
             worst_specular = worst_specular.max((lobe[ch] - order[ch]).abs() / white[ch]);
         }
@@ -596,6 +614,69 @@ fn the_loader_checks_kind_layout_and_sha256() {
     );
 }
 
+/// A table baked before Stam's k² (a manifest without `k_squared_reference_nm` and
+/// `zeroth_order_layers`: here the default table's manifest with both removed) still loads
+/// and renders as it did: marked as lacking the k², the light's gain at 555 nm, and the
+/// mirror image its own layers' peak (GPU = CPU).
+#[test]
+fn a_table_baked_without_k_squared_still_loads_and_renders() {
+    let dir = default_baked_dir();
+    let tmp = tempfile::tempdir().unwrap();
+    for name in [
+        "cd-tracks-fast.integrated.exr",
+        "cd-tracks-fast.integrated.ktx2",
+    ] {
+        std::fs::copy(dir.join(name), tmp.path().join(name)).unwrap();
+    }
+    let text = std::fs::read_to_string(dir.join("cd-tracks-fast.json")).unwrap();
+    let mut json: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let integrated = json["diffraction"]["integrated"].as_object_mut().unwrap();
+    assert!(integrated.remove("k_squared_reference_nm").is_some());
+    assert!(integrated.remove("zeroth_order_layers").is_some());
+    let path = tmp.path().join("cd-tracks-fast.json");
+    std::fs::write(&path, serde_json::to_string_pretty(&json).unwrap()).unwrap();
+    let old = DiffractionIntegrated::load(ctx(), &path, FresnelTerm::Unity).unwrap();
+    let new = technique();
+    assert_eq!(old.integrated.k_squared_reference_nm, None);
+    assert_eq!(old.table.k_squared_reference_nm(), None);
+    assert_eq!(old.table.values(), new.table.values());
+    assert_eq!(
+        nacre_runtime::diffraction::lobe_gain(&old.record),
+        nacre_runtime::diffraction::lobe_gain(&new.record),
+        "555 nm either way"
+    );
+    // Its mirror image is its own layers' peak, as before the k²; the new table's differs
+    // (unweighted Jₚ against the weighted layers).
+    let cases: Vec<ProbeCase> = (0..=10)
+        .map(|i| ProbeCase {
+            omega_i: [0.0, 0.0, 1.0],
+            omega_r: [0.0, 0.0, 1.0],
+            fresnel: FresnelTerm::Unity,
+            cos_theta: 0.5 + 0.05 * i as f32,
+            sigma_uv: 0.0,
+            slope_variance: 0.0,
+        })
+        .collect();
+    let out = run_probe(ctx(), &old, &cases).unwrap();
+    let white = white(&old);
+    let (mut worst, mut apart) = (0.0f64, 0.0f64);
+    for (c, o) in cases.iter().zip(&out) {
+        let w = -2.0 * f64::from(c.cos_theta);
+        let peak = old.table.sum_at(0.0, 0.0, w);
+        let unweighted = new.table.specular_sum(w);
+        for ch in 0..3 {
+            let e = (f64::from(o.specular[ch]) - peak[ch]).abs() / white[ch];
+            worst = worst.max(e / (1.0 + (peak[ch] / white[ch]).abs()));
+            apart = apart.max((peak[ch] - unweighted[ch]).abs() / white[ch]);
+        }
+    }
+    eprintln!(
+        "table without k²: mirror image GPU − CPU peak {worst:.2e} of the white; the k² layers' peak is {apart:.3} of the white from the unweighted zeroth order"
+    );
+    assert!(worst <= TOLERANCE, "{worst:.3e}");
+    assert!(apart > 0.05, "{apart}");
+}
+
 #[test]
 fn the_shaders_validate_and_translate() {
     // The probe.
@@ -658,7 +739,8 @@ fn fs_bindingless(@builtin(position) p: vec4<f32>) -> @location(0) vec4<f32> {
             bound += 1;
         }
     }
-    assert_eq!(bound, 2);
+    // The uniform, the table and the zeroth order's layers.
+    assert_eq!(bound, 3);
 }
 
 /// The prefiltered levels the loader adds (issue 37: the footprint filter and rough

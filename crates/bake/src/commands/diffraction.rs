@@ -353,6 +353,15 @@ pub fn load(src: &Source, directions: &[([f64; 3], [f64; 3])]) -> Result<Loaded>
                     }
                 }
                 let (_, table) = manifest.load_diffraction_integrated(&path)?;
+                // What the colours are: with Stam's k² (issue 37) the table's sum, not ρ's.
+                match table.k_squared_reference_nm() {
+                    Some(r) => eprintln!(
+                        "nacre: table `{name}` is summed with Stam's k^2 as ({r} nm / lambda)^2 per wavelength (k_squared_reference_nm): its colours are those of sum_lambda ({r}/lambda)^2 rho u, what a renderer lights at the gain (sigma_s k_ref)^2/pi, not the relative reflectance's sum_lambda rho u"
+                    ),
+                    None => eprintln!(
+                        "nacre: table `{name}` was baked without Stam's k^2 (no k_squared_reference_nm: an older nacre): its colours are those of sum_lambda rho u"
+                    ),
+                }
                 return Ok(Loaded {
                     evaluator: Evaluator::Integrated(table),
                     colorimeter,
@@ -457,11 +466,13 @@ pub fn load(src: &Source, directions: &[([f64; 3], [f64; 3])]) -> Result<Loaded>
             2 * surface.terms().order() + 1,
             axis.max_uv
         );
+        // Without Stam's k²: the colour of Σ_λ ρ u, as the terms evaluator gives it.
         Evaluator::Integrated(IntegratedTable::compute(
             &surface,
             &grid,
             &colorimeter,
             axis,
+            None,
         ))
     } else {
         Evaluator::Terms(surface)

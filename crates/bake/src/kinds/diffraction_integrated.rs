@@ -26,15 +26,19 @@
 //!
 //! The baker compares the colour a shader rebuilds (f32 texels, bilinear in the warped
 //! coordinates, f32 Horner sum) with the exact colour of the terms layout (f64 terms,
-//! ρ per wavelength, the same [`SpectralGrid`]) over the pairs of
+//! ρ per wavelength weighted by the same Stam's k² (555 nm/λ)² as the table — like with
+//! like —, the same [`SpectralGrid`]) over the pairs of
 //! [`check_directions`] (in-plane, off-plane and around the mirror lobe; several
 //! thousand), and records the largest |Δ| of any output channel in units of that
-//! channel's white — the colour of a flat perfect mirror in its specular direction, the
-//! scale every relative reflectance is expressed in. A per-channel absolute metric is
+//! channel's white — the colour of a flat perfect mirror in its specular direction with
+//! the same weight, Σ_λ (555 nm/λ)² u(λ), the scale every value of the table is expressed
+//! in. A per-channel absolute metric is
 //! used rather than ΔE because the values are unbounded HDR radiance factors (the mirror
 //! lobe reaches the white, the orders a few per cent of it): a ΔE would need an exposure.
 //! The default tolerance 0.01 (1 % of the specular white) passes the CD recipe of the
-//! default set at n = 144 (measured 6.4 × 10⁻³, mean 9 × 10⁻⁵; the worst texels are the
+//! default set at n = 144 (measured 6.8 × 10⁻³, mean 9.9 × 10⁻⁵, with the k²; 6.4 × 10⁻³,
+//! mean 9.2 × 10⁻⁵, without it, `nacre bake tables/recipes/cd-tracks-fast.toml`, the
+//! manifest's `reconstruction_error`; the worst texels are the
 //! lobe edges, where bilinear interpolation rounds the peaks) while the failures it exists
 //! for are orders of magnitude above it: f32 cancellation of tall structures reaches
 //! 27 × the white for a 1 µm blazed grating (max |kwh| = 16.5).
@@ -42,7 +46,10 @@
 //! # Files
 //!
 //! What every texel holds: layer p of column c, row r is I_p(u_c, v_r) in the recipe's
-//! output space (linear RGB of `[colour] space`, or XYZ for `xyz`), f32, u_c =
+//! output space (linear RGB of `[colour] space`, or XYZ for `xyz`), each wavelength of its
+//! sum weighted by Stam's k² as (555 nm/λ)² (the manifest's `k_squared_reference_nm`; the
+//! unweighted layers at u = v = 0, for the mirror image, are its `zeroth_order_layers`;
+//! a manifest without these fields is a table baked before the weight), f32, u_c =
 //! u_max((2c + 1)/n)^γ (c = 0 … n/2 − 1, u ≥ 0 only), v_r = u_max sign(t)|t|^γ with
 //! t = (2r + 1)/n − 1.
 //!
@@ -67,7 +74,7 @@ use nacre_format::diffraction::{
 use nacre_format::manifest::{AxisRecord, KindRecord, Manifest};
 use nacre_format::table_io::{Precision, Table3};
 use nacre_optics::diffraction::integrated::{
-    IntegratedTable, MAX_INTEGRATED_SAMPLES, WarpedAxis, check_directions,
+    IntegratedTable, K_SQUARED_REFERENCE_NM, MAX_INTEGRATED_SAMPLES, WarpedAxis, check_directions,
 };
 use nacre_optics::diffraction::{DiffractionSurface, SpectralGrid, TaylorTerms};
 use nacre_optics::elementary;
@@ -195,6 +202,8 @@ impl IntegratedSettings {
             worst_channel: String::new(),
             pairs: 0,
             storage_error: 0.0,
+            k_squared_reference_nm: Some(K_SQUARED_REFERENCE_NM),
+            zeroth_order_layers: Vec::new(),
         }
     }
 }
@@ -249,7 +258,7 @@ pub fn bake(
     let surface = DiffractionSurface::new(terms, r.sigma_s_um).map_err(optics)?;
     let grid = SpectralGrid::new(c, &recipe.wavelengths_nm).map_err(optics)?;
     let axis = WarpedAxis::new(r.max_uv, s.gamma, s.samples_v).map_err(optics)?;
-    let table = IntegratedTable::compute(&surface, &grid, c, axis);
+    let table = IntegratedTable::compute(&surface, &grid, c, axis, s.k_squared_reference_nm);
     let pairs = check_directions(r.max_angle_deg);
     let e = table.reconstruction_error(&surface, &grid, c, &pairs);
     let w_min = -2.0 * elementary::cos(r.max_angle_deg.to_radians());
@@ -257,12 +266,14 @@ pub fn bake(
     progress();
     let channel_names = c.space().channel_names();
     s.channels = format!(
-        "I_p in linear {} ({}, {}, {}): colour = C * sum_p w^p I_p is the table's output colour directly",
+        "I_p in linear {} ({}, {}, {}), each wavelength weighted by Stam's k^2 as (k/k_ref)^2 = ({} nm/lambda)^2 (k_squared_reference_nm; the light's gain (sigma_s k_ref)^2/pi carries the rest of f = rho (sigma_s k)^2/pi): colour = C * sum_p w^p I_p is the table's output colour of sum_lambda (k/k_ref)^2 rho u directly; zeroth_order_layers are the layers at u = v = 0 without the weight (the mirror image's efficiency)",
         c.space(),
         channel_names[0],
         channel_names[1],
-        channel_names[2]
+        channel_names[2],
+        K_SQUARED_REFERENCE_NM
     );
+    s.zeroth_order_layers = table.specular_layers().to_vec();
     s.reconstruction_error = e.max_error;
     s.mean_error = e.mean_error;
     s.worst_light_deg = polar_deg(e.omega_i).map(sig4);
@@ -472,8 +483,16 @@ integrated_samples = 256
             DiffractionSurface::new(TaylorTerms::compute(&field, record.taylor_order), 4.0)
                 .unwrap();
         let grid = SpectralGrid::new(&d.colorimeter, &d.wavelengths_nm).unwrap();
-        let exact = IntegratedTable::compute(&surface, &grid, &d.colorimeter, table.axis());
+        let exact = IntegratedTable::compute(
+            &surface,
+            &grid,
+            &d.colorimeter,
+            table.axis(),
+            Some(K_SQUARED_REFERENCE_NM),
+        );
         assert_eq!(table, exact);
+        assert_eq!(s.k_squared_reference_nm, Some(K_SQUARED_REFERENCE_NM));
+        assert!(s.channels.contains("k^2") && s.zeroth_order_layers.len() == s.layers);
         let mut ktx_only = m.clone();
         ktx_only
             .files
@@ -489,6 +508,28 @@ integrated_samples = 256
         let e = m.load_diffraction(&manifest_path).unwrap_err().to_string();
         assert!(e.contains("\"integrated\""), "{e}");
         assert!(m.atlas.contains("128 x 256") && m.texel_centres.contains("u >= 0"));
+        // A manifest without the k² fields (baked before issue 37's k²) still loads: the
+        // same texels, marked as summed without the weight, its own peak as the zeroth order.
+        let mut json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&manifest_path).unwrap()).unwrap();
+        let fields = json["diffraction"]["integrated"].as_object_mut().unwrap();
+        assert!(fields.remove("k_squared_reference_nm").is_some());
+        assert!(fields.remove("zeroth_order_layers").is_some());
+        let old_path = out.join("old.json");
+        std::fs::write(&old_path, serde_json::to_string(&json).unwrap()).unwrap();
+        let (old_record, old) = Manifest::read(&old_path)
+            .unwrap()
+            .load_diffraction_integrated(&old_path)
+            .unwrap();
+        let old_s = old_record.integrated.unwrap();
+        assert_eq!(old_s.k_squared_reference_nm, None);
+        assert!(old_s.zeroth_order_layers.is_empty());
+        assert_eq!(
+            (old.k_squared_reference_nm(), old.values()),
+            (None, table.values())
+        );
+        assert_eq!(old.specular_sum(-2.0), old.sum_at(0.0, 0.0, -2.0));
+        assert_ne!(old.specular_sum(-2.0), table.specular_sum(-2.0));
     }
 
     #[test]

@@ -31,6 +31,28 @@
 //! I_{p,c}(u, v) = Σ_λ u_c(λ) kᵖ Σ_{n+m=p} Re(P̃ₙ(ku, kv) P̃ₘ(ku, kv)*)/(n! m!),   k = 2π/λ.
 //! ```
 //!
+//! **Stam's k².** The BRDF is f = ρ (σ_s k)²/π, not ρ: a flat mirror's lobe |P̃|² =
+//! exp(−σ_s²k²|Δ(u, v)|²) integrates to π/(σ_s k)² over (u, v), so its energy is the same
+//! at every wavelength only with the k² (Stam 1999, eq. 11; issue 37). A renderer passes
+//! the light's gain (σ_s k_ref)²/π at one reference wavelength λ_ref
+//! (`nacre_runtime::diffraction::lobe_gain`) and puts back (k/k_ref)² = (λ_ref/λ)² per
+//! wavelength; the terms technique does that in its wavelength loop, and a table of this
+//! layout must do it at bake time, where the wavelengths are summed:
+//!
+//! ```text
+//! I_{p,c}(u, v) = Σ_λ (λ_ref/λ)² u_c(λ) kᵖ Σ_{n+m=p} Re(P̃ₙ P̃ₘ*)/(n! m!)
+//! ```
+//!
+//! ([`IntegratedTable::compute`] with `Some(λ_ref)`; [`K_SQUARED_REFERENCE_NM`] = 555 nm,
+//! the runtime's, for baked tables). Without it (`None`, and every table baked before the
+//! weight existed) the table is Σ_λ u ρ and a picture drawn from it is tilted towards red
+//! by (λ/λ_ref)² (×0.66 at 450 nm, ×1.37 at 650 nm against 555 nm). The weight is a
+//! positive constant per wavelength, so everything below (the factorisation, the symmetry,
+//! the blurred levels) holds unchanged. Only the mirror image's colour is not weighted: the
+//! zeroth order's efficiency is the lobe's peak ρ(0, 0) times its integral
+//! (σ_s k)²/π · π/(σ_s k)² = 1 at every wavelength, so [`IntegratedTable::specular_layers`]
+//! keep Jₚ = Iₚ(0, 0) without the weight.
+//!
 //! Iₚ depends on (u, v) only: w and the wavelength sum are out of the texture coordinates.
 //! Because n, m ≤ N on both sides, Σₚ wᵖ Iₚ is exactly the colour of the truncated terms
 //! layout (`|Σ_{n≤N}|²`), not a second truncation. The channels are stored in the
@@ -89,6 +111,22 @@ use rayon::prelude::*;
 
 /// Most texels per axis of an integrated table.
 pub const MAX_INTEGRATED_SAMPLES: usize = 4096;
+
+/// The reference wavelength λ_ref of Stam's k² weight (λ_ref/λ)² in baked integrated tables,
+/// nm (module docs): the wavelength of the runtime's light gain (σ_s k_ref)²/π
+/// (`nacre_runtime::diffraction::LOBE_REFERENCE_NM` is this constant).
+pub const K_SQUARED_REFERENCE_NM: f64 = 555.0;
+
+/// Stam's k² relative to the reference, (k/k_ref)² = (λ_ref/λ)² (module docs).
+pub fn k_squared_weight(reference_nm: f64, wavelength_nm: f64) -> f64 {
+    let r = reference_nm / wavelength_nm;
+    r * r
+}
+
+/// The weight (λ_ref/λ)² of `wavelength_nm` for an optional reference (1 without one).
+fn weight_of(reference_nm: Option<f64>, wavelength_nm: f64) -> f64 {
+    reference_nm.map_or(1.0, |r| k_squared_weight(r, wavelength_nm))
+}
 
 /// A warped texture axis over [−u_max, u_max] packing texels near 0 (module docs).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -152,18 +190,28 @@ impl WarpedAxis {
 }
 
 /// An integrated table: I_{p,c}(u, v) for p = 0 … 2N, u ≥ 0 (n/2 columns) and v over the
-/// whole axis (n rows), stored as f32 in the colorimeter's output space (module docs).
+/// whole axis (n rows), stored as f32 in the colorimeter's output space (module docs), with
+/// the k² reference it was summed with and the zeroth order's layers Jₚ.
 #[derive(Clone, Debug, PartialEq)]
 pub struct IntegratedTable {
     axis: WarpedAxis,
     order: usize,
     /// `values[(p * n + iv) * n/2 + c]`: layer p, row v, column c (u ≥ 0).
     values: Vec<[f32; 3]>,
+    /// λ_ref of the (λ_ref/λ)² weight in `values`; `None`: summed without Stam's k².
+    k_squared_reference_nm: Option<f64>,
+    /// Jₚ, p = 0 … 2N: the mirror-lobe peak's layers without the k² weight.
+    specular: Vec<[f32; 3]>,
 }
 
 impl IntegratedTable {
     /// Computes the table of `surface` for the wavelengths and weights of `grid`, stored in
-    /// `colorimeter`'s output space. Rows of texels in parallel; each row is summed in a
+    /// `colorimeter`'s output space, each wavelength weighted by Stam's k² relative to
+    /// `k_squared_reference_nm` (λ_ref/λ)² (module docs: the BRDF is ρ (σ_s k)²/π and the
+    /// renderer's gain takes k at λ_ref; `None` sums ρ u without it, as tables baked before
+    /// issue 37's k² did). Also computes the zeroth order's layers
+    /// Jₚ = Σ_λ u(λ) kᵖ Σ_{n+m=p} Re(P̃ₙ(0) P̃ₘ(0)*)/(n! m!), unweighted
+    /// ([`Self::specular_layers`]). Rows of texels in parallel; each row is summed in a
     /// fixed order, so the values do not depend on the thread count.
     ///
     /// Per row (fixed v) and wavelength the window's y factor is applied once to every
@@ -174,6 +222,7 @@ impl IntegratedTable {
         grid: &SpectralGrid,
         colorimeter: &Colorimeter,
         axis: WarpedAxis,
+        k_squared_reference_nm: Option<f64>,
     ) -> Self {
         let terms = surface.terms();
         let order = terms.order();
@@ -202,8 +251,11 @@ impl IntegratedTable {
                 let mut pt = vec![C64::new(0.0, 0.0); terms_per_bin];
                 let mut q = vec![0.0f64; layers];
                 let mut k_pow = vec![0.0f64; layers];
-                for (&wavelength, weight) in grid.wavelengths_nm().iter().zip(&grid.xyz_weights) {
+                for (&wavelength, xyz_weight) in grid.wavelengths_nm().iter().zip(&grid.xyz_weights)
+                {
                     let k = k_per_um(wavelength);
+                    let k2 = weight_of(k_squared_reference_nm, wavelength);
+                    let weight = xyz_weight.map(|x| x * k2);
                     r.fill(C64::new(0.0, 0.0));
                     for (jy, wy) in surface.axis_weights(k * v, false) {
                         let sy = (jy + (ny / 2) as i64) as usize;
@@ -261,15 +313,22 @@ impl IntegratedTable {
                     .copy_from_slice(&row[p * half..(p + 1) * half]);
             }
         }
+        let specular = zeroth_order_layers(surface, grid, colorimeter);
         IntegratedTable {
             axis,
             order,
             values,
+            k_squared_reference_nm,
+            specular,
         }
     }
 
     /// A table from stored values (`values[(p * n + iv) * n/2 + c]`, p = 0 … 2N), e.g.
-    /// read back from a baked file.
+    /// read back from a baked file, summed without Stam's k² (as every table baked before
+    /// issue 37's k²; [`Self::with_k_squared`] marks one baked with it). Its zeroth-order
+    /// layers Jₚ are the layers read at u = v = 0 (bilinear, in f32 as the shader reads
+    /// them), so [`Self::specular_sum`] is [`Self::sum_at`] at (0, 0, w) up to the rounding
+    /// of the Horner sum: such a table renders as before.
     ///
     /// # Errors
     /// [`Error::OutOfRange`] when the value count is not (2N + 1)·n·n/2.
@@ -282,11 +341,71 @@ impl IntegratedTable {
                 expected: "(2N + 1) × n × n/2 texels",
             });
         }
-        Ok(IntegratedTable {
+        let mut table = IntegratedTable {
             axis,
             order,
             values,
-        })
+            k_squared_reference_nm: None,
+            specular: Vec::new(),
+        };
+        let at = table.lookup(0.0, 0.0, 0.0);
+        table.specular = (0..table.layers())
+            .map(|p| table.bilinear(p, &at))
+            .collect();
+        Ok(table)
+    }
+
+    /// This table marked as summed with Stam's k² relative to `reference_nm`, with the
+    /// unweighted zeroth-order layers `specular` (Jₚ, p = 0 … 2N) a manifest records.
+    ///
+    /// # Errors
+    /// [`Error::OutOfRange`] for a reference that is not a finite wavelength in
+    /// (0, 10⁶] nm, or `specular` not of 2N + 1 finite values.
+    pub fn with_k_squared(mut self, reference_nm: f64, specular: Vec<[f32; 3]>) -> Result<Self> {
+        if !(reference_nm > 0.0 && reference_nm <= 1e6) {
+            return Err(Error::OutOfRange {
+                what: "k² reference wavelength of an integrated table (nm)",
+                value: reference_nm,
+                expected: "a finite wavelength in (0, 1e6] nm",
+            });
+        }
+        if specular.len() != self.layers() || !specular.iter().flatten().all(|x| x.is_finite()) {
+            return Err(Error::OutOfRange {
+                what: "zeroth-order layers of an integrated table",
+                value: specular.len() as f64,
+                expected: "2N + 1 finite colours",
+            });
+        }
+        self.k_squared_reference_nm = Some(reference_nm);
+        self.specular = specular;
+        Ok(self)
+    }
+
+    /// λ_ref of the (λ_ref/λ)² weight the table was summed with; `None` for a table summed
+    /// without Stam's k² (baked by a nacre before issue 37's k²): its colours are Σ_λ ρ u,
+    /// tilted towards red by (λ/λ_ref)² against the terms technique (module docs).
+    pub fn k_squared_reference_nm(&self) -> Option<f64> {
+        self.k_squared_reference_nm
+    }
+
+    /// Jₚ, p = 0 … 2N: the layers of the mirror lobe's peak without the k² weight, so that
+    /// F² Σₚ (−2 cos θ)ᵖ Jₚ is the colour of |P̃(0, 0)|², the zeroth order's efficiency
+    /// (module docs).
+    pub fn specular_layers(&self) -> &[[f32; 3]] {
+        &self.specular
+    }
+
+    /// Σₚ wᵖ Jₚ by the f32 Horner sum (the shader's `diffraction_integrated_specular_colour`
+    /// without F²): the colour of |P̃(0, 0)|² at w, unweighted.
+    pub fn specular_sum(&self, w: f64) -> [f64; 3] {
+        let w = w as f32;
+        let mut acc = [0.0f32; 3];
+        for j in self.specular.iter().rev() {
+            for ch in 0..3 {
+                acc[ch] = acc[ch] * w + j[ch];
+            }
+        }
+        acc.map(f64::from)
     }
 
     /// The axis (v whole, u its half u ≥ 0).
@@ -349,6 +468,20 @@ impl IntegratedTable {
         }
     }
 
+    /// Layer p read bilinearly at `at` (f32, as in [`Self::horner`]).
+    fn bilinear(&self, p: usize, at: &Lookup) -> [f32; 3] {
+        let (x0, y0, fx, fy) = (at.x0, at.y0, at.fx, at.fy);
+        let a = self.texel(p, x0, y0);
+        let b = self.texel(p, x0 + 1, y0);
+        let c = self.texel(p, x0, y0 + 1);
+        let d = self.texel(p, x0 + 1, y0 + 1);
+        std::array::from_fn(|ch| {
+            let lo = a[ch] + fx * (b[ch] - a[ch]);
+            let hi = c[ch] + fx * (d[ch] - c[ch]);
+            lo + fy * (hi - lo)
+        })
+    }
+
     /// The f32 Horner sum of the bilinear reads at `at`.
     fn horner(&self, at: &Lookup) -> [f32; 3] {
         let (x0, y0, fx, fy, w) = (at.x0, at.y0, at.fx, at.fy, at.w);
@@ -382,12 +515,27 @@ impl IntegratedTable {
         self.sum_at(u, v, w).map(|s| c * s)
     }
 
+    /// The white the errors are measured in, per output channel: the colour of ρ ≡ 1 (a flat
+    /// perfect mirror in its specular direction) as this table sums it, with its own
+    /// (λ_ref/λ)² weight when it has a k² reference (Σ_λ (λ_ref/λ)² u(λ): the same units on
+    /// both sides of the comparison), without it otherwise (the output space's white).
+    pub fn white(&self, grid: &SpectralGrid, colorimeter: &Colorimeter) -> [f64; 3] {
+        let ones: Vec<f64> = grid
+            .wavelengths_nm()
+            .iter()
+            .map(|&l| weight_of(self.k_squared_reference_nm, l))
+            .collect();
+        colorimeter.output_from_xyz(grid.xyz(&ones))
+    }
+
     /// Measures the table against the terms layout: for every (ω_i, ω_r) of `pairs`, the
     /// colour of [`IntegratedTable::colour`] against the exact colour of `surface`
-    /// (f64 terms, ρ per wavelength, [`SpectralGrid::xyz`], `output_from_xyz`), both with
-    /// F = 1. The metric is the largest |Δ| of any output channel divided by that
-    /// channel's white (the colour ρ ≡ 1 gives: a flat perfect mirror seen in its specular
-    /// direction), i.e. errors in units of the specular white. Pairs in parallel; the
+    /// (f64 terms, ρ per wavelength weighted by the table's own (λ_ref/λ)² when it has a
+    /// k² reference — like with like —, [`SpectralGrid::xyz`], `output_from_xyz`), both
+    /// with F = 1. The metric is the largest |Δ| of any output channel divided by that
+    /// channel's white ([`Self::white`]: the colour ρ ≡ 1 gives, a flat perfect mirror seen
+    /// in its specular direction, with the table's k² weight), i.e. errors in units of the
+    /// specular white. Pairs in parallel; the
     /// maximum is taken in pair order, so the result does not depend on the thread count.
     pub fn reconstruction_error(
         &self,
@@ -396,14 +544,17 @@ impl IntegratedTable {
         colorimeter: &Colorimeter,
         pairs: &[([f64; 3], [f64; 3])],
     ) -> ReconstructionError {
-        let white = colorimeter.output_from_xyz(grid.xyz(&vec![1.0; grid.wavelengths_nm().len()]));
+        let white = self.white(grid, colorimeter);
         let errors: Vec<(f64, usize, [f64; 3], [f64; 3])> = pairs
             .par_iter()
             .map(|&(wi, wr)| {
                 let rho: Vec<f64> = grid
                     .wavelengths_nm()
                     .iter()
-                    .map(|&l| surface.relative_reflectance(wi, wr, l, FresnelTerm::Unity))
+                    .map(|&l| {
+                        weight_of(self.k_squared_reference_nm, l)
+                            * surface.relative_reflectance(wi, wr, l, FresnelTerm::Unity)
+                    })
                     .collect();
                 let exact = colorimeter.output_from_xyz(grid.xyz(&rho));
                 let fast = self.colour(wi, wr, FresnelTerm::Unity);
@@ -450,7 +601,8 @@ impl IntegratedTable {
 
 impl IntegratedTable {
     /// The error of f32 storage and the f32 Horner sum alone (no interpolation): at the
-    /// centres of every `stride`-th column and row, |Σₚ wᵖ Iₚ − M Σ_λ u(λ)|P̃(λ)|²| for
+    /// centres of every `stride`-th column and row, |Σₚ wᵖ Iₚ − M Σ_λ u(λ)|P̃(λ)|²| (each
+    /// wavelength weighted by the table's (λ_ref/λ)² when it has a k² reference) for
     /// w = −2 and w = `w_min` (the smallest |w| served, −2 cos θ_max), P̃ from `surface`'s
     /// f64 terms, in units of the specular white as in
     /// [`IntegratedTable::reconstruction_error`]. This isolates the catastrophic
@@ -464,7 +616,7 @@ impl IntegratedTable {
         stride: usize,
         w_min: f64,
     ) -> f64 {
-        let white = colorimeter.output_from_xyz(grid.xyz(&vec![1.0; grid.wavelengths_nm().len()]));
+        let white = self.white(grid, colorimeter);
         let (cols, rows) = self.size();
         let stride = stride.max(1);
         let probes: Vec<(f64, f64, f64)> = (0..rows)
@@ -488,7 +640,10 @@ impl IntegratedTable {
                 let p2: Vec<f64> = grid
                     .wavelengths_nm()
                     .iter()
-                    .map(|&l| surface.transform(l, u, v, w).norm_sqr())
+                    .map(|&l| {
+                        weight_of(self.k_squared_reference_nm, l)
+                            * surface.transform(l, u, v, w).norm_sqr()
+                    })
                     .collect();
                 let exact = colorimeter.output_from_xyz(grid.xyz(&p2));
                 let fast = self.sum_at(u, v, w);
@@ -501,6 +656,50 @@ impl IntegratedTable {
             .into_iter()
             .fold(0.0, |m: f64, e| if e <= m { m } else { e })
     }
+}
+
+/// Jₚ = Σ_λ u(λ) kᵖ Σ_{n+m=p} Re(P̃ₙ(0) P̃ₘ(0)*)/(n! m!), p = 0 … 2N, in `colorimeter`'s
+/// output space, f32: the table's layers at u = v = 0 without the k² weight. P̃ₙ(0) does not
+/// depend on k (the window is centred on q = k(u, v) = 0), so it is computed once and the
+/// wavelength sum is Σ_λ u(λ) kᵖ.
+fn zeroth_order_layers(
+    surface: &DiffractionSurface,
+    grid: &SpectralGrid,
+    colorimeter: &Colorimeter,
+) -> Vec<[f32; 3]> {
+    let order = surface.terms().order();
+    let layers = 2 * order + 1;
+    let Some(&first) = grid.wavelengths_nm().first() else {
+        return vec![[0.0; 3]; layers];
+    };
+    let pt = surface.transform_terms(first, 0.0, 0.0);
+    let mut fact = vec![1.0f64; order + 1];
+    for i in 1..=order {
+        fact[i] = fact[i - 1] * i as f64;
+    }
+    let mut q = vec![0.0f64; layers];
+    for a in 0..=order {
+        for b in a..=order {
+            let re = pt[a].re * pt[b].re + pt[a].im * pt[b].im;
+            let twin = if a == b { 1.0 } else { 2.0 };
+            q[a + b] += twin * re / (fact[a] * fact[b]);
+        }
+    }
+    let matrix = colorimeter.matrix();
+    (0..layers)
+        .map(|p| {
+            let mut xyz = [0.0f64; 3];
+            for (&wavelength, weight) in grid.wavelengths_nm().iter().zip(&grid.xyz_weights) {
+                let s = q[p] * elementary::powi(k_per_um(wavelength), p as i32);
+                for ch in 0..3 {
+                    xyz[ch] += weight[ch] * s;
+                }
+            }
+            std::array::from_fn(|i| {
+                (matrix[i][0] * xyz[0] + matrix[i][1] * xyz[1] + matrix[i][2] * xyz[2]) as f32
+            })
+        })
+        .collect()
 }
 
 /// Where a point (u, v, w) reads an integrated table (the same for every level).
@@ -640,6 +839,8 @@ impl IntegratedTable {
             axis: self.axis,
             order: self.order,
             values: blocks.concat(),
+            k_squared_reference_nm: self.k_squared_reference_nm,
+            specular: self.specular.clone(),
         }
     }
 }

@@ -466,7 +466,7 @@ fn integrated_table_is_the_terms_colour_at_texel_centres_on_both_halves() {
         let (order, _) = taylor_order_for(max_phase(&field, 380.0, 2.0), 1e-6).unwrap();
         let s = DiffractionSurface::new(TaylorTerms::compute(&field, order), sigma).unwrap();
         let axis = WarpedAxis::new(1.2, 3.0, 24).unwrap();
-        let t = IntegratedTable::compute(&s, &grid, &c, axis);
+        let t = IntegratedTable::compute(&s, &grid, &c, axis, None);
         assert_eq!(t.layers(), 2 * order + 1);
         assert_eq!(t.size(), (12, 24));
         let mut worst: f64 = 0.0;
@@ -494,6 +494,93 @@ fn integrated_table_is_the_terms_colour_at_texel_centres_on_both_halves() {
 }
 
 #[test]
+fn integrated_table_with_k_squared_is_the_weighted_terms_colour() {
+    use super::integrated::{IntegratedTable, K_SQUARED_REFERENCE_NM, WarpedAxis};
+    // Issue 37: a table summed with Stam's k² holds Σ_λ (λ_ref/λ)² u |P̃|², the colour the
+    // terms technique gives with its (λ_ref/λ)² weight, not Σ_λ u |P̃|²; the zeroth-order
+    // layers stay unweighted (the mirror image's efficiency has no k²).
+    let (c, grid) = srgb_grid(20.0);
+    let field = grating("sine", 1.6, 0.05);
+    let (order, _) = taylor_order_for(max_phase(&field, 380.0, 2.0), 1e-6).unwrap();
+    let s = DiffractionSurface::new(TaylorTerms::compute(&field, order), 4.0).unwrap();
+    let axis = WarpedAxis::new(1.2, 3.0, 24).unwrap();
+    let reference = K_SQUARED_REFERENCE_NM;
+    let t = IntegratedTable::compute(&s, &grid, &c, axis, Some(reference));
+    let plain = IntegratedTable::compute(&s, &grid, &c, axis, None);
+    assert_eq!(
+        (t.k_squared_reference_nm(), plain.k_squared_reference_nm()),
+        (Some(reference), None)
+    );
+    let weighted_sum = |u: f64, v: f64, w: f64| {
+        let p2: Vec<f64> = grid
+            .wavelengths_nm()
+            .iter()
+            .map(|&l| (reference / l).powi(2) * s.transform(l, u, v, w).norm_sqr())
+            .collect();
+        c.output_from_xyz(grid.xyz(&p2))
+    };
+    let (mut worst, mut tilt_blue, mut tilt_red) = (0.0f64, 0.0f64, 0.0f64);
+    for iu in [12, 14, 16, 20, 23] {
+        for iv in [0, 5, 11, 12, 18, 23] {
+            let (u, v) = (axis.texel_centre(iu), axis.texel_centre(iv));
+            for w in [-2.0, -1.6] {
+                let want = weighted_sum(u, v, w);
+                let got = t.sum_at(u, v, w);
+                let old = plain.sum_at(u, v, w);
+                for ch in 0..3 {
+                    worst = worst.max((got[ch] - want[ch]).abs());
+                }
+                if old[2] > 1e-3 && old[0] > 1e-3 {
+                    tilt_blue = tilt_blue.max(got[2] / old[2]);
+                    tilt_red = tilt_red.max(old[0] / got[0]);
+                }
+            }
+        }
+    }
+    eprintln!(
+        "k² table vs weighted terms colour: {worst:.2e}; blue ×{tilt_blue:.3}, red ÷{tilt_red:.3} against the table without k²"
+    );
+    assert!(worst < 1e-5, "{worst}");
+    // The weight is what separates them: blue gains, red loses (a table without it is off).
+    assert!(tilt_blue > 1.1 && tilt_red > 1.05, "{tilt_blue} {tilt_red}");
+    // The zeroth order's layers: the unweighted colour of |P̃(0, 0)|², the same with or
+    // without k², and that of the unweighted table's peak.
+    assert_eq!(t.specular_layers(), plain.specular_layers());
+    for w in [-2.0, -1.5] {
+        let exact = exact_sum(&s, &c, &grid, 0.0, 0.0, w);
+        let (spec, peak) = (t.specular_sum(w), plain.sum_at(0.0, 0.0, w));
+        for ch in 0..3 {
+            assert!((spec[ch] - exact[ch]).abs() < 1e-5, "{spec:?} {exact:?}");
+            assert!((spec[ch] - peak[ch]).abs() < 1e-4, "{spec:?} {peak:?}");
+        }
+    }
+    // A table read back without the field (an older bake) takes its peak as its zeroth
+    // order, and one marked with it keeps the recorded layers.
+    let old = IntegratedTable::from_values(axis, order, plain.values().to_vec()).unwrap();
+    assert_eq!(old.k_squared_reference_nm(), None);
+    for w in [-2.0f64, -1.7] {
+        assert_eq!(old.specular_sum(w), old.sum_at(0.0, 0.0, w));
+    }
+    let marked = IntegratedTable::from_values(axis, order, t.values().to_vec())
+        .unwrap()
+        .with_k_squared(reference, t.specular_layers().to_vec())
+        .unwrap();
+    assert_eq!(marked, t);
+    for bad in [0.0, -555.0, f64::NAN, f64::INFINITY] {
+        assert!(
+            old.clone()
+                .with_k_squared(bad, t.specular_layers().to_vec())
+                .is_err()
+        );
+    }
+    assert!(
+        old.clone()
+            .with_k_squared(555.0, vec![[0.0; 3]; 2])
+            .is_err()
+    );
+}
+
+#[test]
 fn integrated_sine_grating_reconstructs_the_terms_colour_within_tolerance() {
     use super::integrated::{IntegratedTable, WarpedAxis, check_directions};
     let (c, grid) = srgb_grid(10.0);
@@ -502,7 +589,7 @@ fn integrated_sine_grating_reconstructs_the_terms_colour_within_tolerance() {
     let s = DiffractionSurface::new(TaylorTerms::compute(&field, order), 4.0).unwrap();
     let max_angle: f64 = 30.0;
     let axis = WarpedAxis::new(2.0 * max_angle.to_radians().sin(), 3.0, 256).unwrap();
-    let t = IntegratedTable::compute(&s, &grid, &c, axis);
+    let t = IntegratedTable::compute(&s, &grid, &c, axis, None);
     let pairs = check_directions(max_angle);
     assert!(pairs.len() > 2000 && pairs.iter().any(|(_, r)| r[1].abs() > 0.1));
     let e = t.reconstruction_error(&s, &grid, &c, &pairs);
@@ -514,7 +601,7 @@ fn integrated_sine_grating_reconstructs_the_terms_colour_within_tolerance() {
     );
     assert!(e.max_error < 1e-2, "{e:?}");
     // Coarser tables err more: the metric sees interpolation.
-    let coarse = IntegratedTable::compute(&s, &grid, &c, WarpedAxis { count: 16, ..axis });
+    let coarse = IntegratedTable::compute(&s, &grid, &c, WarpedAxis { count: 16, ..axis }, None);
     let ec = coarse.reconstruction_error(&s, &grid, &c, &pairs);
     assert!(ec.max_error > 5.0 * e.max_error, "{ec:?}");
 }
@@ -530,7 +617,8 @@ fn f32_storage_cancels_for_tall_structures_only() {
         let x = max_phase(&field, 380.0, 2.0);
         let (order, _) = taylor_order_for(x, 1e-4).unwrap();
         let s = DiffractionSurface::new(TaylorTerms::compute(&field, order), 4.0).unwrap();
-        let t = IntegratedTable::compute(&s, &grid, &c, WarpedAxis::new(1.0, 3.0, 16).unwrap());
+        let t =
+            IntegratedTable::compute(&s, &grid, &c, WarpedAxis::new(1.0, 3.0, 16).unwrap(), None);
         let e = t.storage_error(&s, &grid, &c, 1, -1.7);
         eprintln!("blazed {height} µm: max |kwh| = {x:.2}, N = {order}, f32 storage error {e:.2e}");
         errors.push(e);

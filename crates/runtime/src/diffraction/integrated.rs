@@ -39,6 +39,7 @@
 //! |---|---|---|
 //! | 0 | uniform [`DiffractionIntegratedUniform`] (48 bytes): layer size, 2N + 1, u_max, 1/γ, the host's F², levels L, σ₁², the scene's filter and σ_m² | `diffraction_integrated: DiffractionIntegratedParams` |
 //! | 1 | the table, `texture_2d_array<f32>`, unfilterable (`textureLoad` only) | `diffraction_integrated_table` |
+//! | 2 | read-only storage, 2N + 1 `vec4<f32>`: Jₚ, the zeroth order's layers without Stam's k² ([`IntegratedTable::specular_layers`]) | `diffraction_integrated_zeroth` |
 //!
 //! # Using it from a scene shader
 //!
@@ -59,9 +60,25 @@
 //! composed as [`compose_scene`]: [`TECHNIQUE_ADAPTER`] defines those names from this module,
 //! with F² from the uniform ([`run_scene_probe`] runs that composition's probe entry point on
 //! the device). Its `diffraction_specular_order_colour` is the mirror-lobe peak
-//! F² Σₚ (−2 cos θ)ᵖ Iₚ(0, 0), the colour of |P̃(0, 0)|², which differs from the terms
+//! F² Σₚ (−2 cos θ)ᵖ Jₚ, the colour of |P̃(0, 0)|², which differs from the terms
 //! technique's F² |P_DC|² by the window-weighted bins next to DC (1.4 · 10⁻⁴ of the white
 //! for the CD table).
+//!
+//! # Stam's k²
+//!
+//! Stam's BRDF is f = ρ (σ_s k)²/π; the scenes pass the light's gain (σ_s k_ref)²/π
+//! ([`crate::diffraction::lobe_gain`]) and the colour must carry (k/k_ref)² = (λ_ref/λ)² per
+//! wavelength. A table baked with it (the manifest's `k_squared_reference_nm`, 555 nm,
+//! [`IntegratedTable::k_squared_reference_nm`]) holds that weight in its layers, so its
+//! `diffraction_colour_footprint` needs no `reference_nm` (the adapter ignores it;
+//! `lobe_gain` takes k_ref at the table's own λ_ref) — for the light, the environment's
+//! samples and a rough grating's light alike, which all read the layers, and for every
+//! prefiltered level (a blur is linear: the weight passes through). The mirror image reads
+//! Jₚ (binding 2), which the manifest records unweighted (`zeroth_order_layers`): a zeroth
+//! order's efficiency has no k². **A table without the field** (baked by a nacre before the
+//! weight) loads and renders as it did: its layers are Σ_λ ρ u, tilted towards red by
+//! (λ/555 nm)² against the terms technique (blue × 0.66, red × 1.37 at 450/650 nm), and its
+//! Jₚ are its own layers at u = v = 0. `nacre info` shows the field (`null` for such a table).
 //!
 //! # Cost
 //!
@@ -197,6 +214,8 @@ pub struct DiffractionIntegrated {
     pub levels: IntegratedLevels,
     /// The 2-D array `Rgba32Float` texture (module docs).
     pub texture: wgpu::Texture,
+    /// Jₚ, the zeroth order's layers (binding 2; module docs).
+    pub zeroth_order: wgpu::Buffer,
     /// The uniform as uploaded.
     pub uniform: DiffractionIntegratedUniform,
     layout: wgpu::BindGroupLayout,
@@ -300,6 +319,20 @@ impl DiffractionIntegrated {
         let name = manifest.name.clone();
         let device = &ctx.device;
         let texture = upload_rgba32f_array(ctx, &name, [cols, rows, count * layers], &texels)?;
+        // 2: the zeroth order's layers Jₚ (unweighted; the table's own peak for a table
+        // without Stam's k²), one vec4 each.
+        let zeroth: Vec<[f32; 4]> = table
+            .specular_layers()
+            .iter()
+            .map(|j| [j[0], j[1], j[2], 0.0])
+            .collect();
+        let zeroth_order = ctx.checked("uploading an integrated table's zeroth order", || {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("diffraction_integrated_zeroth"),
+                contents: bytemuck::cast_slice(&zeroth),
+                usage: wgpu::BufferUsages::STORAGE,
+            })
+        })?;
         let (layout, bind_group) =
             ctx.checked("binding an integrated diffraction table", || {
                 let visibility = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
@@ -332,6 +365,17 @@ impl DiffractionIntegrated {
                             },
                             count: None,
                         },
+                        // 2: Jₚ, the zeroth order's layers, read-only storage.
+                        wgpu::BindGroupLayoutEntry {
+                            binding: 2,
+                            visibility,
+                            ty: wgpu::BindingType::Buffer {
+                                ty: wgpu::BufferBindingType::Storage { read_only: true },
+                                has_dynamic_offset: false,
+                                min_binding_size: wgpu::BufferSize::new(16),
+                            },
+                            count: None,
+                        },
                     ],
                 });
                 let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -355,6 +399,10 @@ impl DiffractionIntegrated {
                             binding: 1,
                             resource: wgpu::BindingResource::TextureView(&view),
                         },
+                        wgpu::BindGroupEntry {
+                            binding: 2,
+                            resource: zeroth_order.as_entire_binding(),
+                        },
                     ],
                 });
                 (layout, bind_group)
@@ -368,6 +416,7 @@ impl DiffractionIntegrated {
             table,
             levels,
             texture,
+            zeroth_order,
             uniform,
             layout,
             bind_group,
@@ -407,13 +456,17 @@ impl DiffractionIntegrated {
                         binding: 1,
                         resource: wgpu::BindingResource::TextureView(&view),
                     },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: self.zeroth_order.as_entire_binding(),
+                    },
                 ],
             })
         })
     }
 
-    /// The layout of group 1 (module docs: binding 0 the uniform, 1 the table; fragment and
-    /// compute stages).
+    /// The layout of group 1 (module docs: binding 0 the uniform, 1 the table, 2 the zeroth
+    /// order's layers; fragment and compute stages).
     pub fn bind_group_layout(&self) -> &wgpu::BindGroupLayout {
         &self.layout
     }

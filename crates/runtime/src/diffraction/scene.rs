@@ -873,22 +873,39 @@ fn refuse_rough_without_lobes(
     })
 }
 
-/// Reference wavelength of [`lobe_gain`], nm.
-pub const LOBE_REFERENCE_NM: f64 = 555.0;
+/// Reference wavelength of [`lobe_gain`], nm (the baker's
+/// [`nacre_optics::diffraction::integrated::K_SQUARED_REFERENCE_NM`], which integrated tables
+/// record as their k² reference).
+pub const LOBE_REFERENCE_NM: f64 = nacre_optics::diffraction::integrated::K_SQUARED_REFERENCE_NM;
 
-/// (σ_s k₀)²/π at k₀ = 2π/[`LOBE_REFERENCE_NM`]: the radiance, per unit irradiance at normal
-/// incidence, of a light's mirror image spread over the coherence lobe. A flat mirror's
+/// (σ_s k₀)²/π at k₀ = 2π/λ₀: the radiance, per unit irradiance at normal incidence, of a
+/// light's mirror image spread over the coherence lobe. A flat mirror's
 /// |P̃|² = exp(−σ_s² k² |Δ(u, v)|²) integrates to π/(σ_s k)² over (u, v), so Stam's BRDF is
 /// f = ρ (σ_s k)²/π and a source of irradiance E at normal incidence, at θ_i from the normal
 /// of a surface of relative reflectance ρ, gives the radiance
 /// f · E cos θ_i = ρ · E · (σ_s k₀)²/π · (k/k₀)² · cos θ_i. The scenes pass E · this gain as
-/// one number; the terms technique weights each wavelength by (k/k₀)² = (555 nm/λ)²
-/// (`diffraction_colour_footprint`'s `reference_nm`, `shaders/diffraction.wgsl`) and the
-/// scene multiplies by cos θ_i (`scene_shade`, `shaders/diffraction_scene.wgsl`). An
-/// integrated table, summed over wavelengths at bake time without the k², leaves the
-/// (k/k₀)² out.
+/// one number and the scene multiplies by cos θ_i (`scene_shade`,
+/// `shaders/diffraction_scene.wgsl`); the (k/k₀)² = (λ₀/λ)² per wavelength comes from the
+/// technique:
+///
+/// * layout "terms": λ₀ = [`LOBE_REFERENCE_NM`]; the shader weights each wavelength
+///   (`diffraction_colour_footprint`'s `reference_nm`, `shaders/diffraction.wgsl`, and the
+///   rough light's lobes, `scene_rough_light`);
+/// * layout "integrated" baked with Stam's k² (the manifest's `k_squared_reference_nm`):
+///   λ₀ = that wavelength, whose (λ₀/λ)² the table's layers already hold — for the light,
+///   the environment's samples, a rough grating's blurred levels alike (they all read the
+///   layers; a blur is linear);
+/// * layout "integrated" without the field (a table baked before the weight): λ₀ =
+///   [`LOBE_REFERENCE_NM`] and no (λ₀/λ)² at all — such a table renders as it did, tilted
+///   towards red by (λ/555 nm)² against the terms technique.
 pub fn lobe_gain(record: &DiffractionRecord) -> f32 {
-    let k0 = std::f64::consts::TAU / (LOBE_REFERENCE_NM * 1e-3);
+    let reference_nm = record
+        .integrated
+        .as_ref()
+        .and_then(|s| s.k_squared_reference_nm)
+        .filter(|r| *r > 0.0 && r.is_finite())
+        .unwrap_or(LOBE_REFERENCE_NM);
+    let k0 = std::f64::consts::TAU / (reference_nm * 1e-3);
     ((record.sigma_s_um * k0).powi(2) / std::f64::consts::PI) as f32
 }
 
