@@ -120,11 +120,11 @@ pub struct IntegratedRecord {
     /// loads and renders as it did.
     #[serde(default)]
     pub k_squared_reference_nm: Option<f64>,
-    /// Jₚ, p = 0 … 2N, in the output space (f32 values): the layers at u = v = 0 without the
+    /// Jₚ, p = 0 … 2N, in the output space (f32 values, written as f64): the layers at u = v = 0 without the
     /// k² weight, so that F²(θ) Σₚ (−2 cos θ)ᵖ Jₚ is the colour of the zeroth order's
     /// efficiency |P̃(0, 0)|² (the mirror image has no k²: the lobe's integral
     /// π/(σ_s k)² cancels it). Empty (absent) for a table without
     /// `k_squared_reference_nm`, whose own layers at (0, 0) serve.
     #[serde(default)]
-    pub zeroth_order_layers: Vec<[f32; 3]>,
+    pub zeroth_order_layers: Vec<[f64; 3]>,
 }

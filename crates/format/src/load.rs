@@ -250,7 +250,13 @@ impl Manifest {
         // without the field (an older bake) is read as it was: no k², its own peak.
         if let Some(reference_nm) = s.k_squared_reference_nm {
             table = table
-                .with_k_squared(reference_nm, s.zeroth_order_layers.clone())
+                .with_k_squared(
+                    reference_nm,
+                    s.zeroth_order_layers
+                        .iter()
+                        .map(|j| j.map(|x| x as f32))
+                        .collect(),
+                )
                 .map_err(optics)?;
         }
         Ok((r, table))

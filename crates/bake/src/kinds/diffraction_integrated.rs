@@ -273,7 +273,11 @@ pub fn bake(
         channel_names[2],
         K_SQUARED_REFERENCE_NM
     );
-    s.zeroth_order_layers = table.specular_layers().to_vec();
+    s.zeroth_order_layers = table
+        .specular_layers()
+        .iter()
+        .map(|j| j.map(f64::from))
+        .collect();
     s.reconstruction_error = e.max_error;
     s.mean_error = e.mean_error;
     s.worst_light_deg = polar_deg(e.omega_i).map(sig4);
