@@ -55,17 +55,19 @@ mod common;
 pub mod integrated;
 pub mod lobes;
 mod scene;
+mod scenes;
 mod tables;
 mod terms;
 
 pub use common::{DIFFRACTION_COMMON, DiffractionLayout};
 pub use lobes::EnvironmentLobes;
 pub use scene::{
-    DEFAULT_ENV_SAMPLES, DIFFRACTION_SCENE, DiffractionLightsUniform, DiffractionScene,
-    DiffractionSceneOptions, LOBE_REFERENCE_NM, LobeData, MAX_ENV_SAMPLES, MAX_ROUGHNESS,
-    ScenePass, environment_samples, llvmpipe_filter_radius, lobe_gain, render_diffraction_scene,
-    render_diffraction_scene_in, rough_slope_variance,
+    DEFAULT_ENV_SAMPLES, DIFFRACTION_SCENE, DiffractionLightsUniform, DiffractionSceneOptions,
+    LOBE_REFERENCE_NM, LobeData, MAX_ENV_SAMPLES, MAX_ROUGHNESS, ScenePass, environment_samples,
+    llvmpipe_filter_radius, lobe_gain, render_diffraction_scene, render_diffraction_scene_in,
+    rough_slope_variance,
 };
+pub use scenes::DiffractionScene;
 pub use tables::DiffractionTables;
 pub use terms::{
     DIFFRACTION, DiffractionBinding, DiffractionOptions, DiffractionTable, DiffractionUniform,
